@@ -5,8 +5,10 @@
 //! ([`report`]). The binary in `main.rs` only parses arguments and maps outcomes to exit codes.
 
 pub mod asset;
+pub mod config;
 pub mod diagnostics;
 pub mod layers;
 pub mod report;
 pub mod rules;
+pub mod run;
 pub mod validate;
