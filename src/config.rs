@@ -28,7 +28,10 @@ pub const FILE_NAME: &str = "velvet.toml";
 #[derive(Debug, thiserror::Error)]
 pub enum ConfigError {
     #[error("cannot read {}: {source}", .path.display())]
-    Read { path: PathBuf, source: std::io::Error },
+    Read {
+        path: PathBuf,
+        source: std::io::Error,
+    },
     #[error("{}: {message}", .path.display())]
     Invalid { path: PathBuf, message: String },
     #[error("{0}")]
@@ -102,7 +105,9 @@ enum RawSeverity {
 fn known_code(code: &str, key: &str) -> Result<String, String> {
     match diagnostics::find_code(code) {
         Some(c) => Ok(c.name.to_string()),
-        None => Err(format!("{key}: no such code {code} (`velvet codes` lists them)")),
+        None => Err(format!(
+            "{key}: no such code {code} (`velvet codes` lists them)"
+        )),
     }
 }
 
@@ -137,8 +142,16 @@ fn fail_on_name(f: FailOn) -> &'static str {
 
 /// Builds the selection a layer asks for; setting both `ignore` and `only` is an error (as in
 /// the Khronos validator).
-pub fn selection(ignore: Option<Vec<String>>, only: Option<Vec<String>>, what: &str) -> Result<Option<Selection>, String> {
-    let codes = |list: Vec<String>, key: &str| list.iter().map(|c| known_code(c, key)).collect::<Result<BTreeSet<_>, _>>();
+pub fn selection(
+    ignore: Option<Vec<String>>,
+    only: Option<Vec<String>>,
+    what: &str,
+) -> Result<Option<Selection>, String> {
+    let codes = |list: Vec<String>, key: &str| {
+        list.iter()
+            .map(|c| known_code(c, key))
+            .collect::<Result<BTreeSet<_>, _>>()
+    };
     match (ignore, only) {
         (Some(_), Some(_)) => Err(format!("{what} sets both ignore and only; use one")),
         (Some(list), None) => Ok(Some(Selection::Ignore(codes(list, "ignore")?))),
@@ -159,7 +172,10 @@ impl Layer {
     /// Parses the text of a velvet.toml.
     pub fn parse(text: &str) -> Result<Layer, String> {
         let raw: RawFile = toml::from_str(text).map_err(|e| {
-            let message = e.message().trim_end().replace("unknown field", "unknown key");
+            let message = e
+                .message()
+                .trim_end()
+                .replace("unknown field", "unknown key");
             match e.span() {
                 Some(span) => {
                     let (line, column) = line_column(text, span.start);
@@ -169,7 +185,9 @@ impl Layer {
             }
         })?;
         let max_issues = match raw.max_issues {
-            Some(n) if n < 0 => return Err(format!("max-issues: {n} is negative (0 means no limit)")),
+            Some(n) if n < 0 => {
+                return Err(format!("max-issues: {n} is negative (0 means no limit)"))
+            }
             Some(n) => Some(n as usize),
             None => None,
         };
@@ -193,9 +211,9 @@ impl Layer {
             overrides.insert(code, parsed);
         }
         let fail_on = match raw.fail_on {
-            Some(text) => Some(
-                parse_fail_on(&text).ok_or_else(|| format!("fail-on: \"{text}\" is not one of \"error\", \"warning\", \"info\""))?,
-            ),
+            Some(text) => Some(parse_fail_on(&text).ok_or_else(|| {
+                format!("fail-on: \"{text}\" is not one of \"error\", \"warning\", \"info\"")
+            })?),
             None => None,
         };
         let exclude = raw.exclude.unwrap_or_default();
@@ -224,9 +242,12 @@ impl Layer {
         let nonempty = |l: &[String]| (!l.is_empty()).then(|| l.to_vec());
         let flag = |m: String| ConfigError::CommandLine(format!("--{m}"));
         if !ignore.is_empty() && !only.is_empty() {
-            return Err(ConfigError::CommandLine("--ignore and --only cannot be used together".into()));
+            return Err(ConfigError::CommandLine(
+                "--ignore and --only cannot be used together".into(),
+            ));
         }
-        let selection = selection(nonempty(ignore), nonempty(only), "the command line").map_err(flag)?;
+        let selection =
+            selection(nonempty(ignore), nonempty(only), "the command line").map_err(flag)?;
         let mut map = BTreeMap::new();
         for item in overrides {
             let Some((code, severity)) = item.split_once('=') else {
@@ -262,7 +283,9 @@ impl Layer {
 
 /// An exclude pattern: `*` and `?` stay inside one path component, `**` crosses them.
 fn glob(pattern: &str) -> Result<Glob, globset::Error> {
-    GlobBuilder::new(pattern.trim_start_matches('/')).literal_separator(true).build()
+    GlobBuilder::new(pattern.trim_start_matches('/'))
+        .literal_separator(true)
+        .build()
 }
 
 /// The configuration in force for a set of files: the layers combined, with where each value
@@ -301,8 +324,11 @@ impl Config {
         let max_issues = pick(&cli.max_issues, &file_layer.max_issues, 0);
         let selection = pick(&cli.selection, &file_layer.selection, Selection::All);
         let fail_on = pick(&cli.fail_on, &file_layer.fail_on, FailOn::Error);
-        let mut overrides: BTreeMap<String, (Severity, Source)> =
-            file_layer.overrides.iter().map(|(c, s)| (c.clone(), (*s, Source::File))).collect();
+        let mut overrides: BTreeMap<String, (Severity, Source)> = file_layer
+            .overrides
+            .iter()
+            .map(|(c, s)| (c.clone(), (*s, Source::File)))
+            .collect();
         for (c, s) in &cli.overrides {
             overrides.insert(c.clone(), (*s, Source::CommandLine));
         }
@@ -329,7 +355,10 @@ impl Config {
         };
         let settings = Settings {
             ignore,
-            severity_overrides: overrides.iter().map(|(c, (s, _))| (c.clone(), *s)).collect(),
+            severity_overrides: overrides
+                .iter()
+                .map(|(c, (s, _))| (c.clone(), *s))
+                .collect(),
             max_issues: (max_issues.0 > 0).then_some(max_issues.0),
             fail_on: fail_on.0,
         };
@@ -357,7 +386,11 @@ impl Config {
         if self.exclude.is_empty() {
             return false;
         }
-        let dir = self.file.as_deref().and_then(Path::parent).unwrap_or(Path::new(""));
+        let dir = self
+            .file
+            .as_deref()
+            .and_then(Path::parent)
+            .unwrap_or(Path::new(""));
         let relative = path.strip_prefix(dir).ok();
         if let Some(rel) = relative {
             // A pattern that names a folder excludes everything below it.
@@ -370,7 +403,9 @@ impl Config {
             }
         }
         let components = relative.unwrap_or(path).components();
-        components.into_iter().any(|c| self.component.is_match(Path::new(c.as_os_str())))
+        components
+            .into_iter()
+            .any(|c| self.component.is_match(Path::new(c.as_os_str())))
     }
 
     /// The configuration as velvet.toml text, each value followed by a comment saying where it
@@ -378,28 +413,73 @@ impl Config {
     pub fn to_toml(&self) -> String {
         let mut out = String::new();
         let quoted = |s: &str| toml::Value::String(s.to_string()).to_string();
-        let list = |items: &mut dyn Iterator<Item = &String>| format!("[{}]", items.map(|s| quoted(s)).collect::<Vec<_>>().join(", "));
+        let list = |items: &mut dyn Iterator<Item = &String>| {
+            format!(
+                "[{}]",
+                items.map(|s| quoted(s)).collect::<Vec<_>>().join(", ")
+            )
+        };
         match &self.file {
             Some(p) => {
-                let _ = writeln!(out, "# {FILE_NAME} in force: {}", crate::report::display_path(p));
+                let _ = writeln!(
+                    out,
+                    "# {FILE_NAME} in force: {}",
+                    crate::report::display_path(p)
+                );
             }
-            None => out.push_str("# no velvet.toml in force: built-in defaults and the command line\n"),
+            None => {
+                out.push_str("# no velvet.toml in force: built-in defaults and the command line\n")
+            }
         }
         let (max, source) = self.max_issues;
-        let _ = writeln!(out, "max-issues = {max}  # {}{}", source.describe(), if max == 0 { " (0: no limit)" } else { "" });
+        let _ = writeln!(
+            out,
+            "max-issues = {max}  # {}{}",
+            source.describe(),
+            if max == 0 { " (0: no limit)" } else { "" }
+        );
         let (sel, source) = &self.selection;
         let _ = match sel {
             Selection::All => writeln!(out, "ignore = []  # {}", source.describe()),
-            Selection::Ignore(codes) => writeln!(out, "ignore = {}  # {}", list(&mut codes.iter()), source.describe()),
-            Selection::Only(codes) => writeln!(out, "only = {}  # {}", list(&mut codes.iter()), source.describe()),
+            Selection::Ignore(codes) => writeln!(
+                out,
+                "ignore = {}  # {}",
+                list(&mut codes.iter()),
+                source.describe()
+            ),
+            Selection::Only(codes) => writeln!(
+                out,
+                "only = {}  # {}",
+                list(&mut codes.iter()),
+                source.describe()
+            ),
         };
         let (fail_on, source) = self.fail_on;
-        let _ = writeln!(out, "fail-on = {}  # {}", quoted(fail_on_name(fail_on)), source.describe());
-        let source = if self.exclude.is_empty() { Source::Default } else { Source::File };
-        let _ = writeln!(out, "exclude = {}  # {}", list(&mut self.exclude.iter()), source.describe());
+        let _ = writeln!(
+            out,
+            "fail-on = {}  # {}",
+            quoted(fail_on_name(fail_on)),
+            source.describe()
+        );
+        let source = if self.exclude.is_empty() {
+            Source::Default
+        } else {
+            Source::File
+        };
+        let _ = writeln!(
+            out,
+            "exclude = {}  # {}",
+            list(&mut self.exclude.iter()),
+            source.describe()
+        );
         out.push_str("\n[override]\n");
         for (code, (severity, source)) in &self.overrides {
-            let _ = writeln!(out, "{code} = {}  # {}", quoted(severity.as_str()), source.describe());
+            let _ = writeln!(
+                out,
+                "{code} = {}  # {}",
+                quoted(severity.as_str()),
+                source.describe()
+            );
         }
         out
     }
@@ -419,7 +499,11 @@ pub struct Resolver {
 /// `path` made absolute without touching the file system (links are not resolved, so the
 /// folders walked are those the user sees).
 pub fn absolute(path: &Path) -> PathBuf {
-    let path = if path.as_os_str().is_empty() { Path::new(".") } else { path };
+    let path = if path.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        path
+    };
     let abs = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
     // Drop `.` components and fold `..` where it is lexically safe.
     let mut out = PathBuf::new();
@@ -444,7 +528,10 @@ impl Resolver {
         let fixed = match config_file {
             Some(path) => {
                 let layer = Layer::read(path)?;
-                Some(Arc::new(Config::combine(Some((absolute(path), layer)), &cli)))
+                Some(Arc::new(Config::combine(
+                    Some((absolute(path), layer)),
+                    &cli,
+                )))
             }
             None => None,
         };
@@ -462,7 +549,11 @@ impl Resolver {
             return Ok(fixed.clone());
         }
         let abs = absolute(path);
-        let start = if abs.is_dir() { abs } else { abs.parent().map(Path::to_path_buf).unwrap_or(abs) };
+        let start = if abs.is_dir() {
+            abs
+        } else {
+            abs.parent().map(Path::to_path_buf).unwrap_or(abs)
+        };
         let mut visited = Vec::new();
         let mut found = None;
         for dir in start.ancestors() {
@@ -477,7 +568,8 @@ impl Resolver {
                     Some(c) => c.clone(),
                     None => {
                         let layer = Layer::read(&candidate)?;
-                        let c = Arc::new(Config::combine(Some((candidate.clone(), layer)), &self.cli));
+                        let c =
+                            Arc::new(Config::combine(Some((candidate.clone(), layer)), &self.cli));
                         self.by_file.insert(candidate, c.clone());
                         c
                     }
@@ -506,17 +598,31 @@ mod tests {
         )
         .unwrap();
         assert_eq!(layer.max_issues, Some(5));
-        assert_eq!(layer.selection, Some(Selection::Ignore(["UNEXPECTED_PROPERTY".to_string()].into())));
+        assert_eq!(
+            layer.selection,
+            Some(Selection::Ignore(
+                ["UNEXPECTED_PROPERTY".to_string()].into()
+            ))
+        );
         assert_eq!(layer.fail_on, Some(FailOn::Warning));
         assert_eq!(layer.exclude, vec!["drafts/**"]);
-        assert_eq!(layer.overrides.get("TYPE_MISMATCH"), Some(&Severity::Warning));
-        assert_eq!(layer.overrides.get("VALUE_NOT_IN_RANGE"), Some(&Severity::Hint));
+        assert_eq!(
+            layer.overrides.get("TYPE_MISMATCH"),
+            Some(&Severity::Warning)
+        );
+        assert_eq!(
+            layer.overrides.get("VALUE_NOT_IN_RANGE"),
+            Some(&Severity::Hint)
+        );
     }
 
     #[test]
     fn unknown_key_is_an_error_naming_the_key_and_its_line() {
         let err = Layer::parse("max-issues = 3\nmax_issue = 4\n").unwrap_err();
-        assert!(err.starts_with("line 2, column 1: unknown key `max_issue`"), "{err}");
+        assert!(
+            err.starts_with("line 2, column 1: unknown key `max_issue`"),
+            "{err}"
+        );
     }
 
     #[test]
@@ -525,14 +631,24 @@ mod tests {
             Layer::parse("ignore = [\"NOT_A_CODE\"]").unwrap_err(),
             "ignore: no such code NOT_A_CODE (`velvet codes` lists them)"
         );
-        assert_eq!(Layer::parse("ignore = []\nonly = []").unwrap_err(), "the file sets both ignore and only; use one");
-        assert_eq!(Layer::parse("max-issues = -1").unwrap_err(), "max-issues: -1 is negative (0 means no limit)");
+        assert_eq!(
+            Layer::parse("ignore = []\nonly = []").unwrap_err(),
+            "the file sets both ignore and only; use one"
+        );
+        assert_eq!(
+            Layer::parse("max-issues = -1").unwrap_err(),
+            "max-issues: -1 is negative (0 means no limit)"
+        );
         assert_eq!(
             Layer::parse("fail-on = \"hint\"").unwrap_err(),
             "fail-on: \"hint\" is not one of \"error\", \"warning\", \"info\""
         );
-        assert!(Layer::parse("[override]\nTYPE_MISMATCH = 4").unwrap_err().starts_with("override.TYPE_MISMATCH: 4 is not a severity"));
-        assert!(Layer::parse("exclude = [\"a/[\"]").unwrap_err().starts_with("exclude: "));
+        assert!(Layer::parse("[override]\nTYPE_MISMATCH = 4")
+            .unwrap_err()
+            .starts_with("override.TYPE_MISMATCH: 4 is not a severity"));
+        assert!(Layer::parse("exclude = [\"a/[\"]")
+            .unwrap_err()
+            .starts_with("exclude: "));
     }
 
     #[test]
@@ -540,7 +656,11 @@ mod tests {
         let file = Layer {
             max_issues: Some(7),
             selection: Some(Selection::Ignore(["TYPE_MISMATCH".to_string()].into())),
-            overrides: [("TYPE_MISMATCH".to_string(), Severity::Info), ("VALUE_NOT_IN_RANGE".to_string(), Severity::Info)].into(),
+            overrides: [
+                ("TYPE_MISMATCH".to_string(), Severity::Info),
+                ("VALUE_NOT_IN_RANGE".to_string(), Severity::Info),
+            ]
+            .into(),
             fail_on: None,
             exclude: vec![],
         };
@@ -554,7 +674,10 @@ mod tests {
         assert_eq!(c.selection.1, Source::File);
         assert_eq!(c.fail_on, (FailOn::Error, Source::Default));
         assert_eq!(c.overrides["TYPE_MISMATCH"], (Severity::Info, Source::File));
-        assert_eq!(c.overrides["VALUE_NOT_IN_RANGE"], (Severity::Hint, Source::CommandLine));
+        assert_eq!(
+            c.overrides["VALUE_NOT_IN_RANGE"],
+            (Severity::Hint, Source::CommandLine)
+        );
         assert_eq!(c.settings().max_issues, Some(2));
         assert!(c.settings().ignore.contains("TYPE_MISMATCH"));
     }
@@ -576,20 +699,34 @@ mod tests {
     #[test]
     fn exclude_patterns_anchor_with_a_slash_and_match_components_without() {
         let layer = Layer {
-            exclude: vec!["drafts/**".into(), "*.wip.gltf".into(), "vendor".into(), "/top/a.glb".into()],
+            exclude: vec![
+                "drafts/**".into(),
+                "*.wip.gltf".into(),
+                "vendor".into(),
+                "/top/a.glb".into(),
+            ],
             ..Layer::default()
         };
-        let c = Config::combine(Some((PathBuf::from("/p/velvet.toml"), layer)), &Layer::default());
+        let c = Config::combine(
+            Some((PathBuf::from("/p/velvet.toml"), layer)),
+            &Layer::default(),
+        );
         assert!(c.excludes(Path::new("/p/drafts/x.gltf")));
         assert!(c.excludes(Path::new("/p/drafts/deep/x.gltf")));
         assert!(!c.excludes(Path::new("/p/assets/drafts.gltf")));
-        assert!(!c.excludes(Path::new("/p/assets/drafts/x.gltf")), "anchored patterns start at the config folder");
+        assert!(
+            !c.excludes(Path::new("/p/assets/drafts/x.gltf")),
+            "anchored patterns start at the config folder"
+        );
         assert!(c.excludes(Path::new("/p/a/b/c.wip.gltf")));
         assert!(c.excludes(Path::new("/p/a/vendor/c.gltf")));
         assert!(c.excludes(Path::new("/p/top/a.glb")));
         assert!(!c.excludes(Path::new("/p/top/b.glb")));
         assert!(!c.excludes(Path::new("/p/a.gltf")));
-        assert!(c.excludes(Path::new("/elsewhere/vendor/c.gltf")), "component patterns apply outside the folder too");
+        assert!(
+            c.excludes(Path::new("/elsewhere/vendor/c.gltf")),
+            "component patterns apply outside the folder too"
+        );
     }
 
     #[test]
@@ -601,12 +738,21 @@ mod tests {
         };
         let c = Config::combine(Some((PathBuf::from("/p/velvet.toml"), file)), &cli);
         let text = c.to_toml();
-        let again = Config::combine(Some((PathBuf::from("/p/velvet.toml"), Layer::parse(&text).unwrap())), &Layer::default());
+        let again = Config::combine(
+            Some((
+                PathBuf::from("/p/velvet.toml"),
+                Layer::parse(&text).unwrap(),
+            )),
+            &Layer::default(),
+        );
         assert_eq!(again.max_issues.0, c.max_issues.0);
         assert_eq!(again.selection.0, c.selection.0);
         assert_eq!(again.fail_on.0, c.fail_on.0);
         assert_eq!(again.exclude, c.exclude);
-        assert_eq!(again.settings().severity_overrides, c.settings().severity_overrides);
+        assert_eq!(
+            again.settings().severity_overrides,
+            c.settings().severity_overrides
+        );
     }
 
     #[test]

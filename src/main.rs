@@ -19,7 +19,11 @@ Exit status:
   2  usage or configuration error (bad flag, unknown code, invalid velvet.toml)";
 
 #[derive(Parser)]
-#[command(name = "velvet", version, about = "Validate, migrate and bake glTF assets that use KHR_materials_sheen and KHR_materials_fuzz")]
+#[command(
+    name = "velvet",
+    version,
+    about = "Validate, migrate and bake glTF assets that use KHR_materials_sheen and KHR_materials_fuzz"
+)]
 #[command(after_help = EXIT_STATUS)]
 struct Cli {
     /// When to colour output: auto colours on a terminal unless NO_COLOR is set.
@@ -140,9 +144,14 @@ fn main() -> ExitCode {
 fn man(dir: Option<PathBuf>) -> ExitCode {
     let command = Cli::command();
     match dir {
-        Some(dir) => match std::fs::create_dir_all(&dir).and_then(|()| clap_mangen::generate_to(command, &dir)) {
+        Some(dir) => match std::fs::create_dir_all(&dir)
+            .and_then(|()| clap_mangen::generate_to(command, &dir))
+        {
             Ok(()) => ExitCode::SUCCESS,
-            Err(e) => usage_error(format!("cannot write man pages into {}: {e}", dir.display())),
+            Err(e) => usage_error(format!(
+                "cannot write man pages into {}: {e}",
+                dir.display()
+            )),
         },
         None => {
             let mut out = Vec::new();
@@ -162,12 +171,20 @@ fn codes_table(format: CodesFormat) -> String {
     match format {
         CodesFormat::Text => {
             let width = codes.iter().map(|c| c.name.len()).max().unwrap_or(0);
-            codes.iter().map(|c| format!("{:width$}  {:7}  {}\n", c.name, c.severity.as_str(), c.doc)).collect()
+            codes
+                .iter()
+                .map(|c| format!("{:width$}  {:7}  {}\n", c.name, c.severity.as_str(), c.doc))
+                .collect()
         }
         CodesFormat::Markdown => {
             let mut out = String::from("| code | severity | meaning |\n|---|---|---|\n");
             for c in codes {
-                out += &format!("| `{}` | {} | {} |\n", c.name, c.severity, c.doc.replace('|', "\\|"));
+                out += &format!(
+                    "| `{}` | {} | {} |\n",
+                    c.name,
+                    c.severity,
+                    c.doc.replace('|', "\\|")
+                );
             }
             out
         }
@@ -180,7 +197,13 @@ fn resolver(args: &SettingsArgs) -> Result<Resolver, config::ConfigError> {
         FailOnArg::Warning => FailOn::Warning,
         FailOnArg::Info => FailOn::Info,
     });
-    let layer = Layer::command_line(args.max_issues, &args.ignore, &args.only, &args.overrides, fail_on)?;
+    let layer = Layer::command_line(
+        args.max_issues,
+        &args.ignore,
+        &args.only,
+        &args.overrides,
+        fail_on,
+    )?;
     Resolver::new(args.config.as_deref(), layer)
 }
 
@@ -192,7 +215,10 @@ fn show_config(path: Option<PathBuf>, args: SettingsArgs) -> ExitCode {
     };
     let mut text = String::new();
     if config.excludes(&config::absolute(&path)) {
-        text += &format!("# {} is excluded by this configuration\n", report::display_path(&path));
+        text += &format!(
+            "# {} is excluded by this configuration\n",
+            report::display_path(&path)
+        );
     }
     text += &config.to_toml();
     emit(text.as_bytes());
@@ -213,10 +239,11 @@ fn validate(args: ValidateArgs, color: ColorChoice, quiet: bool) -> ExitCode {
     };
     let validator = Validator::new(schemas, Settings::default());
     let progress = report::progress_bar(quiet);
-    let outcome = match velvet::run::validate(&validator, &args.paths, &mut resolver, progress.as_ref()) {
-        Ok(o) => o,
-        Err(e) => return usage_error(e),
-    };
+    let outcome =
+        match velvet::run::validate(&validator, &args.paths, &mut resolver, progress.as_ref()) {
+            Ok(o) => o,
+            Err(e) => return usage_error(e),
+        };
     let options = report::Options {
         color: args.format == Format::Text && color.for_stdout(),
         quiet,

@@ -67,7 +67,9 @@ pub struct FileReport {
 impl FileReport {
     /// True when a finding is at or above the run's fail-on severity.
     pub fn fails(&self, settings: &Settings) -> bool {
-        self.findings.iter().any(|f| settings.fail_on.fails(f.diagnostic.severity))
+        self.findings
+            .iter()
+            .any(|f| settings.fail_on.fails(f.diagnostic.severity))
     }
 }
 
@@ -87,11 +89,14 @@ impl Validator {
         let (files, walk_errors) = discover::collect(inputs);
         let mut reports: Vec<FileReport> = walk_errors
             .into_iter()
-            .map(|(path, e)| {
-                self.unreadable_folder(path, &e, &self.settings)
-            })
+            .map(|(path, e)| self.unreadable_folder(path, &e, &self.settings))
             .collect();
-        reports.extend(files.par_iter().map(|p| self.validate_file(p)).collect::<Vec<_>>());
+        reports.extend(
+            files
+                .par_iter()
+                .map(|p| self.validate_file(p))
+                .collect::<Vec<_>>(),
+        );
         reports
     }
 
@@ -108,8 +113,17 @@ impl Validator {
     }
 
     /// The report for a folder that could not be walked.
-    pub fn unreadable_folder(&self, path: PathBuf, error: &std::io::Error, settings: &Settings) -> FileReport {
-        let d = Diagnostic::new(&crate::diagnostics::codes::IO_ERROR, "", format!("cannot read folder {}: {error}", path.display()));
+    pub fn unreadable_folder(
+        &self,
+        path: PathBuf,
+        error: &std::io::Error,
+        settings: &Settings,
+    ) -> FileReport {
+        let d = Diagnostic::new(
+            &crate::diagnostics::codes::IO_ERROR,
+            "",
+            format!("cannot read folder {}: {error}", path.display()),
+        );
         self.finish(settings, path, None, 0, vec![d], None)
     }
 
@@ -118,19 +132,40 @@ impl Validator {
         self.validate_loaded_with(path, loaded, &self.settings)
     }
 
-    fn validate_loaded_with(&self, path: &Path, loaded: asset::Loaded, settings: &Settings) -> FileReport {
+    fn validate_loaded_with(
+        &self,
+        path: &Path,
+        loaded: asset::Loaded,
+        settings: &Settings,
+    ) -> FileReport {
         let mut diagnostics = loaded.diagnostics;
         let Some(asset) = loaded.asset else {
             return self.finish(settings, path.to_path_buf(), None, 0, diagnostics, None);
         };
-        let cx = Context { asset: &asset, schemas: &self.schemas };
+        let cx = Context {
+            asset: &asset,
+            schemas: &self.schemas,
+        };
         for rule in rules::REGISTRY {
             rule.check(&cx, &mut diagnostics);
         }
         let info = asset_info(&asset.json);
-        let mut report = self.finish(settings, path.to_path_buf(), Some(asset.container), asset.json_offset, diagnostics, Some(info));
+        let mut report = self.finish(
+            settings,
+            path.to_path_buf(),
+            Some(asset.container),
+            asset.json_offset,
+            diagnostics,
+            Some(info),
+        );
         if !report.findings.is_empty() {
-            let positions = asset::position::locate(&asset.json_text, report.findings.iter().map(|f| f.diagnostic.pointer.as_str()));
+            let positions = asset::position::locate(
+                &asset.json_text,
+                report
+                    .findings
+                    .iter()
+                    .map(|f| f.diagnostic.pointer.as_str()),
+            );
             for f in &mut report.findings {
                 if !f.diagnostic.pointer.is_empty() {
                     f.position = positions.get(&f.diagnostic.pointer).copied();
@@ -157,7 +192,9 @@ impl Validator {
             }
             counts.add(d.severity);
         }
-        let truncated = settings.max_issues.is_some_and(|max| diagnostics.len() > max);
+        let truncated = settings
+            .max_issues
+            .is_some_and(|max| diagnostics.len() > max);
         if let Some(max) = settings.max_issues {
             diagnostics.truncate(max);
         }
@@ -165,7 +202,13 @@ impl Validator {
             path,
             container,
             json_offset,
-            findings: diagnostics.into_iter().map(|diagnostic| Finding { diagnostic, position: None }).collect(),
+            findings: diagnostics
+                .into_iter()
+                .map(|diagnostic| Finding {
+                    diagnostic,
+                    position: None,
+                })
+                .collect(),
             counts,
             truncated,
             info,
@@ -176,13 +219,23 @@ impl Validator {
 fn strings(json: &Value, key: &str) -> Vec<String> {
     json.get(key)
         .and_then(Value::as_array)
-        .map(|a| a.iter().filter_map(Value::as_str).map(str::to_string).collect())
+        .map(|a| {
+            a.iter()
+                .filter_map(Value::as_str)
+                .map(str::to_string)
+                .collect()
+        })
         .unwrap_or_default()
 }
 
 fn asset_info(json: &Value) -> AssetInfo {
     let materials = layers::materials(json);
-    let with = |ext: &str| materials.iter().filter(|m| layers::extensions(m).is_some_and(|e| e.contains_key(ext))).count();
+    let with = |ext: &str| {
+        materials
+            .iter()
+            .filter(|m| layers::extensions(m).is_some_and(|e| e.contains_key(ext)))
+            .count()
+    };
     let text = |p: &str| json.pointer(p).and_then(Value::as_str).map(str::to_string);
     AssetInfo {
         version: text("/asset/version"),

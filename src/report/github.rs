@@ -14,7 +14,9 @@ use std::fmt::Write;
 
 /// Escapes a command's message.
 pub fn escape_data(text: &str) -> String {
-    text.replace('%', "%25").replace('\r', "%0D").replace('\n', "%0A")
+    text.replace('%', "%25")
+        .replace('\r', "%0D")
+        .replace('\n', "%0A")
 }
 
 /// Escapes a command property's value.
@@ -41,7 +43,12 @@ pub fn render(reports: &[FileReport]) -> String {
             let mut message = d.message.clone();
             match (f.position, report.container) {
                 (Some(p), Some(Container::Glb)) => {
-                    let _ = write!(message, " (at {}, byte {})", d.pointer, report.json_offset + p.offset);
+                    let _ = write!(
+                        message,
+                        " (at {}, byte {})",
+                        d.pointer,
+                        report.json_offset + p.offset
+                    );
                 }
                 (Some(p), _) => {
                     let _ = write!(properties, ",line={},col={}", p.line, p.column);
@@ -61,7 +68,10 @@ pub fn render(reports: &[FileReport]) -> String {
             );
         }
         if report.truncated {
-            let _ = writeln!(out, "::notice file={file},title=velvet::further issues not shown (max-issues)");
+            let _ = writeln!(
+                out,
+                "::notice file={file},title=velvet::further issues not shown (max-issues)"
+            );
         }
     }
     out
@@ -75,6 +85,10 @@ mod tests {
     fn escapes_percent_first_then_newlines_and_property_separators() {
         assert_eq!(escape_data("50% a\r\nb: c, d"), "50%25 a%0D%0Ab: c, d");
         assert_eq!(escape_property("a:b,c%d\ne"), "a%3Ab%2Cc%25d%0Ae");
-        assert_eq!(escape_property("%3A"), "%253A", "an escape sequence in the input stays literal");
+        assert_eq!(
+            escape_property("%3A"),
+            "%253A",
+            "an escape sequence in the input stays literal"
+        );
     }
 }

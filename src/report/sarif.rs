@@ -21,7 +21,11 @@ use std::path::{Component, Path};
 pub const SCHEMA_URI: &str = "https://json.schemastore.org/sarif-2.1.0.json";
 
 /// Bytes kept as they are in a URI path segment: RFC 3986 unreserved characters.
-const SEGMENT: &AsciiSet = &NON_ALPHANUMERIC.remove(b'-').remove(b'.').remove(b'_').remove(b'~');
+const SEGMENT: &AsciiSet = &NON_ALPHANUMERIC
+    .remove(b'-')
+    .remove(b'.')
+    .remove(b'_')
+    .remove(b'~');
 
 /// The SARIF level for a severity.
 pub fn level(severity: Severity) -> &'static str {
@@ -35,8 +39,13 @@ pub fn level(severity: Severity) -> &'static str {
 /// The artifact URI of `path` and whether it is relative to the working directory.
 pub fn artifact_uri(path: &Path) -> (String, bool) {
     let abs = crate::config::absolute(path);
-    let encode = |c: &std::ffi::OsStr| utf8_percent_encode(&c.to_string_lossy(), SEGMENT).to_string();
-    if let Some(rel) = std::env::current_dir().ok().and_then(|cwd| abs.strip_prefix(crate::config::absolute(&cwd)).ok().map(Path::to_path_buf)) {
+    let encode =
+        |c: &std::ffi::OsStr| utf8_percent_encode(&c.to_string_lossy(), SEGMENT).to_string();
+    if let Some(rel) = std::env::current_dir().ok().and_then(|cwd| {
+        abs.strip_prefix(crate::config::absolute(&cwd))
+            .ok()
+            .map(Path::to_path_buf)
+    }) {
         let segments: Vec<String> = rel.components().map(|c| encode(c.as_os_str())).collect();
         return (segments.join("/"), true);
     }
@@ -88,24 +97,29 @@ pub fn document(reports: &[FileReport]) -> Value {
             physical.insert("artifactLocation".into(), location.clone());
             match (f.position, report.container) {
                 (Some(p), Some(Container::Glb)) => {
-                    physical.insert("region".into(), json!({ "byteOffset": report.json_offset + p.offset }));
+                    physical.insert(
+                        "region".into(),
+                        json!({ "byteOffset": report.json_offset + p.offset }),
+                    );
                 }
                 (Some(p), _) => {
-                    physical.insert("region".into(), json!({ "startLine": p.line, "startColumn": p.column }));
+                    physical.insert(
+                        "region".into(),
+                        json!({ "startLine": p.line, "startColumn": p.column }),
+                    );
                 }
                 (None, _) => {}
             }
-            let mut result = json!({
+            // Every emitted code is registered; -1 is SARIF's "not in the rules array".
+            let rule_index = index.get(d.code).map_or(-1, |&i| i as i64);
+            results.push(json!({
                 "ruleId": d.code,
+                "ruleIndex": rule_index,
                 "level": level(d.severity),
                 "message": { "text": d.message },
                 "locations": [{ "physicalLocation": physical }],
                 "properties": { "pointer": d.pointer },
-            });
-            if let Some(i) = index.get(d.code) {
-                result["ruleIndex"] = json!(i);
-            }
-            results.push(result);
+            }));
         }
         if report.truncated {
             notifications.push(json!({
@@ -141,7 +155,8 @@ pub fn document(reports: &[FileReport]) -> Value {
 
 /// The SARIF log as pretty-printed JSON.
 pub fn render(reports: &[FileReport]) -> String {
-    let mut text = serde_json::to_string_pretty(&document(reports)).expect("a SARIF log serialises");
+    let mut text =
+        serde_json::to_string_pretty(&document(reports)).expect("a SARIF log serialises");
     text.push('\n');
     text
 }
@@ -167,7 +182,13 @@ mod tests {
     #[test]
     fn levels_map_info_and_hint_to_note() {
         assert_eq!(
-            [Severity::Error, Severity::Warning, Severity::Info, Severity::Hint].map(level),
+            [
+                Severity::Error,
+                Severity::Warning,
+                Severity::Info,
+                Severity::Hint
+            ]
+            .map(level),
             ["error", "warning", "note", "note"]
         );
     }

@@ -39,7 +39,9 @@ pub fn render_with(reports: &[FileReport], options: &Options) -> String {
         for f in &report.findings {
             let d = &f.diagnostic;
             let place = match (f.position, report.container) {
-                (Some(p), Some(Container::Glb)) => format!("{file}: byte {}", report.json_offset + p.offset),
+                (Some(p), Some(Container::Glb)) => {
+                    format!("{file}: byte {}", report.json_offset + p.offset)
+                }
                 (Some(p), _) => format!("{file}:{}:{}", p.line, p.column),
                 (None, _) => file.clone(),
             };
@@ -52,14 +54,21 @@ pub fn render_with(reports: &[FileReport], options: &Options) -> String {
                 d.message
             );
             if !d.pointer.is_empty() {
-                let _ = writeln!(out, "    {}", paint(Style::new().dimmed(), &format!("at {}", d.pointer)));
+                let _ = writeln!(
+                    out,
+                    "    {}",
+                    paint(Style::new().dimmed(), &format!("at {}", d.pointer))
+                );
             }
         }
         if report.truncated {
             let _ = writeln!(out, "{file}: further issues not shown (--max-issues)");
         }
         let c = report.counts;
-        for (t, n) in totals.iter_mut().zip([c.errors, c.warnings, c.infos, c.hints]) {
+        for (t, n) in totals
+            .iter_mut()
+            .zip([c.errors, c.warnings, c.infos, c.hints])
+        {
             *t += n;
         }
     }
