@@ -152,15 +152,12 @@ pub fn split<'a>(bytes: &'a [u8], out: &mut Vec<Diagnostic>) -> Option<GlbParts<
     }
     let (json_start, json_end) = json?;
     let json_bytes = &bytes[json_start..json_end];
-    let content_end = json_bytes
-        .iter()
-        .rposition(|b| !matches!(b, b' ' | b'\t' | b'\n' | b'\r'))
-        .map_or(0, |p| p + 1);
-    if json_bytes[content_end..].iter().any(|b| *b != b' ') || json_bytes.ends_with(&[0]) {
+    // Padding must be spaces; NULs (a common exporter mistake) would also break JSON parsers.
+    if json_bytes.ends_with(&[0]) {
         out.push(Diagnostic::new(
             &codes::GLB_INVALID_PADDING,
             "",
-            "the JSON chunk is padded with something other than spaces (0x20)",
+            "the JSON chunk is padded with NUL bytes; the GLB container requires spaces (0x20)",
         ));
     }
     Some(GlbParts {

@@ -12,11 +12,6 @@ pub const CORE_INVALID_VALUE: Code = Code::new(
     Severity::Error,
     "The core glTF structure holds a value the glTF 2.0 schema does not allow.",
 );
-pub const CORE_UNSUPPORTED: Code = Code::new(
-    "CORE_UNSUPPORTED",
-    Severity::Warning,
-    "The core glTF structure uses something the glTF 2.0 specification does not support.",
-);
 pub const CORE_STRUCTURE_INVALID: Code = Code::new(
     "CORE_STRUCTURE_INVALID",
     Severity::Error,
@@ -57,7 +52,6 @@ impl Rule for CoreStructure {
             &CORE_INVALID_VALUE,
             &super::references::UNRESOLVED_REFERENCE,
             &codes::UNDEFINED_PROPERTY,
-            &CORE_UNSUPPORTED,
             &CORE_STRUCTURE_INVALID,
         ]
     }
@@ -93,15 +87,22 @@ impl Rule for CoreStructure {
             let (code, message) = match error {
                 CoreError::IndexOutOfBounds => (
                     &super::references::UNRESOLVED_REFERENCE,
-                    "index out of range".to_string(),
+                    format!("{}: the index names no object", path.as_str()),
                 ),
                 CoreError::Missing => (
                     &codes::UNDEFINED_PROPERTY,
-                    "required property is missing".to_string(),
+                    format!("{}: required by glTF 2.0 but missing", path.as_str()),
                 ),
-                CoreError::Invalid => (&CORE_INVALID_VALUE, "invalid value".to_string()),
-                CoreError::Unsupported => (&CORE_UNSUPPORTED, "unsupported value".to_string()),
-                CoreError::Oversize => (&CORE_INVALID_VALUE, "value too large".to_string()),
+                CoreError::Invalid => (
+                    &CORE_INVALID_VALUE,
+                    format!("{}: not a value glTF 2.0 allows here", path.as_str()),
+                ),
+                CoreError::Oversize => (
+                    &CORE_INVALID_VALUE,
+                    format!("{}: too large for this platform", path.as_str()),
+                ),
+                // Only raised for extensionsRequired, which is skipped above.
+                CoreError::Unsupported => return,
             };
             out.push(Diagnostic::new(code, pointer, message));
         });
