@@ -6,17 +6,12 @@ use clap::{CommandFactory, Parser, Subcommand, ValueEnum};
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use velvet::cli_docs::{self, EXIT_STATUS};
 use velvet::config::{self, Layer, Resolver};
 use velvet::diagnostics::{self, FailOn, Settings};
 use velvet::report::{self, ColorChoice, Format};
 use velvet::rules::schema::Schemas;
 use velvet::validate::Validator;
-
-const EXIT_STATUS: &str = "\
-Exit status:
-  0  no file has an issue at or above --fail-on
-  1  a file has an issue at or above --fail-on (a file that cannot be read or parsed has an error)
-  2  usage or configuration error (bad flag, unknown code, invalid velvet.toml)";
 
 #[derive(Parser)]
 #[command(
@@ -41,9 +36,12 @@ enum Command {
     /// Check .gltf/.glb files (and folders, recursively) against the sheen and fuzz specs.
     #[command(after_help = EXIT_STATUS)]
     Validate(ValidateArgs),
-    /// Print the configuration in force for PATH (a file or folder; default: the current
-    /// folder), as velvet.toml text with the source of each value.
+    /// Print the configuration in force for a file or folder.
+    ///
+    /// The output is velvet.toml text with the source of each value (default, velvet.toml or
+    /// command line); flags given here are layered as `validate` layers them.
     Config {
+        /// The file or folder to look from [default: the current folder].
         path: Option<PathBuf>,
         #[command(flatten)]
         settings: SettingsArgs,
@@ -53,7 +51,9 @@ enum Command {
         #[arg(long, value_enum, default_value_t = CodesFormat::Text)]
         format: CodesFormat,
     },
-    /// Print a shell completion script (e.g. `velvet completions bash > /etc/bash_completion.d/velvet`).
+    /// Print a shell completion script.
+    ///
+    /// For example `velvet completions bash > ~/.local/share/bash-completion/completions/velvet`.
     Completions { shell: clap_complete::Shell },
     /// Print the man page (roff), or write one page per command into DIR.
     Man {
@@ -90,6 +90,7 @@ struct ValidateArgs {
     /// Files and folders to check (folders are searched for *.gltf and *.glb).
     #[arg(required = true)]
     paths: Vec<PathBuf>,
+    /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Text)]
     format: Format,
     #[command(flatten)]
@@ -142,27 +143,21 @@ fn main() -> ExitCode {
 }
 
 fn man(dir: Option<PathBuf>) -> ExitCode {
-    let command = Cli::command();
     match dir {
-        Some(dir) => match std::fs::create_dir_all(&dir)
-            .and_then(|()| clap_mangen::generate_to(command, &dir))
-        {
+        Some(dir) => match cli_docs::write_man_pages(Cli::command(), &dir) {
             Ok(()) => ExitCode::SUCCESS,
             Err(e) => usage_error(format!(
                 "cannot write man pages into {}: {e}",
                 dir.display()
             )),
         },
-        None => {
-            let mut out = Vec::new();
-            match clap_mangen::Man::new(command).render(&mut out) {
-                Ok(()) => {
-                    emit(&out);
-                    ExitCode::SUCCESS
-                }
-                Err(e) => usage_error(e),
+        None => match cli_docs::man_page(Cli::command()) {
+            Ok(page) => {
+                emit(&page);
+                ExitCode::SUCCESS
             }
-        }
+            Err(e) => usage_error(e),
+        },
     }
 }
 

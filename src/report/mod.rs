@@ -43,7 +43,9 @@ pub enum ColorChoice {
     /// Colour when standard output is a terminal and NO_COLOR is not set.
     #[default]
     Auto,
+    /// Colour even into a pipe or file (CI logs that render ANSI).
     Always,
+    /// No colour.
     Never,
 }
 

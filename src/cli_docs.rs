@@ -1,0 +1,98 @@
+//! Documentation generated from the command-line definition: the exit-status text that `--help`
+//! shows, and man pages (clap_mangen) in which that text becomes an EXIT STATUS section instead
+//! of clap_mangen's generic EXTRA section, as man pages conventionally have it.
+
+use clap_mangen::roff::{bold, roman, Roff};
+use clap_mangen::Man;
+use std::path::Path;
+
+/// The exit statuses of `velvet validate`, as `--help` prints them: one `  N  meaning` line each.
+pub const EXIT_STATUS: &str = "\
+Exit status:
+  0  no file has an issue at or above --fail-on
+  1  a file has an issue at or above --fail-on (a file that cannot be read or parsed has an error)
+  2  usage or configuration error (bad flag, unknown code, invalid velvet.toml)";
+
+/// The EXIT STATUS section in roff.
+fn exit_status_section() -> String {
+    let mut roff = Roff::new();
+    roff.control("SH", ["EXIT STATUS"]);
+    for line in EXIT_STATUS.lines().skip(1) {
+        let (status, meaning) = line.trim().split_once("  ").unwrap_or((line.trim(), ""));
+        roff.control("TP", [])
+            .text([bold(status)])
+            .text([roman(meaning.trim())]);
+    }
+    // The text has no apostrophes, so the page's own apostrophe preamble is not repeated.
+    roff.to_roff()
+}
+
+/// The man page of `command`, its after-help turned into EXIT STATUS when it is the exit-status
+/// text.
+pub fn man_page(command: clap::Command) -> std::io::Result<Vec<u8>> {
+    let has_exit_status = command
+        .get_after_help()
+        .is_some_and(|h| h.to_string() == EXIT_STATUS);
+    let mut page = Vec::new();
+    Man::new(command).render(&mut page)?;
+    if !has_exit_status {
+        return Ok(page);
+    }
+    let text = String::from_utf8(page).expect("clap_mangen writes UTF-8");
+    let start = text
+        .find(".SH EXTRA\n")
+        .expect("a page with after-help has an EXTRA section");
+    let end = text[start + 1..]
+        .find("\n.SH ")
+        .map_or(text.len(), |i| start + 1 + i + 1);
+    Ok(format!(
+        "{}{}{}",
+        &text[..start],
+        exit_status_section(),
+        &text[end..]
+    )
+    .into_bytes())
+}
+
+/// Writes one page per command into `dir`: `velvet.1`, `velvet-validate.1`, …
+pub fn write_man_pages(command: clap::Command, dir: &Path) -> std::io::Result<()> {
+    fn write(command: clap::Command, dir: &Path) -> std::io::Result<()> {
+        for sub in command
+            .get_subcommands()
+            .filter(|s| !s.is_hide_set())
+            .cloned()
+        {
+            write(sub, dir)?;
+        }
+        let name = Man::new(command.clone()).get_filename();
+        crate::asset::write::write_atomic(&dir.join(name), &man_page(command)?)
+    }
+    std::fs::create_dir_all(dir)?;
+    let mut command = command.disable_help_subcommand(true);
+    command.build();
+    write(command, dir)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exit_status_becomes_a_man_section_with_one_entry_per_status() {
+        let command = clap::Command::new("demo")
+            .after_help(EXIT_STATUS)
+            .subcommand(clap::Command::new("sub"));
+        let page = String::from_utf8(man_page(command).unwrap()).unwrap();
+        assert!(!page.contains(".SH EXTRA"), "{page}");
+        let section = &page[page.find(".SH \"EXIT STATUS\"").expect("section present")..];
+        assert!(section.starts_with(".SH \"EXIT STATUS\"\n.TP\n\\fB0\\fR\nno file has an issue at or above \\-\\-fail\\-on\n.TP\n\\fB1\\fR\n"), "{section}");
+        assert_eq!(section.matches(".TP").count(), 3);
+    }
+
+    #[test]
+    fn pages_without_the_exit_status_text_are_left_as_clap_mangen_renders_them() {
+        let command = clap::Command::new("demo").after_help("Other notes.");
+        let page = String::from_utf8(man_page(command).unwrap()).unwrap();
+        assert!(page.contains(".SH EXTRA\nOther notes."), "{page}");
+    }
+}
