@@ -84,6 +84,7 @@ pub struct Layer {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields, rename_all = "kebab-case")]
 struct RawFile {
+    #[serde(default, deserialize_with = "whole_number")]
     max_issues: Option<i64>,
     ignore: Option<Vec<String>>,
     only: Option<Vec<String>>,
@@ -91,6 +92,24 @@ struct RawFile {
     overrides: Option<BTreeMap<String, RawSeverity>>,
     fail_on: Option<String>,
     exclude: Option<Vec<String>>,
+}
+
+/// An integer, with an error message that says so in the file's terms.
+fn whole_number<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<i64>, D::Error> {
+    struct Whole;
+    impl serde::de::Visitor<'_> for Whole {
+        type Value = i64;
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            f.write_str("a whole number (0: no limit)")
+        }
+        fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<i64, E> {
+            Ok(v)
+        }
+        fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<i64, E> {
+            i64::try_from(v).map_err(|_| E::custom(format!("{v} is too large")))
+        }
+    }
+    d.deserialize_i64(Whole).map(Some)
 }
 
 /// A severity as the Khronos validator writes it (0 error … 3 hint) or by name.
@@ -179,7 +198,14 @@ impl Layer {
             match e.span() {
                 Some(span) => {
                     let (line, column) = line_column(text, span.start);
-                    format!("line {line}, column {column}: {message}")
+                    // Name the key of a bad value (the span covers the value only).
+                    let line_text = text.lines().nth(line - 1).unwrap_or("");
+                    match line_text.split_once('=') {
+                        Some((key, _)) if !message.starts_with("unknown key") => {
+                            format!("line {line}, column {column}: {}: {message}", key.trim())
+                        }
+                        _ => format!("line {line}, column {column}: {message}"),
+                    }
                 }
                 None => message,
             }
@@ -649,6 +675,15 @@ mod tests {
         assert!(Layer::parse("exclude = [\"a/[\"]")
             .unwrap_err()
             .starts_with("exclude: "));
+        assert_eq!(
+            Layer::parse("\nmax-issues = \"ten\"").unwrap_err(),
+            "line 2, column 14: max-issues: invalid type: string \"ten\", \
+             expected a whole number (0: no limit)"
+        );
+        assert_eq!(
+            Layer::parse("fail-on = 1").unwrap_err(),
+            "line 1, column 11: fail-on: invalid type: integer `1`, expected a string"
+        );
     }
 
     #[test]
