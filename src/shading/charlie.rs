@@ -80,7 +80,10 @@ impl Lobe {
     pub(crate) fn new(alpha: f64) -> Self {
         debug_assert!(alpha >= ALPHA_MIN);
         let inv_alpha = 1.0 / alpha;
-        Lobe { half_inv_alpha: 0.5 * inv_alpha, ln_norm: (2.0 + inv_alpha).ln() - (2.0 * PI).ln() }
+        Lobe {
+            half_inv_alpha: 0.5 * inv_alpha,
+            ln_norm: (2.0 + inv_alpha).ln() - (2.0 * PI).ln(),
+        }
     }
 
     /// D from ln(sin²θh); the albedo integrand calls this with a ln(sin²θh) it computed without
@@ -298,7 +301,10 @@ mod tests {
             let h = 1e-5;
             let left = (charlie_lambda(0.5, r) - charlie_lambda(0.5 - h, r)) / h;
             let right = (charlie_lambda(0.5 + h, r) - charlie_lambda(0.5, r)) / h;
-            assert!((left - right).abs() <= 1e-3 * left.abs().max(1.0), "{left} {right}");
+            assert!(
+                (left - right).abs() <= 1e-3 * left.abs().max(1.0),
+                "{left} {right}"
+            );
         }
     }
 
@@ -347,7 +353,10 @@ mod tests {
                 sheen_brdf(MU_MIN, MU_MIN, 0.0, 0.0, vis)
             );
         }
-        assert_eq!(ashikhmin_visibility(0.0, 0.0), 1.0 / (4.0 * (2.0 * MU_MIN - MU_MIN * MU_MIN)));
+        assert_eq!(
+            ashikhmin_visibility(0.0, 0.0),
+            1.0 / (4.0 * (2.0 * MU_MIN - MU_MIN * MU_MIN))
+        );
     }
 
     #[test]

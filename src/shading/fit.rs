@@ -87,7 +87,11 @@ pub fn training_samples() -> Vec<(f64, f64, f64)> {
         .map(|k| {
             let mu = 0.1 + 0.9 * (k % n) as f64 / (n - 1) as f64;
             let r = 0.25 + 0.75 * (k / n) as f64 / (n - 1) as f64;
-            (mu, r, albedo_quadrature(mu, r, Visibility::Charlie, QUADRATURE_TOL).value)
+            (
+                mu,
+                r,
+                albedo_quadrature(mu, r, Visibility::Charlie, QUADRATURE_TOL).value,
+            )
         })
         .collect()
 }
@@ -97,14 +101,25 @@ pub fn training_samples() -> Vec<(f64, f64, f64)> {
 pub fn fit_coefficients(samples: &[(f64, f64, f64)]) -> [f64; FIT_TERMS] {
     // Start: minimise Σ (E (P − ln E))², which is Σ (exp P − E)² to first order.
     let positive: Vec<_> = samples.iter().filter(|s| s.2 > 1e-300).collect();
-    let rows: Vec<[f64; FIT_TERMS]> = positive.iter().map(|s| scaled(basis(s.0, s.1), s.2)).collect();
+    let rows: Vec<[f64; FIT_TERMS]> = positive
+        .iter()
+        .map(|s| scaled(basis(s.0, s.1), s.2))
+        .collect();
     let rhs: Vec<f64> = positive.iter().map(|s| s.2 * s.2.ln()).collect();
     let mut c = to_array(&least_squares(&rows, &rhs));
 
-    let sse = |c: &[f64; FIT_TERMS]| samples.iter().map(|s| (eval(c, s.0, s.1) - s.2).powi(2)).sum::<f64>();
+    let sse = |c: &[f64; FIT_TERMS]| {
+        samples
+            .iter()
+            .map(|s| (eval(c, s.0, s.1) - s.2).powi(2))
+            .sum::<f64>()
+    };
     let mut current = sse(&c);
     for _ in 0..100 {
-        let jac: Vec<[f64; FIT_TERMS]> = samples.iter().map(|s| scaled(basis(s.0, s.1), eval(&c, s.0, s.1))).collect();
+        let jac: Vec<[f64; FIT_TERMS]> = samples
+            .iter()
+            .map(|s| scaled(basis(s.0, s.1), eval(&c, s.0, s.1)))
+            .collect();
         let res: Vec<f64> = samples.iter().map(|s| s.2 - eval(&c, s.0, s.1)).collect();
         let step = least_squares(&jac, &res);
         let mut scale = 1.0;
@@ -185,7 +200,11 @@ fn least_squares(a: &[[f64; FIT_TERMS]], b: &[f64]) -> Vec<f64> {
     let mut x = vec![0.0; n];
     for k in (0..n).rev() {
         let s: f64 = (k + 1..n).map(|j| q[k][j] * x[j]).sum();
-        x[k] = if q[k][k] == 0.0 { 0.0 } else { (y[k] - s) / q[k][k] };
+        x[k] = if q[k][k] == 0.0 {
+            0.0
+        } else {
+            (y[k] - s) / q[k][k]
+        };
     }
     x
 }
@@ -197,9 +216,14 @@ mod tests {
     #[test]
     fn least_squares_recovers_an_exact_polynomial() {
         let truth: [f64; FIT_TERMS] = std::array::from_fn(|k| (k as f64 * 0.37).sin());
-        let pts: Vec<(f64, f64)> = (0..30).flat_map(|i| (0..30).map(move |j| (i as f64 / 29.0, j as f64 / 29.0))).collect();
+        let pts: Vec<(f64, f64)> = (0..30)
+            .flat_map(|i| (0..30).map(move |j| (i as f64 / 29.0, j as f64 / 29.0)))
+            .collect();
         let rows: Vec<_> = pts.iter().map(|p| basis(p.0, p.1)).collect();
-        let rhs: Vec<f64> = rows.iter().map(|b| b.iter().zip(&truth).map(|(x, c)| x * c).sum()).collect();
+        let rhs: Vec<f64> = rows
+            .iter()
+            .map(|b| b.iter().zip(&truth).map(|(x, c)| x * c).sum())
+            .collect();
         let x = least_squares(&rows, &rhs);
         for (a, b) in x.iter().zip(&truth) {
             assert!((a - b).abs() < 1e-9, "{a} vs {b}");
@@ -210,7 +234,9 @@ mod tests {
     fn fitter_recovers_an_exact_exp_polynomial() {
         let truth: [f64; FIT_TERMS] = std::array::from_fn(|k| 0.3 * ((k as f64) * 1.3).cos());
         let samples: Vec<_> = (0..20)
-            .flat_map(|i| (0..20).map(move |j| (0.1 + 0.9 * i as f64 / 19.0, 0.25 + 0.75 * j as f64 / 19.0)))
+            .flat_map(|i| {
+                (0..20).map(move |j| (0.1 + 0.9 * i as f64 / 19.0, 0.25 + 0.75 * j as f64 / 19.0))
+            })
             .map(|(m, r)| (m, r, eval(&truth, m, r)))
             .collect();
         let c = fit_coefficients(&samples);
@@ -220,10 +246,31 @@ mod tests {
     }
 
     #[test]
+    fn committed_coefficients_are_what_the_fitter_produces() {
+        let samples = training_samples();
+        assert_eq!(samples.len(), TRAINING_GRID * TRAINING_GRID);
+        let refit = fit_coefficients(&samples);
+        for s in &samples {
+            let (a, b) = (eval(&refit, s.0, s.1), albedo_fit(s.0, s.1));
+            assert!(
+                (a - b).abs() < 1e-9,
+                "({}, {}): refit {a} vs committed {b}",
+                s.0,
+                s.1
+            );
+        }
+    }
+
+    #[test]
     fn horner_matches_the_monomial_sum() {
         let c: [f64; FIT_TERMS] = std::array::from_fn(|k| 0.1 * k as f64 - 1.0);
         let (mu, r) = (0.37, 0.81);
-        let direct: f64 = basis(mu, r).iter().zip(&c).map(|(b, c)| b * c).sum::<f64>().exp();
+        let direct: f64 = basis(mu, r)
+            .iter()
+            .zip(&c)
+            .map(|(b, c)| b * c)
+            .sum::<f64>()
+            .exp();
         assert!((eval(&c, mu, r) - direct).abs() < 1e-14 * direct);
     }
 }

@@ -31,7 +31,10 @@ pub struct Attenuation {
 
 impl Attenuation {
     fn new(unclamped: f64) -> Self {
-        Attenuation { factor: clamp01(unclamped), unclamped }
+        Attenuation {
+            factor: clamp01(unclamped),
+            unclamped,
+        }
     }
 
     /// Whether the clamp changed the value.
@@ -76,16 +79,32 @@ pub fn fuzz_base_attenuation(weight: f64, reflectance: f64) -> Attenuation {
 }
 
 /// One channel set of the sheen layering: sheenColor·f_sheen + base·attenuation.
-pub fn sheen_layer(sheen_color: [f64; 3], sheen_brdf: f64, base: [f64; 3], albedo: f64) -> ([f64; 3], Attenuation) {
+pub fn sheen_layer(
+    sheen_color: [f64; 3],
+    sheen_brdf: f64,
+    base: [f64; 3],
+    albedo: f64,
+) -> ([f64; 3], Attenuation) {
     let a = sheen_base_attenuation(max3(sheen_color), albedo);
-    (std::array::from_fn(|k| sheen_color[k] * sheen_brdf + base[k] * a.factor), a)
+    (
+        std::array::from_fn(|k| sheen_color[k] * sheen_brdf + base[k] * a.factor),
+        a,
+    )
 }
 
 /// One channel set of the fuzz layering: fuzzColor·R·w + base·attenuation.
-pub fn fuzz_layer(fuzz_color: [f64; 3], weight: f64, reflectance: f64, base: [f64; 3]) -> ([f64; 3], Attenuation) {
+pub fn fuzz_layer(
+    fuzz_color: [f64; 3],
+    weight: f64,
+    reflectance: f64,
+    base: [f64; 3],
+) -> ([f64; 3], Attenuation) {
     let a = fuzz_base_attenuation(weight, reflectance);
     let w = clamp01(weight);
-    (std::array::from_fn(|k| fuzz_color[k] * reflectance * w + base[k] * a.factor), a)
+    (
+        std::array::from_fn(|k| fuzz_color[k] * reflectance * w + base[k] * a.factor),
+        a,
+    )
 }
 
 /// A layer's directional reflectance as a function of the view cosine μ and the layer's
@@ -212,10 +231,22 @@ pub fn compare_base_attenuation(
             let fa = fuzz_base_attenuation(fuzz.weight, r);
             clamps.record(sa);
             clamps.record(fa);
-            CurvePoint { mu, sheen_reflectance: e, fuzz_reflectance: r, sheen_attenuation: sa, fuzz_attenuation: fa }
+            CurvePoint {
+                mu,
+                sheen_reflectance: e,
+                fuzz_reflectance: r,
+                sheen_attenuation: sa,
+                fuzz_attenuation: fa,
+            }
         })
         .collect();
-    let worst = curve.iter().fold(&curve[0], |w, p| if p.difference() > w.difference() { p } else { w });
+    let worst = curve.iter().fold(&curve[0], |w, p| {
+        if p.difference() > w.difference() {
+            p
+        } else {
+            w
+        }
+    });
     AttenuationComparison {
         sheen_reflectance: sheen_reflectance.name(),
         fuzz_reflectance: fuzz_reflectance.name(),
@@ -228,7 +259,10 @@ pub fn compare_base_attenuation(
 
 /// [`compare_base_attenuation`] with the sheen E by quadrature and the fuzz R by its current
 /// model (the sheen-E stand-in, by quadrature).
-pub fn sheen_to_fuzz_attenuation_difference(sheen: SheenParams, fuzz: FuzzParams) -> AttenuationComparison {
+pub fn sheen_to_fuzz_attenuation_difference(
+    sheen: SheenParams,
+    fuzz: FuzzParams,
+) -> AttenuationComparison {
     compare_base_attenuation(
         sheen,
         fuzz,
@@ -262,7 +296,13 @@ mod tests {
         let mut count = ClampCount::default();
         assert_eq!(count.record(a), 0.0);
         assert_eq!(count.record(sheen_base_attenuation(0.5, 0.5)), 0.75);
-        assert_eq!(count, ClampCount { evaluated: 2, clamped: 1 });
+        assert_eq!(
+            count,
+            ClampCount {
+                evaluated: 2,
+                clamped: 1
+            }
+        );
     }
 
     #[test]
@@ -315,8 +355,14 @@ mod tests {
     fn comparison_asks_only_for_the_two_roughness_values() {
         let seen = RefCell::new(Vec::new());
         let cmp = compare_base_attenuation(
-            SheenParams { color_max3: 1.0, roughness: 0.3 },
-            FuzzParams { weight: 0.5, roughness: 0.7 },
+            SheenParams {
+                color_max3: 1.0,
+                roughness: 0.3,
+            },
+            FuzzParams {
+                weight: 0.5,
+                roughness: 0.7,
+            },
             &Recording(&seen, 0.4),
             &Recording(&seen, 0.4),
         );
@@ -326,15 +372,27 @@ mod tests {
         // Constant reflectances: sheen 1 − 0.4 = 0.6, fuzz 1 − 0.2 = 0.8.
         assert!((cmp.max_difference - 0.2).abs() < 1e-15);
         assert_eq!(cmp.at_mu, 0.0);
-        assert_eq!(cmp.clamps, ClampCount { evaluated: 2 * COMPARISON_SAMPLES as u64, clamped: 0 });
+        assert_eq!(
+            cmp.clamps,
+            ClampCount {
+                evaluated: 2 * COMPARISON_SAMPLES as u64,
+                clamped: 0
+            }
+        );
     }
 
     #[test]
     fn identical_layers_differ_by_nothing() {
         // Sheen max3 = w and the stand-in R = E at the same roughness: the layers agree exactly.
         let cmp = compare_base_attenuation(
-            SheenParams { color_max3: 0.8, roughness: 0.5 },
-            FuzzParams { weight: 0.8, roughness: 0.5 },
+            SheenParams {
+                color_max3: 0.8,
+                roughness: 0.5,
+            },
+            FuzzParams {
+                weight: 0.8,
+                roughness: 0.5,
+            },
             &SheenAlbedo(AlbedoMethod::Fit),
             &FuzzReflectance::SheenStandIn(AlbedoMethod::Fit),
         );
@@ -347,10 +405,20 @@ mod tests {
     fn a_weaker_fuzz_layer_shows_the_gap_where_e_is_largest() {
         // Same roughness, w = 0.5·max3: the difference is 0.5·max3·E, largest where E is.
         let cmp = sheen_to_fuzz_attenuation_difference(
-            SheenParams { color_max3: 1.0, roughness: 0.5 },
-            FuzzParams { weight: 0.5, roughness: 0.5 },
+            SheenParams {
+                color_max3: 1.0,
+                roughness: 0.5,
+            },
+            FuzzParams {
+                weight: 0.5,
+                roughness: 0.5,
+            },
         );
-        let e_max = cmp.curve.iter().map(|p| p.sheen_reflectance).fold(0.0, f64::max);
+        let e_max = cmp
+            .curve
+            .iter()
+            .map(|p| p.sheen_reflectance)
+            .fold(0.0, f64::max);
         assert!((cmp.max_difference - 0.5 * e_max).abs() < 1e-12);
         assert_eq!(cmp.clamps.clamped, 0, "E < 1 everywhere at r = 0.5");
     }

@@ -2,12 +2,15 @@
 //! ([`charlie`]), its directional albedo E(μ, r) by three methods behind one function
 //! ([`sheen_albedo`]: quadrature in [`albedo`], tables in [`table`], a closed-form fit in [`fit`]),
 //! the layering of sheen and fuzz over a base ([`layering`]), and the speed-against-error report
-//! ([`accuracy`], drawn by [`plot`]).
+//! ([`accuracy`], drawn by [`plot`], run by `velvet bench` through [`bench`]).
 
+pub mod accuracy;
 pub mod albedo;
+pub mod bench;
 pub mod charlie;
 pub mod fit;
 pub mod layering;
+pub mod plot;
 pub mod quadrature;
 pub mod table;
 
@@ -19,7 +22,8 @@ pub use albedo::AlbedoMethod;
 pub fn sheen_albedo(mu: f64, r: f64, method: AlbedoMethod) -> f64 {
     match method {
         AlbedoMethod::Quadrature => {
-            albedo::albedo_quadrature(mu, r, charlie::Visibility::Charlie, albedo::QUADRATURE_TOL).value
+            albedo::albedo_quadrature(mu, r, charlie::Visibility::Charlie, albedo::QUADRATURE_TOL)
+                .value
         }
         AlbedoMethod::Lut16 => table::lut16().lookup(mu, r),
         AlbedoMethod::Lut32 => table::lut32().lookup(mu, r),

@@ -120,7 +120,10 @@ pub const MAX_CELLS: usize = 4000;
 /// ∫∫ f over [xb[0], xb[last]] × [yb[0], yb[last]] to absolute tolerance `tol`, starting from the
 /// cells between consecutive break values (put them at the integrand's kinks).
 pub fn integrate_2d<S: Separable>(f: &S, xb: &[f64], yb: &[f64], tol: f64) -> Estimate {
-    assert!(xb.len() >= 2 && yb.len() >= 2, "need at least two break values per axis");
+    assert!(
+        xb.len() >= 2 && yb.len() >= 2,
+        "need at least two break values per axis"
+    );
     let rule = rule();
     let mut cells: Vec<Cell> = Vec::with_capacity(64);
     let mut evaluations = 0u64;
@@ -151,13 +154,19 @@ pub fn integrate_2d<S: Separable>(f: &S, xb: &[f64], yb: &[f64], tol: f64) -> Es
             if mid <= c.x0 || mid >= c.x1 {
                 break false;
             }
-            (cell(f, &rule, c.x0, mid, c.y0, c.y1), cell(f, &rule, mid, c.x1, c.y0, c.y1))
+            (
+                cell(f, &rule, c.x0, mid, c.y0, c.y1),
+                cell(f, &rule, mid, c.x1, c.y0, c.y1),
+            )
         } else {
             let mid = 0.5 * (c.y0 + c.y1);
             if mid <= c.y0 || mid >= c.y1 {
                 break false;
             }
-            (cell(f, &rule, c.x0, c.x1, c.y0, mid), cell(f, &rule, c.x0, c.x1, mid, c.y1))
+            (
+                cell(f, &rule, c.x0, c.x1, c.y0, mid),
+                cell(f, &rule, c.x0, c.x1, mid, c.y1),
+            )
         };
         evaluations += 450;
         cells[worst] = a;
@@ -230,7 +239,15 @@ fn cell<S: Separable>(
         }
         e.max(50.0 * f64::EPSILON * abs * area.abs())
     };
-    Cell { x0, x1, y0, y1, value: kk * area, err_x: scale(kk - gk), err_y: scale(kk - kg) }
+    Cell {
+        x0,
+        x1,
+        y0,
+        y1,
+        value: kk * area,
+        err_x: scale(kk - gk),
+        err_y: scale(kk - kg),
+    }
 }
 
 #[cfg(test)]
@@ -267,7 +284,11 @@ mod tests {
             let f = Plain(|x: f64, y: f64| x.powi(p) * y.powi(q));
             let est = integrate_2d(&f, &[0.0, 1.0], &[0.0, 1.0], 1.0);
             let exact = 1.0 / ((p as f64 + 1.0) * (q as f64 + 1.0));
-            assert!((est.value - exact).abs() < 1e-14, "x^{p} y^{q}: {}", est.value);
+            assert!(
+                (est.value - exact).abs() < 1e-14,
+                "x^{p} y^{q}: {}",
+                est.value
+            );
             assert_eq!(est.evaluations, 225);
         }
     }
@@ -280,7 +301,12 @@ mod tests {
         let f = Plain(|x: f64, y: f64| 1.0 / ((x * x + eps * eps) * (y * y + eps * eps)));
         let est = integrate_2d(&f, &[0.0, 1.0], &[0.0, 1.0], 1e-3);
         assert!(est.converged);
-        assert!((est.value - one * one).abs() <= 1e-3, "{} vs {}", est.value, one * one);
+        assert!(
+            (est.value - one * one).abs() <= 1e-3,
+            "{} vs {}",
+            est.value,
+            one * one
+        );
     }
 
     #[test]

@@ -111,7 +111,12 @@ mod tests {
     #[test]
     fn interpolation_is_exact_for_bilinear_data_inside_the_nodes() {
         let t = linear_table(16);
-        for &(mu, r) in &[(0.5, 0.5), (0.1, 0.9), (1.0 / 32.0, 31.0 / 32.0), (0.33, 0.77)] {
+        for &(mu, r) in &[
+            (0.5, 0.5),
+            (0.1, 0.9),
+            (1.0 / 32.0, 31.0 / 32.0),
+            (0.33, 0.77),
+        ] {
             let exact = 2.0 * mu + 3.0 * r + 1.0;
             assert!((t.lookup(mu, r) - exact).abs() < 1e-14, "({mu}, {r})");
         }
@@ -124,6 +129,18 @@ mod tests {
         assert_eq!(t.lookup(1.0, 1.0), t.at(15, 15));
         assert_eq!(t.lookup(0.01, 0.5), t.lookup(1.0 / 32.0, 0.5));
         assert_eq!(t.lookup(-3.0, f64::NAN), t.at(0, 0));
+    }
+
+    #[test]
+    fn generated_nodes_are_the_quadrature_values() {
+        let t = lut16();
+        assert_eq!(t.size(), 16);
+        for (i, j) in [(0, 0), (5, 9), (15, 15), (15, 0)] {
+            let q =
+                albedo_quadrature(t.node(i), t.node(j), Visibility::Charlie, QUADRATURE_TOL).value;
+            assert_eq!(t.at(i, j), q);
+        }
+        assert_eq!(lut32().size(), 32);
     }
 
     #[test]
