@@ -174,25 +174,29 @@ fn least_squares(a: &[[f64; FIT_TERMS]], b: &[f64]) -> Vec<f64> {
     let mut q: Vec<[f64; FIT_TERMS]> = a.to_vec();
     let mut y = b.to_vec();
     for k in 0..n {
-        let norm = (k..m).map(|i| q[i][k] * q[i][k]).sum::<f64>().sqrt();
+        let norm = q[k..].iter().map(|row| row[k] * row[k]).sum::<f64>().sqrt();
         if norm == 0.0 {
             continue;
         }
         let alpha = if q[k][k] > 0.0 { -norm } else { norm };
-        // v = x − α e₁ over rows k.., stored in place of column k.
+        // The Householder vector v = x − α e₁ over rows k.., stored in place of column k.
         q[k][k] -= alpha;
-        let vnorm2 = (k..m).map(|i| q[i][k] * q[i][k]).sum::<f64>();
+        let vnorm2 = q[k..].iter().map(|row| row[k] * row[k]).sum::<f64>();
         for j in k + 1..n {
-            let dot = (k..m).map(|i| q[i][k] * q[i][j]).sum::<f64>();
-            let f = 2.0 * dot / vnorm2;
-            for i in k..m {
-                q[i][j] -= f * q[i][k];
+            let f = 2.0 * q[k..].iter().map(|row| row[k] * row[j]).sum::<f64>() / vnorm2;
+            for row in q[k..].iter_mut() {
+                row[j] -= f * row[k];
             }
         }
-        let dot = (k..m).map(|i| q[i][k] * y[i]).sum::<f64>();
-        let f = 2.0 * dot / vnorm2;
-        for i in k..m {
-            y[i] -= f * q[i][k];
+        let f = 2.0
+            * q[k..]
+                .iter()
+                .zip(&y[k..])
+                .map(|(row, yi)| row[k] * yi)
+                .sum::<f64>()
+            / vnorm2;
+        for (row, yi) in q[k..].iter().zip(y[k..].iter_mut()) {
+            *yi -= f * row[k];
         }
         q[k][k] = alpha;
     }

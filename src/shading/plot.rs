@@ -9,6 +9,9 @@ use plotters::prelude::*;
 /// Width and height of the plot in pixels.
 const SIZE: (u32, u32) = (900, 560);
 
+/// (time per evaluation in ns, max error, method name).
+type Point<'a> = (f64, f64, &'a str);
+
 /// Errors below this are drawn at it (a log axis has no 0).
 const ERROR_FLOOR: f64 = 1e-12;
 
@@ -27,7 +30,7 @@ pub fn accuracy_svg(report: &AccuracyReport) -> Result<String, String> {
             _ => quadrature = Some((t, QUADRATURE_BOUND, m.method.name())),
         }
     }
-    let all: Vec<&(f64, f64, &str)> = ordinary
+    let all: Vec<&Point> = ordinary
         .iter()
         .chain(&hard)
         .chain(quadrature.iter())
@@ -69,7 +72,7 @@ pub fn accuracy_svg(report: &AccuracyReport) -> Result<String, String> {
             .map_err(|e| e.to_string())?;
 
         let font = ("sans-serif", 13).into_font();
-        let series: [(&[(f64, f64, &str)], RGBColor, &str); 2] = [
+        let series: [(&[Point], RGBColor, &str); 2] = [
             (
                 &ordinary,
                 RGBColor(31, 119, 180),

@@ -16,6 +16,7 @@
 
 /// Kronrod nodes on [−1, 1] (non-negative half; the rule is symmetric). Odd indices are the
 /// 7-point Gauss nodes; the last is the centre.
+#[allow(clippy::excessive_precision)] // QUADPACK's published digits, kept as published.
 const XGK: [f64; 8] = [
     0.991_455_371_120_812_639_206_854_697_526_329,
     0.949_107_912_342_758_524_526_189_684_047_851,
@@ -28,6 +29,7 @@ const XGK: [f64; 8] = [
 ];
 
 /// Kronrod weights for the nodes of [`XGK`].
+#[allow(clippy::excessive_precision)] // QUADPACK's published digits, kept as published.
 const WGK: [f64; 8] = [
     0.022_935_322_010_529_224_963_732_008_058_970,
     0.063_092_092_629_978_553_290_700_663_189_204,
@@ -40,6 +42,7 @@ const WGK: [f64; 8] = [
 ];
 
 /// Gauss weights for the nodes XGK[1], XGK[3], XGK[5], XGK[7].
+#[allow(clippy::excessive_precision)] // QUADPACK's published digits, kept as published.
 const WG: [f64; 4] = [
     0.129_484_966_168_869_693_270_611_432_679_082,
     0.279_705_391_489_276_667_901_467_771_423_780,
