@@ -13,7 +13,8 @@
 //! Sheen only adds light, while fuzz blends towards its colour: dark fuzz over a bright base
 //! darkens it, which no sheen can show. Per unit of layer reflectance the fallback is brighter
 //! by fuzzFactor × (1 − max3(fuzzColor)) × max3(baseColor); that is reported when it exceeds
-//! [`DARK_FUZZ_THRESHOLD`].
+//! [`DARK_FUZZ_THRESHOLD`]. Black fuzz would give a switched-off sheen, which is no fallback
+//! (and contradicts the active fuzz): none is written, said so.
 
 use super::note::{Conversion, Note, Skip};
 use super::plan::{number_like, MaterialCx, MaterialPlan};
@@ -123,6 +124,11 @@ pub fn sheen_for(cx: &MaterialCx, fuzz: &Value) -> (Map<String, Value>, Vec<Note
     (sheen, notes)
 }
 
+/// True when a sheen with these properties is switched off (sheenColorFactor all zero).
+fn switched_off(sheen: &Map<String, Value>) -> bool {
+    sheen["sheenColorFactor"].as_array().is_some_and(|c| c.iter().all(|v| v.as_f64() == Some(0.0)))
+}
+
 /// Adds a fallback sheen to a material that has fuzz only.
 pub fn add(cx: &MaterialCx, fuzz: &Value, plan: &mut MaterialPlan) {
     if !FuzzView::read(fuzz).is_some_and(|f| f.is_on()) {
@@ -130,8 +136,13 @@ pub fn add(cx: &MaterialCx, fuzz: &Value, plan: &mut MaterialPlan) {
         return;
     }
     let (sheen, notes) = sheen_for(cx, fuzz);
-    plan.edits.push(Edit::set(cx.extension_pointer(layers::SHEEN), Value::Object(sheen)));
     plan.notes.extend(notes);
+    if switched_off(&sheen) {
+        // A switched-off sheen next to an active fuzz is no fallback, and contradicts it.
+        plan.skip(Skip::BlackFuzz, Note::BlackFuzz);
+        return;
+    }
+    plan.edits.push(Edit::set(cx.extension_pointer(layers::SHEEN), Value::Object(sheen)));
     plan.conversions.push(Conversion::FallbackSheen);
 }
 
@@ -139,6 +150,11 @@ pub fn add(cx: &MaterialCx, fuzz: &Value, plan: &mut MaterialPlan) {
 /// and removed when the fuzz gives none; the sheen's other members (extras, extensions) stay.
 pub fn refresh(cx: &MaterialCx, sheen: &Value, fuzz: &Value, plan: &mut MaterialPlan) {
     let (target, notes) = sheen_for(cx, fuzz);
+    plan.notes.extend(notes);
+    if switched_off(&target) && FuzzView::read(fuzz).is_some_and(|f| f.is_on()) {
+        plan.skip(Skip::BlackFuzz, Note::BlackFuzz);
+        return;
+    }
     let base = cx.extension_pointer(layers::SHEEN);
     let mut edits = Vec::new();
     for property in super::legacy::legacy_properties(sheen) {
@@ -152,7 +168,6 @@ pub fn refresh(cx: &MaterialCx, sheen: &Value, fuzz: &Value, plan: &mut Material
             (None, None) => {}
         }
     }
-    plan.notes.extend(notes);
     if edits.is_empty() {
         plan.skip(Skip::FallbackUpToDate, Note::FallbackUpToDate);
     } else {

@@ -48,6 +48,8 @@ pub enum Skip {
     Unlit,
     /// The material uses KHR_materials_pbrSpecularGlossiness, which excludes both layers.
     SpecularGlossiness,
+    /// The fuzz colour is black: no sheen can stand for it (sheen only adds light).
+    BlackFuzz,
     /// A layer's value is not a JSON object.
     Malformed,
 }
@@ -61,6 +63,7 @@ impl Skip {
             Skip::FallbackUpToDate => "fallback sheen already up to date",
             Skip::Unlit => "uses KHR_materials_unlit",
             Skip::SpecularGlossiness => "uses KHR_materials_pbrSpecularGlossiness",
+            Skip::BlackFuzz => "black fuzz, which no sheen can show",
             Skip::Malformed => "layer is not a JSON object",
         }
     }
@@ -104,6 +107,8 @@ pub enum Note {
     FuzzTextureNeedsBake { texture: String },
     /// fuzzTexture and fuzzColorTexture cannot be combined into one texture.
     FuzzTexturesIncompatible { reason: String },
+    /// Black fuzz on an active layer: a fallback sheen would be switched off.
+    BlackFuzz,
     /// Dark fuzz over a bright base: the fallback sheen only adds light.
     DarkFuzz { difference: f64, fuzz_color_max: f64, base_color_max: f64 },
     /// Legacy sheenColor × sheenFactor left [0, 1] and was clamped.
@@ -153,6 +158,7 @@ impl Note {
             | Note::FuzzTextureNeedsBake { .. }
             | Note::FuzzTexturesIncompatible { .. }
             | Note::DarkFuzz { .. }
+            | Note::BlackFuzz
             | Note::LegacyClamped { .. }
             | Note::LegacyRoughnessTexture { .. }
             | Note::LegacyTextureIntensity
@@ -198,8 +204,11 @@ impl Note {
                 "fuzzTexture and fuzzColorTexture cannot be combined into one sheen colour texture ({reason}): the fallback sheen uses the factors instead"
             ),
             Note::DarkFuzz { difference, fuzz_color_max, base_color_max } => format!(
-                "dark fuzz over a bright base (max fuzz colour {fuzz_color_max:?}, max base colour {base_color_max:?}): sheen only adds light, so where the fuzz darkens the base the fallback is brighter by up to {difference:.4} of the layer's reflectance (from the factors; textures can make it larger)"
+                "the fuzz (max colour {fuzz_color_max:?}) is darker than the base (max colour {base_color_max:?}): sheen only adds light, so where the fuzz darkens the base, loaders without fuzz show it brighter by up to {difference:.4} of the layer's reflectance (from the factors; textures can make it larger)"
             ),
+            Note::BlackFuzz => {
+                "the fuzz colour is black: a sheen of that colour is switched off, so no sheen can stand for it; no fallback is written (loaders without fuzz show no layer)".into()
+            }
             Note::LegacyClamped { product, clamped } => format!(
                 "sheenColor × sheenFactor = {} lies outside [0, 1]: sheenColorFactor is clamped to {}",
                 rgb(*product),
