@@ -16,16 +16,24 @@ fn material(i: usize) -> Value {
     let t = (i % 97) as f64 / 97.0;
     let name = format!("material {i}");
     match i % 10 {
-        0..=3 => json!({"name": name, "pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.7, 0.6, 1.0], "roughnessFactor": 0.8},
-            "extensions": {"KHR_materials_sheen": {"sheenColorFactor": [0.9 * t, 0.5, 0.25 + 0.5 * t], "sheenRoughnessFactor": t}}}),
-        4 | 5 => json!({"name": name, "extensions": {"KHR_materials_sheen": {"sheenColorFactor": [1.0, 0.8, 0.6], "sheenRoughnessFactor": 0.5,
+        0..=3 => {
+            json!({"name": name, "pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.7, 0.6, 1.0], "roughnessFactor": 0.8},
+            "extensions": {"KHR_materials_sheen": {"sheenColorFactor": [0.9 * t, 0.5, 0.25 + 0.5 * t], "sheenRoughnessFactor": t}}})
+        }
+        4 | 5 => {
+            json!({"name": name, "extensions": {"KHR_materials_sheen": {"sheenColorFactor": [1.0, 0.8, 0.6], "sheenRoughnessFactor": 0.5,
             "sheenColorTexture": {"index": 0, "extensions": {"KHR_texture_transform": {"scale": [30.0, -30.0]}}},
-            "sheenRoughnessTexture": {"index": 1}}}}),
-        6 | 7 => json!({"name": name, "pbrMetallicRoughness": {"baseColorFactor": [0.9, 0.9, 0.9, 1.0]},
-            "extensions": {"KHR_materials_fuzz": {"fuzzFactor": t, "fuzzColorFactor": [1.0, t, 0.5], "fuzzRoughnessFactor": 0.7}}}),
+            "sheenRoughnessTexture": {"index": 1}}}})
+        }
+        6 | 7 => {
+            json!({"name": name, "pbrMetallicRoughness": {"baseColorFactor": [0.9, 0.9, 0.9, 1.0]},
+            "extensions": {"KHR_materials_fuzz": {"fuzzFactor": t, "fuzzColorFactor": [1.0, t, 0.5], "fuzzRoughnessFactor": 0.7}}})
+        }
         8 => json!({"name": name, "pbrMetallicRoughness": {"roughnessFactor": 0.6},
             "extensions": {"KHR_materials_sheen": {"sheenFactor": 1.5, "sheenColor": [0.5, 0.6, t]}}}),
-        _ => json!({"name": name, "pbrMetallicRoughness": {"roughnessFactor": t}, "extras": {"id": i}}),
+        _ => {
+            json!({"name": name, "pbrMetallicRoughness": {"roughnessFactor": t}, "extras": {"id": i}})
+        }
     }
 }
 
@@ -86,14 +94,22 @@ fn benches(c: &mut Criterion) {
     let out = dir.path().join("out");
 
     let report = run(&big, &out);
-    assert!(report.summary.materials_migrated > 17_000, "{:?}", report.summary);
+    assert!(
+        report.summary.materials_migrated > 17_000,
+        "{:?}",
+        report.summary
+    );
     let report = run(&tree, &out);
     assert_eq!(report.summary.files, 500);
 
     let mut group = c.benchmark_group("migrate");
-    group.sample_size(10).measurement_time(Duration::from_secs(20));
+    group
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(20));
     group.bench_function("one file, 20000 materials", |b| b.iter(|| run(&big, &out)));
-    group.bench_function("500 files, 12 materials each", |b| b.iter(|| run(&tree, &out)));
+    group.bench_function("500 files, 12 materials each", |b| {
+        b.iter(|| run(&tree, &out))
+    });
     group.finish();
 }
 

@@ -28,15 +28,22 @@ pub enum Edit {
 
 impl Edit {
     pub fn set(pointer: impl Into<String>, value: Value) -> Edit {
-        Edit::Set { pointer: pointer.into(), value }
+        Edit::Set {
+            pointer: pointer.into(),
+            value,
+        }
     }
 
     pub fn remove(pointer: impl Into<String>) -> Edit {
-        Edit::Remove { pointer: pointer.into() }
+        Edit::Remove {
+            pointer: pointer.into(),
+        }
     }
 
     pub fn declare_used(extension: impl Into<String>) -> Edit {
-        Edit::DeclareUsed { extension: extension.into() }
+        Edit::DeclareUsed {
+            extension: extension.into(),
+        }
     }
 }
 
@@ -56,24 +63,34 @@ pub enum EditError {
     #[error("{pointer}: the document root cannot be replaced by an edit")]
     Root { pointer: String },
     #[error("{pointer}: '{token}' leads into a {kind}, which holds no members")]
-    NotAContainer { pointer: String, token: String, kind: &'static str },
+    NotAContainer {
+        pointer: String,
+        token: String,
+        kind: &'static str,
+    },
     #[error("{pointer}: '{token}' is not an index of an array of {len}")]
-    BadIndex { pointer: String, token: String, len: usize },
+    BadIndex {
+        pointer: String,
+        token: String,
+        len: usize,
+    },
     #[error("/extensionsUsed is not an array")]
     ExtensionsUsedNotArray,
 }
 
-/// Applies `edits` in order. On error the document may hold the edits before the failing one;
-/// callers apply to a copy and discard it on failure.
-pub fn apply(json: &mut Value, edits: &[Edit]) -> Result<(), EditError> {
+/// Applies `edits` in order; `Ok(true)` when the document changed (an edit that sets a value
+/// already there, removes an absent one or declares a declared extension changes nothing). On
+/// error the document may hold the edits before the failing one: callers discard it.
+pub fn apply(json: &mut Value, edits: &[Edit]) -> Result<bool, EditError> {
+    let mut changed = false;
     for edit in edits {
-        match edit {
+        changed |= match edit {
             Edit::Set { pointer, value } => set(json, pointer, value.clone())?,
             Edit::Remove { pointer } => remove(json, pointer)?,
             Edit::DeclareUsed { extension } => declare_used(json, extension)?,
-        }
+        };
     }
-    Ok(())
+    Ok(changed)
 }
 
 fn kind_of(value: &Value) -> &'static str {
@@ -89,12 +106,19 @@ fn kind_of(value: &Value) -> &'static str {
 
 /// Index of `token` in an array of `len`; `append` allows `len` and `-` (the end).
 fn array_index(token: &str, len: usize, append: bool, path: &str) -> Result<usize, EditError> {
-    let bad = || EditError::BadIndex { pointer: path.to_string(), token: token.to_string(), len };
+    let bad = || EditError::BadIndex {
+        pointer: path.to_string(),
+        token: token.to_string(),
+        len,
+    };
     if token == "-" {
         return if append { Ok(len) } else { Err(bad()) };
     }
     // RFC 6901: no leading zeros, no sign.
-    if token.is_empty() || (token.len() > 1 && token.starts_with('0')) || !token.bytes().all(|b| b.is_ascii_digit()) {
+    if token.is_empty()
+        || (token.len() > 1 && token.starts_with('0'))
+        || !token.bytes().all(|b| b.is_ascii_digit())
+    {
         return Err(bad());
     }
     let index: usize = token.parse().map_err(|_| bad())?;
@@ -106,87 +130,120 @@ fn array_index(token: &str, len: usize, append: bool, path: &str) -> Result<usiz
 }
 
 /// The container that holds the last token of `path`, creating missing objects on the way.
-fn parent_mut<'a>(json: &'a mut Value, path: &str, tokens: &[String]) -> Result<&'a mut Value, EditError> {
+fn parent_mut<'a>(
+    json: &'a mut Value,
+    path: &str,
+    tokens: &[String],
+) -> Result<&'a mut Value, EditError> {
     let mut current = json;
     for token in tokens {
         current = match current {
-            Value::Object(map) => map.entry(token.clone()).or_insert_with(|| Value::Object(Map::new())),
+            Value::Object(map) => map
+                .entry(token.clone())
+                .or_insert_with(|| Value::Object(Map::new())),
             Value::Array(items) => {
                 let index = array_index(token, items.len(), false, path)?;
                 &mut items[index]
             }
             other => {
-                return Err(EditError::NotAContainer { pointer: path.to_string(), token: token.clone(), kind: kind_of(other) })
+                return Err(EditError::NotAContainer {
+                    pointer: path.to_string(),
+                    token: token.clone(),
+                    kind: kind_of(other),
+                })
             }
         };
     }
     Ok(current)
 }
 
-fn set(json: &mut Value, path: &str, value: Value) -> Result<(), EditError> {
+fn set(json: &mut Value, path: &str, value: Value) -> Result<bool, EditError> {
     let tokens = pointer::tokens(path);
     let Some((last, parents)) = tokens.split_last() else {
-        return Err(EditError::Root { pointer: path.to_string() });
+        return Err(EditError::Root {
+            pointer: path.to_string(),
+        });
     };
     match parent_mut(json, path, parents)? {
         // `insert` on an existing key keeps its place (the map preserves order).
         Value::Object(map) => {
+            let changed = map.get(last) != Some(&value);
             map.insert(last.clone(), value);
+            Ok(changed)
         }
         Value::Array(items) => {
             let index = array_index(last, items.len(), true, path)?;
             if index == items.len() {
                 items.push(value);
+                Ok(true)
             } else {
+                let changed = items[index] != value;
                 items[index] = value;
+                Ok(changed)
             }
         }
-        other => {
-            return Err(EditError::NotAContainer { pointer: path.to_string(), token: last.clone(), kind: kind_of(other) })
-        }
+        other => Err(EditError::NotAContainer {
+            pointer: path.to_string(),
+            token: last.clone(),
+            kind: kind_of(other),
+        }),
     }
-    Ok(())
 }
 
-fn remove(json: &mut Value, path: &str) -> Result<(), EditError> {
+fn remove(json: &mut Value, path: &str) -> Result<bool, EditError> {
     let tokens = pointer::tokens(path);
     let Some((last, parents)) = tokens.split_last() else {
-        return Err(EditError::Root { pointer: path.to_string() });
+        return Err(EditError::Root {
+            pointer: path.to_string(),
+        });
     };
-    let parent_pointer: String = parents.iter().map(|t| format!("/{}", pointer::escape(t))).collect();
-    let Some(parent) = json.pointer_mut(&parent_pointer) else { return Ok(()) };
-    match parent {
+    let parent_pointer: String = parents
+        .iter()
+        .map(|t| format!("/{}", pointer::escape(t)))
+        .collect();
+    let Some(parent) = json.pointer_mut(&parent_pointer) else {
+        return Ok(false);
+    };
+    Ok(match parent {
         // shift_remove: `remove` would move the last key into the gap.
-        Value::Object(map) => {
-            map.shift_remove(last);
-        }
-        Value::Array(items) => {
-            if let Ok(index) = array_index(last, items.len(), false, path) {
+        Value::Object(map) => map.shift_remove(last).is_some(),
+        Value::Array(items) => match array_index(last, items.len(), false, path) {
+            Ok(index) => {
                 items.remove(index);
+                true
             }
-        }
-        _ => {}
-    }
-    Ok(())
+            Err(_) => false,
+        },
+        _ => false,
+    })
 }
 
-fn declare_used(json: &mut Value, extension: &str) -> Result<(), EditError> {
+fn declare_used(json: &mut Value, extension: &str) -> Result<bool, EditError> {
     let Value::Object(root) = json else {
-        return Err(EditError::NotAContainer { pointer: "/extensionsUsed".into(), token: "extensionsUsed".into(), kind: kind_of(json) });
+        return Err(EditError::NotAContainer {
+            pointer: "/extensionsUsed".into(),
+            token: "extensionsUsed".into(),
+            kind: kind_of(json),
+        });
     };
     match root.get_mut("extensionsUsed") {
         Some(Value::Array(used)) => {
-            if !used.iter().any(|e| e.as_str() == Some(extension)) {
-                used.push(Value::String(extension.to_string()));
+            if used.iter().any(|e| e.as_str() == Some(extension)) {
+                return Ok(false);
             }
-            Ok(())
+            used.push(Value::String(extension.to_string()));
+            Ok(true)
         }
         Some(_) => Err(EditError::ExtensionsUsedNotArray),
         None => {
             // Where glTF writers put it: right after `asset` (or first when there is none).
             let at = root.keys().position(|k| k == "asset").map_or(0, |i| i + 1);
-            root.shift_insert(at, "extensionsUsed".to_string(), Value::Array(vec![Value::String(extension.to_string())]));
-            Ok(())
+            root.shift_insert(
+                at,
+                "extensionsUsed".to_string(),
+                Value::Array(vec![Value::String(extension.to_string())]),
+            );
+            Ok(true)
         }
     }
 }
@@ -219,31 +276,92 @@ mod tests {
             ],
         )
         .unwrap();
-        assert_eq!(text(&v), r#"{"a":2,"b":{"x":0.50,"y":[1.0]},"c":[1,3,4,5],"d":{"e":{"f":"new"}}}"#);
+        assert_eq!(
+            text(&v),
+            r#"{"a":2,"b":{"x":0.50,"y":[1.0]},"c":[1,3,4,5],"d":{"e":{"f":"new"}}}"#
+        );
     }
 
     #[test]
     fn remove_keeps_the_order_of_the_other_keys_and_ignores_absent_values() {
         let mut v = doc(r#"{"a":1,"b":2,"c":3,"d":[0,1,2]}"#);
-        apply(&mut v, &[Edit::remove("/b"), Edit::remove("/zz/y"), Edit::remove("/d/0"), Edit::remove("/d/9")]).unwrap();
+        apply(
+            &mut v,
+            &[
+                Edit::remove("/b"),
+                Edit::remove("/zz/y"),
+                Edit::remove("/d/0"),
+                Edit::remove("/d/9"),
+            ],
+        )
+        .unwrap();
         assert_eq!(text(&v), r#"{"a":1,"c":3,"d":[1,2]}"#);
     }
 
     #[test]
     fn escaped_tokens_name_keys_with_slash_and_tilde() {
         let mut v = doc(r#"{"a/b":{"~":1}}"#);
-        apply(&mut v, &[Edit::set("/a~1b/~0", json!(2)), Edit::set("/a~1b/x~1y", json!(3))]).unwrap();
+        apply(
+            &mut v,
+            &[
+                Edit::set("/a~1b/~0", json!(2)),
+                Edit::set("/a~1b/x~1y", json!(3)),
+            ],
+        )
+        .unwrap();
         assert_eq!(text(&v), r#"{"a/b":{"~":2,"x/y":3}}"#);
     }
 
     #[test]
     fn declare_used_appends_once_or_creates_the_array_after_asset() {
         let mut v = doc(r#"{"asset":{"version":"2.0"},"extensionsUsed":["A"]}"#);
-        apply(&mut v, &[Edit::declare_used("B"), Edit::declare_used("A"), Edit::declare_used("B")]).unwrap();
-        assert_eq!(text(&v), r#"{"asset":{"version":"2.0"},"extensionsUsed":["A","B"]}"#);
+        apply(
+            &mut v,
+            &[
+                Edit::declare_used("B"),
+                Edit::declare_used("A"),
+                Edit::declare_used("B"),
+            ],
+        )
+        .unwrap();
+        assert_eq!(
+            text(&v),
+            r#"{"asset":{"version":"2.0"},"extensionsUsed":["A","B"]}"#
+        );
         let mut v = doc(r#"{"asset":{"version":"2.0"},"materials":[]}"#);
         apply(&mut v, &[Edit::declare_used("B")]).unwrap();
-        assert_eq!(text(&v), r#"{"asset":{"version":"2.0"},"extensionsUsed":["B"],"materials":[]}"#);
+        assert_eq!(
+            text(&v),
+            r#"{"asset":{"version":"2.0"},"extensionsUsed":["B"],"materials":[]}"#
+        );
+    }
+
+    #[test]
+    fn apply_tells_whether_the_document_changed() {
+        let mut v = doc(r#"{"asset":{},"extensionsUsed":["A"],"a":{"x":1.0},"l":[1]}"#);
+        let no_ops = [
+            Edit::set("/a/x", json!(1.0)),
+            Edit::set("/l/0", json!(1)),
+            Edit::remove("/a/missing"),
+            Edit::remove("/l/4"),
+            Edit::declare_used("A"),
+        ];
+        assert!(!apply(&mut v, &no_ops).unwrap());
+        for edit in [
+            Edit::set("/a/x", json!(1)),
+            Edit::set("/l/-", json!(2)),
+            Edit::remove("/l/0"),
+            Edit::declare_used("B"),
+        ] {
+            assert!(
+                apply(&mut v, std::slice::from_ref(&edit)).unwrap(),
+                "{edit}"
+            );
+        }
+        assert_eq!(
+            text(&v),
+            r#"{"asset":{},"extensionsUsed":["A","B"],"a":{"x":1},"l":[2]}"#
+        );
     }
 
     #[test]
@@ -251,18 +369,36 @@ mod tests {
         let mut v = doc(r#"{"a":[1],"n":3,"extensionsUsed":{}}"#);
         assert_eq!(
             apply(&mut v, &[Edit::set("/a/5", json!(0))]).unwrap_err(),
-            EditError::BadIndex { pointer: "/a/5".into(), token: "5".into(), len: 1 }
+            EditError::BadIndex {
+                pointer: "/a/5".into(),
+                token: "5".into(),
+                len: 1
+            }
         );
         assert_eq!(
             apply(&mut v, &[Edit::set("/a/01", json!(0))]).unwrap_err(),
-            EditError::BadIndex { pointer: "/a/01".into(), token: "01".into(), len: 1 }
+            EditError::BadIndex {
+                pointer: "/a/01".into(),
+                token: "01".into(),
+                len: 1
+            }
         );
         assert_eq!(
             apply(&mut v, &[Edit::set("/n/x", json!(0))]).unwrap_err(),
-            EditError::NotAContainer { pointer: "/n/x".into(), token: "x".into(), kind: "number" }
+            EditError::NotAContainer {
+                pointer: "/n/x".into(),
+                token: "x".into(),
+                kind: "number"
+            }
         );
-        assert_eq!(apply(&mut v, &[Edit::set("", json!(0))]).unwrap_err(), EditError::Root { pointer: "".into() });
-        assert_eq!(apply(&mut v, &[Edit::declare_used("X")]).unwrap_err(), EditError::ExtensionsUsedNotArray);
+        assert_eq!(
+            apply(&mut v, &[Edit::set("", json!(0))]).unwrap_err(),
+            EditError::Root { pointer: "".into() }
+        );
+        assert_eq!(
+            apply(&mut v, &[Edit::declare_used("X")]).unwrap_err(),
+            EditError::ExtensionsUsedNotArray
+        );
     }
 
     #[test]
@@ -270,7 +406,13 @@ mod tests {
         let e = Edit::set("/materials/0/x", json!([1.0, 0.5]));
         assert_eq!(e.to_string(), "set /materials/0/x = [1.0,0.5]");
         assert_eq!(Edit::remove("/a").to_string(), "remove /a");
-        assert_eq!(Edit::declare_used("KHR_materials_fuzz").to_string(), "declare KHR_materials_fuzz in /extensionsUsed");
-        assert_eq!(text(&serde_json::to_value(&e).unwrap()), r#"{"op":"set","pointer":"/materials/0/x","value":[1.0,0.5]}"#);
+        assert_eq!(
+            Edit::declare_used("KHR_materials_fuzz").to_string(),
+            "declare KHR_materials_fuzz in /extensionsUsed"
+        );
+        assert_eq!(
+            text(&serde_json::to_value(&e).unwrap()),
+            r#"{"op":"set","pointer":"/materials/0/x","value":[1.0,0.5]}"#
+        );
     }
 }

@@ -50,7 +50,8 @@ pub enum Written {
 
 /// Loads and plans one file. Errors name the file and what is wrong.
 pub fn plan_file(job: &Job, options: &Options) -> Result<FilePlan, String> {
-    let bytes = std::fs::read(&job.input).map_err(|e| format!("cannot read {}: {e}", job.input.display()))?;
+    let bytes = std::fs::read(&job.input)
+        .map_err(|e| format!("cannot read {}: {e}", job.input.display()))?;
     let loaded = asset::load_bytes(&job.input, &bytes);
     let errors: Vec<String> = loaded
         .diagnostics
@@ -60,47 +61,75 @@ pub fn plan_file(job: &Job, options: &Options) -> Result<FilePlan, String> {
         .collect();
     let asset = match loaded.asset {
         Some(asset) if errors.is_empty() => asset,
-        _ => return Err(format!("{} cannot be migrated: {}", job.input.display(), errors.join("; "))),
+        _ => {
+            return Err(format!(
+                "{} cannot be migrated: {}",
+                job.input.display(),
+                errors.join("; ")
+            ))
+        }
     };
     let document = plan_document(&asset, options);
     let relocation = match &job.output {
-        Some(output) if output != &job.input => {
-            relocate(&asset, output, options.copy_resources).map_err(|e| format!("{}: {e}", job.input.display()))?
-        }
+        Some(output) if output != &job.input => relocate(&asset, output, options.copy_resources)
+            .map_err(|e| format!("{}: {e}", job.input.display()))?,
         _ => Relocation::default(),
     };
-    Ok(FilePlan { input: job.input.clone(), output: job.output.clone(), bytes, asset, document, relocation })
+    Ok(FilePlan {
+        input: job.input.clone(),
+        output: job.output.clone(),
+        bytes,
+        asset,
+        document,
+        relocation,
+    })
 }
 
 fn create_parent(path: &Path) -> Result<(), String> {
     match path.parent() {
-        Some(dir) if !dir.as_os_str().is_empty() => {
-            std::fs::create_dir_all(dir).map_err(|e| format!("cannot create folder {}: {e}", dir.display()))
-        }
+        Some(dir) if !dir.as_os_str().is_empty() => std::fs::create_dir_all(dir)
+            .map_err(|e| format!("cannot create folder {}: {e}", dir.display())),
         _ => Ok(()),
     }
 }
 
 /// Applies a file's plan and writes its output (and resource copies). On failure the output
-/// is as it was: every write goes through a temporary file renamed into place.
-pub fn execute(plan: &FilePlan) -> Result<Written, String> {
-    let Some(output) = &plan.output else {
+/// is as it was: every write goes through a temporary file renamed into place. The document is
+/// edited where it lies (a large one is not copied), so the plan's asset holds the edited
+/// document afterwards.
+pub fn execute(plan: &mut FilePlan) -> Result<Written, String> {
+    let Some(output) = plan.output.clone() else {
         return Err(format!("{}: no output path", plan.input.display()));
     };
-    let mut json = plan.asset.json.clone();
-    let edits: Vec<_> = plan.document.edits().chain(&plan.relocation.edits).cloned().collect();
-    edit::apply(&mut json, &edits).map_err(|e| format!("{}: {e}", plan.input.display()))?;
-    let changed = !write::unchanged(&plan.asset, &json, plan.asset.bin.as_deref());
+    let edits: Vec<_> = plan
+        .document
+        .edits()
+        .chain(&plan.relocation.edits)
+        .cloned()
+        .collect();
+    let changed = edit::apply(&mut plan.asset.json, &edits)
+        .map_err(|e| format!("{}: {e}", plan.input.display()))?;
     if !changed && plan.in_place() {
         return Ok(Written::Untouched);
     }
     for copy in &plan.relocation.copies {
-        let data = std::fs::read(&copy.from).map_err(|e| format!("cannot read resource {}: {e}", copy.from.display()))?;
+        let data = std::fs::read(&copy.from)
+            .map_err(|e| format!("cannot read resource {}: {e}", copy.from.display()))?;
         create_parent(&copy.to)?;
-        write::write_atomic(&copy.to, &data).map_err(|e| format!("cannot write resource {}: {e}", copy.to.display()))?;
+        write::write_atomic(&copy.to, &data)
+            .map_err(|e| format!("cannot write resource {}: {e}", copy.to.display()))?;
     }
-    create_parent(output)?;
-    let bytes = if changed { write::to_bytes(&plan.asset, &json, plan.asset.bin.as_deref()) } else { plan.bytes.clone() };
-    write::write_atomic(output, &bytes).map_err(|e| format!("cannot write {}: {e}", output.display()))?;
-    Ok(if changed { Written::Changed } else { Written::Copied })
+    create_parent(&output)?;
+    let bytes = if changed {
+        write::to_bytes(&plan.asset, &plan.asset.json, plan.asset.bin.as_deref())
+    } else {
+        std::mem::take(&mut plan.bytes)
+    };
+    write::write_atomic(&output, &bytes)
+        .map_err(|e| format!("cannot write {}: {e}", output.display()))?;
+    Ok(if changed {
+        Written::Changed
+    } else {
+        Written::Copied
+    })
 }

@@ -102,14 +102,16 @@ impl RunReport {
 }
 
 fn migrate_one(job: &Job, options: &Options, dry_run: bool) -> FileResult {
-    let plan = match plan_file(job, options) {
+    let mut plan = match plan_file(job, options) {
         Ok(plan) => plan,
         Err(error) => return FileResult::failed(job, error),
     };
     let outcome = if dry_run {
-        FileOutcome::Planned { changes: plan.changes() }
+        FileOutcome::Planned {
+            changes: plan.changes(),
+        }
     } else {
-        match execute(&plan) {
+        match execute(&mut plan) {
             Ok(Written::Changed) => FileOutcome::Changed,
             Ok(Written::Copied) => FileOutcome::Copied,
             Ok(Written::Untouched) => FileOutcome::Untouched,
@@ -119,13 +121,24 @@ fn migrate_one(job: &Job, options: &Options, dry_run: bool) -> FileResult {
     let mut notes = plan.relocation.notes.clone();
     if !plan.changes() {
         // Relocation notes matter only when the document is rewritten.
-        notes.retain(|n| matches!(n, Note::ResourcesCopied { .. } | Note::ResourceMissing { .. }));
+        notes.retain(|n| {
+            matches!(
+                n,
+                Note::ResourcesCopied { .. } | Note::ResourceMissing { .. }
+            )
+        });
     }
     FileResult {
         input: plan.input.clone(),
         output: plan.output.clone(),
         outcome,
-        edits: plan.document.declarations.iter().chain(&plan.relocation.edits).cloned().collect(),
+        edits: plan
+            .document
+            .declarations
+            .iter()
+            .chain(&plan.relocation.edits)
+            .cloned()
+            .collect(),
         materials: plan.document.materials,
         copies: plan.relocation.copies,
         notes,
@@ -140,14 +153,24 @@ pub fn run(request: &Request) -> Result<RunReport, UsageError> {
     let (jobs, walk_errors) = jobs(&request.inputs, &request.destination, request.dry_run)?;
     let bar = (request.progress && std::io::stderr().is_terminal() && jobs.len() > 1).then(|| {
         let bar = indicatif::ProgressBar::new(jobs.len() as u64);
-        if let Ok(style) = indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} files {msg}") {
+        if let Ok(style) =
+            indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} files {msg}")
+        {
             bar.set_style(style);
         }
         bar
     });
     let mut files: Vec<FileResult> = walk_errors
         .into_iter()
-        .map(|(path, e)| FileResult::failed(&Job { input: path.clone(), output: None }, format!("cannot read folder {}: {e}", path.display())))
+        .map(|(path, e)| {
+            FileResult::failed(
+                &Job {
+                    input: path.clone(),
+                    output: None,
+                },
+                format!("cannot read folder {}: {e}", path.display()),
+            )
+        })
         .collect();
     files.par_extend(jobs.par_iter().map(|job| {
         let result = migrate_one(job, &request.options, request.dry_run);
@@ -160,24 +183,41 @@ pub fn run(request: &Request) -> Result<RunReport, UsageError> {
         bar.finish_and_clear();
     }
     let summary = summarise(&files);
-    Ok(RunReport { dry_run: request.dry_run, files, summary })
+    Ok(RunReport {
+        dry_run: request.dry_run,
+        files,
+        summary,
+    })
 }
 
 fn summarise(files: &[FileResult]) -> Summary {
-    let mut s = Summary { files: files.len(), ..Summary::default() };
+    let mut s = Summary {
+        files: files.len(),
+        ..Summary::default()
+    };
     for file in files {
         match &file.outcome {
             FileOutcome::Changed => s.changed += 1,
-            FileOutcome::Copied | FileOutcome::Untouched | FileOutcome::Planned { changes: false } => s.unchanged += 1,
+            FileOutcome::Copied
+            | FileOutcome::Untouched
+            | FileOutcome::Planned { changes: false } => s.unchanged += 1,
             FileOutcome::Planned { changes: true } => s.would_change += 1,
             FileOutcome::Failed { .. } => s.failed += 1,
         }
         if matches!(file.outcome, FileOutcome::Failed { .. }) {
             continue;
         }
-        s.warnings += file.notes.iter().filter(|n| n.level() == Level::Warning).count();
+        s.warnings += file
+            .notes
+            .iter()
+            .filter(|n| n.level() == Level::Warning)
+            .count();
         for material in &file.materials {
-            s.warnings += material.notes.iter().filter(|n| n.level() == Level::Warning).count();
+            s.warnings += material
+                .notes
+                .iter()
+                .filter(|n| n.level() == Level::Warning)
+                .count();
             if material.migrated() {
                 s.materials_migrated += 1;
             }

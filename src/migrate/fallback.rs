@@ -30,7 +30,12 @@ use serde_json::{Map, Value};
 pub const DARK_FUZZ_THRESHOLD: f64 = 0.01;
 
 /// The properties a fallback sheen has, in the spec's order; refreshing sets or removes each.
-const SHEEN_PROPERTIES: [&str; 4] = ["sheenColorFactor", "sheenColorTexture", "sheenRoughnessFactor", "sheenRoughnessTexture"];
+const SHEEN_PROPERTIES: [&str; 4] = [
+    "sheenColorFactor",
+    "sheenColorTexture",
+    "sheenRoughnessFactor",
+    "sheenRoughnessTexture",
+];
 
 /// `value` written with the text of the first of `originals` that already holds it.
 fn number_from(originals: &[Option<&Value>], value: f64) -> Value {
@@ -47,8 +52,14 @@ fn incompatible(a: &Value, b: &Value) -> Option<String> {
     if set_a != set_b {
         return Some(format!("texCoord {set_a} and {set_b}"));
     }
-    let transform = |t: &Value| t.pointer(&format!("/extensions/{}", layers::TEXTURE_TRANSFORM)).cloned();
-    if !same_json(&transform(a).unwrap_or(Value::Null), &transform(b).unwrap_or(Value::Null)) {
+    let transform = |t: &Value| {
+        t.pointer(&format!("/extensions/{}", layers::TEXTURE_TRANSFORM))
+            .cloned()
+    };
+    if !same_json(
+        &transform(a).unwrap_or(Value::Null),
+        &transform(b).unwrap_or(Value::Null),
+    ) {
         return Some(format!("different {} values", layers::TEXTURE_TRANSFORM));
     }
     None
@@ -58,9 +69,13 @@ fn incompatible(a: &Value, b: &Value) -> Option<String> {
 pub fn same_json(a: &Value, b: &Value) -> bool {
     match (a, b) {
         (Value::Number(x), Value::Number(y)) => x.as_f64() == y.as_f64(),
-        (Value::Array(x), Value::Array(y)) => x.len() == y.len() && x.iter().zip(y).all(|(x, y)| same_json(x, y)),
+        (Value::Array(x), Value::Array(y)) => {
+            x.len() == y.len() && x.iter().zip(y).all(|(x, y)| same_json(x, y))
+        }
         (Value::Object(x), Value::Object(y)) => {
-            x.len() == y.len() && x.iter().all(|(k, v)| y.get(k).is_some_and(|w| same_json(v, w)))
+            x.len() == y.len()
+                && x.iter()
+                    .all(|(k, v)| y.get(k).is_some_and(|w| same_json(v, w)))
         }
         _ => a == b,
     }
@@ -78,9 +93,13 @@ pub fn sheen_for(cx: &MaterialCx, fuzz: &Value) -> (Map<String, Value>, Vec<Note
             number_from(&[color_raw.and_then(|c| c.get(i)), factor_raw], value)
         })
         .collect();
-    let roughness_raw = fuzz.get("fuzzRoughnessFactor").filter(|v| v.as_f64().is_some());
+    let roughness_raw = fuzz
+        .get("fuzzRoughnessFactor")
+        .filter(|v| v.as_f64().is_some());
     if view.roughness_factor.is_none() {
-        notes.push(Note::FuzzRoughnessDefault { assumed: layers::FUZZ_ROUGHNESS_DEFAULT_TABLE });
+        notes.push(Note::FuzzRoughnessDefault {
+            assumed: layers::FUZZ_ROUGHNESS_DEFAULT_TABLE,
+        });
     }
     let roughness = roughness::map(view.roughness_or_table_default(), Direction::FuzzToSheen);
 
@@ -92,14 +111,21 @@ pub fn sheen_for(cx: &MaterialCx, fuzz: &Value) -> (Map<String, Value>, Vec<Note
         (None, Some(texture)) => {
             sheen.insert("sheenColorTexture".into(), texture.clone());
         }
-        (Some(_), None) => notes.push(Note::FuzzTextureNeedsBake { texture: "fuzzTexture".into() }),
+        (Some(_), None) => notes.push(Note::FuzzTextureNeedsBake {
+            texture: "fuzzTexture".into(),
+        }),
         (Some(intensity), Some(colour)) => notes.push(match incompatible(intensity, colour) {
             Some(reason) => Note::FuzzTexturesIncompatible { reason },
-            None => Note::FuzzTextureNeedsBake { texture: "fuzzTexture with fuzzColorTexture".into() },
+            None => Note::FuzzTextureNeedsBake {
+                texture: "fuzzTexture with fuzzColorTexture".into(),
+            },
         }),
         (None, None) => {}
     }
-    sheen.insert("sheenRoughnessFactor".into(), number_like(roughness_raw, roughness));
+    sheen.insert(
+        "sheenRoughnessFactor".into(),
+        number_like(roughness_raw, roughness),
+    );
     if let Some(texture) = fuzz.get("fuzzRoughnessTexture").filter(|v| v.is_object()) {
         sheen.insert("sheenRoughnessTexture".into(), texture.clone());
     }
@@ -118,7 +144,11 @@ pub fn sheen_for(cx: &MaterialCx, fuzz: &Value) -> (Map<String, Value>, Vec<Note
         let (fuzz_max, base_max) = (max3(view.color_factor), max3(base));
         let difference = view.factor * (1.0 - fuzz_max).max(0.0) * base_max;
         if difference > DARK_FUZZ_THRESHOLD {
-            notes.push(Note::DarkFuzz { difference, fuzz_color_max: fuzz_max, base_color_max: base_max });
+            notes.push(Note::DarkFuzz {
+                difference,
+                fuzz_color_max: fuzz_max,
+                base_color_max: base_max,
+            });
         }
     }
     (sheen, notes)
@@ -126,7 +156,9 @@ pub fn sheen_for(cx: &MaterialCx, fuzz: &Value) -> (Map<String, Value>, Vec<Note
 
 /// True when a sheen with these properties is switched off (sheenColorFactor all zero).
 fn switched_off(sheen: &Map<String, Value>) -> bool {
-    sheen["sheenColorFactor"].as_array().is_some_and(|c| c.iter().all(|v| v.as_f64() == Some(0.0)))
+    sheen["sheenColorFactor"]
+        .as_array()
+        .is_some_and(|c| c.iter().all(|v| v.as_f64() == Some(0.0)))
 }
 
 /// Adds a fallback sheen to a material that has fuzz only.
@@ -142,7 +174,10 @@ pub fn add(cx: &MaterialCx, fuzz: &Value, plan: &mut MaterialPlan) {
         plan.skip(Skip::BlackFuzz, Note::BlackFuzz);
         return;
     }
-    plan.edits.push(Edit::set(cx.extension_pointer(layers::SHEEN), Value::Object(sheen)));
+    plan.edits.push(Edit::set(
+        cx.extension_pointer(layers::SHEEN),
+        Value::Object(sheen),
+    ));
     plan.conversions.push(Conversion::FallbackSheen);
 }
 
@@ -163,7 +198,9 @@ pub fn refresh(cx: &MaterialCx, sheen: &Value, fuzz: &Value, plan: &mut Material
     for property in SHEEN_PROPERTIES {
         match (sheen.get(property), target.get(property)) {
             (Some(now), Some(wanted)) if same_json(now, wanted) => {}
-            (_, Some(wanted)) => edits.push(Edit::set(pointer::join(&base, property), wanted.clone())),
+            (_, Some(wanted)) => {
+                edits.push(Edit::set(pointer::join(&base, property), wanted.clone()))
+            }
             (Some(_), None) => edits.push(Edit::remove(pointer::join(&base, property))),
             (None, None) => {}
         }
@@ -173,5 +210,47 @@ pub fn refresh(cx: &MaterialCx, sheen: &Value, fuzz: &Value, plan: &mut Material
     } else {
         plan.edits.extend(edits);
         plan.conversions.push(Conversion::RefreshedFallback);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    #[test]
+    fn numbers_compare_by_value_and_objects_ignore_key_order() {
+        let a: Value = serde_json::from_str(r#"{"x":[1,0.50],"y":{"k":2}}"#).unwrap();
+        let b: Value = serde_json::from_str(r#"{"y":{"k":2.0},"x":[1.0,0.5]}"#).unwrap();
+        assert!(same_json(&a, &b));
+        assert!(!same_json(&a, &json!({"x": [1, 0.5], "y": {"k": 3}})));
+        assert!(!same_json(&json!([1, 2]), &json!([1, 2, 3])));
+    }
+
+    #[test]
+    fn textures_combine_only_with_the_same_set_and_transform() {
+        let plain = json!({"index": 0});
+        let set1 = json!({"index": 1, "texCoord": 1});
+        let moved =
+            json!({"index": 1, "extensions": {"KHR_texture_transform": {"offset": [0.5, 0]}}});
+        let moved_to_set1 =
+            json!({"index": 1, "extensions": {"KHR_texture_transform": {"texCoord": 1}}});
+        assert_eq!(
+            incompatible(&plain, &json!({"index": 3, "texCoord": 0})),
+            None
+        );
+        assert_eq!(
+            incompatible(&plain, &set1).as_deref(),
+            Some("texCoord 0 and 1")
+        );
+        assert_eq!(
+            incompatible(&plain, &moved).as_deref(),
+            Some("different KHR_texture_transform values")
+        );
+        // The transform's texCoord overrides the textureInfo's.
+        assert_eq!(
+            incompatible(&plain, &moved_to_set1).as_deref(),
+            Some("texCoord 0 and 1")
+        );
     }
 }

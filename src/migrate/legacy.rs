@@ -20,11 +20,19 @@ use crate::layers;
 use crate::rules::legacy_sheen::LEGACY_PROPERTIES;
 use serde_json::Value;
 
-const RATIFIED_PROPERTIES: [&str; 4] = ["sheenColorFactor", "sheenColorTexture", "sheenRoughnessFactor", "sheenRoughnessTexture"];
+const RATIFIED_PROPERTIES: [&str; 4] = [
+    "sheenColorFactor",
+    "sheenColorTexture",
+    "sheenRoughnessFactor",
+    "sheenRoughnessTexture",
+];
 
 /// The draft properties present on a sheen object.
 pub fn legacy_properties(sheen: &Value) -> Vec<&'static str> {
-    LEGACY_PROPERTIES.into_iter().filter(|p| sheen.get(p).is_some()).collect()
+    LEGACY_PROPERTIES
+        .into_iter()
+        .filter(|p| sheen.get(p).is_some())
+        .collect()
 }
 
 fn rgb(value: Option<&Value>) -> Option<[f64; 3]> {
@@ -43,7 +51,9 @@ pub fn upgrade(cx: &MaterialCx, sheen: &Value, plan: &mut MaterialPlan) -> Optio
         return None;
     }
     if RATIFIED_PROPERTIES.iter().any(|p| sheen.get(p).is_some()) {
-        plan.notes.push(Note::LegacyMixed { properties: legacy.iter().map(|p| p.to_string()).collect() });
+        plan.notes.push(Note::LegacyMixed {
+            properties: legacy.iter().map(|p| p.to_string()).collect(),
+        });
         return None;
     }
     let base = cx.extension_pointer(layers::SHEEN);
@@ -58,15 +68,23 @@ pub fn upgrade(cx: &MaterialCx, sheen: &Value, plan: &mut MaterialPlan) -> Optio
     }
     let color_values: [Value; 3] = std::array::from_fn(|i| {
         // The draft's own numbers when sheenFactor leaves them as they are.
-        let original = color_raw.and_then(|c| c.get(i)).or(if color_raw.is_none() { factor_value } else { None });
+        let original = color_raw.and_then(|c| c.get(i)).or(if color_raw.is_none() {
+            factor_value
+        } else {
+            None
+        });
         number_like(original, clamped[i])
     });
 
     let pbr = cx.material.get("pbrMetallicRoughness");
-    let roughness_raw = pbr.and_then(|p| p.get("roughnessFactor")).filter(|v| v.as_f64().is_some());
+    let roughness_raw = pbr
+        .and_then(|p| p.get("roughnessFactor"))
+        .filter(|v| v.as_f64().is_some());
     let roughness = roughness_raw.and_then(Value::as_f64).unwrap_or(1.0);
     if let Some(texture) = pbr.and_then(|p| p.get("metallicRoughnessTexture")) {
-        plan.notes.push(Note::LegacyRoughnessTexture { texture: texture.clone() });
+        plan.notes.push(Note::LegacyRoughnessTexture {
+            texture: texture.clone(),
+        });
     }
 
     let mut color_texture = None;
@@ -81,12 +99,16 @@ pub fn upgrade(cx: &MaterialCx, sheen: &Value, plan: &mut MaterialPlan) -> Optio
                 color_texture = Some(texture.clone());
                 plan.notes.push(Note::LegacyTextureIntensity);
             }
-            Some(reason) => plan.notes.push(Note::TextureDropped { property: "sheenTexture".into(), reason }),
+            Some(reason) => plan.notes.push(Note::TextureDropped {
+                property: "sheenTexture".into(),
+                reason,
+            }),
         }
     }
 
     for property in &legacy {
-        plan.edits.push(Edit::remove(pointer::join(&base, property)));
+        plan.edits
+            .push(Edit::remove(pointer::join(&base, property)));
     }
     let upgraded = Sheen {
         color: clamped,
@@ -96,11 +118,20 @@ pub fn upgrade(cx: &MaterialCx, sheen: &Value, plan: &mut MaterialPlan) -> Optio
         color_texture,
         roughness_texture: None,
     };
-    plan.edits.push(Edit::set(pointer::join(&base, "sheenColorFactor"), Value::Array(upgraded.color_values.to_vec())));
+    plan.edits.push(Edit::set(
+        pointer::join(&base, "sheenColorFactor"),
+        Value::Array(upgraded.color_values.to_vec()),
+    ));
     if let Some(texture) = &upgraded.color_texture {
-        plan.edits.push(Edit::set(pointer::join(&base, "sheenColorTexture"), texture.clone()));
+        plan.edits.push(Edit::set(
+            pointer::join(&base, "sheenColorTexture"),
+            texture.clone(),
+        ));
     }
-    plan.edits.push(Edit::set(pointer::join(&base, "sheenRoughnessFactor"), upgraded.roughness_value.clone()));
+    plan.edits.push(Edit::set(
+        pointer::join(&base, "sheenRoughnessFactor"),
+        upgraded.roughness_value.clone(),
+    ));
     plan.conversions.push(Conversion::LegacyUpgrade);
     Some(upgraded)
 }

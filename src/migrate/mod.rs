@@ -56,11 +56,20 @@ pub enum UsageError {
     #[error("-o names one output file, but {0} is a folder; use --out-dir DIR")]
     OutputForFolder(String),
     #[error("-o {output}: the input {input} is a {container} file and the output keeps its container; name the output *.{extension}")]
-    ContainerMismatch { input: String, output: String, container: &'static str, extension: &'static str },
+    ContainerMismatch {
+        input: String,
+        output: String,
+        container: &'static str,
+        extension: &'static str,
+    },
     #[error("the output {output} is the input {input}; use --in-place to overwrite inputs")]
     OutputIsInput { output: String, input: String },
     #[error("{first} and {second} would both be written to {output}")]
-    OutputCollision { output: String, first: String, second: String },
+    OutputCollision {
+        output: String,
+        first: String,
+        second: String,
+    },
     #[error("no inputs given")]
     NoInputs,
 }

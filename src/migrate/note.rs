@@ -96,7 +96,13 @@ pub enum Note {
     /// Fast mode: the sheen colour texture became the fuzz colour texture as it is.
     ColorTextureAsIs { w: f64 },
     /// --report: the attenuation difference of fast mode, measured over the texture's texels.
-    AttenuationMeasured { image: usize, texels: u64, w: f64, max: f64, mean: f64 },
+    AttenuationMeasured {
+        image: usize,
+        texels: u64,
+        w: f64,
+        max: f64,
+        mean: f64,
+    },
     /// --report: the measurement could not be made.
     MeasureFailed { reason: String },
     /// Fuzz lies over a clear coat where sheen lay under it.
@@ -110,9 +116,16 @@ pub enum Note {
     /// Black fuzz on an active layer: a fallback sheen would be switched off.
     BlackFuzz,
     /// Dark fuzz over a bright base: the fallback sheen only adds light.
-    DarkFuzz { difference: f64, fuzz_color_max: f64, base_color_max: f64 },
+    DarkFuzz {
+        difference: f64,
+        fuzz_color_max: f64,
+        base_color_max: f64,
+    },
     /// Legacy sheenColor × sheenFactor left [0, 1] and was clamped.
-    LegacyClamped { product: [f64; 3], clamped: [f64; 3] },
+    LegacyClamped {
+        product: [f64; 3],
+        clamped: [f64; 3],
+    },
     /// Legacy sheen roughness followed a metallicRoughnessTexture (green): needs a bake.
     LegacyRoughnessTexture { texture: Value },
     /// Legacy sheenTexture's intensity (alpha) is not applied by sheenColorTexture.
@@ -241,7 +254,10 @@ impl Note {
     pub fn to_json(&self) -> Value {
         let mut value = serde_json::to_value(self).expect("notes serialise");
         if let Value::Object(map) = &mut value {
-            map.insert("level".into(), serde_json::to_value(self.level()).expect("levels serialise"));
+            map.insert(
+                "level".into(),
+                serde_json::to_value(self.level()).expect("levels serialise"),
+            );
             map.insert("message".into(), Value::String(self.message()));
         }
         value
@@ -254,12 +270,19 @@ mod tests {
 
     #[test]
     fn notes_serialise_with_code_data_level_and_message() {
-        let note = Note::DarkFuzz { difference: 0.5, fuzz_color_max: 0.5, base_color_max: 1.0 };
+        let note = Note::DarkFuzz {
+            difference: 0.5,
+            fuzz_color_max: 0.5,
+            base_color_max: 1.0,
+        };
         let v = note.to_json();
         assert_eq!(v["code"], "dark-fuzz");
         assert_eq!(v["level"], "warning");
         assert_eq!(v["difference"].as_f64(), Some(0.5));
-        assert!(v["message"].as_str().unwrap().contains("brighter by up to 0.5000"));
+        assert!(v["message"]
+            .as_str()
+            .unwrap()
+            .contains("brighter by up to 0.5000"));
         assert_eq!(Note::SheenOff.to_json()["code"], "sheen-off");
     }
 }

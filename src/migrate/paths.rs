@@ -68,9 +68,16 @@ fn container_extension(path: &Path) -> Option<&'static str> {
     }
 }
 
+/// Folders that could not be walked, with their error.
+pub type WalkErrors = Vec<(PathBuf, io::Error)>;
+
 /// Pairs every input file (folders walked) with its output, or refuses the request.
 /// Folders that cannot be read are returned with their error.
-pub fn jobs(inputs: &[PathBuf], destination: &Destination, dry_run: bool) -> Result<(Vec<Job>, Vec<(PathBuf, io::Error)>), UsageError> {
+pub fn jobs(
+    inputs: &[PathBuf],
+    destination: &Destination,
+    dry_run: bool,
+) -> Result<(Vec<Job>, WalkErrors), UsageError> {
     if inputs.is_empty() {
         return Err(UsageError::NoInputs);
     }
@@ -110,15 +117,24 @@ pub fn jobs(inputs: &[PathBuf], destination: &Destination, dry_run: bool) -> Res
                     _ => dir.join(file.file_name().unwrap_or(file.as_os_str())),
                 }),
             };
-            jobs.push(Job { input: file, output });
+            jobs.push(Job {
+                input: file,
+                output,
+            });
         }
     }
     if *destination != Destination::InPlace {
-        let inputs: HashMap<PathBuf, &Path> = jobs.iter().map(|j| (identity(&j.input), j.input.as_path())).collect();
+        let inputs: HashMap<PathBuf, &Path> = jobs
+            .iter()
+            .map(|j| (identity(&j.input), j.input.as_path()))
+            .collect();
         for job in &jobs {
             let Some(output) = &job.output else { continue };
             if let Some(input) = inputs.get(&identity(output)) {
-                return Err(UsageError::OutputIsInput { output: output.display().to_string(), input: input.display().to_string() });
+                return Err(UsageError::OutputIsInput {
+                    output: output.display().to_string(),
+                    input: input.display().to_string(),
+                });
             }
         }
     }
@@ -185,7 +201,9 @@ pub fn relative_prefix(from: &Path, to: &Path) -> Option<String> {
     let common = from.iter().zip(&to).take_while(|(a, b)| a == b).count();
     let mut prefix = "../".repeat(from.len() - common);
     for component in &to[common..] {
-        let Component::Normal(name) = component else { return None };
+        let Component::Normal(name) = component else {
+            return None;
+        };
         prefix += &utf8_percent_encode(&name.to_string_lossy(), SEGMENT).to_string();
         prefix.push('/');
     }
@@ -218,42 +236,70 @@ pub fn relocate(asset: &Asset, output: &Path, copy_resources: bool) -> Result<Re
     let mut prefix: Option<String> = None;
     let mut rewritten = 0;
     for kind in ["buffers", "images"] {
-        let Some(items) = asset.json.get(kind).and_then(Value::as_array) else { continue };
+        let Some(items) = asset.json.get(kind).and_then(Value::as_array) else {
+            continue;
+        };
         for (i, item) in items.iter().enumerate() {
-            let Some(uri) = item.get("uri").and_then(Value::as_str).filter(|u| is_relative_path(u)) else { continue };
+            let Some(uri) = item
+                .get("uri")
+                .and_then(Value::as_str)
+                .filter(|u| is_relative_path(u))
+            else {
+                continue;
+            };
             let pointer = format!("/{kind}/{i}/uri");
             if copy_resources {
                 // Only resources inside the input's folder are copied: a copy must not land
                 // outside the output's folder. The others are rewritten.
-                if let Ok(resource::Location::File(from)) = resource::resolve(uri, from_dir, &pointer) {
+                if let Ok(resource::Location::File(from)) =
+                    resource::resolve(uri, from_dir, &pointer)
+                {
                     if !from.is_file() {
-                        relocation.notes.push(Note::ResourceMissing { uri: uri.to_string() });
+                        relocation.notes.push(Note::ResourceMissing {
+                            uri: uri.to_string(),
+                        });
                     } else if !relocation.copies.iter().any(|c| c.uri == uri) {
-                        let relative = from.strip_prefix(from_dir).map_err(|_| format!("'{uri}' does not resolve inside {}", from_dir.display()))?;
-                        relocation.copies.push(ResourceCopy { uri: uri.to_string(), from: from.clone(), to: to_dir.join(relative) });
+                        let relative = from.strip_prefix(from_dir).map_err(|_| {
+                            format!("'{uri}' does not resolve inside {}", from_dir.display())
+                        })?;
+                        relocation.copies.push(ResourceCopy {
+                            uri: uri.to_string(),
+                            from: from.clone(),
+                            to: to_dir.join(relative),
+                        });
                     }
                     continue;
                 }
             }
             if prefix.is_none() {
                 prefix = Some(relative_prefix(to_dir, from_dir).ok_or_else(|| {
-                    format!("no relative path leads from {} to {}; use --copy-resources", to_dir.display(), from_dir.display())
+                    format!(
+                        "no relative path leads from {} to {}; use --copy-resources",
+                        to_dir.display(),
+                        from_dir.display()
+                    )
                 })?);
             }
             let prefix = prefix.as_deref().unwrap_or_default();
-            relocation.edits.push(Edit::set(pointer, Value::String(format!("{prefix}{uri}"))));
+            relocation
+                .edits
+                .push(Edit::set(pointer, Value::String(format!("{prefix}{uri}"))));
             rewritten += 1;
         }
     }
     if rewritten > 0 {
-        let leaves_folder = relocation
-            .edits
-            .iter()
-            .any(|e| matches!(e, Edit::Set { value: Value::String(u), .. } if u.starts_with("../")));
-        relocation.notes.push(Note::UrisRewritten { count: rewritten, leaves_folder });
+        let leaves_folder = relocation.edits.iter().any(
+            |e| matches!(e, Edit::Set { value: Value::String(u), .. } if u.starts_with("../")),
+        );
+        relocation.notes.push(Note::UrisRewritten {
+            count: rewritten,
+            leaves_folder,
+        });
     }
     if !relocation.copies.is_empty() {
-        relocation.notes.push(Note::ResourcesCopied { count: relocation.copies.len() });
+        relocation.notes.push(Note::ResourcesCopied {
+            count: relocation.copies.len(),
+        });
     }
     Ok(relocation)
 }
@@ -268,11 +314,23 @@ mod tests {
         let base = dir.path();
         std::fs::create_dir_all(base.join("in/my chair")).unwrap();
         std::fs::create_dir_all(base.join("out/a")).unwrap();
-        assert_eq!(relative_prefix(&base.join("out/a"), &base.join("in/my chair")).unwrap(), "../../in/my%20chair/");
-        assert_eq!(relative_prefix(&base.join("in"), &base.join("in/my chair")).unwrap(), "my%20chair/");
-        assert_eq!(relative_prefix(&base.join("in"), &base.join("in")).unwrap(), "");
+        assert_eq!(
+            relative_prefix(&base.join("out/a"), &base.join("in/my chair")).unwrap(),
+            "../../in/my%20chair/"
+        );
+        assert_eq!(
+            relative_prefix(&base.join("in"), &base.join("in/my chair")).unwrap(),
+            "my%20chair/"
+        );
+        assert_eq!(
+            relative_prefix(&base.join("in"), &base.join("in")).unwrap(),
+            ""
+        );
         // A folder that does not exist yet is placed lexically.
-        assert_eq!(relative_prefix(&base.join("new/deep"), &base.join("in")).unwrap(), "../../in/");
+        assert_eq!(
+            relative_prefix(&base.join("new/deep"), &base.join("in")).unwrap(),
+            "../../in/"
+        );
     }
 
     #[test]
@@ -280,7 +338,14 @@ mod tests {
         for uri in ["a.bin", "tex/My%20Image.png", "../up.png", "./a:b.png"] {
             assert!(is_relative_path(uri), "{uri}");
         }
-        for uri in ["data:application/octet-stream;base64,AA==", "https://x/y.png", "/abs/x.png", "C:/x.png", "file:///x", "a:b/c"] {
+        for uri in [
+            "data:application/octet-stream;base64,AA==",
+            "https://x/y.png",
+            "/abs/x.png",
+            "C:/x.png",
+            "file:///x",
+            "a:b/c",
+        ] {
             assert!(!is_relative_path(uri), "{uri}");
         }
     }

@@ -37,7 +37,10 @@ impl MaterialPlan {
     fn new(index: usize, material: &Value) -> MaterialPlan {
         MaterialPlan {
             index,
-            name: material.get("name").and_then(Value::as_str).map(str::to_string),
+            name: material
+                .get("name")
+                .and_then(Value::as_str)
+                .map(str::to_string),
             conversions: Vec::new(),
             skipped: None,
             edits: Vec::new(),
@@ -92,7 +95,10 @@ pub struct DocumentPlan {
 impl DocumentPlan {
     /// Every edit, materials first, in the order they are applied.
     pub fn edits(&self) -> impl Iterator<Item = &Edit> {
-        self.materials.iter().flat_map(|m| m.edits.iter()).chain(&self.declarations)
+        self.materials
+            .iter()
+            .flat_map(|m| m.edits.iter())
+            .chain(&self.declarations)
     }
 
     pub fn is_empty(&self) -> bool {
@@ -102,24 +108,37 @@ impl DocumentPlan {
 
 /// Plans the migration of every material of `asset`.
 pub fn plan_document(asset: &Asset, options: &Options) -> DocumentPlan {
-    let materials: Vec<MaterialPlan> =
-        (0..layers::materials(&asset.json).len()).filter_map(|i| plan_material(asset, i, options)).collect();
+    let materials: Vec<MaterialPlan> = (0..layers::materials(&asset.json).len())
+        .filter_map(|i| plan_material(asset, i, options))
+        .collect();
     let declared: Vec<&str> = asset
         .json
         .get("extensionsUsed")
         .and_then(Value::as_array)
         .map(|a| a.iter().filter_map(Value::as_str).collect())
         .unwrap_or_default();
-    let any = |wanted: &[Conversion]| materials.iter().any(|m| m.conversions.iter().any(|c| wanted.contains(c)));
+    let any = |wanted: &[Conversion]| {
+        materials
+            .iter()
+            .any(|m| m.conversions.iter().any(|c| wanted.contains(c)))
+    };
     let mut declarations = Vec::new();
     // extensionsRequired is never touched: fuzz is optional, sheen is its fallback.
     if any(&[Conversion::SheenToFuzz]) && !declared.contains(&layers::FUZZ) {
         declarations.push(Edit::declare_used(layers::FUZZ));
     }
-    if any(&[Conversion::FallbackSheen, Conversion::RefreshedFallback, Conversion::LegacyUpgrade]) && !declared.contains(&layers::SHEEN) {
+    if any(&[
+        Conversion::FallbackSheen,
+        Conversion::RefreshedFallback,
+        Conversion::LegacyUpgrade,
+    ]) && !declared.contains(&layers::SHEEN)
+    {
         declarations.push(Edit::declare_used(layers::SHEEN));
     }
-    DocumentPlan { materials, declarations }
+    DocumentPlan {
+        materials,
+        declarations,
+    }
 }
 
 /// The plan of material `index`, or `None` when it has neither sheen nor fuzz.
@@ -131,19 +150,37 @@ pub fn plan_material(asset: &Asset, index: usize, options: &Options) -> Option<M
         return None;
     }
     let mut plan = MaterialPlan::new(index, material);
-    for (extension, why) in [(layers::UNLIT, Skip::Unlit), (layers::SPEC_GLOSS, Skip::SpecularGlossiness)] {
+    for (extension, why) in [
+        (layers::UNLIT, Skip::Unlit),
+        (layers::SPEC_GLOSS, Skip::SpecularGlossiness),
+    ] {
         if exts.contains_key(extension) {
-            plan.skip(why, Note::Excluded { extension: extension.to_string() });
+            plan.skip(
+                why,
+                Note::Excluded {
+                    extension: extension.to_string(),
+                },
+            );
             return Some(plan);
         }
     }
     for (name, value) in [(layers::SHEEN, sheen), (layers::FUZZ, fuzz)] {
         if value.is_some_and(|v| !v.is_object()) {
-            plan.skip(Skip::Malformed, Note::Malformed { extension: name.to_string() });
+            plan.skip(
+                Skip::Malformed,
+                Note::Malformed {
+                    extension: name.to_string(),
+                },
+            );
             return Some(plan);
         }
     }
-    let cx = MaterialCx { asset, index, material, options };
+    let cx = MaterialCx {
+        asset,
+        index,
+        material,
+        options,
+    };
     match (sheen, fuzz) {
         (Some(sheen), None) => {
             let sheen = match legacy::upgrade(&cx, sheen, &mut plan) {
@@ -153,7 +190,9 @@ pub fn plan_material(asset: &Asset, index: usize, options: &Options) -> Option<M
             sheen_to_fuzz::convert(&cx, &sheen, &mut plan);
         }
         (None, Some(fuzz)) => fallback::add(&cx, fuzz, &mut plan),
-        (Some(sheen), Some(fuzz)) if options.refresh_fallback => fallback::refresh(&cx, sheen, fuzz, &mut plan),
+        (Some(sheen), Some(fuzz)) if options.refresh_fallback => {
+            fallback::refresh(&cx, sheen, fuzz, &mut plan)
+        }
         (Some(_), Some(_)) => plan.skip(Skip::BothPresent, Note::BothPresent),
         (None, None) => unreachable!("checked above"),
     }
@@ -171,17 +210,24 @@ pub(crate) fn number_like(original: Option<&Value>, value: f64) -> Value {
 
 /// The texCoord set a textureInfo reads, and the first primitive drawn with `material` that
 /// lacks it, if any (carrying such a texture into a slot velvet checks would add an error).
-pub(crate) fn primitive_lacking_tex_coord(json: &Value, material: usize, texture_info: &Value) -> Option<String> {
+pub(crate) fn primitive_lacking_tex_coord(
+    json: &Value,
+    material: usize,
+    texture_info: &Value,
+) -> Option<String> {
     let set = crate::rules::effective_tex_coord(texture_info);
     let attribute = format!("TEXCOORD_{set}");
     let meshes = json.get("meshes").and_then(Value::as_array)?;
     for (m, mesh) in meshes.iter().enumerate() {
-        let Some(primitives) = mesh.get("primitives").and_then(Value::as_array) else { continue };
+        let Some(primitives) = mesh.get("primitives").and_then(Value::as_array) else {
+            continue;
+        };
         for (p, primitive) in primitives.iter().enumerate() {
             if primitive.get("material").and_then(Value::as_u64) != Some(material as u64) {
                 continue;
             }
-            if !primitive.pointer(&format!("/attributes/{attribute}")).is_some() {
+            let attributes = primitive.get("attributes");
+            if attributes.and_then(|a| a.get(&attribute)).is_none() {
                 return Some(format!("mesh {m} primitive {p} has no {attribute}"));
             }
         }
@@ -191,11 +237,22 @@ pub(crate) fn primitive_lacking_tex_coord(json: &Value, material: usize, texture
 
 /// Why a textureInfo cannot be carried into a checked slot, if it cannot: its index names no
 /// texture, or a primitive lacks its texCoord set.
-pub(crate) fn texture_unusable(json: &Value, material: usize, texture_info: &Value) -> Option<String> {
-    let textures = json.get("textures").and_then(Value::as_array).map_or(0, Vec::len);
+pub(crate) fn texture_unusable(
+    json: &Value,
+    material: usize,
+    texture_info: &Value,
+) -> Option<String> {
+    let textures = json
+        .get("textures")
+        .and_then(Value::as_array)
+        .map_or(0, Vec::len);
     match texture_info.get("index").and_then(Value::as_u64) {
-        Some(i) if (i as usize) < textures => primitive_lacking_tex_coord(json, material, texture_info),
-        Some(i) => Some(format!("its index {i} names no texture (the asset has {textures})")),
+        Some(i) if (i as usize) < textures => {
+            primitive_lacking_tex_coord(json, material, texture_info)
+        }
+        Some(i) => Some(format!(
+            "its index {i} names no texture (the asset has {textures})"
+        )),
         None => Some("it has no valid index".to_string()),
     }
 }

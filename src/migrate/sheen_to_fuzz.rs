@@ -43,14 +43,21 @@ impl Sheen {
             roughness_texture: None,
         });
         let raw = ext.get("sheenColorFactor").and_then(Value::as_array);
-        let color_values = std::array::from_fn(|i| number_like(raw.and_then(|a| a.get(i)), view.color_factor[i]));
+        let color_values =
+            std::array::from_fn(|i| number_like(raw.and_then(|a| a.get(i)), view.color_factor[i]));
         Sheen {
             color: view.color_factor,
             color_values,
             roughness: view.roughness_factor,
             roughness_value: number_like(ext.get("sheenRoughnessFactor"), view.roughness_factor),
-            color_texture: ext.get("sheenColorTexture").filter(|v| v.is_object()).cloned(),
-            roughness_texture: ext.get("sheenRoughnessTexture").filter(|v| v.is_object()).cloned(),
+            color_texture: ext
+                .get("sheenColorTexture")
+                .filter(|v| v.is_object())
+                .cloned(),
+            roughness_texture: ext
+                .get("sheenRoughnessTexture")
+                .filter(|v| v.is_object())
+                .cloned(),
         }
     }
 }
@@ -59,19 +66,26 @@ impl Sheen {
 /// Keys follow the draft's parameter table.
 pub fn fuzz_for(sheen: &Sheen) -> Option<Map<String, Value>> {
     let w = max3(sheen.color);
-    if !(w > 0.0) {
+    if !w.is_finite() || w <= 0.0 {
         return None;
     }
-    let strongest = (0..3).find(|i| sheen.color[*i] == w).expect("w is one of the components");
+    let strongest = (0..3)
+        .find(|i| sheen.color[*i] == w)
+        .expect("w is one of the components");
     let mut fuzz = Map::new();
     fuzz.insert("fuzzFactor".into(), sheen.color_values[strongest].clone());
-    let color: Vec<Value> = (0..3).map(|i| number_like(Some(&sheen.color_values[i]), sheen.color[i] / w)).collect();
+    let color: Vec<Value> = (0..3)
+        .map(|i| number_like(Some(&sheen.color_values[i]), sheen.color[i] / w))
+        .collect();
     fuzz.insert("fuzzColorFactor".into(), Value::Array(color));
     if let Some(texture) = &sheen.color_texture {
         fuzz.insert("fuzzColorTexture".into(), texture.clone());
     }
     let r = roughness::map(sheen.roughness, Direction::SheenToFuzz);
-    fuzz.insert("fuzzRoughnessFactor".into(), number_like(Some(&sheen.roughness_value), r));
+    fuzz.insert(
+        "fuzzRoughnessFactor".into(),
+        number_like(Some(&sheen.roughness_value), r),
+    );
     if let Some(texture) = &sheen.roughness_texture {
         fuzz.insert("fuzzRoughnessTexture".into(), texture.clone());
     }
@@ -85,7 +99,10 @@ pub fn convert(cx: &MaterialCx, sheen: &Sheen, plan: &mut MaterialPlan) {
         return;
     };
     let w = max3(sheen.color);
-    plan.edits.push(Edit::set(cx.extension_pointer(layers::FUZZ), Value::Object(fuzz)));
+    plan.edits.push(Edit::set(
+        cx.extension_pointer(layers::FUZZ),
+        Value::Object(fuzz),
+    ));
     plan.conversions.push(Conversion::SheenToFuzz);
     if cx.has_extension(layers::CLEARCOAT) {
         plan.notes.push(Note::ClearcoatOrder { fallback: false });
@@ -93,10 +110,18 @@ pub fn convert(cx: &MaterialCx, sheen: &Sheen, plan: &mut MaterialPlan) {
     if let Some(texture) = &sheen.color_texture {
         plan.notes.push(Note::ColorTextureAsIs { w });
         if cx.options.report {
-            plan.notes.push(match measure::attenuation(cx.asset, texture, sheen.color, w) {
-                Ok(m) => Note::AttenuationMeasured { image: m.image, texels: m.texels, w, max: m.max, mean: m.mean },
-                Err(reason) => Note::MeasureFailed { reason },
-            });
+            plan.notes.push(
+                match measure::attenuation(cx.asset, texture, sheen.color, w) {
+                    Ok(m) => Note::AttenuationMeasured {
+                        image: m.image,
+                        texels: m.texels,
+                        w,
+                        max: m.max,
+                        mean: m.mean,
+                    },
+                    Err(reason) => Note::MeasureFailed { reason },
+                },
+            );
         }
     }
 }
@@ -112,7 +137,10 @@ mod tests {
 
     #[test]
     fn colour_splits_into_strength_and_normalised_colour() {
-        let sheen: Value = serde_json::from_str(r#"{"sheenColorFactor":[0.9,0.45,0],"sheenRoughnessFactor":0.25}"#).unwrap();
+        let sheen: Value = serde_json::from_str(
+            r#"{"sheenColorFactor":[0.9,0.45,0],"sheenRoughnessFactor":0.25}"#,
+        )
+        .unwrap();
         assert_eq!(
             fuzz_text(sheen).unwrap(),
             r#"{"fuzzFactor":0.9,"fuzzColorFactor":[1.0,0.5,0],"fuzzRoughnessFactor":0.25}"#
@@ -122,13 +150,23 @@ mod tests {
     #[test]
     fn full_strength_keeps_the_colour_text_and_roughness_default_is_written() {
         let sheen: Value = serde_json::from_str(r#"{"sheenColorFactor":[1,0,0.75]}"#).unwrap();
-        assert_eq!(fuzz_text(sheen).unwrap(), r#"{"fuzzFactor":1,"fuzzColorFactor":[1,0,0.75],"fuzzRoughnessFactor":0.0}"#);
+        assert_eq!(
+            fuzz_text(sheen).unwrap(),
+            r#"{"fuzzFactor":1,"fuzzColorFactor":[1,0,0.75],"fuzzRoughnessFactor":0.0}"#
+        );
     }
 
     #[test]
     fn switched_off_sheen_gives_no_fuzz() {
-        assert_eq!(fuzz_text(json!({"sheenColorFactor": [0.0, 0.0, 0.0], "sheenRoughnessFactor": 0.5})), None);
-        assert_eq!(fuzz_text(json!({"sheenRoughnessFactor": 0.5})), None, "the default colour is black");
+        assert_eq!(
+            fuzz_text(json!({"sheenColorFactor": [0.0, 0.0, 0.0], "sheenRoughnessFactor": 0.5})),
+            None
+        );
+        assert_eq!(
+            fuzz_text(json!({"sheenRoughnessFactor": 0.5})),
+            None,
+            "the default colour is black"
+        );
     }
 
     #[test]
@@ -138,18 +176,35 @@ mod tests {
         let fuzz = fuzz_for(&Sheen::read(&sheen)).unwrap();
         assert_eq!(fuzz["fuzzColorTexture"], tex);
         assert_eq!(fuzz["fuzzRoughnessTexture"], tex);
-        assert_eq!(fuzz.keys().collect::<Vec<_>>(), ["fuzzFactor", "fuzzColorFactor", "fuzzColorTexture", "fuzzRoughnessFactor", "fuzzRoughnessTexture"]);
+        assert_eq!(
+            fuzz.keys().collect::<Vec<_>>(),
+            [
+                "fuzzFactor",
+                "fuzzColorFactor",
+                "fuzzColorTexture",
+                "fuzzRoughnessFactor",
+                "fuzzRoughnessTexture"
+            ]
+        );
     }
 
     #[test]
     fn lobe_colour_is_preserved_exactly_enough() {
-        for c in [[0.9, 0.7, 0.6], [0.05, 0.17, 0.5], [1e-6, 0.0, 3e-7], [0.12, 0.12, 0.13]] {
+        for c in [
+            [0.9, 0.7, 0.6],
+            [0.05, 0.17, 0.5],
+            [1e-6, 0.0, 3e-7],
+            [0.12, 0.12, 0.13],
+        ] {
             let fuzz = fuzz_for(&Sheen::read(&json!({ "sheenColorFactor": c }))).unwrap();
             let w = fuzz["fuzzFactor"].as_f64().unwrap();
             for i in 0..3 {
                 let colour = fuzz["fuzzColorFactor"][i].as_f64().unwrap();
                 assert!(colour <= 1.0);
-                assert!((colour * w - c[i]).abs() <= 1e-15 * c[i].max(1e-300), "{c:?}");
+                assert!(
+                    (colour * w - c[i]).abs() <= 1e-15 * c[i].max(1e-300),
+                    "{c:?}"
+                );
             }
         }
     }
