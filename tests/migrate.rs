@@ -168,6 +168,38 @@ fn unchanged_files_are_the_cases_with_nothing_to_migrate() {
     assert_eq!(unchanged, ["both", "excluded", "no-layers", "sheen-off"]);
 }
 
+#[test]
+fn migrating_an_output_again_changes_nothing() {
+    for case in cases() {
+        let (dir, output, _) = migrate_case(&case);
+        for refresh_fallback in [false, true] {
+            // Inputs whose own fallback is stale (both), or that keep draft properties beside
+            // ratified ones (legacy), are what a refresh changes.
+            if refresh_fallback && ["both", "legacy"].contains(&stem(&case).as_str()) {
+                continue;
+            }
+            let options = Options {
+                refresh_fallback,
+                ..Options::default()
+            };
+            let again = dir.path().join(format!("again-{refresh_fallback}.gltf"));
+            let report = migrate::run(&request(
+                vec![output.clone()],
+                Destination::File(again.clone()),
+                options,
+            ))
+            .unwrap();
+            assert_eq!(
+                report.files[0].outcome,
+                FileOutcome::Copied,
+                "{} (refresh {refresh_fallback})",
+                case.display()
+            );
+            assert_file(&again, &std::fs::read(&output).unwrap());
+        }
+    }
+}
+
 fn errors(path: &Path) -> Vec<(String, String)> {
     let validator = Validator::new(Schemas::builtin(), velvet::diagnostics::Settings::default());
     let report = validator.validate_file(path);
