@@ -208,11 +208,20 @@ pub fn refresh(cx: &MaterialCx, sheen: &Value, fuzz: &Value, plan: &mut Material
         edits.push(Edit::remove(pointer::join(&base, property)));
     }
     for property in SHEEN_PROPERTIES {
-        match (sheen.get(property), target.get(property)) {
+        // An absent factor stands for its default: a sheen that leaves out a roughness of 0
+        // already says what the fuzz gives.
+        let default = match property {
+            "sheenColorFactor" => Some(serde_json::json!(layers::SHEEN_COLOR_DEFAULT)),
+            "sheenRoughnessFactor" => Some(serde_json::json!(layers::SHEEN_ROUGHNESS_DEFAULT)),
+            _ => None,
+        };
+        let now = sheen.get(property).cloned().or(default);
+        match (now.as_ref(), target.get(property)) {
             (Some(now), Some(wanted)) if same_json(now, wanted) => {}
             (_, Some(wanted)) => {
                 edits.push(Edit::set(pointer::join(&base, property), wanted.clone()))
             }
+            // Only textures are ever absent from the target, and they have no default.
             (Some(_), None) => edits.push(Edit::remove(pointer::join(&base, property))),
             (None, None) => {}
         }
