@@ -9,4 +9,5 @@ pub mod diagnostics;
 pub mod layers;
 pub mod report;
 pub mod rules;
+pub mod shading;
 pub mod validate;
