@@ -11,4 +11,5 @@ pub mod layers;
 pub mod migrate;
 pub mod report;
 pub mod rules;
+pub mod shading;
 pub mod validate;

@@ -35,6 +35,9 @@ enum Command {
         #[arg(long, value_enum, default_value_t = CodesFormat::Text)]
         format: CodesFormat,
     },
+    /// Numeric reports: what velvet's shading methods cost and how far they are off.
+    #[command(subcommand)]
+    Bench(velvet::shading::bench::BenchCommand),
 }
 
 #[derive(clap::Args)]
@@ -91,6 +94,12 @@ fn main() -> ExitCode {
         Command::Codes { format } => {
             print!("{}", codes_table(format));
             ExitCode::SUCCESS
+        }
+        Command::Bench(cmd) => {
+            match velvet::shading::bench::run(&cmd, &mut std::io::stdout().lock()) {
+                Ok(()) => ExitCode::SUCCESS,
+                Err(e) => usage_error(e),
+            }
         }
     }
 }

@@ -347,8 +347,15 @@ fn codes_command_lists_every_registered_code_once() {
 #[test]
 fn readme_codes_table_is_the_registry() {
     let readme = std::fs::read_to_string("README.md").unwrap();
-    let start = readme.find("<!-- codes:start -->\n").expect("README has the codes table markers") + "<!-- codes:start -->\n".len();
+    let start = readme
+        .find("<!-- codes:start -->\n")
+        .expect("README has the codes table markers")
+        + "<!-- codes:start -->\n".len();
     let end = readme.find("<!-- codes:end -->").unwrap();
     let (_, table, _) = velvet(&["codes", "--format", "markdown"]);
-    assert_eq!(&readme[start..end], table, "regenerate with `velvet codes --format markdown`");
+    assert_eq!(
+        &readme[start..end],
+        table,
+        "regenerate with `velvet codes --format markdown`"
+    );
 }
