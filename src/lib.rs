@@ -6,7 +6,9 @@
 
 pub mod asset;
 pub mod diagnostics;
+pub mod edit;
 pub mod layers;
+pub mod migrate;
 pub mod report;
 pub mod rules;
 pub mod shading;
