@@ -3,52 +3,55 @@
 //! fonts: the SVG names a font family and the viewer renders the text).
 
 use super::accuracy::AccuracyReport;
-use super::albedo::QUADRATURE_BOUND;
+use super::albedo::{AlbedoMethod, QUADRATURE_BOUND};
 use plotters::prelude::*;
 
 /// Width and height of the plot in pixels.
 const SIZE: (u32, u32) = (900, 560);
 
-/// (time per evaluation in ns, max error, method name).
-type Point<'a> = (f64, f64, &'a str);
-
 /// Errors below this are drawn at it (a log axis has no 0).
 const ERROR_FLOOR: f64 = 1e-12;
 
-/// The report's plot as SVG text.
+const ORDINARY: RGBColor = RGBColor(31, 119, 180);
+const HARD: RGBColor = RGBColor(214, 39, 40);
+
+/// The report's plot as SVG text. Colour tells the region (blue ordinary, red hard), the marker
+/// tells the method (circle lut16, square lut32, triangle fit); quadrature, the reference, is a
+/// cross at its stated bound. The table methods run at similar speeds, so a legend names them
+/// rather than labels that would overlap.
 pub fn accuracy_svg(report: &AccuracyReport) -> Result<String, String> {
-    let mut ordinary = Vec::new();
-    let mut hard = Vec::new();
+    // (method, time per evaluation in ns, ordinary max, hard max); quadrature has no errors.
+    let mut rows = Vec::new();
     let mut quadrature = None;
     for m in &report.methods {
         let t = m.nanos_per_eval.max(1e-3);
         match (m.ordinary, m.hard) {
             (Some(o), Some(h)) => {
-                ordinary.push((t, o.max.max(ERROR_FLOOR), m.method.name()));
-                hard.push((t, h.max.max(ERROR_FLOOR), m.method.name()));
+                rows.push((m.method, t, o.max.max(ERROR_FLOOR), h.max.max(ERROR_FLOOR)))
             }
-            _ => quadrature = Some((t, QUADRATURE_BOUND, m.method.name())),
+            _ => quadrature = Some(t),
         }
     }
-    let all: Vec<&Point> = ordinary
+    let times = rows.iter().map(|r| r.1).chain(quadrature);
+    let errors = rows
         .iter()
-        .chain(&hard)
-        .chain(quadrature.iter())
-        .collect();
-    if all.is_empty() {
+        .flat_map(|r| [r.2, r.3])
+        .chain(quadrature.map(|_| QUADRATURE_BOUND));
+    let (t_min, t_max) = times.fold((f64::INFINITY, 0.0f64), |(lo, hi), t| {
+        (lo.min(t), hi.max(t))
+    });
+    let (e_min, e_max) = errors.fold((f64::INFINITY, 0.0f64), |(lo, hi), e| {
+        (lo.min(e), hi.max(e))
+    });
+    if !(t_min <= t_max && e_min <= e_max) {
         return Err("the report has no methods to plot".into());
     }
-    let (t_min, t_max) = all.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), p| {
-        (lo.min(p.0), hi.max(p.0))
-    });
-    let (e_min, e_max) = all.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), p| {
-        (lo.min(p.1), hi.max(p.1))
-    });
+    let err = |e: &dyn std::fmt::Display| e.to_string();
 
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| e.to_string())?;
+        root.fill(&WHITE).map_err(|e| err(&e))?;
         let mut chart = ChartBuilder::on(&root)
             .caption(
                 "Sheen albedo E(μ, r): max error against time per evaluation",
@@ -61,7 +64,7 @@ pub fn accuracy_svg(report: &AccuracyReport) -> Result<String, String> {
                 (t_min / 3.0..t_max * 3.0).log_scale(),
                 (e_min / 10.0..e_max * 10.0).log_scale(),
             )
-            .map_err(|e| e.to_string())?;
+            .map_err(|e| err(&e))?;
         chart
             .configure_mesh()
             .x_desc("time per evaluation (ns)")
@@ -69,43 +72,74 @@ pub fn accuracy_svg(report: &AccuracyReport) -> Result<String, String> {
             .x_label_formatter(&|x| format!("{x:.0e}"))
             .y_label_formatter(&|y| format!("{y:.0e}"))
             .draw()
-            .map_err(|e| e.to_string())?;
+            .map_err(|e| err(&e))?;
 
-        let font = ("sans-serif", 13).into_font();
-        let series: [(&[Point], RGBColor, &str); 2] = [
-            (
-                &ordinary,
-                RGBColor(31, 119, 180),
-                "ordinary region (μ ≥ 0.1, r ≥ 0.25)",
-            ),
-            (&hard, RGBColor(214, 39, 40), "hard region (the rest)"),
-        ];
-        for (points, colour, label) in series {
-            let mut line: Vec<(f64, f64)> = points.iter().map(|p| (p.0, p.1)).collect();
-            line.sort_by(|a, b| a.0.total_cmp(&b.0));
-            chart
-                .draw_series(LineSeries::new(line, colour.stroke_width(1)))
-                .map_err(|e| e.to_string())?;
-            chart
-                .draw_series(points.iter().map(|&(t, e, name)| {
-                    EmptyElement::at((t, e))
-                        + Circle::new((0, 0), 5, colour.filled())
-                        + Text::new(name.to_string(), label_offset(name), font.clone())
-                }))
-                .map_err(|e| e.to_string())?
-                .label(label)
-                .legend(move |(x, y)| Circle::new((x, y), 5, colour.filled()));
+        for (method, t, ordinary, hard) in rows {
+            let points = [(t, ordinary, ORDINARY), (t, hard, HARD)];
+            let name = method.name();
+            match method {
+                AlbedoMethod::Lut16 => {
+                    chart
+                        .draw_series(
+                            points
+                                .iter()
+                                .map(|&(t, e, c)| Circle::new((t, e), 5, c.filled())),
+                        )
+                        .map_err(|e| err(&e))?
+                        .label(name)
+                        .legend(|(x, y)| Circle::new((x, y), 5, BLACK.filled()));
+                }
+                AlbedoMethod::Lut32 => {
+                    chart
+                        .draw_series(points.iter().map(|&(t, e, c)| {
+                            EmptyElement::at((t, e))
+                                + Rectangle::new([(-4, -4), (4, 4)], c.filled())
+                        }))
+                        .map_err(|e| err(&e))?
+                        .label(name)
+                        .legend(|(x, y)| {
+                            Rectangle::new([(x - 4, y - 4), (x + 4, y + 4)], BLACK.filled())
+                        });
+                }
+                _ => {
+                    chart
+                        .draw_series(
+                            points
+                                .iter()
+                                .map(|&(t, e, c)| TriangleMarker::new((t, e), 6, c.filled())),
+                        )
+                        .map_err(|e| err(&e))?
+                        .label(name)
+                        .legend(|(x, y)| TriangleMarker::new((x, y), 6, BLACK.filled()));
+                }
+            }
         }
-        if let Some((t, e, name)) = quadrature {
+        if let Some(t) = quadrature {
             chart
                 .draw_series(std::iter::once(
-                    EmptyElement::at((t, e))
-                        + TriangleMarker::new((0, 0), 7, BLACK.filled())
-                        + Text::new(format!("{name} (stated bound)"), (-150, -18), font.clone()),
+                    EmptyElement::at((t, QUADRATURE_BOUND))
+                        + Cross::new((0, 0), 6, BLACK.stroke_width(2))
+                        + Text::new(
+                            "quadrature (stated bound)",
+                            (-150, -20),
+                            ("sans-serif", 13).into_font(),
+                        ),
                 ))
-                .map_err(|e| e.to_string())?
-                .label("quadrature (the reference), at its stated bound")
-                .legend(|(x, y)| TriangleMarker::new((x, y), 6, BLACK.filled()));
+                .map_err(|e| err(&e))?
+                .label("quadrature, the reference, at its stated bound")
+                .legend(|(x, y)| Cross::new((x, y), 5, BLACK.stroke_width(2)));
+        }
+        for (colour, label) in [
+            (ORDINARY, "ordinary region (μ ≥ 0.1, r ≥ 0.25)"),
+            (HARD, "hard region (the rest)"),
+        ] {
+            chart
+                .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())
+                .map_err(|e| err(&e))?
+                .label(label)
+                .legend(move |(x, y)| {
+                    Rectangle::new([(x - 6, y - 3), (x + 6, y + 3)], colour.filled())
+                });
         }
         chart
             .configure_series_labels()
@@ -114,27 +148,15 @@ pub fn accuracy_svg(report: &AccuracyReport) -> Result<String, String> {
             .border_style(BLACK)
             .label_font(("sans-serif", 13))
             .draw()
-            .map_err(|e| e.to_string())?;
-        root.present().map_err(|e| e.to_string())?;
+            .map_err(|e| err(&e))?;
+        root.present().map_err(|e| err(&e))?;
     }
     Ok(svg)
-}
-
-/// Where a method's label sits relative to its point: the table methods run at similar speeds,
-/// so their labels are spread vertically and the fit's goes to the left.
-fn label_offset(name: &str) -> (i32, i32) {
-    match name {
-        "lut16" => (9, -18),
-        "lut32" => (9, -2),
-        "fit" => (-26, -6),
-        _ => (9, -10),
-    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::super::accuracy::{ErrorStats, MethodResult};
-    use super::super::AlbedoMethod;
     use super::*;
 
     fn stats(max: f64) -> Option<ErrorStats> {
