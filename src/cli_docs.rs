@@ -13,11 +13,20 @@ Exit status:
   1  a file has an issue at or above --fail-on (a file that cannot be read or parsed has an error)
   2  usage or configuration error (bad flag, unknown code, invalid velvet.toml)";
 
-/// The EXIT STATUS section in roff.
-fn exit_status_section() -> String {
+/// The exit statuses common to every command, for `velvet --help`.
+pub const EXIT_STATUS_ALL: &str = "\
+Exit status:
+  0  success: no file has an issue at or above --fail-on (validate); every file done (migrate)
+  1  a file has an issue at or above --fail-on (validate), or a file failed (migrate)
+  2  usage or configuration error (bad flag, unknown code, invalid velvet.toml)";
+
+const HEADING: &str = "Exit status:\n";
+
+/// The EXIT STATUS section in roff, from exit-status text.
+fn exit_status_section(text: &str) -> String {
     let mut roff = Roff::new();
     roff.control("SH", ["EXIT STATUS"]);
-    for line in EXIT_STATUS.lines().skip(1) {
+    for line in text.lines().skip(1) {
         let (status, meaning) = line.trim().split_once("  ").unwrap_or((line.trim(), ""));
         roff.control("TP", [])
             .text([bold(status)])
@@ -27,31 +36,28 @@ fn exit_status_section() -> String {
     roff.to_roff()
 }
 
-/// The man page of `command`, its after-help turned into EXIT STATUS when it is the exit-status
+/// The man page of `command`, its after-help turned into EXIT STATUS when it is exit-status
 /// text.
 pub fn man_page(command: clap::Command) -> std::io::Result<Vec<u8>> {
-    let has_exit_status = command
+    let exit_status = command
         .get_after_help()
-        .is_some_and(|h| h.to_string() == EXIT_STATUS);
+        .map(|h| h.to_string())
+        .filter(|h| h.starts_with(HEADING));
     let mut page = Vec::new();
     Man::new(command).render(&mut page)?;
-    if !has_exit_status {
+    let Some(exit_status) = exit_status else {
         return Ok(page);
-    }
+    };
     let text = String::from_utf8(page).expect("clap_mangen writes UTF-8");
-    let start = text
-        .find(".SH EXTRA\n")
-        .expect("a page with after-help has an EXTRA section");
+    // clap_mangen renders after-help as the EXTRA section; replace that section.
+    let Some(start) = text.find(".SH EXTRA\n") else {
+        return Ok(text.into_bytes());
+    };
     let end = text[start + 1..]
         .find("\n.SH ")
         .map_or(text.len(), |i| start + 1 + i + 1);
-    Ok(format!(
-        "{}{}{}",
-        &text[..start],
-        exit_status_section(),
-        &text[end..]
-    )
-    .into_bytes())
+    let section = exit_status_section(&exit_status);
+    Ok(format!("{}{section}{}", &text[..start], &text[end..]).into_bytes())
 }
 
 /// Writes one page per command into `dir`: `velvet.1`, `velvet-validate.1`, …

@@ -36,6 +36,18 @@ pub enum Transfer {
     Linear,
 }
 
+impl Transfer {
+    /// A stored texel value in [0, 1] as a linear value: the sRGB decoding curve (IEC 61966-2-1,
+    /// linear segment below 0.04045) or the value itself.
+    pub fn to_linear(self, encoded: f64) -> f64 {
+        match self {
+            Transfer::Linear => encoded,
+            Transfer::Srgb if encoded <= 0.04045 => encoded / 12.92,
+            Transfer::Srgb => ((encoded + 0.055) / 1.055).powf(2.4),
+        }
+    }
+}
+
 /// One texture slot of one extension, with the factor that scales it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Slot {
@@ -198,4 +210,21 @@ pub fn materials(json: &Value) -> &[Value] {
     json.get("materials")
         .and_then(Value::as_array)
         .map_or(&[], Vec::as_slice)
+}
+
+#[cfg(test)]
+mod transfer_tests {
+    use super::Transfer;
+
+    #[test]
+    fn srgb_decoding_pins_its_ends_and_the_segment_threshold() {
+        assert_eq!(Transfer::Srgb.to_linear(0.0), 0.0);
+        assert!((Transfer::Srgb.to_linear(1.0) - 1.0).abs() < 1e-15);
+        // The two pieces meet at 0.04045 (to within the standard's rounding).
+        let below = Transfer::Srgb.to_linear(0.04045);
+        let above = ((0.04045f64 + 0.055) / 1.055).powf(2.4);
+        assert!((below - 0.04045 / 12.92).abs() < 1e-18 && (below - above).abs() < 1e-7);
+        assert!((Transfer::Srgb.to_linear(0.5) - 0.214_041_140_482_232_5).abs() < 1e-12);
+        assert_eq!(Transfer::Linear.to_linear(0.25), 0.25);
+    }
 }

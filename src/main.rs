@@ -6,7 +6,7 @@ use clap::{CommandFactory, Parser, Subcommand, ValueEnum};
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
-use velvet::cli_docs::{self, EXIT_STATUS};
+use velvet::cli_docs::{self, EXIT_STATUS, EXIT_STATUS_ALL};
 use velvet::config::{self, Layer, Resolver};
 use velvet::diagnostics::{self, FailOn, Settings};
 use velvet::report::{self, ColorChoice, Format};
@@ -19,7 +19,7 @@ use velvet::validate::Validator;
     version,
     about = "Validate, migrate and bake glTF assets that use KHR_materials_sheen and KHR_materials_fuzz"
 )]
-#[command(after_help = EXIT_STATUS)]
+#[command(after_help = EXIT_STATUS_ALL)]
 struct Cli {
     /// When to colour output: auto colours on a terminal unless NO_COLOR is set.
     #[arg(long, value_enum, global = true, default_value_t = ColorChoice::Auto, value_name = "WHEN")]
@@ -36,6 +36,9 @@ enum Command {
     /// Check .gltf/.glb files (and folders, recursively) against the sheen and fuzz specs.
     #[command(after_help = EXIT_STATUS)]
     Validate(ValidateArgs),
+    /// Add KHR_materials_fuzz to sheen materials (keeping the sheen as the fallback), a fallback
+    /// sheen to fuzz materials, and upgrade the pre-ratification sheen draft.
+    Migrate(MigrateArgs),
     /// Print the configuration in force for a file or folder.
     ///
     /// The output is velvet.toml text with the source of each value (default, velvet.toml or
@@ -60,6 +63,9 @@ enum Command {
         #[arg(long, value_name = "DIR")]
         dir: Option<PathBuf>,
     },
+    /// Numeric reports: what velvet's shading methods cost and how far they are off.
+    #[command(subcommand)]
+    Bench(velvet::shading::bench::BenchCommand),
 }
 
 /// Settings shared by `validate` and `config`; each flag given beats velvet.toml.
@@ -127,6 +133,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
         Command::Validate(args) => validate(args, cli.color, cli.quiet),
+        Command::Migrate(args) => migrate(args, cli.quiet),
         Command::Config { path, settings } => show_config(path, settings),
         Command::Codes { format } => {
             emit(codes_table(format).as_bytes());
@@ -139,6 +146,12 @@ fn main() -> ExitCode {
             ExitCode::SUCCESS
         }
         Command::Man { dir } => man(dir),
+        Command::Bench(cmd) => {
+            match velvet::shading::bench::run(&cmd, &mut std::io::stdout().lock()) {
+                Ok(()) => ExitCode::SUCCESS,
+                Err(e) => usage_error(e),
+            }
+        }
     }
 }
 
@@ -245,6 +258,86 @@ fn validate(args: ValidateArgs, color: ColorChoice, quiet: bool) -> ExitCode {
     };
     emit(report::render(args.format, &outcome.reports, &options).as_bytes());
     if outcome.failed {
+        ExitCode::from(1)
+    } else {
+        ExitCode::SUCCESS
+    }
+}
+
+#[derive(clap::Args)]
+#[command(
+    after_help = "Exit status: 0 done, 1 a file failed (the others are still migrated), 2 usage error (nothing written)."
+)]
+struct MigrateArgs {
+    /// Files and folders to migrate (folders are searched for *.gltf and *.glb).
+    #[arg(required = true)]
+    paths: Vec<PathBuf>,
+    /// Write the one input's output here (same container as the input).
+    #[arg(short = 'o', long = "output", value_name = "FILE", conflicts_with_all = ["out_dir", "in_place"])]
+    output: Option<PathBuf>,
+    /// Write outputs under DIR, mirroring each input folder's tree.
+    #[arg(long, value_name = "DIR", conflicts_with = "in_place")]
+    out_dir: Option<PathBuf>,
+    /// Overwrite the inputs (files with nothing to migrate are not written).
+    #[arg(long)]
+    in_place: bool,
+    /// Print what would change per material; write nothing.
+    #[arg(long)]
+    dry_run: bool,
+    #[arg(long, value_enum, default_value_t = MigrateFormat::Text)]
+    format: MigrateFormat,
+    /// Decode sheen colour textures to measure what the fast conversion changes.
+    #[arg(long)]
+    report: bool,
+    /// Bake textures so that the fuzz matches the sheen texel by texel (needs the bake engine).
+    #[arg(long)]
+    exact: bool,
+    /// Regenerate the sheen fallback of materials that already have fuzz and sheen.
+    #[arg(long)]
+    refresh_fallback: bool,
+    /// Copy relative resources next to outputs in another folder instead of rewriting URIs.
+    #[arg(long)]
+    copy_resources: bool,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum MigrateFormat {
+    Text,
+    Json,
+}
+
+fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
+    use velvet::migrate::{self, Destination};
+    let destination = match (args.output, args.out_dir, args.in_place) {
+        (Some(file), _, _) => Destination::File(file),
+        (_, Some(dir), _) => Destination::Dir(dir),
+        (_, _, true) => Destination::InPlace,
+        _ => Destination::None,
+    };
+    let request = migrate::Request {
+        inputs: args.paths,
+        destination,
+        options: migrate::Options {
+            refresh_fallback: args.refresh_fallback,
+            report: args.report,
+            exact: args.exact,
+            copy_resources: args.copy_resources,
+        },
+        dry_run: args.dry_run,
+        progress: !quiet,
+    };
+    let report = match migrate::run(&request) {
+        Ok(report) => report,
+        Err(e) => return usage_error(e),
+    };
+    print!(
+        "{}",
+        match args.format {
+            MigrateFormat::Text => migrate::render::text(&report),
+            MigrateFormat::Json => migrate::render::json(&report),
+        }
+    );
+    if report.failed() {
         ExitCode::from(1)
     } else {
         ExitCode::SUCCESS

@@ -301,6 +301,34 @@ impl Asset {
         }
     }
 
+    /// The pixels of image `index`, decoded (PNG, JPEG or WebP). Decoding is costly: only the
+    /// steps that need texel values call this.
+    pub fn decode_image(&self, index: usize) -> Result<image::DynamicImage, Diagnostic> {
+        let bytes = self.image_bytes(index)?;
+        let pointer = format!("/images/{index}");
+        let unreadable = |detail: String| {
+            Diagnostic::new(
+                &codes::IMAGE_UNRECOGNIZED_FORMAT,
+                &pointer,
+                format!("image {index}: {detail}"),
+            )
+        };
+        let format = match resource::ImageFormat::sniff(&bytes) {
+            Some(resource::ImageFormat::Png) => image::ImageFormat::Png,
+            Some(resource::ImageFormat::Jpeg) => image::ImageFormat::Jpeg,
+            Some(resource::ImageFormat::Webp) => image::ImageFormat::WebP,
+            Some(resource::ImageFormat::Ktx2) => {
+                return Err(unreadable("KTX2 images are not decoded".to_string()))
+            }
+            None => {
+                return Err(unreadable(
+                    "not a PNG, JPEG, WebP or KTX2 image".to_string(),
+                ))
+            }
+        };
+        image::load_from_memory_with_format(&bytes, format).map_err(|e| unreadable(e.to_string()))
+    }
+
     /// The header of image `index`, read once per asset. A file is opened and only its header
     /// read; embedded images are read from their bytes.
     pub fn image_header(&self, index: usize) -> Result<ImageHeader, Diagnostic> {
