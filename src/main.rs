@@ -266,7 +266,7 @@ fn validate(args: ValidateArgs, color: ColorChoice, quiet: bool) -> ExitCode {
 
 #[derive(clap::Args)]
 #[command(
-    after_help = "Exit status: 0 done, 1 a file failed (the others are still migrated), 2 usage error (nothing written)."
+    after_help = "Exit status: 0 done, 1 a file failed (the others are still migrated) or, with --check, a file would change, 2 usage error (nothing written)."
 )]
 struct MigrateArgs {
     /// Files and folders to migrate (folders are searched for *.gltf and *.glb).
@@ -284,6 +284,9 @@ struct MigrateArgs {
     /// Print what would change per material; write nothing.
     #[arg(long)]
     dry_run: bool,
+    /// Write nothing; exit with status 1 when a file would change (for CI and pre-commit).
+    #[arg(long, conflicts_with_all = ["output", "out_dir", "in_place"])]
+    check: bool,
     #[arg(long, value_enum, default_value_t = MigrateFormat::Text)]
     format: MigrateFormat,
     /// Decode sheen colour textures to measure what the fast conversion changes.
@@ -323,7 +326,7 @@ fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
             exact: args.exact,
             copy_resources: args.copy_resources,
         },
-        dry_run: args.dry_run,
+        dry_run: args.dry_run || args.check,
         progress: !quiet,
     };
     let report = match migrate::run(&request) {
@@ -337,7 +340,7 @@ fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
             MigrateFormat::Json => migrate::render::json(&report),
         }
     );
-    if report.failed() {
+    if report.failed() || (args.check && report.summary.would_change > 0) {
         ExitCode::from(1)
     } else {
         ExitCode::SUCCESS

@@ -666,6 +666,36 @@ fn validate_hook_fails_on_the_fixture_project_and_passes_on_clean_files() {
     );
 }
 
+/// The bytes of every file below `dir`, to show that a hook left them as they were.
+fn snapshot_tree(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    all_files(dir)
+        .into_iter()
+        .map(|f| (f.clone(), std::fs::read(dir.join(&f)).unwrap()))
+        .collect()
+}
+
+#[test]
+fn migrate_check_hook_fails_when_a_file_would_change_and_writes_nothing() {
+    let hook = hooks()
+        .into_iter()
+        .find(|h| h.id == "velvet-migrate-check")
+        .unwrap();
+    // The project has sheen without fuzz (clean.gltf) and fuzz without a fallback (mixed.gltf).
+    let before = snapshot_tree(&project());
+    let (ok, out) = run_hook(&hook, &project(), 100);
+    assert!(!ok, "{out}");
+    assert_eq!(snapshot_tree(&project()), before, "a check writes nothing");
+    // A checkout whose assets already carry fuzz with a sheen fallback passes.
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::copy(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/ci/migrated/both.gltf"),
+        dir.path().join("both.gltf"),
+    )
+    .unwrap();
+    let (ok, out) = run_hook(&hook, dir.path(), 100);
+    assert!(ok, "{out}");
+}
+
 // ---------------------------------------------------------------- terminal behaviour
 
 const ESC: &str = "\u{1b}[";
