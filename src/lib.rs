@@ -5,11 +5,14 @@
 //! ([`report`]). The binary in `main.rs` only parses arguments and maps outcomes to exit codes.
 
 pub mod asset;
+pub mod cli_docs;
+pub mod config;
 pub mod diagnostics;
 pub mod edit;
 pub mod layers;
 pub mod migrate;
 pub mod report;
 pub mod rules;
+pub mod run;
 pub mod shading;
 pub mod validate;

@@ -89,14 +89,7 @@ impl Validator {
         let (files, walk_errors) = discover::collect(inputs);
         let mut reports: Vec<FileReport> = walk_errors
             .into_iter()
-            .map(|(path, e)| {
-                let d = Diagnostic::new(
-                    &crate::diagnostics::codes::IO_ERROR,
-                    "",
-                    format!("cannot read folder {}: {e}", path.display()),
-                );
-                self.finish(path, None, 0, vec![d], None)
-            })
+            .map(|(path, e)| self.unreadable_folder(path, &e, &self.settings))
             .collect();
         reports.extend(
             files
@@ -109,15 +102,45 @@ impl Validator {
 
     /// Validates one file.
     pub fn validate_file(&self, path: &Path) -> FileReport {
+        self.validate_file_with(path, &self.settings)
+    }
+
+    /// Validates one file under `settings` instead of the validator's own (a run whose
+    /// configuration differs from folder to folder).
+    pub fn validate_file_with(&self, path: &Path, settings: &Settings) -> FileReport {
         let loaded = asset::load(path);
-        self.validate_loaded(path, loaded)
+        self.validate_loaded_with(path, loaded, settings)
+    }
+
+    /// The report for a folder that could not be walked.
+    pub fn unreadable_folder(
+        &self,
+        path: PathBuf,
+        error: &std::io::Error,
+        settings: &Settings,
+    ) -> FileReport {
+        let d = Diagnostic::new(
+            &crate::diagnostics::codes::IO_ERROR,
+            "",
+            format!("cannot read folder {}: {error}", path.display()),
+        );
+        self.finish(settings, path, None, 0, vec![d], None)
     }
 
     /// Validates a file already loaded (or that failed to load).
     pub fn validate_loaded(&self, path: &Path, loaded: asset::Loaded) -> FileReport {
+        self.validate_loaded_with(path, loaded, &self.settings)
+    }
+
+    fn validate_loaded_with(
+        &self,
+        path: &Path,
+        loaded: asset::Loaded,
+        settings: &Settings,
+    ) -> FileReport {
         let mut diagnostics = loaded.diagnostics;
         let Some(asset) = loaded.asset else {
-            return self.finish(path.to_path_buf(), None, 0, diagnostics, None);
+            return self.finish(settings, path.to_path_buf(), None, 0, diagnostics, None);
         };
         let cx = Context {
             asset: &asset,
@@ -128,6 +151,7 @@ impl Validator {
         }
         let info = asset_info(&asset.json);
         let mut report = self.finish(
+            settings,
             path.to_path_buf(),
             Some(asset.container),
             asset.json_offset,
@@ -153,13 +177,13 @@ impl Validator {
 
     fn finish(
         &self,
+        settings: &Settings,
         path: PathBuf,
         container: Option<Container>,
         json_offset: usize,
         mut diagnostics: Vec<Diagnostic>,
         info: Option<AssetInfo>,
     ) -> FileReport {
-        let settings = &self.settings;
         diagnostics.retain(|d| !settings.ignore.contains(d.code));
         let mut counts = Counts::default();
         for d in &mut diagnostics {

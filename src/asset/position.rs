@@ -252,6 +252,39 @@ mod tests {
     }
 
     #[test]
+    fn pretty_printed_escaped_keys_and_non_ascii_before_the_value() {
+        // Line 3 holds "ü/ß~" (4 characters, 6 bytes) before the value: the column counts
+        // characters, the offset counts bytes.
+        let text = "{\n  \"extras\": {\n    \"ü/ß~\": [true, {\"a~b/c\": \"ö\"}]\n  }\n}";
+        let p = "/extras/ü~1ß~0";
+        let pos = locate(text, [p])[p];
+        assert_eq!((pos.line, pos.column), (3, 13));
+        assert_eq!(&text[pos.offset..pos.offset + 5], "[true");
+        assert_eq!(at(text, "/extras/ü~1ß~0/1/a~0b~1c"), Some((3, 30)));
+        assert_eq!(
+            at(text, "/extras/ü~1ß~0/1/a~1b~0c"),
+            None,
+            "~0 and ~1 are not interchangeable"
+        );
+    }
+
+    #[test]
+    fn minified_keys_with_json_escapes_match_their_decoded_pointer() {
+        // The key is written with \u00fc and an escaped quote; the pointer uses the decoded text.
+        let text = r#"{"k\u00fc\"y":{"x":[0,"\"]",{"z":null}]}}"#;
+        assert_eq!(at(text, "/kü\"y/x/2/z"), Some((1, 34)));
+        assert_eq!(at(text, "/kü\"y/x/1"), Some((1, 23)));
+    }
+
+    #[test]
+    fn crlf_line_ends_and_multibyte_strings_before_a_value_on_the_same_line() {
+        let text = "{\r\n\"name\": \"日本語\", \"v\": 1.5\r\n}";
+        assert_eq!(at(text, "/v"), Some((2, 21)));
+        let p = "/v";
+        assert_eq!(&text[locate(text, [p])[p].offset..][..3], "1.5");
+    }
+
+    #[test]
     fn escaped_keys_and_non_ascii_columns_count_characters() {
         let text = "{\"név\": \"ü\", \"a/b\": {\"~k\": 1}}";
         assert_eq!(at(text, "/a~1b/~0k"), Some((1, 28)));

@@ -1,13 +1,37 @@
 //! Human-readable report: one line per finding, `file:line:column: severity CODE message`,
-//! then the pointer; a summary line at the end.
+//! then the pointer; a summary line at the end. Colour (ANSI, via anstyle) only when asked.
 
-use super::display_path;
+use super::{display_path, Options};
 use crate::asset::Container;
+use crate::diagnostics::Severity;
 use crate::validate::FileReport;
+use anstyle::{AnsiColor, Style};
 use std::fmt::Write;
 
-/// Renders findings of every report, then a summary.
+/// Renders findings of every report, then a summary, without colour.
 pub fn render(reports: &[FileReport]) -> String {
+    render_with(reports, &Options::default())
+}
+
+fn severity_style(severity: Severity) -> Style {
+    let color = match severity {
+        Severity::Error => AnsiColor::Red,
+        Severity::Warning => AnsiColor::Yellow,
+        Severity::Info => AnsiColor::Cyan,
+        Severity::Hint => AnsiColor::Blue,
+    };
+    Style::new().fg_color(Some(color.into())).bold()
+}
+
+/// Renders with the given options: colour, and no summary line when quiet.
+pub fn render_with(reports: &[FileReport], options: &Options) -> String {
+    let paint = |style: Style, text: &str| {
+        if options.color {
+            format!("{style}{text}{style:#}")
+        } else {
+            text.to_string()
+        }
+    };
     let mut out = String::new();
     let mut totals = [0usize; 4];
     for report in reports {
@@ -21,9 +45,20 @@ pub fn render(reports: &[FileReport]) -> String {
                 (Some(p), _) => format!("{file}:{}:{}", p.line, p.column),
                 (None, _) => file.clone(),
             };
-            let _ = writeln!(out, "{place}: {} {}: {}", d.severity, d.code, d.message);
+            let _ = writeln!(
+                out,
+                "{}: {} {}: {}",
+                paint(Style::new().bold(), &place),
+                paint(severity_style(d.severity), d.severity.as_str()),
+                paint(Style::new().bold(), d.code),
+                d.message
+            );
             if !d.pointer.is_empty() {
-                let _ = writeln!(out, "    at {}", d.pointer);
+                let _ = writeln!(
+                    out,
+                    "    {}",
+                    paint(Style::new().dimmed(), &format!("at {}", d.pointer))
+                );
             }
         }
         if report.truncated {
@@ -36,6 +71,9 @@ pub fn render(reports: &[FileReport]) -> String {
         {
             *t += n;
         }
+    }
+    if options.quiet {
+        return out;
     }
     let files = reports.len();
     let _ = writeln!(

@@ -1,0 +1,94 @@
+//! GitHub Actions workflow commands: one `::error`, `::warning` or `::notice` line per finding,
+//! which the Actions runner turns into annotations on the changed files.
+//!
+//! `file` is the path relative to the working directory (the checkout, in a workflow); `line`
+//! and `col` are given for a .gltf finding whose pointer names a value (a .glb has no lines:
+//! its byte offset goes into the message instead). Properties and message are escaped as the
+//! runner unescapes them: `%`, CR and LF everywhere, and `:` and `,` in properties too.
+
+use super::display_path;
+use crate::asset::Container;
+use crate::diagnostics::Severity;
+use crate::validate::FileReport;
+use std::fmt::Write;
+
+/// Escapes a command's message.
+pub fn escape_data(text: &str) -> String {
+    text.replace('%', "%25")
+        .replace('\r', "%0D")
+        .replace('\n', "%0A")
+}
+
+/// Escapes a command property's value.
+pub fn escape_property(text: &str) -> String {
+    escape_data(text).replace(':', "%3A").replace(',', "%2C")
+}
+
+fn command(severity: Severity) -> &'static str {
+    match severity {
+        Severity::Error => "error",
+        Severity::Warning => "warning",
+        Severity::Info | Severity::Hint => "notice",
+    }
+}
+
+/// One workflow command per finding, and a notice for each file whose findings were capped.
+pub fn render(reports: &[FileReport]) -> String {
+    let mut out = String::new();
+    for report in reports {
+        let file = escape_property(&display_path(&report.path));
+        for f in &report.findings {
+            let d = &f.diagnostic;
+            let mut properties = format!("file={file}");
+            let mut message = d.message.clone();
+            match (f.position, report.container) {
+                (Some(p), Some(Container::Glb)) => {
+                    let _ = write!(
+                        message,
+                        " (at {}, byte {})",
+                        d.pointer,
+                        report.json_offset + p.offset
+                    );
+                }
+                (Some(p), _) => {
+                    let _ = write!(properties, ",line={},col={}", p.line, p.column);
+                    let _ = write!(message, " (at {})", d.pointer);
+                }
+                (None, _) if !d.pointer.is_empty() => {
+                    let _ = write!(message, " (at {})", d.pointer);
+                }
+                (None, _) => {}
+            }
+            let _ = writeln!(
+                out,
+                "::{} {properties},title={}::{}",
+                command(d.severity),
+                escape_property(d.code),
+                escape_data(&message)
+            );
+        }
+        if report.truncated {
+            let _ = writeln!(
+                out,
+                "::notice file={file},title=velvet::further issues not shown (max-issues)"
+            );
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn escapes_percent_first_then_newlines_and_property_separators() {
+        assert_eq!(escape_data("50% a\r\nb: c, d"), "50%25 a%0D%0Ab: c, d");
+        assert_eq!(escape_property("a:b,c%d\ne"), "a%3Ab%2Cc%25d%0Ae");
+        assert_eq!(
+            escape_property("%3A"),
+            "%253A",
+            "an escape sequence in the input stays literal"
+        );
+    }
+}
