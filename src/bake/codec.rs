@@ -1,0 +1,298 @@
+//! Image codecs for baking: recognises PNG, JPEG, WebP and KTX2 by their signatures, decodes
+//! the first three into [`Pixels`] (through the `image` crate) and encodes PNG at the pixels'
+//! depth, lossless WebP, or JPEG. KTX2 (KHR_texture_basisu) is recognised and refused: its
+//! payload is GPU block-compressed and supercompressed, and baking it would mean transcoding and
+//! re-encoding, which would change texels the recipe does not touch.
+//!
+//! What decoding keeps: 8- and 16-bit PNG at their depth; PNG of 1, 2 or 4 bits and palette PNG
+//! become 8-bit (grey, or RGB/RGBA when the palette has transparency); a tRNS colour key becomes
+//! an alpha channel. JPEG decodes to 8-bit grey or RGB, WebP to 8-bit RGB or RGBA. Colour
+//! profiles and gamma chunks are not applied: glTF defines the transfer function per slot.
+
+use std::io::Cursor;
+
+use image::codecs::jpeg::JpegEncoder;
+use image::codecs::png::{CompressionType, FilterType, PngEncoder};
+use image::codecs::webp::WebPEncoder;
+use image::{DynamicImage, ExtendedColorType, ImageEncoder, ImageReader, Limits};
+
+use super::pixels::{Depth, Layout, Pixels, Samples};
+
+/// A container format recognised from an image's first bytes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum SourceFormat {
+    /// PNG.
+    Png,
+    /// JPEG.
+    Jpeg,
+    /// WebP (EXT_texture_webp).
+    Webp,
+    /// KTX 2.0 (KHR_texture_basisu); recognised, not decoded.
+    Ktx2,
+}
+
+impl SourceFormat {
+    /// The format's name for messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            SourceFormat::Png => "PNG",
+            SourceFormat::Jpeg => "JPEG",
+            SourceFormat::Webp => "WebP",
+            SourceFormat::Ktx2 => "KTX2",
+        }
+    }
+}
+
+/// The format an output image is written in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum OutputFormat {
+    /// PNG at the pixels' depth.
+    Png,
+    /// Baseline JPEG (only with `keep_format` for JPEG sources).
+    Jpeg,
+    /// Lossless WebP.
+    WebpLossless,
+}
+
+impl OutputFormat {
+    /// The glTF `mimeType`.
+    pub fn mime_type(self) -> &'static str {
+        match self {
+            OutputFormat::Png => "image/png",
+            OutputFormat::Jpeg => "image/jpeg",
+            OutputFormat::WebpLossless => "image/webp",
+        }
+    }
+
+    /// The file extension, without the dot.
+    pub fn extension(self) -> &'static str {
+        match self {
+            OutputFormat::Png => "png",
+            OutputFormat::Jpeg => "jpg",
+            OutputFormat::WebpLossless => "webp",
+        }
+    }
+}
+
+/// PNG compression effort.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum PngCompression {
+    /// Quick and larger.
+    Fast,
+    /// Balanced (the default).
+    #[default]
+    Default,
+    /// Slow and smaller.
+    Best,
+}
+
+/// How outputs are encoded.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct EncodeOptions {
+    /// PNG compression effort.
+    pub png: PngCompression,
+    /// JPEG quality (1–100) when a JPEG is kept as JPEG.
+    pub jpeg_quality: u8,
+}
+
+impl Default for EncodeOptions {
+    fn default() -> Self {
+        EncodeOptions {
+            png: PngCompression::Default,
+            jpeg_quality: 95,
+        }
+    }
+}
+
+/// Why an image could not be decoded or encoded.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum CodecError {
+    /// Not a PNG, JPEG, WebP or KTX2 stream.
+    #[error("not a PNG, JPEG, WebP or KTX2 image (starts with {0})")]
+    Unrecognised(String),
+    /// A format velvet recognises but does not bake.
+    #[error("{format} images cannot be baked: {reason}")]
+    Unsupported {
+        /// The format.
+        format: &'static str,
+        /// Why.
+        reason: &'static str,
+    },
+    /// The stream is damaged or uses a feature the decoder lacks.
+    #[error("cannot decode the {format} image: {message}")]
+    Decode {
+        /// The format.
+        format: &'static str,
+        /// The decoder's message.
+        message: String,
+    },
+    /// The encoder failed.
+    #[error("cannot encode a {format} image: {message}")]
+    Encode {
+        /// The format.
+        format: &'static str,
+        /// The encoder's message.
+        message: String,
+    },
+}
+
+/// Why KTX2 is refused, for messages and reports.
+pub const KTX2_REASON: &str = "KTX2 / Basis Universal data is GPU block-compressed; baking it \
+     would need transcoding and lossy re-encoding, so the slot is left as it is";
+
+/// Recognises a container format from its signature.
+pub fn sniff(bytes: &[u8]) -> Option<SourceFormat> {
+    const PNG: &[u8] = b"\x89PNG\r\n\x1a\n";
+    const KTX2: &[u8] = b"\xabKTX 20\xbb\r\n\x1a\n";
+    if bytes.starts_with(PNG) {
+        Some(SourceFormat::Png)
+    } else if bytes.starts_with(&[0xff, 0xd8, 0xff]) {
+        Some(SourceFormat::Jpeg)
+    } else if bytes.len() >= 12 && &bytes[..4] == b"RIFF" && &bytes[8..12] == b"WEBP" {
+        Some(SourceFormat::Webp)
+    } else if bytes.starts_with(KTX2) {
+        Some(SourceFormat::Ktx2)
+    } else {
+        None
+    }
+}
+
+/// Decodes an image (PNG, JPEG or WebP) to pixels; KTX2 and unknown data are refused.
+pub fn decode(bytes: &[u8]) -> Result<(Pixels, SourceFormat), CodecError> {
+    let format = sniff(bytes).ok_or_else(|| {
+        let head: Vec<String> = bytes.iter().take(8).map(|b| format!("{b:02x}")).collect();
+        CodecError::Unrecognised(if head.is_empty() {
+            "no bytes".to_owned()
+        } else {
+            head.join(" ")
+        })
+    })?;
+    let image_format = match format {
+        SourceFormat::Png => image::ImageFormat::Png,
+        SourceFormat::Jpeg => image::ImageFormat::Jpeg,
+        SourceFormat::Webp => image::ImageFormat::WebP,
+        SourceFormat::Ktx2 => {
+            return Err(CodecError::Unsupported {
+                format: "KTX2",
+                reason: KTX2_REASON,
+            })
+        }
+    };
+    let decode_error = |e: image::ImageError| CodecError::Decode {
+        format: format.name(),
+        message: e.to_string(),
+    };
+    let mut reader = ImageReader::with_format(Cursor::new(bytes), image_format);
+    // The default limits (512 MiB of allocation) stop a forged header from exhausting memory.
+    reader.limits(Limits::default());
+    let image = reader.decode().map_err(decode_error)?;
+    let (w, h) = (image.width(), image.height());
+    let (layout, samples) = match image {
+        DynamicImage::ImageLuma8(b) => (Layout::Grey, Samples::U8(b.into_raw())),
+        DynamicImage::ImageLumaA8(b) => (Layout::GreyAlpha, Samples::U8(b.into_raw())),
+        DynamicImage::ImageRgb8(b) => (Layout::Rgb, Samples::U8(b.into_raw())),
+        DynamicImage::ImageRgba8(b) => (Layout::Rgba, Samples::U8(b.into_raw())),
+        DynamicImage::ImageLuma16(b) => (Layout::Grey, Samples::U16(b.into_raw())),
+        DynamicImage::ImageLumaA16(b) => (Layout::GreyAlpha, Samples::U16(b.into_raw())),
+        DynamicImage::ImageRgb16(b) => (Layout::Rgb, Samples::U16(b.into_raw())),
+        DynamicImage::ImageRgba16(b) => (Layout::Rgba, Samples::U16(b.into_raw())),
+        other => {
+            return Err(CodecError::Decode {
+                format: format.name(),
+                message: format!("unexpected sample type {:?}", other.color()),
+            })
+        }
+    };
+    let pixels = Pixels::new(w, h, layout, samples).map_err(|e| CodecError::Decode {
+        format: format.name(),
+        message: e.to_string(),
+    })?;
+    Ok((pixels, format))
+}
+
+/// The format an output takes for a source format: PNG stays PNG, WebP becomes lossless WebP,
+/// JPEG becomes PNG (lossless) unless `keep_format`. A format that cannot hold the pixels
+/// (16-bit in WebP or JPEG, alpha in JPEG) falls back to PNG.
+pub fn output_format(
+    source: SourceFormat,
+    keep_format: bool,
+    layout: Layout,
+    depth: Depth,
+) -> OutputFormat {
+    let wanted = match source {
+        SourceFormat::Webp => OutputFormat::WebpLossless,
+        SourceFormat::Jpeg if keep_format => OutputFormat::Jpeg,
+        _ => OutputFormat::Png,
+    };
+    match wanted {
+        OutputFormat::WebpLossless if depth == Depth::Eight => wanted,
+        OutputFormat::Jpeg if depth == Depth::Eight && !layout.has_alpha() => wanted,
+        _ => OutputFormat::Png,
+    }
+}
+
+fn color_type(layout: Layout, depth: Depth) -> ExtendedColorType {
+    match (layout, depth) {
+        (Layout::Grey, Depth::Eight) => ExtendedColorType::L8,
+        (Layout::GreyAlpha, Depth::Eight) => ExtendedColorType::La8,
+        (Layout::Rgb, Depth::Eight) => ExtendedColorType::Rgb8,
+        (Layout::Rgba, Depth::Eight) => ExtendedColorType::Rgba8,
+        (Layout::Grey, Depth::Sixteen) => ExtendedColorType::L16,
+        (Layout::GreyAlpha, Depth::Sixteen) => ExtendedColorType::La16,
+        (Layout::Rgb, Depth::Sixteen) => ExtendedColorType::Rgb16,
+        (Layout::Rgba, Depth::Sixteen) => ExtendedColorType::Rgba16,
+    }
+}
+
+/// Encodes pixels. PNG keeps the pixels' depth; WebP and JPEG need 8-bit pixels and JPEG no
+/// alpha (see [`output_format`]).
+pub fn encode(
+    pixels: &Pixels,
+    format: OutputFormat,
+    options: EncodeOptions,
+) -> Result<Vec<u8>, CodecError> {
+    let name = match format {
+        OutputFormat::Png => "PNG",
+        OutputFormat::Jpeg => "JPEG",
+        OutputFormat::WebpLossless => "WebP",
+    };
+    let encode_error = |e: image::ImageError| CodecError::Encode {
+        format: name,
+        message: e.to_string(),
+    };
+    let ct = color_type(pixels.layout(), pixels.depth());
+    let (w, h) = (pixels.width(), pixels.height());
+    // 16-bit codes go to the encoders as native-endian bytes.
+    let wide;
+    let bytes: &[u8] = match pixels.samples() {
+        Samples::U8(v) => v,
+        Samples::U16(v) => {
+            wide = v.iter().flat_map(|c| c.to_ne_bytes()).collect::<Vec<u8>>();
+            &wide
+        }
+    };
+    let mut out = Vec::new();
+    match format {
+        OutputFormat::Png => {
+            let compression = match options.png {
+                PngCompression::Fast => CompressionType::Fast,
+                PngCompression::Default => CompressionType::Default,
+                PngCompression::Best => CompressionType::Best,
+            };
+            PngEncoder::new_with_quality(&mut out, compression, FilterType::Adaptive)
+                .write_image(bytes, w, h, ct)
+                .map_err(encode_error)?;
+        }
+        OutputFormat::WebpLossless => {
+            WebPEncoder::new_lossless(&mut out)
+                .encode(bytes, w, h, ct)
+                .map_err(encode_error)?;
+        }
+        OutputFormat::Jpeg => {
+            JpegEncoder::new_with_quality(&mut out, options.jpeg_quality)
+                .write_image(bytes, w, h, ct)
+                .map_err(encode_error)?;
+        }
+    }
+    Ok(out)
+}

@@ -1,0 +1,707 @@
+//! The pixel kernel: applies one [`Recipe`] to decoded images and yields the output pixels
+//! with per-channel statistics (texels clamped, largest quantisation error in codes).
+//!
+//! Each output channel is compiled to the cheapest program that gives the exact f64 result:
+//! - a copy (codes moved unchanged; 8-bit codes widened ×257 into a 16-bit output);
+//! - a constant, when the value reads no texel;
+//! - a lookup table over every input code, when the value reads one channel of one image of
+//!   the output's size: the table entry for code c is the exact f64 computation for c, so the
+//!   table path equals the per-texel computation by construction (8-bit inputs always; 16-bit
+//!   inputs when the image has at least as many texels as the table has entries);
+//! - a per-texel f64 evaluation otherwise (two-source products, maxima, ratios, resampling).
+//!
+//! Images of another size than the base are sampled bilinearly in linear values at the base's
+//! texel centres, clamped to the edge: that is what a renderer's bilinear filter gives where the
+//! two textures are sampled at the same UV, and it keeps the base's copied channels bit-exact.
+//!
+//! Rows are processed in bands in parallel (rayon). Alpha is never premultiplied: every channel
+//! is computed from its own codes only.
+
+use std::collections::HashMap;
+
+use rayon::prelude::*;
+
+use super::pixels::{Depth, Layout, Pixels, Samples};
+use super::recipe::{Channel, ChannelRecipe, ImageId, OutputLayout, Recipe, Texel, Transfer, Value};
+use super::srgb;
+
+/// How the kernel runs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct KernelOptions {
+    /// Evaluate every texel in f64 instead of using lookup tables (for comparison; the results
+    /// are identical).
+    pub exact: bool,
+    /// Measure the largest quantisation error of table channels (costs a histogram pass).
+    pub measure: bool,
+}
+
+/// What happened in one output channel.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ChannelStats {
+    /// The glTF channel the stored channel holds (grey is reported as red).
+    pub channel: Channel,
+    /// Whether the channel was computed (false: copied codes).
+    pub computed: bool,
+    /// Texels whose value fell outside [0, 1] and were clamped.
+    pub clamped: u64,
+    /// Largest |code − exact value × max code| over the texels, in codes; `None` when not
+    /// measured. Copies are exact (0).
+    pub max_error: Option<f64>,
+}
+
+/// Per-channel statistics of one output, in stored channel order.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct KernelStats {
+    /// One entry per stored output channel.
+    pub channels: Vec<ChannelStats>,
+}
+
+impl KernelStats {
+    /// Texels clamped over all channels.
+    pub fn clamped(&self) -> u64 {
+        self.channels.iter().map(|c| c.clamped).sum()
+    }
+
+    /// The largest measured error over all channels, if any channel was measured.
+    pub fn max_error(&self) -> Option<f64> {
+        self.channels
+            .iter()
+            .filter_map(|c| c.max_error)
+            .reduce(f64::max)
+    }
+}
+
+/// A recipe that cannot run on the images given.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum KernelError {
+    /// The recipe reads an image that was not supplied.
+    #[error("{0} is not decoded")]
+    MissingImage(ImageId),
+}
+
+/// Applies `recipe` to `images` (which must hold every image the recipe reads).
+pub fn apply(
+    recipe: &Recipe,
+    images: &HashMap<ImageId, Pixels>,
+    options: KernelOptions,
+) -> Result<(Pixels, KernelStats), KernelError> {
+    let plan = Plan::compile(recipe, images, options)?;
+    Ok(match plan.depth {
+        Depth::Eight => plan.run::<u8>(),
+        Depth::Sixteen => plan.run::<u16>(),
+    })
+}
+
+/// The output layout, size and depth `recipe` gives on `images`, without computing pixels.
+pub fn output_shape(
+    recipe: &Recipe,
+    images: &HashMap<ImageId, Pixels>,
+) -> Result<(u32, u32, Layout, Depth), KernelError> {
+    let plan = Plan::compile(recipe, images, KernelOptions::default())?;
+    Ok((plan.width, plan.height, plan.layout, plan.depth))
+}
+
+/// An output code type.
+trait Code: Copy + Default + Send + Sync + 'static {
+    fn from_code(code: u32) -> Self;
+}
+
+impl Code for u8 {
+    fn from_code(code: u32) -> Self {
+        code as u8
+    }
+}
+
+impl Code for u16 {
+    fn from_code(code: u32) -> Self {
+        code as u16
+    }
+}
+
+/// One stored channel of a source image.
+#[derive(Clone, Copy)]
+struct Src<'a> {
+    pixels: &'a Pixels,
+    offset: usize,
+}
+
+impl Src<'_> {
+    fn stride(&self) -> usize {
+        self.pixels.layout().channels()
+    }
+}
+
+/// Bilinear sampling positions of a source of another size.
+struct Resample {
+    /// Per output column: left and right source column, weight of the right one.
+    xs: Vec<(usize, usize, f64)>,
+    /// Per output row: upper and lower source row, weight of the lower one.
+    ys: Vec<(usize, usize, f64)>,
+}
+
+impl Resample {
+    fn axis(out: u32, src: u32) -> Vec<(usize, usize, f64)> {
+        let last = src.saturating_sub(1) as f64;
+        (0..out)
+            .map(|i| {
+                let u = ((f64::from(i) + 0.5) * f64::from(src) / f64::from(out) - 0.5).clamp(0.0, last);
+                let i0 = u.floor();
+                let i1 = (i0 + 1.0).min(last);
+                (i0 as usize, i1 as usize, u - i0)
+            })
+            .collect()
+    }
+}
+
+/// A texel read by a per-texel program.
+struct Slot<'a> {
+    texel: Texel,
+    src: Src<'a>,
+    decode: &'static [f64],
+    resample: Option<Resample>,
+}
+
+impl Slot<'_> {
+    fn value(&self, x: usize, y: usize, out_width: usize) -> f64 {
+        let samples = self.src.pixels.samples();
+        let stride = self.src.stride();
+        let code = |px: usize| samples.code(px * stride + self.src.offset) as usize;
+        match &self.resample {
+            None => self.decode[code(y * out_width + x)],
+            Some(r) => {
+                let w = self.src.pixels.width() as usize;
+                let (x0, x1, fx) = r.xs[x];
+                let (y0, y1, fy) = r.ys[y];
+                let at = |xx: usize, yy: usize| self.decode[code(yy * w + xx)];
+                let top = at(x0, y0) * (1.0 - fx) + at(x1, y0) * fx;
+                let bottom = at(x0, y1) * (1.0 - fx) + at(x1, y1) * fx;
+                top * (1.0 - fy) + bottom * fy
+            }
+        }
+    }
+}
+
+enum Program<'a> {
+    Copy {
+        src: Src<'a>,
+    },
+    Const {
+        code: u32,
+        error: f64,
+        clamped: bool,
+    },
+    Lut {
+        src: Src<'a>,
+        table: Vec<u16>,
+        /// Per input code: |code − exact|, and whether the value was clamped.
+        error: Vec<f64>,
+        clamped: Vec<bool>,
+        histogram: bool,
+    },
+    General {
+        slots: Vec<Slot<'a>>,
+        value: Value,
+        transfer: Transfer,
+    },
+}
+
+struct Plan<'a> {
+    width: u32,
+    height: u32,
+    layout: Layout,
+    depth: Depth,
+    programs: Vec<(Channel, Program<'a>)>,
+}
+
+fn decode_table(depth: Depth, transfer: Transfer) -> &'static [f64] {
+    match (depth, transfer) {
+        (Depth::Eight, Transfer::Srgb) => srgb::decode_table_8(),
+        (Depth::Eight, Transfer::Linear) => srgb::linear_table_8(),
+        (Depth::Sixteen, Transfer::Srgb) => srgb::decode_table_16(),
+        (Depth::Sixteen, Transfer::Linear) => srgb::linear_table_16(),
+    }
+}
+
+fn encode(value: f64, transfer: Transfer) -> f64 {
+    match transfer {
+        Transfer::Linear => value,
+        Transfer::Srgb => srgb::encode(value),
+    }
+}
+
+/// The exact result of a computed channel for a raw linear value: (code, |code − exact|,
+/// clamped).
+fn quantise(raw: f64, transfer: Transfer, max: u32) -> (u32, f64, bool) {
+    let clamped = !(0.0..=1.0).contains(&raw);
+    let encoded = encode(raw.clamp(0.0, 1.0), transfer);
+    let code = srgb::quantise(encoded, max);
+    (code, (f64::from(code) - encoded * f64::from(max)).abs(), clamped)
+}
+
+fn get(images: &HashMap<ImageId, Pixels>, id: ImageId) -> Result<&Pixels, KernelError> {
+    images.get(&id).ok_or(KernelError::MissingImage(id))
+}
+
+/// Rewrites texels to the stored channel they read: green and blue of grey images read red,
+/// alpha of images without alpha is the constant 1.
+fn normalise_value(
+    value: &Value,
+    images: &HashMap<ImageId, Pixels>,
+) -> Result<Value, KernelError> {
+    Ok(match value {
+        Value::Const(_) => value.clone(),
+        Value::Texel(t) => {
+            let p = get(images, t.image)?;
+            match (p.layout().has_colour(), p.layout().has_alpha(), t.channel) {
+                (_, false, Channel::A) => Value::Const(super::recipe::Factor::ONE),
+                (false, _, Channel::G | Channel::B) => Value::texel(t.image, Channel::R, t.transfer),
+                _ => value.clone(),
+            }
+        }
+        Value::Product(terms) => {
+            let terms = terms
+                .iter()
+                .map(|t| normalise_value(t, images))
+                .collect::<Result<Vec<_>, _>>()?;
+            Value::product(terms.clone()).unwrap_or(Value::Product(terms))
+        }
+        Value::Max(terms) => {
+            let terms = terms
+                .iter()
+                .map(|t| normalise_value(t, images))
+                .collect::<Result<Vec<_>, _>>()?;
+            Value::max(terms.clone()).unwrap_or(Value::Max(terms))
+        }
+        Value::Ratio { num, den, if_zero } => Value::ratio(
+            normalise_value(num, images)?,
+            normalise_value(den, images)?,
+            *if_zero,
+        ),
+        Value::Curve(c, v) => Value::curve(c.clone(), normalise_value(v, images)?),
+    })
+}
+
+fn normalise_channel(
+    recipe: ChannelRecipe,
+    images: &HashMap<ImageId, Pixels>,
+) -> Result<ChannelRecipe, KernelError> {
+    Ok(match recipe {
+        ChannelRecipe::Copy(image, channel) => {
+            let p = get(images, image)?;
+            match (p.layout().has_colour(), p.layout().has_alpha(), channel) {
+                (_, false, Channel::A) => ChannelRecipe::Computed {
+                    value: Value::Const(super::recipe::Factor::ONE),
+                    transfer: Transfer::Linear,
+                },
+                (false, _, Channel::G | Channel::B) => ChannelRecipe::Copy(image, Channel::R),
+                _ => ChannelRecipe::Copy(image, channel),
+            }
+        }
+        ChannelRecipe::Computed { value, transfer } => {
+            ChannelRecipe::computed(normalise_value(&value, images)?, transfer)
+        }
+    })
+}
+
+impl<'a> Plan<'a> {
+    fn compile(
+        recipe: &Recipe,
+        images: &'a HashMap<ImageId, Pixels>,
+        options: KernelOptions,
+    ) -> Result<Plan<'a>, KernelError> {
+        let base = get(images, recipe.base())?;
+        let resolved = Channel::ALL
+            .iter()
+            .map(|&c| normalise_channel(recipe.resolved(c), images))
+            .collect::<Result<Vec<_>, _>>()?;
+        let layout = match recipe.layout() {
+            OutputLayout::Fixed(layout) => layout,
+            OutputLayout::Auto => {
+                let colour = base.layout().has_colour()
+                    || resolved[0] != resolved[1]
+                    || resolved[1] != resolved[2];
+                let alpha = base.layout().has_alpha() || recipe.channel(Channel::A).is_some();
+                Layout::from_parts(colour, alpha)
+            }
+        };
+        let stored = layout.stored_channels();
+        let mut depth = base.depth();
+        for &c in stored {
+            for image in resolved[c as usize].images() {
+                depth = depth.max(get(images, image)?.depth());
+            }
+        }
+        let (width, height) = (base.width(), base.height());
+        let same_size = |p: &Pixels| p.width() == width && p.height() == height;
+        let max = depth.max_code();
+        let mut programs = Vec::with_capacity(stored.len());
+        for &channel in stored {
+            let program = match resolved[channel as usize].clone() {
+                ChannelRecipe::Copy(image, c) if same_size(get(images, image)?) => {
+                    let pixels = get(images, image)?;
+                    let offset = pixels.layout().storage_index(c).expect("normalised");
+                    Program::Copy {
+                        src: Src { pixels, offset },
+                    }
+                }
+                ChannelRecipe::Copy(image, c) => {
+                    // A copy from an image of another size is a resampled linear read.
+                    Self::computed(
+                        Value::texel(image, c, Transfer::Linear),
+                        Transfer::Linear,
+                        images,
+                        (width, height),
+                        max,
+                        options,
+                    )?
+                }
+                ChannelRecipe::Computed { value, transfer } => {
+                    Self::computed(value, transfer, images, (width, height), max, options)?
+                }
+            };
+            programs.push((channel, program));
+        }
+        Ok(Plan {
+            width,
+            height,
+            layout,
+            depth,
+            programs,
+        })
+    }
+
+    fn computed(
+        value: Value,
+        transfer: Transfer,
+        images: &'a HashMap<ImageId, Pixels>,
+        (width, height): (u32, u32),
+        max: u32,
+        options: KernelOptions,
+    ) -> Result<Program<'a>, KernelError> {
+        let texels = value.texels();
+        if texels.is_empty() {
+            let (code, error, clamped) = quantise(value.eval(&mut |_| 0.0), transfer, max);
+            return Ok(Program::Const {
+                code,
+                error,
+                clamped,
+            });
+        }
+        let mut slots = Vec::with_capacity(texels.len());
+        for texel in texels {
+            let pixels = get(images, texel.image)?;
+            let offset = pixels
+                .layout()
+                .storage_index(texel.channel)
+                .expect("normalised");
+            let resample = (pixels.width() != width || pixels.height() != height).then(|| {
+                Resample {
+                    xs: Resample::axis(width, pixels.width()),
+                    ys: Resample::axis(height, pixels.height()),
+                }
+            });
+            slots.push(Slot {
+                texel,
+                src: Src { pixels, offset },
+                decode: decode_table(pixels.depth(), texel.transfer),
+                resample,
+            });
+        }
+        let table_pays = |p: &Pixels| match p.depth() {
+            Depth::Eight => true,
+            Depth::Sixteen => p.pixel_count() >= 65536,
+        };
+        if !options.exact
+            && slots.len() == 1
+            && slots[0].resample.is_none()
+            && table_pays(slots[0].src.pixels)
+        {
+            let slot = slots.pop().expect("one slot");
+            let n = slot.decode.len();
+            let mut table = Vec::with_capacity(n);
+            let mut error = Vec::with_capacity(n);
+            let mut clamped = Vec::with_capacity(n);
+            for &linear in slot.decode {
+                let (code, e, c) = quantise(value.eval(&mut |_| linear), transfer, max);
+                table.push(code as u16);
+                error.push(e);
+                clamped.push(c);
+            }
+            let histogram = options.measure || clamped.iter().any(|&c| c);
+            return Ok(Program::Lut {
+                src: slot.src,
+                table,
+                error,
+                clamped,
+                histogram,
+            });
+        }
+        Ok(Program::General {
+            slots,
+            value,
+            transfer,
+        })
+    }
+
+    fn run<O: Code>(self) -> (Pixels, KernelStats) {
+        let n = self.layout.channels();
+        let width = self.width as usize;
+        let row = width * n;
+        let total = row * self.height as usize;
+        let mut out = vec![O::default(); total];
+        // Bands of about 64K texels keep a band's input and output in cache.
+        let rows_per_band = (65536 / width.max(1)).max(1);
+        let band_len = (rows_per_band * row).max(1);
+        let max = self.depth.max_code();
+        let accs: Vec<Vec<Acc>> = out
+            .par_chunks_mut(band_len)
+            .enumerate()
+            .map(|(b, band)| {
+                let first_pixel = b * rows_per_band * width;
+                self.programs
+                    .iter()
+                    .enumerate()
+                    .map(|(s, (_, program))| {
+                        run_program(program, band, first_pixel, s, n, width, max)
+                    })
+                    .collect()
+            })
+            .collect();
+        let stats = self
+            .programs
+            .iter()
+            .enumerate()
+            .map(|(s, (channel, program))| {
+                let mut acc = Acc::default();
+                for band in &accs {
+                    acc.merge(&band[s]);
+                }
+                finish_stats(*channel, program, acc, self.pixels())
+            })
+            .collect();
+        let samples = wrap_samples(out);
+        let pixels = Pixels::new(self.width, self.height, self.layout, samples)
+            .expect("the output buffer matches its size");
+        (pixels, KernelStats { channels: stats })
+    }
+
+    fn pixels(&self) -> u64 {
+        u64::from(self.width) * u64::from(self.height)
+    }
+
+}
+
+fn wrap_samples<O: Code>(out: Vec<O>) -> Samples {
+    // The two instantiations are u8 and u16; move the vector into the matching variant.
+    let any: Box<dyn std::any::Any> = Box::new(out);
+    match any.downcast::<Vec<u8>>() {
+        Ok(v) => Samples::U8(*v),
+        Err(any) => Samples::U16(*any.downcast::<Vec<u16>>().expect("u8 or u16 codes")),
+    }
+}
+
+/// Per-band accumulation of one channel's statistics.
+#[derive(Default)]
+struct Acc {
+    clamped: u64,
+    max_error: f64,
+    histogram: Vec<u64>,
+}
+
+impl Acc {
+    fn merge(&mut self, other: &Acc) {
+        self.clamped += other.clamped;
+        self.max_error = self.max_error.max(other.max_error);
+        if self.histogram.is_empty() {
+            self.histogram = other.histogram.clone();
+        } else {
+            for (a, b) in self.histogram.iter_mut().zip(&other.histogram) {
+                *a += b;
+            }
+        }
+    }
+}
+
+fn finish_stats(
+    channel: Channel,
+    program: &Program<'_>,
+    acc: Acc,
+    pixels: u64,
+) -> ChannelStats {
+    match program {
+        Program::Copy { .. } => ChannelStats {
+            channel,
+            computed: false,
+            clamped: 0,
+            max_error: Some(0.0),
+        },
+        Program::Const { error, clamped, .. } => ChannelStats {
+            channel,
+            computed: true,
+            clamped: if *clamped { pixels } else { 0 },
+            max_error: Some(if pixels == 0 { 0.0 } else { *error }),
+        },
+        Program::Lut {
+            error,
+            clamped,
+            histogram,
+            ..
+        } => {
+            if !*histogram {
+                return ChannelStats {
+                    channel,
+                    computed: true,
+                    clamped: 0,
+                    max_error: None,
+                };
+            }
+            let mut count = 0;
+            let mut max_error = 0.0f64;
+            for (code, &hits) in acc.histogram.iter().enumerate() {
+                if hits > 0 {
+                    if clamped[code] {
+                        count += hits;
+                    }
+                    max_error = max_error.max(error[code]);
+                }
+            }
+            ChannelStats {
+                channel,
+                computed: true,
+                clamped: count,
+                max_error: Some(max_error),
+            }
+        }
+        Program::General { .. } => ChannelStats {
+            channel,
+            computed: true,
+            clamped: acc.clamped,
+            max_error: Some(acc.max_error),
+        },
+    }
+}
+
+fn widen<O: Code>(code: u32, from: Depth, to_max: u32) -> O {
+    match (from, to_max) {
+        (Depth::Eight, 65535) => O::from_code(code * 257),
+        _ => O::from_code(code),
+    }
+}
+
+/// Runs one channel's program over a band (`band` holds whole output pixels of `n` channels,
+/// starting at pixel `first`), writing stored channel `s`.
+fn run_program<O: Code>(
+    program: &Program<'_>,
+    band: &mut [O],
+    first: usize,
+    s: usize,
+    n: usize,
+    width: usize,
+    max: u32,
+) -> Acc {
+    let count = band.len() / n;
+    let mut acc = Acc::default();
+    match program {
+        Program::Copy { src } => {
+            let stride = src.stride();
+            let depth = src.pixels.depth();
+            match src.pixels.samples() {
+                Samples::U8(codes) => {
+                    let codes = &codes[first * stride..(first + count) * stride];
+                    for (d, c) in band.chunks_exact_mut(n).zip(codes.chunks_exact(stride)) {
+                        d[s] = widen(u32::from(c[src.offset]), depth, max);
+                    }
+                }
+                Samples::U16(codes) => {
+                    let codes = &codes[first * stride..(first + count) * stride];
+                    for (d, c) in band.chunks_exact_mut(n).zip(codes.chunks_exact(stride)) {
+                        d[s] = O::from_code(u32::from(c[src.offset]));
+                    }
+                }
+            }
+        }
+        Program::Const { code, .. } => {
+            let code = O::from_code(*code);
+            for d in band.chunks_exact_mut(n) {
+                d[s] = code;
+            }
+        }
+        Program::Lut {
+            src,
+            table,
+            histogram,
+            ..
+        } => {
+            let stride = src.stride();
+            let table: Vec<O> = table.iter().map(|&c| O::from_code(u32::from(c))).collect();
+            if *histogram {
+                acc.histogram = vec![0; table.len()];
+            }
+            match src.pixels.samples() {
+                Samples::U8(codes) => {
+                    let codes = &codes[first * stride..(first + count) * stride];
+                    let table: &[O; 256] = table.as_slice().try_into().expect("256 entries");
+                    lut_band(band, codes, stride, src.offset, s, n, table, &mut acc.histogram);
+                }
+                Samples::U16(codes) => {
+                    let codes = &codes[first * stride..(first + count) * stride];
+                    let table: &[O; 65536] = table.as_slice().try_into().expect("65536 entries");
+                    lut_band(band, codes, stride, src.offset, s, n, table, &mut acc.histogram);
+                }
+            }
+        }
+        Program::General {
+            slots,
+            value,
+            transfer,
+        } => {
+            let mut values = vec![0.0; slots.len()];
+            for (i, d) in band.chunks_exact_mut(n).enumerate() {
+                let pixel = first + i;
+                let (x, y) = (pixel % width, pixel / width);
+                for (v, slot) in values.iter_mut().zip(slots) {
+                    *v = slot.value(x, y, width);
+                }
+                let raw = value.eval(&mut |t: &Texel| {
+                    let k = slots.iter().position(|s| s.texel == *t).expect("slot per texel");
+                    values[k]
+                });
+                let (code, error, clamped) = quantise(raw, *transfer, max);
+                d[s] = O::from_code(code);
+                acc.clamped += u64::from(clamped);
+                acc.max_error = acc.max_error.max(error);
+            }
+        }
+    }
+    acc
+}
+
+/// The table loop. Tables are fixed-size arrays indexed by a code of the same width, so the
+/// index needs no bounds check.
+#[allow(clippy::too_many_arguments)]
+fn lut_band<I, O, const N: usize>(
+    band: &mut [O],
+    codes: &[I],
+    stride: usize,
+    offset: usize,
+    s: usize,
+    n: usize,
+    table: &[O; N],
+    histogram: &mut [u64],
+) where
+    I: Copy + Into<usize>,
+    O: Code,
+{
+    let pairs = band.chunks_exact_mut(n).zip(codes.chunks_exact(stride));
+    if histogram.is_empty() {
+        for (d, c) in pairs {
+            d[s] = table[c[offset].into()];
+        }
+    } else {
+        for (d, c) in pairs {
+            let code: usize = c[offset].into();
+            d[s] = table[code];
+            histogram[code] += 1;
+        }
+    }
+}
