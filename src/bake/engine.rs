@@ -244,7 +244,10 @@ fn bake_component(
     source: &dyn ImageSource,
     options: &BakeOptions,
 ) -> Vec<(usize, Result<Baked, BakeError>)> {
-    let mut images: Vec<ImageId> = component.iter().flat_map(|&i| recipes[i].images()).collect();
+    let mut images: Vec<ImageId> = component
+        .iter()
+        .flat_map(|&i| recipes[i].images())
+        .collect();
     images.sort();
     images.dedup();
     let decoded: Vec<(ImageId, Decoded)> = images
@@ -294,8 +297,12 @@ fn bake_one(
     let encoded = match uniform {
         Some(_) => None,
         None => {
-            let format =
-                codec::output_format(source_format, options.keep_format, out.layout(), out.depth());
+            let format = codec::output_format(
+                source_format,
+                options.keep_format,
+                out.layout(),
+                out.depth(),
+            );
             let bytes = codec::encode(&out, format, options.encode).map_err(BakeError::Encode)?;
             Some((format, bytes))
         }

@@ -22,7 +22,9 @@ use std::collections::HashMap;
 use rayon::prelude::*;
 
 use super::pixels::{Depth, Layout, Pixels, Samples};
-use super::recipe::{Channel, ChannelRecipe, ImageId, OutputLayout, Recipe, Texel, Transfer, Value};
+use super::recipe::{
+    Channel, ChannelRecipe, ImageId, OutputLayout, Recipe, Texel, Transfer, Value,
+};
 use super::srgb;
 
 /// How the kernel runs.
@@ -144,7 +146,8 @@ impl Resample {
         let last = src.saturating_sub(1) as f64;
         (0..out)
             .map(|i| {
-                let u = ((f64::from(i) + 0.5) * f64::from(src) / f64::from(out) - 0.5).clamp(0.0, last);
+                let u =
+                    ((f64::from(i) + 0.5) * f64::from(src) / f64::from(out) - 0.5).clamp(0.0, last);
                 let i0 = u.floor();
                 let i1 = (i0 + 1.0).min(last);
                 (i0 as usize, i1 as usize, u - i0)
@@ -235,7 +238,11 @@ fn quantise(raw: f64, transfer: Transfer, max: u32) -> (u32, f64, bool) {
     let clamped = !(0.0..=1.0).contains(&raw);
     let encoded = encode(raw.clamp(0.0, 1.0), transfer);
     let code = srgb::quantise(encoded, max);
-    (code, (f64::from(code) - encoded * f64::from(max)).abs(), clamped)
+    (
+        code,
+        (f64::from(code) - encoded * f64::from(max)).abs(),
+        clamped,
+    )
 }
 
 fn get(images: &HashMap<ImageId, Pixels>, id: ImageId) -> Result<&Pixels, KernelError> {
@@ -244,17 +251,16 @@ fn get(images: &HashMap<ImageId, Pixels>, id: ImageId) -> Result<&Pixels, Kernel
 
 /// Rewrites texels to the stored channel they read: green and blue of grey images read red,
 /// alpha of images without alpha is the constant 1.
-fn normalise_value(
-    value: &Value,
-    images: &HashMap<ImageId, Pixels>,
-) -> Result<Value, KernelError> {
+fn normalise_value(value: &Value, images: &HashMap<ImageId, Pixels>) -> Result<Value, KernelError> {
     Ok(match value {
         Value::Const(_) => value.clone(),
         Value::Texel(t) => {
             let p = get(images, t.image)?;
             match (p.layout().has_colour(), p.layout().has_alpha(), t.channel) {
                 (_, false, Channel::A) => Value::Const(super::recipe::Factor::ONE),
-                (false, _, Channel::G | Channel::B) => Value::texel(t.image, Channel::R, t.transfer),
+                (false, _, Channel::G | Channel::B) => {
+                    Value::texel(t.image, Channel::R, t.transfer)
+                }
                 _ => value.clone(),
             }
         }
@@ -394,12 +400,11 @@ impl<'a> Plan<'a> {
                 .layout()
                 .storage_index(texel.channel)
                 .expect("normalised");
-            let resample = (pixels.width() != width || pixels.height() != height).then(|| {
-                Resample {
+            let resample =
+                (pixels.width() != width || pixels.height() != height).then(|| Resample {
                     xs: Resample::axis(width, pixels.width()),
                     ys: Resample::axis(height, pixels.height()),
-                }
-            });
+                });
             slots.push(Slot {
                 texel,
                 src: Src { pixels, offset },
@@ -488,7 +493,6 @@ impl<'a> Plan<'a> {
     fn pixels(&self) -> u64 {
         u64::from(self.width) * u64::from(self.height)
     }
-
 }
 
 fn wrap_samples<O: Code>(out: Vec<O>) -> Samples {
@@ -522,12 +526,7 @@ impl Acc {
     }
 }
 
-fn finish_stats(
-    channel: Channel,
-    program: &Program<'_>,
-    acc: Acc,
-    pixels: u64,
-) -> ChannelStats {
+fn finish_stats(channel: Channel, program: &Program<'_>, acc: Acc, pixels: u64) -> ChannelStats {
     match program {
         Program::Copy { .. } => ChannelStats {
             channel,
@@ -641,12 +640,30 @@ fn run_program<O: Code>(
                 Samples::U8(codes) => {
                     let codes = &codes[first * stride..(first + count) * stride];
                     let table: &[O; 256] = table.as_slice().try_into().expect("256 entries");
-                    lut_band(band, codes, stride, src.offset, s, n, table, &mut acc.histogram);
+                    lut_band(
+                        band,
+                        codes,
+                        stride,
+                        src.offset,
+                        s,
+                        n,
+                        table,
+                        &mut acc.histogram,
+                    );
                 }
                 Samples::U16(codes) => {
                     let codes = &codes[first * stride..(first + count) * stride];
                     let table: &[O; 65536] = table.as_slice().try_into().expect("65536 entries");
-                    lut_band(band, codes, stride, src.offset, s, n, table, &mut acc.histogram);
+                    lut_band(
+                        band,
+                        codes,
+                        stride,
+                        src.offset,
+                        s,
+                        n,
+                        table,
+                        &mut acc.histogram,
+                    );
                 }
             }
         }
@@ -663,7 +680,10 @@ fn run_program<O: Code>(
                     *v = slot.value(x, y, width);
                 }
                 let raw = value.eval(&mut |t: &Texel| {
-                    let k = slots.iter().position(|s| s.texel == *t).expect("slot per texel");
+                    let k = slots
+                        .iter()
+                        .position(|s| s.texel == *t)
+                        .expect("slot per texel");
                     values[k]
                 });
                 let (code, error, clamped) = quantise(raw, *transfer, max);
@@ -703,5 +723,438 @@ fn lut_band<I, O, const N: usize>(
             d[s] = table[code];
             histogram[code] += 1;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bake::recipe::{Curve, Factor};
+
+    const IMG: ImageId = ImageId(0);
+    const OTHER: ImageId = ImageId(1);
+
+    /// The exact computation, written out independently of the kernel: decode, scale, clamp,
+    /// encode, round to the nearest code (ties to even).
+    fn reference(code: u32, max: u32, factor: f64, transfer: Transfer) -> u32 {
+        let v = f64::from(code) / f64::from(max);
+        let linear = match transfer {
+            Transfer::Linear => v,
+            Transfer::Srgb if v <= 0.04045 => v / 12.92,
+            Transfer::Srgb => ((v + 0.055) / 1.055).powf(2.4),
+        };
+        let l = (factor * linear).clamp(0.0, 1.0);
+        let e = match transfer {
+            Transfer::Linear => l,
+            Transfer::Srgb if l <= 0.0031308 => l * 12.92,
+            Transfer::Srgb => 1.055 * l.powf(1.0 / 2.4) - 0.055,
+        };
+        (e * f64::from(max)).round_ties_even() as u32
+    }
+
+    const FACTORS: [f64; 8] = [0.0, 1.0, 0.5, 1.0 / 255.0, 0.999, 0.25, 0.7316, 0.0031308];
+
+    /// Every 8-bit code once: R = G = B = c, A = 255 - c.
+    fn all_codes_8() -> Pixels {
+        let codes = (0..=255u8).flat_map(|c| [c, c, c, 255 - c]).collect();
+        Pixels::new(256, 1, Layout::Rgba, Samples::U8(codes)).unwrap()
+    }
+
+    /// Every 16-bit code once (256 × 256): R = G = B = c, A = 65535 - c.
+    fn all_codes_16() -> Pixels {
+        let codes = (0..=65535u16).flat_map(|c| [c, c, c, 65535 - c]).collect();
+        Pixels::new(256, 256, Layout::Rgba, Samples::U16(codes)).unwrap()
+    }
+
+    fn scaled(channel: Channel, factor: f64, transfer: Transfer) -> ChannelRecipe {
+        // Built by hand so that factor 1 goes through the computed path too.
+        ChannelRecipe::Computed {
+            value: Value::Product(vec![
+                Value::Const(Factor::new(factor).unwrap()),
+                Value::texel(IMG, channel, transfer),
+            ]),
+            transfer,
+        }
+    }
+
+    fn colour_and_alpha(colour: f64, alpha: f64) -> Recipe {
+        Recipe::new(IMG)
+            .with(Channel::R, scaled(Channel::R, colour, Transfer::Srgb))
+            .with(Channel::G, scaled(Channel::G, colour, Transfer::Srgb))
+            .with(Channel::B, scaled(Channel::B, colour, Transfer::Srgb))
+            .with(Channel::A, scaled(Channel::A, alpha, Transfer::Linear))
+    }
+
+    fn one(image: Pixels) -> HashMap<ImageId, Pixels> {
+        HashMap::from([(IMG, image)])
+    }
+
+    fn run(
+        recipe: &Recipe,
+        images: &HashMap<ImageId, Pixels>,
+        exact: bool,
+    ) -> (Pixels, KernelStats) {
+        let options = KernelOptions {
+            exact,
+            measure: true,
+        };
+        apply(recipe, images, options).unwrap()
+    }
+
+    fn codes(p: &Pixels) -> Vec<u32> {
+        (0..p.samples().len())
+            .map(|i| p.samples().code(i))
+            .collect()
+    }
+
+    #[test]
+    fn the_8_bit_table_and_exact_paths_equal_the_reference_for_every_code_and_factor() {
+        let images = one(all_codes_8());
+        for factor in FACTORS {
+            let recipe = colour_and_alpha(factor, factor);
+            for exact in [false, true] {
+                let (out, stats) = run(&recipe, &images, exact);
+                assert_eq!(out.layout(), Layout::Rgba);
+                assert_eq!(out.depth(), Depth::Eight);
+                for c in 0..=255u32 {
+                    let px = codes(&out)[c as usize * 4..c as usize * 4 + 4].to_vec();
+                    let colour = reference(c, 255, factor, Transfer::Srgb);
+                    let alpha = reference(255 - c, 255, factor, Transfer::Linear);
+                    assert_eq!(
+                        px,
+                        vec![colour, colour, colour, alpha],
+                        "code {c} factor {factor} exact {exact}"
+                    );
+                }
+                assert_eq!(stats.clamped(), 0);
+                assert!(stats.max_error().unwrap() <= 0.5, "{stats:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn the_16_bit_table_and_exact_paths_equal_the_reference_for_every_code() {
+        let images = one(all_codes_16());
+        for factor in [0.0, 1.0, 0.5, 0.999, 1.0 / 65535.0] {
+            let recipe = colour_and_alpha(factor, factor);
+            let (table, _) = run(&recipe, &images, false);
+            let (exact, _) = run(&recipe, &images, true);
+            assert_eq!(table, exact, "factor {factor}");
+            assert_eq!(table.depth(), Depth::Sixteen);
+            let got = codes(&table);
+            for c in 0..=65535u32 {
+                let i = c as usize * 4;
+                assert_eq!(
+                    got[i],
+                    reference(c, 65535, factor, Transfer::Srgb),
+                    "code {c}"
+                );
+                assert_eq!(
+                    got[i + 3],
+                    reference(65535 - c, 65535, factor, Transfer::Linear)
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn factor_1_leaves_every_code_unchanged_and_factor_0_gives_exact_zeros() {
+        for image in [all_codes_8(), all_codes_16()] {
+            let images = one(image.clone());
+            for exact in [false, true] {
+                let (out, _) = run(&colour_and_alpha(1.0, 1.0), &images, exact);
+                assert_eq!(out, image);
+                let (out, _) = run(&colour_and_alpha(0.0, 0.0), &images, exact);
+                assert!(codes(&out).iter().all(|&c| c == 0));
+            }
+        }
+    }
+
+    #[test]
+    fn codes_either_side_of_the_srgb_threshold_scale_by_their_own_segment() {
+        // 8-bit codes 10 (0.0392, toe) and 11 (0.0431, power segment) with factor 0.5:
+        // 10: 0.5 * 0.0392/12.92 = 0.001518 (toe again) -> 0.01961 * 255 = 5.0 -> 5;
+        // 11: 0.5 * 0.003347 = 0.001673 (toe) -> 0.02162 * 255 = 5.51 -> 6.
+        let image =
+            Pixels::new(2, 1, Layout::Rgb, Samples::U8(vec![10, 10, 10, 11, 11, 11])).unwrap();
+        let recipe = colour_and_alpha(0.5, 1.0);
+        let (out, _) = run(&recipe, &one(image), false);
+        assert_eq!(codes(&out), vec![5, 5, 5, 255, 6, 6, 6, 255]);
+        assert_eq!(
+            out.layout(),
+            Layout::Rgba,
+            "setting alpha adds an alpha channel"
+        );
+        assert_eq!(reference(10, 255, 0.5, Transfer::Srgb), 5);
+        assert_eq!(reference(11, 255, 0.5, Transfer::Srgb), 6);
+    }
+
+    #[test]
+    fn alpha_is_never_premultiplied() {
+        // Transparent texels keep their colour, and scaling alpha leaves colour alone.
+        let image = Pixels::new(
+            2,
+            1,
+            Layout::Rgba,
+            Samples::U8(vec![200, 100, 50, 0, 200, 100, 50, 128]),
+        )
+        .unwrap();
+        let images = one(image);
+        let (out, _) = run(&colour_and_alpha(1.0, 0.5), &images, false);
+        assert_eq!(codes(&out), vec![200, 100, 50, 0, 200, 100, 50, 64]);
+        let (out, _) = run(&colour_and_alpha(0.5, 1.0), &images, false);
+        let half = |c| reference(c, 255, 0.5, Transfer::Srgb);
+        assert_eq!(
+            codes(&out),
+            vec![
+                half(200),
+                half(100),
+                half(50),
+                0,
+                half(200),
+                half(100),
+                half(50),
+                128
+            ]
+        );
+    }
+
+    #[test]
+    fn channels_the_recipe_does_not_touch_stay_bit_exact() {
+        let image = all_codes_16();
+        let recipe = Recipe::new(IMG).with(Channel::A, scaled(Channel::A, 0.3, Transfer::Linear));
+        let (out, stats) = run(&recipe, &one(image.clone()), false);
+        let (a, b) = (codes(&out), codes(&image));
+        for i in 0..65536 {
+            assert_eq!(a[i * 4..i * 4 + 3], b[i * 4..i * 4 + 3]);
+        }
+        assert!(!stats.channels[0].computed);
+        assert!(stats.channels[3].computed);
+    }
+
+    #[test]
+    fn green_moves_to_alpha_bit_exact() {
+        let image = Pixels::new(2, 1, Layout::Rgb, Samples::U8(vec![1, 2, 3, 4, 5, 6])).unwrap();
+        let recipe = Recipe::new(IMG).with(Channel::A, ChannelRecipe::Copy(IMG, Channel::G));
+        let (out, _) = run(&recipe, &one(image), false);
+        assert_eq!(out.layout(), Layout::Rgba);
+        assert_eq!(codes(&out), vec![1, 2, 3, 2, 4, 5, 6, 5]);
+    }
+
+    #[test]
+    fn grey_images_stay_grey_for_grey_factors_and_become_rgb_for_coloured_ones() {
+        let image = Pixels::new(2, 1, Layout::Grey, Samples::U8(vec![100, 200])).unwrap();
+        let images = one(image);
+        let (out, _) = run(
+            &colour_and_alpha(0.5, 1.0).with(Channel::A, ChannelRecipe::Copy(IMG, Channel::A)),
+            &images,
+            false,
+        );
+        assert_eq!(out.layout(), Layout::Grey);
+        let half = |c| reference(c, 255, 0.5, Transfer::Srgb);
+        assert_eq!(codes(&out), vec![half(100), half(200)]);
+        let recipe = Recipe::new(IMG)
+            .with(Channel::R, scaled(Channel::R, 0.5, Transfer::Srgb))
+            .with(Channel::G, scaled(Channel::G, 0.25, Transfer::Srgb))
+            .with(Channel::B, scaled(Channel::B, 0.5, Transfer::Srgb));
+        let (out, _) = run(&recipe, &images, false);
+        assert_eq!(out.layout(), Layout::Rgb);
+        let quarter = |c| reference(c, 255, 0.25, Transfer::Srgb);
+        assert_eq!(
+            codes(&out),
+            vec![
+                half(100),
+                quarter(100),
+                half(100),
+                half(200),
+                quarter(200),
+                half(200)
+            ]
+        );
+    }
+
+    #[test]
+    fn out_of_range_factors_clamp_and_are_counted() {
+        let images = one(all_codes_8());
+        let recipe = Recipe::new(IMG).with(Channel::A, scaled(Channel::A, 2.0, Transfer::Linear));
+        for exact in [false, true] {
+            // Alpha codes 255 - c for c in 0..=255: 2a/255 > 1 for a >= 128, i.e. 128 texels.
+            let options = KernelOptions {
+                exact,
+                measure: false,
+            };
+            let (out, stats) = apply(&recipe, &images, options).unwrap();
+            assert_eq!(stats.clamped(), 128);
+            assert_eq!(stats.channels[3].clamped, 128);
+            assert_eq!(out.code(0, 0, Channel::A), 255);
+            assert_eq!(out.code(255, 0, Channel::A), 0);
+            assert_eq!(out.code(200, 0, Channel::A), 110);
+        }
+        let recipe = Recipe::new(IMG).with(Channel::A, scaled(Channel::A, -0.5, Transfer::Linear));
+        let (out, stats) = run(&recipe, &images, false);
+        assert_eq!(stats.clamped(), 255, "every non-zero alpha goes negative");
+        assert!((0..256).all(|x| out.code(x, 0, Channel::A) == 0));
+    }
+
+    #[test]
+    fn two_sources_of_equal_size_multiply_texel_by_texel() {
+        let colour = Pixels::new(
+            2,
+            1,
+            Layout::Rgb,
+            Samples::U8(vec![255, 128, 0, 64, 64, 64]),
+        )
+        .unwrap();
+        let intensity = Pixels::new(2, 1, Layout::Grey, Samples::U8(vec![255, 51])).unwrap();
+        let images = HashMap::from([(IMG, colour), (OTHER, intensity)]);
+        let k = Factor::new(0.5).unwrap();
+        let channel = |c| {
+            ChannelRecipe::computed(
+                Value::product(vec![
+                    Value::Const(k),
+                    Value::texel(IMG, c, Transfer::Srgb),
+                    Value::texel(OTHER, Channel::R, Transfer::Linear),
+                ])
+                .unwrap(),
+                Transfer::Srgb,
+            )
+        };
+        let recipe = Recipe::new(IMG)
+            .with(Channel::R, channel(Channel::R))
+            .with(Channel::G, channel(Channel::G))
+            .with(Channel::B, channel(Channel::B));
+        let (out, stats) = run(&recipe, &images, false);
+        let expect = |c: u32, i: f64| reference(c, 255, 0.5 * i, Transfer::Srgb);
+        let i1 = 51.0 / 255.0;
+        assert_eq!(
+            codes(&out),
+            vec![
+                expect(255, 1.0),
+                expect(128, 1.0),
+                0,
+                expect(64, i1),
+                expect(64, i1),
+                expect(64, i1)
+            ]
+        );
+        assert!(stats.max_error().unwrap() <= 0.5);
+    }
+
+    #[test]
+    fn a_second_source_of_another_size_is_sampled_bilinearly_at_the_base_texel_centres() {
+        // Base 4x1, intensity 2x1 holding linear 0 and 1: the base's texel centres fall at
+        // intensity coordinates -0.25, 0.25, 0.75, 1.25 -> clamped weights 0, 0.25, 0.75, 1.
+        let base = Pixels::new(4, 1, Layout::Grey, Samples::U8(vec![255; 4])).unwrap();
+        let intensity = Pixels::new(2, 1, Layout::Grey, Samples::U8(vec![0, 255])).unwrap();
+        let images = HashMap::from([(IMG, base), (OTHER, intensity)]);
+        let value = Value::product(vec![
+            Value::texel(IMG, Channel::R, Transfer::Linear),
+            Value::texel(OTHER, Channel::R, Transfer::Linear),
+        ])
+        .unwrap();
+        let recipe = Recipe::new(IMG).with(
+            Channel::R,
+            ChannelRecipe::computed(value.clone(), Transfer::Linear),
+        );
+        let recipe = recipe
+            .with(
+                Channel::G,
+                ChannelRecipe::computed(value.clone(), Transfer::Linear),
+            )
+            .with(Channel::B, ChannelRecipe::computed(value, Transfer::Linear));
+        let (out, _) = run(&recipe, &images, false);
+        assert_eq!(
+            (out.width(), out.height(), out.layout()),
+            (4, 1, Layout::Grey)
+        );
+        // 0.25 * 255 = 63.75 -> 64; 0.75 * 255 = 191.25 -> 191.
+        assert_eq!(codes(&out), vec![0, 64, 191, 255]);
+    }
+
+    #[test]
+    fn an_8_bit_base_copied_into_a_16_bit_output_keeps_its_values() {
+        let base = Pixels::new(1, 1, Layout::Rgba, Samples::U8(vec![10, 20, 30, 40])).unwrap();
+        let rough = Pixels::new(1, 1, Layout::Grey, Samples::U16(vec![65535])).unwrap();
+        let images = HashMap::from([(IMG, base), (OTHER, rough)]);
+        let recipe = Recipe::new(IMG).with(
+            Channel::A,
+            ChannelRecipe::computed(
+                Value::product(vec![
+                    Value::texel(IMG, Channel::A, Transfer::Linear),
+                    Value::texel(OTHER, Channel::R, Transfer::Linear),
+                ])
+                .unwrap(),
+                Transfer::Linear,
+            ),
+        );
+        let (out, _) = run(&recipe, &images, false);
+        assert_eq!(out.depth(), Depth::Sixteen);
+        assert_eq!(codes(&out), vec![10 * 257, 20 * 257, 30 * 257, 40 * 257]);
+    }
+
+    #[test]
+    fn a_curve_is_applied_to_the_scaled_value() {
+        let images = one(all_codes_8());
+        let curve = Curve::sampled(
+            "square",
+            &(0..=64)
+                .map(|i| (f64::from(i) / 64.0).powi(2))
+                .collect::<Vec<_>>(),
+        )
+        .unwrap();
+        let value = Value::curve(
+            curve.clone(),
+            Value::scaled(
+                Value::texel(IMG, Channel::A, Transfer::Linear),
+                Factor::new(0.8).unwrap(),
+            ),
+        );
+        let recipe =
+            Recipe::new(IMG).with(Channel::A, ChannelRecipe::computed(value, Transfer::Linear));
+        let (table, _) = run(&recipe, &images, false);
+        let (exact, _) = run(&recipe, &images, true);
+        assert_eq!(table, exact);
+        for a in 0..=255u32 {
+            let want = (curve.eval(0.8 * f64::from(a) / 255.0) * 255.0).round_ties_even() as u32;
+            assert_eq!(table.code(255 - a, 0, Channel::A), want, "alpha {a}");
+        }
+    }
+
+    #[test]
+    fn the_maximum_and_the_normalised_colour_of_an_rgb_texel() {
+        // The per-texel maximum of the linear colour (red channel, linear) and the colour
+        // divided by it (sRGB); a black texel gets the `if_zero` value.
+        let image =
+            Pixels::new(2, 1, Layout::Rgb, Samples::U8(vec![255, 128, 0, 0, 0, 0])).unwrap();
+        let images = one(image);
+        let lin = |c| Value::texel(IMG, c, Transfer::Srgb);
+        let max = Value::max(vec![lin(Channel::R), lin(Channel::G), lin(Channel::B)]).unwrap();
+        let recipe = Recipe::new(IMG)
+            .with_layout(OutputLayout::Fixed(Layout::Grey))
+            .with(
+                Channel::R,
+                ChannelRecipe::computed(max.clone(), Transfer::Linear),
+            );
+        let (out, _) = run(&recipe, &images, false);
+        assert_eq!(codes(&out), vec![255, 0]);
+        let norm = |c| {
+            ChannelRecipe::computed(
+                Value::ratio(lin(c), max.clone(), Factor::ONE),
+                Transfer::Srgb,
+            )
+        };
+        let recipe = Recipe::new(IMG)
+            .with(Channel::R, norm(Channel::R))
+            .with(Channel::G, norm(Channel::G))
+            .with(Channel::B, norm(Channel::B));
+        let (out, _) = run(&recipe, &images, false);
+        assert_eq!(codes(&out), vec![255, 128, 0, 255, 255, 255]);
+    }
+
+    #[test]
+    fn a_recipe_reading_an_image_not_supplied_is_an_error() {
+        let recipe = Recipe::new(IMG).with(Channel::A, ChannelRecipe::Copy(OTHER, Channel::R));
+        let err = apply(&recipe, &one(all_codes_8()), KernelOptions::default()).unwrap_err();
+        assert_eq!(err, KernelError::MissingImage(OTHER));
     }
 }

@@ -519,14 +519,29 @@ mod tests {
     #[test]
     fn products_are_canonical() {
         let k = Factor::new(0.5).unwrap();
-        let a = Value::product(vec![tex(1, Channel::R), Value::Const(k), tex(0, Channel::G)]);
-        let b = Value::product(vec![tex(0, Channel::G), tex(1, Channel::R), Value::Const(k)]);
+        let a = Value::product(vec![
+            tex(1, Channel::R),
+            Value::Const(k),
+            tex(0, Channel::G),
+        ]);
+        let b = Value::product(vec![
+            tex(0, Channel::G),
+            tex(1, Channel::R),
+            Value::Const(k),
+        ]);
         assert_eq!(a, b);
         assert_eq!(
             a.unwrap(),
-            Value::Product(vec![Value::Const(k), tex(0, Channel::G), tex(1, Channel::R)])
+            Value::Product(vec![
+                Value::Const(k),
+                tex(0, Channel::G),
+                tex(1, Channel::R)
+            ])
         );
-        assert_eq!(Value::scaled(tex(0, Channel::R), Factor::ONE), tex(0, Channel::R));
+        assert_eq!(
+            Value::scaled(tex(0, Channel::R), Factor::ONE),
+            tex(0, Channel::R)
+        );
         assert_eq!(
             Value::scaled(tex(0, Channel::R), Factor::ZERO),
             Value::Const(Factor::ZERO)
@@ -554,7 +569,8 @@ mod tests {
     #[test]
     fn a_recipe_copying_its_base_is_the_identity_and_equal_recipes_hash_equal() {
         use std::collections::HashSet;
-        let r = Recipe::new(ImageId(0)).with(Channel::A, ChannelRecipe::Copy(ImageId(0), Channel::A));
+        let r =
+            Recipe::new(ImageId(0)).with(Channel::A, ChannelRecipe::Copy(ImageId(0), Channel::A));
         assert!(r.is_identity());
         let k = Factor::new(0.5).unwrap();
         let make = || {
@@ -590,9 +606,8 @@ mod tests {
             Value::max(vec![tex(0, Channel::R), tex(0, Channel::G)]).unwrap(),
             Factor::ONE,
         );
-        let at = |r: f64, g: f64| {
-            v.eval(&mut |t: &Texel| if t.channel == Channel::R { r } else { g })
-        };
+        let at =
+            |r: f64, g: f64| v.eval(&mut |t: &Texel| if t.channel == Channel::R { r } else { g });
         assert_eq!(at(0.25, 0.5), 0.5);
         assert_eq!(at(0.5, 0.25), 1.0);
         assert_eq!(at(0.0, 0.0), 1.0);

@@ -48,7 +48,11 @@ pub fn decode_table_8() -> &'static [f64; 256] {
 /// Linear light of every 16-bit sRGB code: `table[c] = decode(c / 65535)`. Built on first use.
 pub fn decode_table_16() -> &'static [f64] {
     static TABLE: OnceLock<Box<[f64]>> = OnceLock::new();
-    TABLE.get_or_init(|| (0..=65535u32).map(|c| decode(f64::from(c) / 65535.0)).collect())
+    TABLE.get_or_init(|| {
+        (0..=65535u32)
+            .map(|c| decode(f64::from(c) / 65535.0))
+            .collect()
+    })
 }
 
 /// Normalised value of every 8-bit linear code: `table[c] = c / 255`.
@@ -111,7 +115,10 @@ mod tests {
     fn the_codes_either_side_of_the_threshold_use_their_own_segment() {
         // 8-bit: 10/255 = 0.0392 is on the toe, 11/255 = 0.0431 on the power segment.
         assert_eq!(decode_table_8()[10], (10.0 / 255.0) / 12.92);
-        assert_eq!(decode_table_8()[11], ((11.0f64 / 255.0 + 0.055) / 1.055).powf(2.4));
+        assert_eq!(
+            decode_table_8()[11],
+            ((11.0f64 / 255.0 + 0.055) / 1.055).powf(2.4)
+        );
         // 16-bit: 2650/65535 = 0.040436 toe, 2651/65535 = 0.040452 power.
         assert_eq!(decode_table_16()[2650], (2650.0 / 65535.0) / 12.92);
         assert_eq!(
