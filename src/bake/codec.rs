@@ -296,3 +296,175 @@ pub fn encode(
     }
     Ok(out)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bake::recipe::Channel;
+
+    fn fixture(name: &str) -> Pixels {
+        let path = format!("{}/fixtures/bake/{name}", env!("CARGO_MANIFEST_DIR"));
+        let bytes = std::fs::read(&path).unwrap();
+        let (pixels, format) = decode(&bytes).unwrap();
+        assert_eq!(format, SourceFormat::Png);
+        pixels
+    }
+
+    fn codes(p: &Pixels) -> Vec<u32> {
+        (0..p.samples().len())
+            .map(|i| p.samples().code(i))
+            .collect()
+    }
+
+    fn sample_image(layout: Layout, depth: Depth) -> Pixels {
+        let n = 5 * 3 * layout.channels();
+        let samples = match depth {
+            Depth::Eight => Samples::U8((0..n).map(|i| (i * 37 % 256) as u8).collect()),
+            Depth::Sixteen => Samples::U16((0..n).map(|i| (i * 7919 % 65536) as u16).collect()),
+        };
+        Pixels::new(5, 3, layout, samples).unwrap()
+    }
+
+    const LAYOUTS: [Layout; 4] = [Layout::Grey, Layout::GreyAlpha, Layout::Rgb, Layout::Rgba];
+
+    #[test]
+    fn png_round_trips_every_layout_at_8_and_16_bits() {
+        for layout in LAYOUTS {
+            for depth in [Depth::Eight, Depth::Sixteen] {
+                let image = sample_image(layout, depth);
+                for png in [
+                    PngCompression::Fast,
+                    PngCompression::Default,
+                    PngCompression::Best,
+                ] {
+                    let options = EncodeOptions {
+                        png,
+                        ..EncodeOptions::default()
+                    };
+                    let bytes = encode(&image, OutputFormat::Png, options).unwrap();
+                    let (back, format) = decode(&bytes).unwrap();
+                    assert_eq!(format, SourceFormat::Png);
+                    assert_eq!(back, image, "{layout:?} {depth:?} {png:?}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn lossless_webp_round_trips_8_bit_images() {
+        for layout in [Layout::Rgb, Layout::Rgba] {
+            let image = sample_image(layout, Depth::Eight);
+            let bytes =
+                encode(&image, OutputFormat::WebpLossless, EncodeOptions::default()).unwrap();
+            assert_eq!(sniff(&bytes), Some(SourceFormat::Webp));
+            let (back, _) = decode(&bytes).unwrap();
+            assert_eq!(back, image, "{layout:?}");
+        }
+    }
+
+    #[test]
+    fn jpeg_decodes_to_8_bit_rgb_or_grey() {
+        for layout in [Layout::Grey, Layout::Rgb] {
+            let image =
+                Pixels::new(8, 8, layout, Samples::U8(vec![90; 64 * layout.channels()])).unwrap();
+            let bytes = encode(&image, OutputFormat::Jpeg, EncodeOptions::default()).unwrap();
+            let (back, format) = decode(&bytes).unwrap();
+            assert_eq!(format, SourceFormat::Jpeg);
+            assert_eq!((back.layout(), back.depth()), (layout, Depth::Eight));
+            // A flat block survives JPEG to within a code.
+            assert!(
+                codes(&back).iter().all(|&c| c.abs_diff(90) <= 1),
+                "{layout:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn palette_png_expands_to_rgb_or_rgba_with_its_transparency() {
+        let p = fixture("palette_trns.png");
+        assert_eq!((p.layout(), p.depth()), (Layout::Rgba, Depth::Eight));
+        assert_eq!(
+            codes(&p),
+            vec![255, 0, 0, 255, 0, 255, 0, 128, 0, 0, 255, 255]
+        );
+        let p = fixture("palette_2bit.png");
+        assert_eq!(p.layout(), Layout::Rgb);
+        assert_eq!(
+            codes(&p),
+            vec![10, 20, 30, 40, 50, 60, 70, 80, 90, 40, 50, 60]
+        );
+    }
+
+    #[test]
+    fn low_bit_grey_png_scales_to_8_bits_and_a_colour_key_becomes_alpha() {
+        let p = fixture("grey_1bit.png");
+        assert_eq!((p.layout(), p.depth()), (Layout::Grey, Depth::Eight));
+        assert_eq!(codes(&p), vec![255, 0, 255, 255, 0, 0, 0, 0]);
+        let p = fixture("grey_4bit.png");
+        assert_eq!(codes(&p), vec![0x33, 0xff]);
+        let p = fixture("grey_trns.png");
+        assert_eq!(p.layout(), Layout::GreyAlpha);
+        assert_eq!(codes(&p), vec![0, 0, 100, 255]);
+        assert_eq!(p.code(1, 0, Channel::A), 255);
+    }
+
+    #[test]
+    fn ktx2_is_recognised_and_refused_with_its_reason() {
+        let mut bytes = b"\xabKTX 20\xbb\r\n\x1a\n".to_vec();
+        bytes.extend([0; 64]);
+        assert_eq!(sniff(&bytes), Some(SourceFormat::Ktx2));
+        let err = decode(&bytes).unwrap_err();
+        assert_eq!(
+            err,
+            CodecError::Unsupported {
+                format: "KTX2",
+                reason: KTX2_REASON
+            }
+        );
+        assert!(err.to_string().starts_with("KTX2 images cannot be baked: "));
+    }
+
+    #[test]
+    fn unknown_and_damaged_data_are_errors_not_panics() {
+        assert_eq!(
+            decode(b"GIF89a..").unwrap_err(),
+            CodecError::Unrecognised("47 49 46 38 39 61 2e 2e".into())
+        );
+        assert_eq!(
+            decode(b"").unwrap_err(),
+            CodecError::Unrecognised("no bytes".into())
+        );
+        let image = sample_image(Layout::Rgba, Depth::Eight);
+        let bytes = encode(&image, OutputFormat::Png, EncodeOptions::default()).unwrap();
+        let err = decode(&bytes[..bytes.len() / 2]).unwrap_err();
+        assert!(
+            matches!(err, CodecError::Decode { format: "PNG", .. }),
+            "{err:?}"
+        );
+    }
+
+    #[test]
+    fn output_formats_follow_the_source_unless_the_pixels_do_not_fit() {
+        use OutputFormat::*;
+        let f = output_format;
+        assert_eq!(
+            f(SourceFormat::Png, false, Layout::Rgba, Depth::Sixteen),
+            Png
+        );
+        assert_eq!(f(SourceFormat::Jpeg, false, Layout::Rgb, Depth::Eight), Png);
+        assert_eq!(f(SourceFormat::Jpeg, true, Layout::Rgb, Depth::Eight), Jpeg);
+        assert_eq!(f(SourceFormat::Jpeg, true, Layout::Rgba, Depth::Eight), Png);
+        assert_eq!(
+            f(SourceFormat::Webp, false, Layout::Rgba, Depth::Eight),
+            WebpLossless
+        );
+        assert_eq!(
+            f(SourceFormat::Webp, false, Layout::Rgba, Depth::Sixteen),
+            Png
+        );
+        assert_eq!(
+            (Png.mime_type(), WebpLossless.extension()),
+            ("image/png", "webp")
+        );
+    }
+}

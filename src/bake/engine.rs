@@ -37,7 +37,7 @@ impl ImageSource for HashMap<ImageId, Vec<u8>> {
     fn image_bytes(&self, image: ImageId) -> Result<Cow<'_, [u8]>, String> {
         self.get(&image)
             .map(|b| Cow::Borrowed(b.as_slice()))
-            .ok_or_else(|| format!("{image} does not exist"))
+            .ok_or_else(|| "no such image".to_owned())
     }
 }
 
@@ -317,4 +317,206 @@ fn bake_one(
         uniform,
         stats,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bake::codec::EncodeOptions;
+    use crate::bake::pixels::Samples;
+    use crate::bake::recipe::{Channel, ChannelRecipe, Factor, Transfer, Value};
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    use std::sync::Mutex;
+
+    /// Serves encoded images and counts how often each is fetched.
+    struct Counting {
+        images: HashMap<ImageId, Vec<u8>>,
+        fetches: Mutex<HashMap<ImageId, usize>>,
+        total: AtomicUsize,
+    }
+
+    impl Counting {
+        fn new(images: Vec<(usize, Vec<u8>)>) -> Counting {
+            Counting {
+                images: images.into_iter().map(|(i, b)| (ImageId(i), b)).collect(),
+                fetches: Mutex::new(HashMap::new()),
+                total: AtomicUsize::new(0),
+            }
+        }
+    }
+
+    impl ImageSource for Counting {
+        fn image_bytes(&self, image: ImageId) -> Result<Cow<'_, [u8]>, String> {
+            *self.fetches.lock().unwrap().entry(image).or_default() += 1;
+            self.total.fetch_add(1, Ordering::Relaxed);
+            self.images.image_bytes(image)
+        }
+    }
+
+    fn png(layout: Layout, codes: Vec<u8>, width: u32) -> Vec<u8> {
+        let height = (codes.len() / layout.channels()) as u32 / width;
+        let p = Pixels::new(width, height, layout, Samples::U8(codes)).unwrap();
+        codec::encode(&p, OutputFormat::Png, EncodeOptions::default()).unwrap()
+    }
+
+    fn colour_bake(image: usize, factor: f64) -> Recipe {
+        let k = Factor::new(factor).unwrap();
+        let mut r = Recipe::new(ImageId(image));
+        for c in [Channel::R, Channel::G, Channel::B] {
+            let v = Value::scaled(Value::texel(ImageId(image), c, Transfer::Srgb), k);
+            r = r.with(c, ChannelRecipe::computed(v, Transfer::Srgb));
+        }
+        r
+    }
+
+    #[test]
+    fn equal_recipes_share_one_output() {
+        let mut set = RecipeSet::new();
+        let a = set.insert(colour_bake(0, 0.5));
+        let b = set.insert(colour_bake(1, 0.5));
+        let c = set.insert(colour_bake(0, 0.5));
+        assert_eq!((a, b, c), (OutputId(0), OutputId(1), OutputId(0)));
+        assert_eq!(set.len(), 2);
+        assert_eq!(set.images(), vec![ImageId(0), ImageId(1)]);
+    }
+
+    #[test]
+    fn each_image_is_fetched_and_decoded_once_however_many_recipes_read_it() {
+        let source = Counting::new(vec![
+            (
+                0,
+                png(Layout::Rgba, vec![200, 100, 50, 255, 10, 20, 30, 40], 2),
+            ),
+            (1, png(Layout::Grey, vec![255, 0], 2)),
+            (2, png(Layout::Rgb, vec![1, 2, 3, 4, 5, 6], 2)),
+        ]);
+        let mut set = RecipeSet::new();
+        set.insert(colour_bake(0, 0.5));
+        set.insert(colour_bake(0, 0.25));
+        let roughness = Recipe::new(ImageId(0)).with(
+            Channel::A,
+            ChannelRecipe::computed(
+                Value::product(vec![
+                    Value::texel(ImageId(0), Channel::A, Transfer::Linear),
+                    Value::texel(ImageId(1), Channel::R, Transfer::Linear),
+                ])
+                .unwrap(),
+                Transfer::Linear,
+            ),
+        );
+        set.insert(roughness);
+        set.insert(colour_bake(2, 0.5));
+        let results = bake(&set, &source, &BakeOptions::default());
+        assert_eq!(results.len(), 4);
+        assert!(results.iter().all(Result::is_ok));
+        let fetches = source.fetches.lock().unwrap().clone();
+        assert_eq!(
+            fetches,
+            HashMap::from([(ImageId(0), 1), (ImageId(1), 1), (ImageId(2), 1)])
+        );
+        // The roughness output: alpha 255 * 1 and 40 * 0.
+        let (format, bytes) = results[2].as_ref().unwrap().encoded.clone().unwrap();
+        assert_eq!(format, OutputFormat::Png);
+        let (out, _) = codec::decode(&bytes).unwrap();
+        assert_eq!(
+            out.samples(),
+            &Samples::U8(vec![200, 100, 50, 255, 10, 20, 30, 0])
+        );
+    }
+
+    #[test]
+    fn a_failing_image_fails_only_the_recipes_that_read_it() {
+        let mut ktx2 = b"\xabKTX 20\xbb\r\n\x1a\n".to_vec();
+        ktx2.extend([0; 32]);
+        let source = Counting::new(vec![
+            (0, png(Layout::Rgb, vec![1, 2, 3], 1)),
+            (1, ktx2),
+            (2, b"not an image".to_vec()),
+        ]);
+        let mut set = RecipeSet::new();
+        set.insert(colour_bake(0, 0.5));
+        set.insert(colour_bake(1, 0.5));
+        set.insert(colour_bake(2, 0.5));
+        set.insert(colour_bake(3, 0.5));
+        let results = bake(&set, &source, &BakeOptions::default());
+        assert!(results[0].is_ok());
+        let ktx = results[1].as_ref().unwrap_err();
+        assert!(ktx.is_unsupported_format());
+        assert!(
+            ktx.to_string()
+                .starts_with("image 1: KTX2 images cannot be baked"),
+            "{ktx}"
+        );
+        let bad = results[2].as_ref().unwrap_err();
+        assert!(!bad.is_unsupported_format());
+        assert_eq!(
+            bad.to_string(),
+            "image 2: not a PNG, JPEG, WebP or KTX2 image (starts with 6e 6f 74 20 61 6e 20 69)"
+        );
+        assert_eq!(
+            results[3].as_ref().unwrap_err().to_string(),
+            "image 3: no such image"
+        );
+    }
+
+    #[test]
+    fn uniform_outputs_are_collapsed_only_when_asked() {
+        let source = Counting::new(vec![(
+            0,
+            png(Layout::Rgb, vec![200, 100, 50, 200, 100, 50], 2),
+        )]);
+        let mut set = RecipeSet::new();
+        set.insert(colour_bake(0, 0.5));
+        let kept = bake(&set, &source, &BakeOptions::default());
+        assert!(kept[0].as_ref().unwrap().encoded.is_some());
+        assert_eq!(kept[0].as_ref().unwrap().uniform, None);
+        let options = BakeOptions {
+            collapse_uniform: true,
+            ..BakeOptions::default()
+        };
+        let collapsed = bake(&set, &source, &options);
+        let baked = collapsed[0].as_ref().unwrap();
+        assert_eq!(baked.encoded, None);
+        let half = |c: f64| {
+            crate::bake::srgb::quantise(
+                crate::bake::srgb::encode(0.5 * crate::bake::srgb::decode(c / 255.0)),
+                255,
+            )
+        };
+        assert_eq!(
+            baked.uniform,
+            Some(vec![half(200.0), half(100.0), half(50.0)])
+        );
+    }
+
+    #[test]
+    fn jpeg_sources_become_png_unless_the_format_is_kept() {
+        let p = Pixels::new(8, 8, Layout::Rgb, Samples::U8(vec![128; 192])).unwrap();
+        let jpeg = codec::encode(&p, OutputFormat::Jpeg, EncodeOptions::default()).unwrap();
+        let source = Counting::new(vec![(0, jpeg)]);
+        let mut set = RecipeSet::new();
+        set.insert(colour_bake(0, 0.5));
+        let png_out = bake(&set, &source, &BakeOptions::default());
+        let baked = png_out[0].as_ref().unwrap();
+        assert_eq!(baked.source_format, SourceFormat::Jpeg);
+        assert_eq!(baked.encoded.as_ref().unwrap().0, OutputFormat::Png);
+        let options = BakeOptions {
+            keep_format: true,
+            ..BakeOptions::default()
+        };
+        let kept = bake(&set, &source, &options);
+        assert_eq!(
+            kept[0].as_ref().unwrap().encoded.as_ref().unwrap().0,
+            OutputFormat::Jpeg
+        );
+    }
+
+    #[test]
+    fn components_group_recipes_that_share_images() {
+        let pair = |a: usize, b: usize| {
+            Recipe::new(ImageId(a)).with(Channel::A, ChannelRecipe::Copy(ImageId(b), Channel::R))
+        };
+        let recipes = vec![pair(0, 1), pair(2, 3), pair(1, 4), pair(5, 5), pair(4, 2)];
+        assert_eq!(components(&recipes), vec![vec![0, 1, 2, 4], vec![3]]);
+    }
 }
