@@ -1,4 +1,13 @@
 //! velvet: validate, migrate and bake glTF 2.0 assets that use KHR_materials_sheen and
 //! KHR_materials_fuzz.
+//!
+//! The flow is one way: load ([`asset`]) → validate ([`validate`], [`rules`]) → report
+//! ([`report`]). The binary in `main.rs` only parses arguments and maps outcomes to exit codes.
 
+pub mod asset;
 pub mod bake;
+pub mod diagnostics;
+pub mod layers;
+pub mod report;
+pub mod rules;
+pub mod validate;

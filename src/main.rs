@@ -1,1 +1,141 @@
-fn main() {}
+//! The `velvet` command line: parses arguments, calls the library, maps outcomes to exit
+//! codes (0 clean, 1 issues at or above --fail-on or a file failed, 2 usage or configuration
+//! error).
+
+use clap::{Parser, Subcommand, ValueEnum};
+use std::path::PathBuf;
+use std::process::ExitCode;
+use velvet::diagnostics::{self, FailOn, Settings};
+use velvet::rules::schema::Schemas;
+use velvet::validate::Validator;
+
+#[derive(Parser)]
+#[command(name = "velvet", version, about = "Validate, migrate and bake glTF assets that use KHR_materials_sheen and KHR_materials_fuzz")]
+#[command(after_help = "Exit status: 0 clean, 1 issues at or above --fail-on (or a file failed), 2 usage or configuration error.")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Check .gltf/.glb files (and folders, recursively) against the sheen and fuzz specs.
+    Validate(ValidateArgs),
+    /// List every code velvet reports, with its severity and description.
+    Codes {
+        #[arg(long, value_enum, default_value_t = CodesFormat::Text)]
+        format: CodesFormat,
+    },
+}
+
+#[derive(clap::Args)]
+struct ValidateArgs {
+    /// Files and folders to check (folders are searched for *.gltf and *.glb).
+    #[arg(required = true)]
+    paths: Vec<PathBuf>,
+    #[arg(long, value_enum, default_value_t = Format::Text)]
+    format: Format,
+    /// Report at most N issues per file (the report then says truncated).
+    #[arg(long, value_name = "N")]
+    max_issues: Option<usize>,
+    /// Leave out issues with this code (repeatable).
+    #[arg(long, value_name = "CODE")]
+    ignore: Vec<String>,
+    /// The lowest severity that makes the exit status 1.
+    #[arg(long, value_enum, default_value_t = FailOnArg::Error)]
+    fail_on: FailOnArg,
+    /// Read schema files from DIR instead of the built-in ones (files absent there stay built-in).
+    #[arg(long, value_name = "DIR")]
+    schema_dir: Option<PathBuf>,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Format {
+    Text,
+    Json,
+    Jsonl,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum CodesFormat {
+    Text,
+    Markdown,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum FailOnArg {
+    Error,
+    Warning,
+    Info,
+}
+
+fn usage_error(message: impl std::fmt::Display) -> ExitCode {
+    eprintln!("velvet: {message}");
+    ExitCode::from(2)
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match cli.command {
+        Command::Validate(args) => validate(args),
+        Command::Codes { format } => {
+            print!("{}", codes_table(format));
+            ExitCode::SUCCESS
+        }
+    }
+}
+
+fn codes_table(format: CodesFormat) -> String {
+    let codes = diagnostics::all_codes();
+    match format {
+        CodesFormat::Text => {
+            let width = codes.iter().map(|c| c.name.len()).max().unwrap_or(0);
+            codes.iter().map(|c| format!("{:width$}  {:7}  {}\n", c.name, c.severity.as_str(), c.doc)).collect()
+        }
+        CodesFormat::Markdown => {
+            let mut out = String::from("| code | severity | meaning |\n|---|---|---|\n");
+            for c in codes {
+                out += &format!("| `{}` | {} | {} |\n", c.name, c.severity, c.doc.replace('|', "\\|"));
+            }
+            out
+        }
+    }
+}
+
+fn validate(args: ValidateArgs) -> ExitCode {
+    for code in &args.ignore {
+        if diagnostics::find_code(code).is_none() {
+            return usage_error(format!("--ignore {code}: no such code (`velvet codes` lists them)"));
+        }
+    }
+    let schemas = match &args.schema_dir {
+        Some(dir) => match Schemas::with_overrides(dir) {
+            Ok(s) => s,
+            Err(e) => return usage_error(e),
+        },
+        None => Schemas::builtin(),
+    };
+    let settings = Settings {
+        ignore: args.ignore.iter().cloned().collect(),
+        severity_overrides: Default::default(),
+        max_issues: args.max_issues,
+        fail_on: match args.fail_on {
+            FailOnArg::Error => FailOn::Error,
+            FailOnArg::Warning => FailOn::Warning,
+            FailOnArg::Info => FailOn::Info,
+        },
+    };
+    let validator = Validator::new(schemas, settings);
+    let reports = validator.validate_inputs(&args.paths);
+    let text = match args.format {
+        Format::Text => velvet::report::text::render(&reports),
+        Format::Json => velvet::report::json::render(&reports),
+        Format::Jsonl => velvet::report::json::render_lines(&reports),
+    };
+    print!("{text}");
+    if reports.iter().any(|r| r.fails(&validator.settings)) {
+        ExitCode::from(1)
+    } else {
+        ExitCode::SUCCESS
+    }
+}

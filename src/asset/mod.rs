@@ -1,0 +1,247 @@
+//! Asset I/O: turning a .gltf or .glb file into an [`Asset`] (the JSON as an order-preserving
+//! `serde_json::Value`, which is the source of truth, plus the GLB BIN chunk), lazy access to
+//! buffers and images, JSON pointers and source positions, and the atomic writer.
+//!
+//! Nothing external is opened while loading: buffers and images are read when a rule or a
+//! conversion asks, and for images only the header when that is enough.
+
+pub mod discover;
+pub mod glb;
+pub mod pointer;
+pub mod position;
+pub mod resource;
+pub mod write;
+
+use crate::diagnostics::{codes, Diagnostic};
+use resource::{ImageHeader, Location};
+use serde_json::Value;
+use std::borrow::Cow;
+use std::collections::HashMap;
+use std::io::{BufReader, Cursor};
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+/// The file format an asset came in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Container {
+    Gltf,
+    Glb,
+}
+
+impl Container {
+    pub fn mime_type(self) -> &'static str {
+        match self {
+            Container::Gltf => "model/gltf+json",
+            Container::Glb => "model/gltf-binary",
+        }
+    }
+}
+
+/// A loaded asset. `json` is what velvet reads and edits; `json_text` is the JSON as it was in
+/// the file, kept for source positions and for byte-identical output when nothing changes.
+#[derive(Debug)]
+pub struct Asset {
+    pub path: PathBuf,
+    pub container: Container,
+    pub json: Value,
+    pub json_text: String,
+    /// Byte offset of `json_text` in the file (20 in a GLB, 3 after a byte-order mark).
+    pub json_offset: usize,
+    /// The GLB BIN chunk, if any.
+    pub bin: Option<Vec<u8>>,
+    image_headers: Mutex<HashMap<usize, Result<ImageHeader, Diagnostic>>>,
+}
+
+/// The outcome of loading one file: the asset when its JSON could be read, and every fault
+/// found on the way.
+#[derive(Debug)]
+pub struct Loaded {
+    pub asset: Option<Asset>,
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+/// Reads and parses one file. Never fails: faults become diagnostics.
+pub fn load(path: &Path) -> Loaded {
+    match std::fs::read(path) {
+        Ok(bytes) => load_bytes(path, &bytes),
+        Err(e) => Loaded {
+            asset: None,
+            diagnostics: vec![Diagnostic::new(&codes::IO_ERROR, "", format!("cannot read {}: {e}", path.display()))],
+        },
+    }
+}
+
+/// Parses the bytes of a file that lives (or would live) at `path`; `path` is used for the
+/// container kind (when the bytes do not tell) and to resolve relative URIs.
+pub fn load_bytes(path: &Path, bytes: &[u8]) -> Loaded {
+    let mut diagnostics = Vec::new();
+    let is_glb = bytes.starts_with(b"glTF")
+        || path.extension().is_some_and(|e| e.eq_ignore_ascii_case("glb"));
+    let (container, json_bytes, json_offset, bin) = if is_glb {
+        match glb::split(bytes, &mut diagnostics) {
+            Some(parts) => (Container::Glb, parts.json, parts.json_offset, parts.bin.map(<[u8]>::to_vec)),
+            None => return Loaded { asset: None, diagnostics },
+        }
+    } else {
+        (Container::Gltf, bytes, 0, None)
+    };
+    let (json_bytes, json_offset) = match json_bytes.strip_prefix(b"\xEF\xBB\xBF") {
+        Some(rest) => {
+            diagnostics.push(Diagnostic::new(
+                &codes::BOM_PRESENT,
+                "",
+                "the JSON starts with a UTF-8 byte-order mark; glTF requires UTF-8 without one",
+            ));
+            (rest, json_offset + 3)
+        }
+        None => (json_bytes, json_offset),
+    };
+    let json_text = match std::str::from_utf8(json_bytes) {
+        Ok(text) => text.to_string(),
+        Err(e) => {
+            let at = e.valid_up_to();
+            let line = json_bytes[..at].iter().filter(|b| **b == b'\n').count() + 1;
+            let line_start = json_bytes[..at].iter().rposition(|b| *b == b'\n').map_or(0, |p| p + 1);
+            let column = String::from_utf8_lossy(&json_bytes[line_start..at]).chars().count() + 1;
+            diagnostics.push(Diagnostic::new(
+                &codes::INVALID_JSON,
+                "",
+                format!("invalid UTF-8 at line {line}, column {column} (byte {})", json_offset + at),
+            ));
+            return Loaded { asset: None, diagnostics };
+        }
+    };
+    // A GLB's JSON chunk may carry NUL padding (reported by glb::split); parse past it.
+    let parse_text = json_text.trim_end_matches(['\0', ' ']);
+    let json: Value = match serde_json::from_str(parse_text) {
+        Ok(v) => v,
+        Err(e) => {
+            diagnostics.push(Diagnostic::new(
+                &codes::INVALID_JSON,
+                "",
+                format!("line {}, column {}: {}", e.line(), e.column(), strip_position(&e.to_string())),
+            ));
+            return Loaded { asset: None, diagnostics };
+        }
+    };
+    if !json.is_object() {
+        diagnostics.push(Diagnostic::new(&codes::INVALID_JSON_ROOT_OBJECT, "", "the JSON root is not an object"));
+        return Loaded { asset: None, diagnostics };
+    }
+    Loaded {
+        asset: Some(Asset {
+            path: path.to_path_buf(),
+            container,
+            json,
+            json_text,
+            json_offset,
+            bin,
+            image_headers: Mutex::new(HashMap::new()),
+        }),
+        diagnostics,
+    }
+}
+
+/// serde_json appends " at line L column C"; velvet states the position itself, first.
+fn strip_position(message: &str) -> &str {
+    message.rsplit_once(" at line ").map_or(message, |(m, _)| m)
+}
+
+impl Asset {
+    /// The folder relative URIs are resolved against.
+    pub fn base_dir(&self) -> &Path {
+        self.path.parent().unwrap_or(Path::new("."))
+    }
+
+    /// The bytes of buffer `index`: the GLB BIN chunk, a `data:` URI or a file.
+    pub fn buffer_bytes(&self, index: usize) -> Result<Cow<'_, [u8]>, Diagnostic> {
+        let pointer = format!("/buffers/{index}");
+        let buffer = self.json.pointer(&pointer).ok_or_else(|| {
+            Diagnostic::new(&crate::rules::references::UNRESOLVED_REFERENCE, &pointer, format!("buffer {index} does not exist"))
+        })?;
+        match buffer.get("uri").and_then(Value::as_str) {
+            Some(uri) => self.read_uri(uri, &format!("{pointer}/uri")).map(Cow::Owned),
+            None => match (&self.bin, index) {
+                (Some(bin), 0) => Ok(Cow::Borrowed(bin.as_slice())),
+                _ => Err(Diagnostic::new(
+                    &codes::IO_ERROR,
+                    &pointer,
+                    format!("buffer {index} has no uri and is not the GLB's BIN chunk"),
+                )),
+            },
+        }
+    }
+
+    /// The encoded bytes of image `index`, from its URI or its bufferView.
+    pub fn image_bytes(&self, index: usize) -> Result<Cow<'_, [u8]>, Diagnostic> {
+        let pointer = format!("/images/{index}");
+        let image = self.json.pointer(&pointer).ok_or_else(|| {
+            Diagnostic::new(&crate::rules::references::UNRESOLVED_REFERENCE, &pointer, format!("image {index} does not exist"))
+        })?;
+        if let Some(uri) = image.get("uri").and_then(Value::as_str) {
+            return self.read_uri(uri, &format!("{pointer}/uri")).map(Cow::Owned);
+        }
+        let view_index = image.get("bufferView").and_then(Value::as_u64).ok_or_else(|| {
+            Diagnostic::new(&codes::IO_ERROR, &pointer, format!("image {index} has neither a uri nor a bufferView"))
+        })?;
+        self.buffer_view_bytes(view_index as usize, &format!("{pointer}/bufferView"))
+    }
+
+    fn buffer_view_bytes(&self, view_index: usize, pointer: &str) -> Result<Cow<'_, [u8]>, Diagnostic> {
+        let view = self.json.pointer(&format!("/bufferViews/{view_index}")).ok_or_else(|| {
+            Diagnostic::new(&crate::rules::references::UNRESOLVED_REFERENCE, pointer, format!("bufferView {view_index} does not exist"))
+        })?;
+        let buffer = view.get("buffer").and_then(Value::as_u64).unwrap_or(u64::MAX) as usize;
+        let offset = view.get("byteOffset").and_then(Value::as_u64).unwrap_or(0) as usize;
+        let length = view.get("byteLength").and_then(Value::as_u64).unwrap_or(0) as usize;
+        let bytes = self.buffer_bytes(buffer)?;
+        let end = offset.checked_add(length).filter(|end| *end <= bytes.len()).ok_or_else(|| {
+            Diagnostic::new(
+                &codes::BUFFER_VIEW_OUT_OF_RANGE,
+                pointer,
+                format!(
+                    "bufferView {view_index} spans bytes {offset}..{} of buffer {buffer}, which has {}",
+                    offset.saturating_add(length),
+                    bytes.len()
+                ),
+            )
+        })?;
+        Ok(match bytes {
+            Cow::Borrowed(b) => Cow::Borrowed(&b[offset..end]),
+            Cow::Owned(b) => Cow::Owned(b[offset..end].to_vec()),
+        })
+    }
+
+    fn read_uri(&self, uri: &str, pointer: &str) -> Result<Vec<u8>, Diagnostic> {
+        match resource::resolve(uri, self.base_dir(), pointer)? {
+            Location::Data { bytes, .. } => Ok(bytes),
+            Location::File(path) => std::fs::read(&path).map_err(|e| {
+                Diagnostic::new(&codes::IO_ERROR, pointer, format!("cannot read '{uri}' ({}): {e}", path.display()))
+            }),
+        }
+    }
+
+    /// The header of image `index`, read once per asset. A file is opened and only its header
+    /// read; embedded images are read from their bytes.
+    pub fn image_header(&self, index: usize) -> Result<ImageHeader, Diagnostic> {
+        let mut cache = self.image_headers.lock().unwrap_or_else(|e| e.into_inner());
+        cache.entry(index).or_insert_with(|| self.read_image_header(index)).clone()
+    }
+
+    fn read_image_header(&self, index: usize) -> Result<ImageHeader, Diagnostic> {
+        let what = format!("image {index}");
+        let pointer = format!("/images/{index}");
+        let uri = self.json.pointer(&format!("{pointer}/uri")).and_then(Value::as_str);
+        if let Some(uri) = uri {
+            let uri_pointer = format!("{pointer}/uri");
+            if let Location::File(path) = resource::resolve(uri, self.base_dir(), &uri_pointer)? {
+                let file = std::fs::File::open(&path).map_err(|e| {
+                    Diagnostic::new(&codes::IO_ERROR, &uri_pointer, format!("cannot read '{uri}' ({}): {e}", path.display()))
+                })?;
+                return resource::read_header(BufReader::new(file), &pointer, &what);
+            }
+        }
+        let bytes = self.image_bytes(index)?;
+        resource::read_header(Cursor::new(bytes.as_ref()), &pointer, &what)
+    }
+}

@@ -1,0 +1,47 @@
+//! RFC 6901 JSON pointers: building them from path segments and resolving them.
+
+use serde_json::Value;
+
+/// Escapes one reference token (`~` → `~0`, `/` → `~1`).
+pub fn escape(segment: &str) -> String {
+    segment.replace('~', "~0").replace('/', "~1")
+}
+
+/// Undoes `escape`.
+pub fn unescape(token: &str) -> String {
+    token.replace("~1", "/").replace("~0", "~")
+}
+
+/// `base` followed by one more segment.
+pub fn join(base: &str, segment: impl std::fmt::Display) -> String {
+    let segment = segment.to_string();
+    format!("{base}/{}", escape(&segment))
+}
+
+/// The reference tokens of a pointer, unescaped. `""` has none.
+pub fn tokens(pointer: &str) -> Vec<String> {
+    if pointer.is_empty() {
+        return Vec::new();
+    }
+    pointer[1..].split('/').map(unescape).collect()
+}
+
+/// The value a pointer names, if any.
+pub fn resolve<'a>(root: &'a Value, pointer: &str) -> Option<&'a Value> {
+    root.pointer(pointer)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn escapes_tilde_before_slash_so_both_round_trip() {
+        assert_eq!(escape("a/b~c"), "a~1b~0c");
+        assert_eq!(unescape("a~1b~0c"), "a/b~c");
+        assert_eq!(unescape("~01"), "~1");
+        assert_eq!(join("/extras", "x/y"), "/extras/x~1y");
+        assert_eq!(tokens("/a~1b/0/~0"), vec!["a/b", "0", "~"]);
+        assert!(tokens("").is_empty());
+    }
+}

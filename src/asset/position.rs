@@ -1,0 +1,248 @@
+//! Source positions: the line and column where the value a JSON pointer names starts in the
+//! JSON text.
+//!
+//! serde_json gives no spans, so this is a small scanner of our own. It walks the text once for
+//! a whole set of pointers, descends only into containers on the way to one of them, and skips
+//! everything else at byte speed; it is run only when a report has something to place.
+//! Columns count characters (not bytes), both 1-based.
+
+use super::pointer;
+use std::collections::{HashMap, HashSet};
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub struct Position {
+    pub line: usize,
+    pub column: usize,
+    /// Byte offset of the value's first byte in the JSON text.
+    pub offset: usize,
+}
+
+/// Locates the values named by `pointers` in `text`. Pointers that name nothing are absent
+/// from the result.
+pub fn locate<'p>(text: &str, pointers: impl IntoIterator<Item = &'p str>) -> HashMap<String, Position> {
+    let wanted: HashSet<Vec<String>> = pointers.into_iter().map(pointer::tokens).collect();
+    let mut prefixes: HashSet<Vec<String>> = HashSet::new();
+    for w in &wanted {
+        for n in 0..=w.len() {
+            prefixes.insert(w[..n].to_vec());
+        }
+    }
+    let mut scanner = Scanner {
+        bytes: text.as_bytes(),
+        text,
+        at: 0,
+        wanted: &wanted,
+        prefixes: &prefixes,
+        path: Vec::new(),
+        found: HashMap::new(),
+        line_starts: line_starts(text),
+    };
+    scanner.skip_ws();
+    scanner.value();
+    scanner.found
+}
+
+fn line_starts(text: &str) -> Vec<usize> {
+    std::iter::once(0)
+        .chain(text.bytes().enumerate().filter(|(_, b)| *b == b'\n').map(|(i, _)| i + 1))
+        .collect()
+}
+
+struct Scanner<'a> {
+    bytes: &'a [u8],
+    text: &'a str,
+    at: usize,
+    wanted: &'a HashSet<Vec<String>>,
+    prefixes: &'a HashSet<Vec<String>>,
+    path: Vec<String>,
+    found: HashMap<String, Position>,
+    line_starts: Vec<usize>,
+}
+
+impl Scanner<'_> {
+    fn position(&self, offset: usize) -> Position {
+        let line = self.line_starts.partition_point(|&s| s <= offset);
+        let start = self.line_starts[line - 1];
+        let column = self.text[start..offset].chars().count() + 1;
+        Position {
+            line,
+            column,
+            offset,
+        }
+    }
+
+    fn peek(&self) -> Option<u8> {
+        self.bytes.get(self.at).copied()
+    }
+
+    fn skip_ws(&mut self) {
+        while matches!(self.peek(), Some(b' ' | b'\t' | b'\n' | b'\r')) {
+            self.at += 1;
+        }
+    }
+
+    /// Scans one value at `self.at`; records it if wanted, descends if on the way.
+    fn value(&mut self) {
+        if self.wanted.contains(&self.path) {
+            let pointer: String = self.path.iter().map(|s| format!("/{}", pointer::escape(s))).collect();
+            let pos = self.position(self.at);
+            self.found.insert(pointer, pos);
+        }
+        let descend = self.prefixes.contains(&self.path);
+        match self.peek() {
+            Some(b'{') if descend => self.object(),
+            Some(b'[') if descend => self.array(),
+            Some(b'{' | b'[') => self.skip_container(),
+            Some(b'"') => {
+                self.string();
+            }
+            Some(_) => self.scalar(),
+            None => {}
+        }
+    }
+
+    fn object(&mut self) {
+        self.at += 1;
+        loop {
+            self.skip_ws();
+            match self.peek() {
+                Some(b'}') | None => {
+                    self.at += 1;
+                    return;
+                }
+                Some(b',') => {
+                    self.at += 1;
+                    continue;
+                }
+                Some(b'"') => {
+                    let key = self.string();
+                    self.skip_ws();
+                    if self.peek() == Some(b':') {
+                        self.at += 1;
+                    }
+                    self.skip_ws();
+                    self.path.push(key);
+                    self.value();
+                    self.path.pop();
+                }
+                Some(_) => {
+                    // Not JSON we understand: stop rather than guess.
+                    self.at = self.bytes.len();
+                    return;
+                }
+            }
+        }
+    }
+
+    fn array(&mut self) {
+        self.at += 1;
+        let mut index = 0usize;
+        loop {
+            self.skip_ws();
+            match self.peek() {
+                Some(b']') | None => {
+                    self.at += 1;
+                    return;
+                }
+                Some(b',') => {
+                    self.at += 1;
+                    index += 1;
+                    continue;
+                }
+                Some(_) => {
+                    self.path.push(index.to_string());
+                    self.value();
+                    self.path.pop();
+                }
+            }
+        }
+    }
+
+    /// Reads a string token, returning its decoded content.
+    fn string(&mut self) -> String {
+        let start = self.at;
+        self.at += 1;
+        while let Some(b) = self.peek() {
+            self.at += 1;
+            match b {
+                b'\\' => self.at += 1,
+                b'"' => break,
+                _ => {}
+            }
+        }
+        let raw = &self.text[start..self.at.min(self.bytes.len())];
+        serde_json::from_str::<String>(raw).unwrap_or_else(|_| raw.trim_matches('"').to_string())
+    }
+
+    fn scalar(&mut self) {
+        while let Some(b) = self.peek() {
+            if matches!(b, b',' | b'}' | b']' | b' ' | b'\t' | b'\n' | b'\r') {
+                break;
+            }
+            self.at += 1;
+        }
+    }
+
+    fn skip_container(&mut self) {
+        let mut depth = 0usize;
+        while let Some(b) = self.peek() {
+            match b {
+                b'"' => {
+                    self.at += 1;
+                    while let Some(c) = self.peek() {
+                        self.at += 1;
+                        match c {
+                            b'\\' => self.at += 1,
+                            b'"' => break,
+                            _ => {}
+                        }
+                    }
+                    continue;
+                }
+                b'{' | b'[' => depth += 1,
+                b'}' | b']' => {
+                    depth -= 1;
+                    if depth == 0 {
+                        self.at += 1;
+                        return;
+                    }
+                }
+                _ => {}
+            }
+            self.at += 1;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn at(text: &str, p: &str) -> Option<(usize, usize)> {
+        locate(text, [p]).get(p).map(|pos| (pos.line, pos.column))
+    }
+
+    #[test]
+    fn finds_values_in_pretty_printed_json() {
+        let text = "{\n  \"materials\": [\n    {\n      \"name\": \"a\",\n      \"x\": [1, 2]\n    }\n  ]\n}\n";
+        assert_eq!(at(text, "/materials/0/name"), Some((4, 15)));
+        assert_eq!(at(text, "/materials/0/x/1"), Some((5, 16)));
+        assert_eq!(at(text, "/materials/0"), Some((3, 5)));
+        assert_eq!(at(text, ""), Some((1, 1)));
+        assert_eq!(at(text, "/materials/1"), None);
+    }
+
+    #[test]
+    fn finds_values_in_minified_json_skipping_siblings_with_brackets_in_strings() {
+        let text = r#"{"a":{"s":"]}{["},"b":[{"c":true},{"c":false}]}"#;
+        assert_eq!(at(text, "/b/1/c"), Some((1, 41)));
+        assert_eq!(at(text, "/a/s"), Some((1, 11)));
+    }
+
+    #[test]
+    fn escaped_keys_and_non_ascii_columns_count_characters() {
+        let text = "{\"név\": \"ü\", \"a/b\": {\"~k\": 1}}";
+        assert_eq!(at(text, "/a~1b/~0k"), Some((1, 28)));
+        assert_eq!(at(text, "/név"), Some((1, 9)));
+    }
+}

@@ -1,0 +1,265 @@
+//! External resources: resolving a buffer's or image's URI (relative path, percent-decoded, or
+//! `data:` base64) and reading image headers without decoding pixels.
+//!
+//! URIs are refused unless they are `data:` or a relative path that stays inside the asset's
+//! folder: velvet runs unattended over assets nobody checked, and must not read `/etc/passwd`
+//! because a glTF names it.
+
+use crate::diagnostics::{codes, Diagnostic};
+use base64::Engine;
+use std::path::{Component, Path, PathBuf};
+
+/// Where a URI leads.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Location {
+    /// The decoded bytes of a `data:` URI, with its media type.
+    Data { media_type: String, bytes: Vec<u8> },
+    /// A file next to the asset.
+    File(PathBuf),
+}
+
+/// Resolves `uri` against `base_dir`. `pointer` names the URI in the document, for diagnostics.
+pub fn resolve(uri: &str, base_dir: &Path, pointer: &str) -> Result<Location, Diagnostic> {
+    if let Some(rest) = uri.strip_prefix("data:") {
+        let (header, payload) = rest.split_once(',').ok_or_else(|| {
+            Diagnostic::new(&codes::INVALID_URI, pointer, "the data: URI has no ',' before its payload")
+        })?;
+        let Some(media_type) = header.strip_suffix(";base64") else {
+            return Err(Diagnostic::new(
+                &codes::INVALID_URI,
+                pointer,
+                "the data: URI is not base64-encoded (glTF requires ';base64')",
+            ));
+        };
+        let bytes = base64::engine::general_purpose::STANDARD
+            .decode(payload.trim_end())
+            .map_err(|e| Diagnostic::new(&codes::INVALID_URI, pointer, format!("the data: URI's base64 is invalid: {e}")))?;
+        return Ok(Location::Data {
+            media_type: media_type.to_string(),
+            bytes,
+        });
+    }
+    if has_scheme(uri) {
+        return Err(Diagnostic::new(
+            &codes::URI_NOT_FOLLOWED,
+            pointer,
+            format!("'{uri}' has a URL scheme; only data: URIs and relative paths are read"),
+        ));
+    }
+    let decoded = percent_encoding::percent_decode_str(uri)
+        .decode_utf8()
+        .map_err(|_| Diagnostic::new(&codes::INVALID_URI, pointer, format!("'{uri}' does not percent-decode to UTF-8")))?;
+    let relative = Path::new(decoded.as_ref());
+    let mut depth: i64 = 0;
+    for component in relative.components() {
+        match component {
+            Component::Normal(_) => depth += 1,
+            Component::CurDir => {}
+            Component::ParentDir => {
+                depth -= 1;
+                if depth < 0 {
+                    return Err(Diagnostic::new(
+                        &codes::URI_NOT_FOLLOWED,
+                        pointer,
+                        format!("'{uri}' climbs out of the asset's folder"),
+                    ));
+                }
+            }
+            Component::RootDir | Component::Prefix(_) => {
+                return Err(Diagnostic::new(
+                    &codes::URI_NOT_FOLLOWED,
+                    pointer,
+                    format!("'{uri}' is an absolute path; only relative paths are read"),
+                ))
+            }
+        }
+    }
+    Ok(Location::File(base_dir.join(relative)))
+}
+
+/// RFC 3986 scheme: a letter, then letters, digits, '+', '-' or '.', then ':'. A Windows drive
+/// letter ("C:") counts too, which is what we want: it is not a relative path either.
+fn has_scheme(uri: &str) -> bool {
+    match uri.split_once(':') {
+        Some((scheme, _)) => {
+            let mut chars = scheme.chars();
+            chars.next().is_some_and(|c| c.is_ascii_alphabetic())
+                && chars.all(|c| c.is_ascii_alphanumeric() || matches!(c, '+' | '-' | '.'))
+        }
+        None => false,
+    }
+}
+
+/// An image's container format, from its first bytes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ImageFormat {
+    Png,
+    Jpeg,
+    Webp,
+    Ktx2,
+}
+
+impl ImageFormat {
+    pub fn sniff(bytes: &[u8]) -> Option<ImageFormat> {
+        if bytes.starts_with(b"\x89PNG\r\n\x1a\n") {
+            Some(ImageFormat::Png)
+        } else if bytes.starts_with(&[0xFF, 0xD8, 0xFF]) {
+            Some(ImageFormat::Jpeg)
+        } else if bytes.len() >= 12 && &bytes[0..4] == b"RIFF" && &bytes[8..12] == b"WEBP" {
+            Some(ImageFormat::Webp)
+        } else if bytes.starts_with(b"\xABKTX 20\xBB\r\n\x1A\n") {
+            Some(ImageFormat::Ktx2)
+        } else {
+            None
+        }
+    }
+}
+
+/// What an image's header says, read without decoding pixels.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ImageHeader {
+    pub format: ImageFormat,
+    pub width: u32,
+    pub height: u32,
+    /// Channels after the decoder's expansion (a PNG palette or tRNS chunk counts as its
+    /// expanded form). `None` where the header does not tell (KTX2).
+    pub channels: Option<u8>,
+    pub has_alpha: Option<bool>,
+    /// Bits per channel, where known.
+    pub bits: Option<u8>,
+}
+
+/// Reads the header of an image whose first bytes `reader` yields. Only the header is read
+/// from the reader (for PNG, up to the first image-data chunk).
+pub fn read_header<R: std::io::BufRead + std::io::Seek>(
+    mut reader: R,
+    pointer: &str,
+    what: &str,
+) -> Result<ImageHeader, Diagnostic> {
+    use image::ImageDecoder;
+    let unrecognized = |detail: String| {
+        Diagnostic::new(&codes::IMAGE_UNRECOGNIZED_FORMAT, pointer, format!("{what}: {detail}"))
+    };
+    let mut magic = [0u8; 12];
+    let read = read_up_to(&mut reader, &mut magic).map_err(|e| unrecognized(e.to_string()))?;
+    reader
+        .seek(std::io::SeekFrom::Start(0))
+        .map_err(|e| unrecognized(e.to_string()))?;
+    let format = ImageFormat::sniff(&magic[..read])
+        .ok_or_else(|| unrecognized("not a PNG, JPEG, WebP or KTX2 image".to_string()))?;
+    if format == ImageFormat::Ktx2 {
+        let mut head = [0u8; 28];
+        let n = read_up_to(&mut reader, &mut head).map_err(|e| unrecognized(e.to_string()))?;
+        if n < 28 {
+            return Err(unrecognized("the KTX2 header is truncated".to_string()));
+        }
+        let width = u32::from_le_bytes([head[20], head[21], head[22], head[23]]);
+        let height = u32::from_le_bytes([head[24], head[25], head[26], head[27]]);
+        return Ok(ImageHeader {
+            format,
+            width,
+            height,
+            channels: None,
+            has_alpha: None,
+            bits: None,
+        });
+    }
+    let decoder: Box<dyn ImageDecoder> = match format {
+        ImageFormat::Png => Box::new(image::codecs::png::PngDecoder::new(reader).map_err(|e| unrecognized(e.to_string()))?),
+        ImageFormat::Jpeg => Box::new(image::codecs::jpeg::JpegDecoder::new(reader).map_err(|e| unrecognized(e.to_string()))?),
+        ImageFormat::Webp => Box::new(image::codecs::webp::WebPDecoder::new(reader).map_err(|e| unrecognized(e.to_string()))?),
+        ImageFormat::Ktx2 => unreachable!("handled above"),
+    };
+    let (width, height) = decoder.dimensions();
+    let color = decoder.color_type();
+    let channels = color.channel_count();
+    Ok(ImageHeader {
+        format,
+        width,
+        height,
+        channels: Some(channels),
+        has_alpha: Some(color.has_alpha()),
+        bits: Some((color.bits_per_pixel() / u16::from(channels)) as u8),
+    })
+}
+
+fn read_up_to<R: std::io::Read>(reader: &mut R, buf: &mut [u8]) -> std::io::Result<usize> {
+    let mut filled = 0;
+    while filled < buf.len() {
+        match reader.read(&mut buf[filled..])? {
+            0 => break,
+            n => filled += n,
+        }
+    }
+    Ok(filled)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn base() -> &'static Path {
+        Path::new("/assets/chair")
+    }
+
+    #[test]
+    fn relative_uris_are_percent_decoded_and_joined() {
+        assert_eq!(
+            resolve("tex/My%20Image.png", base(), "/images/0/uri").unwrap(),
+            Location::File(PathBuf::from("/assets/chair/tex/My Image.png"))
+        );
+        assert_eq!(
+            resolve("a/../b.png", base(), "").unwrap(),
+            Location::File(PathBuf::from("/assets/chair/a/../b.png"))
+        );
+    }
+
+    #[test]
+    fn escaping_absolute_and_remote_uris_are_refused() {
+        for uri in ["../x.png", "a/../../x.png", "/etc/passwd", "https://example.com/x.png", "C:/x.png", "file:///x"] {
+            let err = resolve(uri, base(), "/images/3/uri").unwrap_err();
+            assert_eq!((err.code, err.pointer.as_str()), ("URI_NOT_FOLLOWED", "/images/3/uri"), "{uri}");
+        }
+    }
+
+    #[test]
+    fn data_uris_decode_base64_and_refuse_the_rest() {
+        assert_eq!(
+            resolve("data:application/octet-stream;base64,AAEC", base(), "").unwrap(),
+            Location::Data {
+                media_type: "application/octet-stream".into(),
+                bytes: vec![0, 1, 2]
+            }
+        );
+        for uri in ["data:text/plain,hello", "data:;base64,@@@", "data:nocomma"] {
+            assert_eq!(resolve(uri, base(), "").unwrap_err().code, "INVALID_URI", "{uri}");
+        }
+    }
+
+    fn png(color: image::ExtendedColorType) -> Vec<u8> {
+        let mut bytes = Vec::new();
+        let channels = color.channel_count() as usize;
+        let bytes_per = (color.bits_per_pixel() as usize / channels).div_ceil(8);
+        let data = vec![0u8; 4 * channels * bytes_per];
+        image::ImageEncoder::write_image(image::codecs::png::PngEncoder::new(&mut bytes), &data, 2, 2, color).unwrap();
+        bytes
+    }
+
+    #[test]
+    fn png_headers_tell_alpha_and_depth() {
+        use image::ExtendedColorType::*;
+        for (color, channels, alpha, bits) in [(L8, 1, false, 8), (La8, 2, true, 8), (Rgb8, 3, false, 8), (Rgba16, 4, true, 16)] {
+            let h = read_header(std::io::Cursor::new(png(color)), "", "image 0").unwrap();
+            assert_eq!((h.format, h.width, h.height), (ImageFormat::Png, 2, 2));
+            assert_eq!((h.channels, h.has_alpha, h.bits), (Some(channels), Some(alpha), Some(bits)), "{color:?}");
+        }
+    }
+
+    #[test]
+    fn garbage_is_an_unrecognized_image() {
+        let err = read_header(std::io::Cursor::new(b"hello world, not an image".to_vec()), "/images/1", "image 1").unwrap_err();
+        assert_eq!(err.code, "IMAGE_UNRECOGNIZED_FORMAT");
+        let err = read_header(std::io::Cursor::new(b"\x89PNG\r\n\x1a\n\0\0".to_vec()), "/images/1", "image 1").unwrap_err();
+        assert_eq!(err.code, "IMAGE_UNRECOGNIZED_FORMAT");
+    }
+}

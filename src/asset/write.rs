@@ -1,0 +1,119 @@
+//! Writing assets: serialising an edited document in the input's own JSON style, packing GLBs,
+//! and the atomic write (a temporary file in the target folder, renamed into place) that every
+//! output of velvet goes through.
+
+use super::{glb, Asset, Container};
+use serde::Serialize;
+use serde_json::Value;
+use std::io::{self, Write};
+use std::path::Path;
+
+/// How the input's JSON was laid out, so that an edited file keeps its look.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct JsonStyle {
+    /// The indentation unit, or `None` for minified JSON.
+    pub indent: Option<String>,
+    pub trailing_newline: bool,
+}
+
+impl JsonStyle {
+    /// Reads the style off a JSON text: the first indented line gives the unit.
+    pub fn detect(text: &str) -> JsonStyle {
+        let trimmed = text.trim_end_matches(['\0', ' ']);
+        let indent = trimmed.lines().skip(1).find_map(|line| {
+            let unit: String = line.chars().take_while(|c| *c == ' ' || *c == '\t').collect();
+            (!unit.is_empty()).then_some(unit)
+        });
+        JsonStyle {
+            indent,
+            trailing_newline: trimmed.ends_with('\n'),
+        }
+    }
+
+    pub fn render(&self, json: &Value) -> Vec<u8> {
+        let mut out = Vec::new();
+        match &self.indent {
+            Some(unit) => {
+                let formatter = serde_json::ser::PrettyFormatter::with_indent(unit.as_bytes());
+                let mut ser = serde_json::Serializer::with_formatter(&mut out, formatter);
+                json.serialize(&mut ser).expect("serialising a Value into memory cannot fail");
+            }
+            None => serde_json::to_writer(&mut out, json).expect("serialising a Value into memory cannot fail"),
+        }
+        if self.trailing_newline {
+            out.push(b'\n');
+        }
+        out
+    }
+}
+
+/// The bytes of `asset` with `json` as its document and `bin` as its GLB BIN chunk. When
+/// `json` equals the loaded document and the BIN chunk is the loaded one, this is not called:
+/// see [`unchanged`].
+pub fn to_bytes(asset: &Asset, json: &Value, bin: Option<&[u8]>) -> Vec<u8> {
+    let text = JsonStyle::detect(&asset.json_text).render(json);
+    match asset.container {
+        Container::Gltf => text,
+        Container::Glb => glb::join(&text, bin),
+    }
+}
+
+/// True when an edit left the document as loaded, so the input's bytes can stand as they are.
+pub fn unchanged(asset: &Asset, json: &Value, bin: Option<&[u8]>) -> bool {
+    &asset.json == json && asset.bin.as_deref() == bin
+}
+
+/// Writes `bytes` to `path` atomically: into a temporary file in the same folder, flushed to
+/// disk, then renamed over `path`. On any failure the temporary file is removed and `path` is
+/// as it was.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let mut tmp = tempfile::Builder::new().prefix(".velvet-").suffix(".tmp").tempfile_in(dir)?;
+    tmp.write_all(bytes)?;
+    tmp.as_file().sync_all()?;
+    if let Ok(meta) = std::fs::metadata(path) {
+        // Keep the permissions of a file being replaced.
+        let _ = std::fs::set_permissions(tmp.path(), meta.permissions());
+    }
+    tmp.persist(path).map_err(|e| e.error)?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn style_is_detected_and_reproduced() {
+        let pretty = "{\n    \"a\": [\n        1.0\n    ]\n}\n";
+        let style = JsonStyle::detect(pretty);
+        assert_eq!(style, JsonStyle { indent: Some("    ".into()), trailing_newline: true });
+        let v: Value = serde_json::from_str(pretty).unwrap();
+        assert_eq!(style.render(&v), pretty.as_bytes());
+        let minified = r#"{"b":1e-5,"a":0.50}"#;
+        let v: Value = serde_json::from_str(minified).unwrap();
+        assert_eq!(JsonStyle::detect(minified).render(&v), minified.as_bytes(), "numbers and key order kept");
+    }
+
+    #[test]
+    fn atomic_write_replaces_and_leaves_no_temporary_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("out.gltf");
+        write_atomic(&target, b"first").unwrap();
+        write_atomic(&target, b"second").unwrap();
+        assert_eq!(std::fs::read(&target).unwrap(), b"second");
+        let names: Vec<_> = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
+        assert_eq!(names, vec![std::ffi::OsString::from("out.gltf")]);
+    }
+
+    #[test]
+    fn atomic_write_into_missing_folder_fails_without_output() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("missing").join("out.gltf");
+        assert!(write_atomic(&target, b"x").is_err());
+        assert!(!target.exists());
+    }
+}

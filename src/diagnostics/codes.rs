@@ -1,0 +1,157 @@
+//! Codes owned by the loader (reading .gltf/.glb files and their resources) and by the schema
+//! check. Names follow the Khronos glTF-Validator where the meaning is the same.
+
+use super::{Code, Severity::*};
+
+pub const IO_ERROR: Code = Code::new(
+    "IO_ERROR",
+    Error,
+    "A file or an external resource could not be read.",
+);
+pub const INVALID_JSON: Code = Code::new(
+    "INVALID_JSON",
+    Error,
+    "The glTF JSON is not valid UTF-8 JSON (the message gives line and column).",
+);
+pub const INVALID_JSON_ROOT_OBJECT: Code = Code::new(
+    "INVALID_JSON_ROOT_OBJECT",
+    Error,
+    "The glTF JSON's root is not an object.",
+);
+pub const BOM_PRESENT: Code = Code::new(
+    "BOM_PRESENT",
+    Error,
+    "The JSON starts with a UTF-8 byte-order mark, which glTF forbids; the rest was checked.",
+);
+pub const GLB_INVALID_MAGIC: Code = Code::new(
+    "GLB_INVALID_MAGIC",
+    Error,
+    "A .glb file does not start with the magic 'glTF'.",
+);
+pub const GLB_INVALID_VERSION: Code = Code::new(
+    "GLB_INVALID_VERSION",
+    Error,
+    "A .glb header declares a container version other than 2.",
+);
+pub const GLB_LENGTH_MISMATCH: Code = Code::new(
+    "GLB_LENGTH_MISMATCH",
+    Error,
+    "The length in the GLB header differs from the file's length.",
+);
+pub const GLB_UNEXPECTED_END: Code = Code::new(
+    "GLB_UNEXPECTED_END",
+    Error,
+    "The GLB ends inside its header, a chunk header or a chunk's data (truncated file).",
+);
+pub const GLB_CHUNK_LENGTH_UNALIGNED: Code = Code::new(
+    "GLB_CHUNK_LENGTH_UNALIGNED",
+    Error,
+    "A GLB chunk's length is not a multiple of 4.",
+);
+pub const GLB_UNEXPECTED_FIRST_CHUNK: Code = Code::new(
+    "GLB_UNEXPECTED_FIRST_CHUNK",
+    Error,
+    "The first GLB chunk is not the JSON chunk.",
+);
+pub const GLB_UNEXPECTED_CHUNK: Code = Code::new(
+    "GLB_UNEXPECTED_CHUNK",
+    Error,
+    "A second JSON chunk, a second BIN chunk, or a BIN chunk after an unknown chunk.",
+);
+pub const GLB_UNKNOWN_CHUNK_TYPE: Code = Code::new(
+    "GLB_UNKNOWN_CHUNK_TYPE",
+    Warning,
+    "A GLB chunk of unknown type; loaders skip it.",
+);
+pub const GLB_INVALID_PADDING: Code = Code::new(
+    "GLB_INVALID_PADDING",
+    Warning,
+    "A GLB chunk's trailing padding is not spaces (JSON) or zeros (BIN).",
+);
+pub const URI_NOT_FOLLOWED: Code = Code::new(
+    "URI_NOT_FOLLOWED",
+    Error,
+    "A resource URI that velvet does not follow: another scheme than data:, an absolute path, \
+     or a path that climbs out of the asset's folder.",
+);
+pub const INVALID_URI: Code = Code::new(
+    "INVALID_URI",
+    Error,
+    "A resource URI that cannot be decoded (malformed data: URI, base64 or percent-encoding).",
+);
+pub const BUFFER_VIEW_OUT_OF_RANGE: Code = Code::new(
+    "BUFFER_VIEW_OUT_OF_RANGE",
+    Error,
+    "An image's bufferView lies outside the data of its buffer.",
+);
+pub const IMAGE_UNRECOGNIZED_FORMAT: Code = Code::new(
+    "IMAGE_UNRECOGNIZED_FORMAT",
+    Error,
+    "An image's header is not PNG, JPEG, WebP or KTX2, or is damaged.",
+);
+
+pub const LOADER: &[&Code] = &[
+    &IO_ERROR,
+    &INVALID_JSON,
+    &INVALID_JSON_ROOT_OBJECT,
+    &BOM_PRESENT,
+    &GLB_INVALID_MAGIC,
+    &GLB_INVALID_VERSION,
+    &GLB_LENGTH_MISMATCH,
+    &GLB_UNEXPECTED_END,
+    &GLB_CHUNK_LENGTH_UNALIGNED,
+    &GLB_UNEXPECTED_FIRST_CHUNK,
+    &GLB_UNEXPECTED_CHUNK,
+    &GLB_UNKNOWN_CHUNK_TYPE,
+    &GLB_INVALID_PADDING,
+    &URI_NOT_FOLLOWED,
+    &INVALID_URI,
+    &BUFFER_VIEW_OUT_OF_RANGE,
+    &IMAGE_UNRECOGNIZED_FORMAT,
+];
+
+pub const TYPE_MISMATCH: Code = Code::new(
+    "TYPE_MISMATCH",
+    Error,
+    "A property's value has the wrong JSON type.",
+);
+pub const VALUE_NOT_IN_RANGE: Code = Code::new(
+    "VALUE_NOT_IN_RANGE",
+    Error,
+    "A number lies outside the range the schema allows.",
+);
+pub const ARRAY_LENGTH_NOT_IN_LIST: Code = Code::new(
+    "ARRAY_LENGTH_NOT_IN_LIST",
+    Error,
+    "An array has a length the schema does not allow.",
+);
+pub const UNDEFINED_PROPERTY: Code = Code::new(
+    "UNDEFINED_PROPERTY",
+    Error,
+    "A required property is missing.",
+);
+pub const UNEXPECTED_PROPERTY: Code = Code::new(
+    "UNEXPECTED_PROPERTY",
+    Warning,
+    "A property the schema does not define (loaders ignore it).",
+);
+pub const VALUE_NOT_IN_LIST: Code = Code::new(
+    "VALUE_NOT_IN_LIST",
+    Error,
+    "A value is not one of those the schema allows.",
+);
+pub const SCHEMA_MISMATCH: Code = Code::new(
+    "SCHEMA_MISMATCH",
+    Error,
+    "A schema constraint without a more specific code failed (the message names it).",
+);
+
+pub const SCHEMA: &[&Code] = &[
+    &TYPE_MISMATCH,
+    &VALUE_NOT_IN_RANGE,
+    &ARRAY_LENGTH_NOT_IN_LIST,
+    &UNDEFINED_PROPERTY,
+    &UNEXPECTED_PROPERTY,
+    &VALUE_NOT_IN_LIST,
+    &SCHEMA_MISMATCH,
+];

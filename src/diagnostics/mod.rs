@@ -1,0 +1,117 @@
+//! Diagnostics: what a finding is (code, severity, message, JSON pointer), the codes that the
+//! loader and the schema check own, and the registry that lists every code velvet can emit.
+//!
+//! Rules declare their own codes next to their logic (see `crate::rules`); `all_codes` gathers
+//! them with the loader's and the schema check's into the one list that `velvet codes`, the
+//! README table and the SARIF rule list are generated from.
+
+pub mod codes;
+pub mod settings;
+
+use serde::Serialize;
+use std::fmt;
+
+pub use settings::{FailOn, Settings};
+
+/// Severity, numbered as in the Khronos glTF-Validator report (0 error … 3 hint).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Severity {
+    Error = 0,
+    Warning = 1,
+    Info = 2,
+    Hint = 3,
+}
+
+impl Severity {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Severity::Error => "error",
+            Severity::Warning => "warning",
+            Severity::Info => "info",
+            Severity::Hint => "hint",
+        }
+    }
+
+    pub fn parse(text: &str) -> Option<Severity> {
+        match text {
+            "error" => Some(Severity::Error),
+            "warning" => Some(Severity::Warning),
+            "info" => Some(Severity::Info),
+            "hint" => Some(Severity::Hint),
+            _ => None,
+        }
+    }
+}
+
+impl fmt::Display for Severity {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+impl Serialize for Severity {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_u8(*self as u8)
+    }
+}
+
+/// A code velvet can emit: its name, default severity and one line of documentation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Code {
+    pub name: &'static str,
+    pub severity: Severity,
+    pub doc: &'static str,
+}
+
+impl Code {
+    pub const fn new(name: &'static str, severity: Severity, doc: &'static str) -> Code {
+        Code {
+            name,
+            severity,
+            doc,
+        }
+    }
+}
+
+/// One finding in one file. `pointer` is an RFC 6901 JSON pointer into the glTF JSON
+/// (empty for the whole file).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct Diagnostic {
+    pub code: &'static str,
+    pub message: String,
+    pub severity: Severity,
+    pub pointer: String,
+}
+
+impl Diagnostic {
+    pub fn new(code: &Code, pointer: impl Into<String>, message: impl Into<String>) -> Diagnostic {
+        Diagnostic {
+            code: code.name,
+            message: message.into(),
+            severity: code.severity,
+            pointer: pointer.into(),
+        }
+    }
+}
+
+/// Every code velvet can emit, loader and schema codes first, then the rules' codes in
+/// registry order. Each name appears once.
+pub fn all_codes() -> Vec<&'static Code> {
+    let mut out: Vec<&'static Code> = Vec::new();
+    for code in codes::LOADER
+        .iter()
+        .chain(codes::SCHEMA)
+        .copied()
+        .chain(crate::rules::REGISTRY.iter().flat_map(|r| r.codes().iter().copied()))
+    {
+        if !out.iter().any(|c| c.name == code.name) {
+            out.push(code);
+        }
+    }
+    out
+}
+
+/// Looks a code up by name.
+pub fn find_code(name: &str) -> Option<&'static Code> {
+    all_codes().into_iter().find(|c| c.name == name)
+}

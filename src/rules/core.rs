@@ -1,0 +1,103 @@
+//! Core structure: the gltf crate's own validation of the whole document (indices in range,
+//! required properties, enum values), run on `gltf::json::Root` directly so that an unknown
+//! entry in extensionsRequired does not stop it. Its paths (`meshes[0].primitives[1].material`)
+//! are turned into JSON pointers.
+
+use super::{Context, Rule};
+use crate::diagnostics::{codes, Code, Diagnostic, Severity};
+use gltf::json::validation::{Error as CoreError, Validate};
+
+pub const CORE_INVALID_VALUE: Code = Code::new(
+    "CORE_INVALID_VALUE",
+    Severity::Error,
+    "The core glTF structure holds a value the glTF 2.0 schema does not allow.",
+);
+pub const CORE_UNSUPPORTED: Code = Code::new(
+    "CORE_UNSUPPORTED",
+    Severity::Warning,
+    "The core glTF structure uses something the glTF 2.0 specification does not support.",
+);
+pub const CORE_STRUCTURE_INVALID: Code = Code::new(
+    "CORE_STRUCTURE_INVALID",
+    Severity::Error,
+    "The document does not have the core glTF 2.0 structure (a property of the wrong type or shape).",
+);
+
+pub struct CoreStructure;
+
+/// `meshes[0].primitives[1].attributes["TEXCOORD_0"]` → `/meshes/0/primitives/1/attributes/TEXCOORD_0`.
+pub fn path_to_pointer(path: &str) -> String {
+    let mut out = String::new();
+    let mut rest = path;
+    while !rest.is_empty() {
+        if let Some(after) = rest.strip_prefix("[\"") {
+            let end = after.find("\"]").unwrap_or(after.len());
+            out.push('/');
+            out.push_str(&crate::asset::pointer::escape(&after[..end]));
+            rest = after.get(end + 2..).unwrap_or("");
+        } else if let Some(after) = rest.strip_prefix('[') {
+            let end = after.find(']').unwrap_or(after.len());
+            out.push('/');
+            out.push_str(&after[..end]);
+            rest = after.get(end + 1..).unwrap_or("");
+        } else {
+            let rest_trim = rest.strip_prefix('.').unwrap_or(rest);
+            let end = rest_trim.find(['.', '[']).unwrap_or(rest_trim.len());
+            out.push('/');
+            out.push_str(&crate::asset::pointer::escape(&rest_trim[..end]));
+            rest = &rest_trim[end..];
+        }
+    }
+    out
+}
+
+impl Rule for CoreStructure {
+    fn codes(&self) -> &'static [&'static Code] {
+        &[&CORE_INVALID_VALUE, &super::references::UNRESOLVED_REFERENCE, &codes::UNDEFINED_PROPERTY, &CORE_UNSUPPORTED, &CORE_STRUCTURE_INVALID]
+    }
+
+    fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
+        let text = cx.asset.json_text.trim_end_matches(['\0', ' ']);
+        let root: gltf::json::Root = match gltf::json::deserialize::from_str(text) {
+            Ok(root) => root,
+            Err(e) => {
+                out.push(Diagnostic::new(
+                    &CORE_STRUCTURE_INVALID,
+                    "",
+                    format!("line {}, column {}: {}", e.line(), e.column(), e.to_string().rsplit_once(" at line ").map_or(e.to_string(), |(m, _)| m.to_string())),
+                ));
+                return;
+            }
+        };
+        root.validate(&root, gltf::json::Path::new, &mut |path, error| {
+            let path = path();
+            // The crate rejects required extensions it does not implement; that is a loader's
+            // capability, not a fault of the asset.
+            if path.as_str().starts_with("extensionsRequired") {
+                return;
+            }
+            let pointer = path_to_pointer(path.as_str());
+            let (code, message) = match error {
+                CoreError::IndexOutOfBounds => (&super::references::UNRESOLVED_REFERENCE, "index out of range".to_string()),
+                CoreError::Missing => (&codes::UNDEFINED_PROPERTY, "required property is missing".to_string()),
+                CoreError::Invalid => (&CORE_INVALID_VALUE, "invalid value".to_string()),
+                CoreError::Unsupported => (&CORE_UNSUPPORTED, "unsupported value".to_string()),
+                CoreError::Oversize => (&CORE_INVALID_VALUE, "value too large".to_string()),
+            };
+            out.push(Diagnostic::new(code, pointer, message));
+        });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn gltf_paths_become_pointers() {
+        assert_eq!(path_to_pointer("meshes[0].primitives[12].material"), "/meshes/0/primitives/12/material");
+        assert_eq!(path_to_pointer("meshes[0].primitives[0].attributes[\"TEXCOORD_0\"]"), "/meshes/0/primitives/0/attributes/TEXCOORD_0");
+        assert_eq!(path_to_pointer("asset"), "/asset");
+        assert_eq!(path_to_pointer(""), "");
+    }
+}

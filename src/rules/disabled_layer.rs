@@ -1,0 +1,54 @@
+//! Switched-off layers with textures: sheen is off when sheenColorFactor is [0,0,0] (its
+//! default) and fuzz when fuzzFactor is 0 (its default). Textures on such a layer have no
+//! effect, which usually means a forgotten factor: exporters often write the texture and rely
+//! on a default that turns the layer off.
+
+use super::{layer_objects, slot_uses, Context, Rule};
+use crate::diagnostics::{Code, Diagnostic, Severity};
+use crate::layers::{self, FuzzView, SheenView};
+
+pub const SHEEN_TEXTURE_WITHOUT_EFFECT: Code = Code::new(
+    "KHR_MATERIALS_SHEEN_TEXTURE_WITHOUT_EFFECT",
+    Severity::Warning,
+    "A sheen texture on a layer switched off by sheenColorFactor [0,0,0] (the default).",
+);
+pub const FUZZ_TEXTURE_WITHOUT_EFFECT: Code = Code::new(
+    "KHR_MATERIALS_FUZZ_TEXTURE_WITHOUT_EFFECT",
+    Severity::Warning,
+    "A fuzz texture on a layer switched off by fuzzFactor 0 (the default).",
+);
+
+pub struct DisabledLayer;
+
+impl Rule for DisabledLayer {
+    fn codes(&self) -> &'static [&'static Code] {
+        &[&SHEEN_TEXTURE_WITHOUT_EFFECT, &FUZZ_TEXTURE_WITHOUT_EFFECT]
+    }
+
+    fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
+        for layer in layer_objects(cx.json()) {
+            let (off, code, why) = if layer.extension == layers::SHEEN {
+                let Some(view) = SheenView::read(layer.value) else { continue };
+                (!view.is_on(), &SHEEN_TEXTURE_WITHOUT_EFFECT, "sheenColorFactor is [0, 0, 0]")
+            } else {
+                let Some(view) = FuzzView::read(layer.value) else { continue };
+                (!view.is_on(), &FUZZ_TEXTURE_WITHOUT_EFFECT, "fuzzFactor is 0")
+            };
+            if !off {
+                continue;
+            }
+            for slot in slot_uses(&layer) {
+                let stated = layer.value.get(slot.slot.factor).is_some();
+                out.push(Diagnostic::new(
+                    code,
+                    &slot.pointer,
+                    format!(
+                        "{} has no effect: {why}{}, which switches the layer off",
+                        slot.slot.texture,
+                        if stated { "" } else { " (the default)" }
+                    ),
+                ));
+            }
+        }
+    }
+}

@@ -1,0 +1,44 @@
+//! Exclusions: both specs say the layer "must not be used on a material that also uses
+//! KHR_materials_pbrSpecularGlossiness" or "KHR_materials_unlit". The Khronos validator only
+//! warns (MULTIPLE_EXTENSIONS); a loader may drop the layer or the material's look, so velvet
+//! reports an error.
+
+use super::{layer_objects, Context, Rule};
+use crate::diagnostics::{Code, Diagnostic, Severity};
+use crate::layers;
+
+pub const SHEEN_EXCLUDED: Code = Code::new(
+    "KHR_MATERIALS_SHEEN_EXCLUDED_COMBINATION",
+    Severity::Error,
+    "KHR_materials_sheen on a material that also uses KHR_materials_pbrSpecularGlossiness or KHR_materials_unlit.",
+);
+pub const FUZZ_EXCLUDED: Code = Code::new(
+    "KHR_MATERIALS_FUZZ_EXCLUDED_COMBINATION",
+    Severity::Error,
+    "KHR_materials_fuzz on a material that also uses KHR_materials_pbrSpecularGlossiness or KHR_materials_unlit.",
+);
+
+pub struct Exclusions;
+
+impl Rule for Exclusions {
+    fn codes(&self) -> &'static [&'static Code] {
+        &[&SHEEN_EXCLUDED, &FUZZ_EXCLUDED]
+    }
+
+    fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
+        let materials = layers::materials(cx.json());
+        for layer in layer_objects(cx.json()) {
+            let Some(exts) = layers::extensions(&materials[layer.material]) else { continue };
+            for excluded in [layers::SPEC_GLOSS, layers::UNLIT] {
+                if exts.contains_key(excluded) {
+                    let code = if layer.extension == layers::SHEEN { &SHEEN_EXCLUDED } else { &FUZZ_EXCLUDED };
+                    out.push(Diagnostic::new(
+                        code,
+                        &layer.pointer,
+                        format!("{} must not be used together with {excluded} on one material", layer.extension),
+                    ));
+                }
+            }
+        }
+    }
+}

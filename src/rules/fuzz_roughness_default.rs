@@ -1,0 +1,39 @@
+//! The fuzz roughness default is ambiguous: the draft's parameter table says 0.5, its JSON
+//! schema 0.0. A material that leaves fuzzRoughnessFactor out while the layer is on looks
+//! different in loaders that follow one or the other.
+
+use super::{layer_objects, Context, Rule};
+use crate::diagnostics::{Code, Diagnostic, Severity};
+use crate::layers::{self, FuzzView};
+
+pub const FUZZ_ROUGHNESS_DEFAULT_AMBIGUOUS: Code = Code::new(
+    "KHR_MATERIALS_FUZZ_ROUGHNESS_DEFAULT_AMBIGUOUS",
+    Severity::Hint,
+    "fuzzRoughnessFactor omitted on an active fuzz layer: the draft's table says 0.5, its schema 0.0; write it explicitly.",
+);
+
+pub struct FuzzRoughnessDefault;
+
+impl Rule for FuzzRoughnessDefault {
+    fn codes(&self) -> &'static [&'static Code] {
+        &[&FUZZ_ROUGHNESS_DEFAULT_AMBIGUOUS]
+    }
+
+    fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
+        for layer in layer_objects(cx.json()).filter(|l| l.extension == layers::FUZZ) {
+            let Some(fuzz) = FuzzView::read(layer.value) else { continue };
+            if fuzz.is_on() && layer.value.get("fuzzRoughnessFactor").is_none() {
+                out.push(Diagnostic::new(
+                    &FUZZ_ROUGHNESS_DEFAULT_AMBIGUOUS,
+                    &layer.pointer,
+                    format!(
+                        "fuzzRoughnessFactor is omitted: the draft's table gives {} and its schema {}; loaders may differ, so write it explicitly (velvet assumes {})",
+                        layers::FUZZ_ROUGHNESS_DEFAULT_TABLE,
+                        layers::FUZZ_ROUGHNESS_DEFAULT_SCHEMA,
+                        layers::FUZZ_ROUGHNESS_DEFAULT_TABLE
+                    ),
+                ));
+            }
+        }
+    }
+}

@@ -1,0 +1,40 @@
+//! The pre-ratification sheen draft used sheenFactor, sheenColor and sheenTexture (with the
+//! roughness taken from the material). Ratified loaders ignore those properties, so such a
+//! material shows no sheen; `velvet migrate` upgrades it.
+
+use super::{layer_objects, Context, Rule};
+use crate::asset::pointer;
+use crate::diagnostics::{Code, Diagnostic, Severity};
+use crate::layers;
+
+pub const SHEEN_LEGACY_DRAFT: Code = Code::new(
+    "KHR_MATERIALS_SHEEN_LEGACY_DRAFT",
+    Severity::Warning,
+    "A property of the pre-ratification sheen draft (sheenFactor, sheenColor, sheenTexture); ratified loaders ignore it.",
+);
+
+pub const LEGACY_PROPERTIES: [&str; 3] = ["sheenFactor", "sheenColor", "sheenTexture"];
+
+pub struct LegacySheen;
+
+impl Rule for LegacySheen {
+    fn codes(&self) -> &'static [&'static Code] {
+        &[&SHEEN_LEGACY_DRAFT]
+    }
+
+    fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
+        for layer in layer_objects(cx.json()).filter(|l| l.extension == layers::SHEEN) {
+            for name in LEGACY_PROPERTIES {
+                if layer.value.get(name).is_some() {
+                    out.push(Diagnostic::new(
+                        &SHEEN_LEGACY_DRAFT,
+                        pointer::join(&layer.pointer, name),
+                        format!(
+                            "{name} belongs to the pre-ratification KHR_materials_sheen draft and is ignored by ratified loaders; `velvet migrate` upgrades it"
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+}

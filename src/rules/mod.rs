@@ -1,0 +1,162 @@
+//! Validation rules. Each rule is one unit in its own file: the codes it emits (name, default
+//! severity, doc line), what it checks and why, and a test with a fixture that triggers it and a
+//! twin that does not. [`REGISTRY`] is the one place rules are listed; `velvet codes`, the
+//! README's table and report rule lists are generated from it.
+//!
+//! Rules read the asset and push diagnostics; they never change anything.
+
+pub mod clearcoat;
+pub mod core;
+pub mod declaration;
+pub mod disabled_layer;
+pub mod exclusions;
+pub mod fallback;
+pub mod fuzz_roughness_default;
+pub mod legacy_sheen;
+pub mod placement;
+pub mod references;
+pub mod roughness_alpha;
+pub mod schema;
+pub mod texcoord;
+
+use crate::asset::{pointer, Asset};
+use crate::diagnostics::{Code, Diagnostic};
+use crate::layers::{self, Slot, TextureRef};
+use serde_json::Value;
+
+/// What a rule sees: the asset and the schemas compiled for this run.
+pub struct Context<'a> {
+    pub asset: &'a Asset,
+    pub schemas: &'a schema::Schemas,
+}
+
+impl Context<'_> {
+    pub fn json(&self) -> &Value {
+        &self.asset.json
+    }
+}
+
+/// A validation rule.
+pub trait Rule: Sync {
+    /// The codes this rule may emit.
+    fn codes(&self) -> &'static [&'static Code];
+    /// Checks the asset, pushing what it finds.
+    fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>);
+}
+
+/// Every rule, in the order their findings are reported.
+pub static REGISTRY: &[&dyn Rule] = &[
+    &core::CoreStructure,
+    &schema::SchemaCheck,
+    &declaration::Declaration,
+    &placement::Placement,
+    &exclusions::Exclusions,
+    &references::References,
+    &texcoord::TexCoords,
+    &disabled_layer::DisabledLayer,
+    &roughness_alpha::RoughnessAlpha,
+    &fallback::Fallback,
+    &fuzz_roughness_default::FuzzRoughnessDefault,
+    &legacy_sheen::LegacySheen,
+    &clearcoat::Clearcoat,
+];
+
+/// One sheen or fuzz object on a material.
+pub struct LayerObject<'a> {
+    pub material: usize,
+    pub extension: &'static str,
+    pub value: &'a Value,
+    /// Pointer to the extension object.
+    pub pointer: String,
+}
+
+/// Every KHR_materials_sheen and KHR_materials_fuzz object in `materials[*].extensions`.
+pub fn layer_objects(json: &Value) -> impl Iterator<Item = LayerObject<'_>> {
+    layers::materials(json).iter().enumerate().flat_map(|(i, material)| {
+        [layers::SHEEN, layers::FUZZ].into_iter().filter_map(move |ext| {
+            let value = layers::extensions(material)?.get(ext)?;
+            Some(LayerObject {
+                material: i,
+                extension: ext,
+                value,
+                pointer: format!("/materials/{i}/extensions/{ext}"),
+            })
+        })
+    })
+}
+
+/// A texture slot that is present on a layer object.
+pub struct SlotUse<'a> {
+    pub slot: &'static Slot,
+    pub texture: TextureRef,
+    pub value: &'a Value,
+    pub pointer: String,
+}
+
+/// The texture slots a layer object fills.
+pub fn slot_uses<'a>(layer: &'a LayerObject<'a>) -> impl Iterator<Item = SlotUse<'a>> + 'a {
+    layers::slots_of(layer.extension).filter_map(move |slot| {
+        let value = layer.value.get(slot.texture)?;
+        Some(SlotUse {
+            slot,
+            texture: TextureRef::read(value)?,
+            value,
+            pointer: pointer::join(&layer.pointer, slot.texture),
+        })
+    })
+}
+
+/// The texCoord set a textureInfo really uses: KHR_texture_transform may override it.
+pub fn effective_tex_coord(texture_info: &Value) -> u64 {
+    texture_info
+        .pointer(&format!("/extensions/{}/texCoord", layers::TEXTURE_TRANSFORM))
+        .and_then(Value::as_u64)
+        .or_else(|| texture_info.get("texCoord").and_then(Value::as_u64))
+        .unwrap_or(0)
+}
+
+/// The images a texture may be drawn from: `source` and the sources of image-format extensions
+/// (EXT_texture_webp, KHR_texture_basisu, …), each with its pointer.
+pub fn texture_sources(texture: &Value, texture_pointer: &str) -> Vec<(Option<u64>, String)> {
+    let mut out = Vec::new();
+    if let Some(source) = texture.get("source") {
+        out.push((source.as_u64(), format!("{texture_pointer}/source")));
+    }
+    if let Some(exts) = texture.get("extensions").and_then(Value::as_object) {
+        for (name, ext) in exts {
+            if let Some(source) = ext.get("source") {
+                out.push((source.as_u64(), format!("{texture_pointer}/extensions/{}/source", pointer::escape(name))));
+            }
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+pub(crate) mod testing {
+    //! Helpers for rule tests: run one rule over a JSON document.
+    use super::*;
+    use std::path::Path;
+
+    pub fn run(rule: &dyn Rule, json: &str) -> Vec<(String, String)> {
+        run_at(rule, Path::new("memory/test.gltf"), json)
+    }
+
+    pub fn run_at(rule: &dyn Rule, path: &Path, json: &str) -> Vec<(String, String)> {
+        let loaded = crate::asset::load_bytes(path, json.as_bytes());
+        let asset = loaded.asset.expect("test JSON parses");
+        let schemas = schema::Schemas::builtin();
+        let cx = Context { asset: &asset, schemas: &schemas };
+        let mut out = Vec::new();
+        rule.check(&cx, &mut out);
+        for d in &out {
+            let code = rule.codes().iter().find(|c| c.name == d.code).expect("rule emits only its own codes");
+            assert_eq!(d.severity, code.severity, "{}", d.code);
+        }
+        out.into_iter().map(|d| (d.code.to_string(), d.pointer)).collect()
+    }
+
+    pub fn pairs(items: &[(&str, &str)]) -> Vec<(String, String)> {
+        items.iter().map(|(c, p)| (c.to_string(), p.to_string())).collect()
+    }
+}

@@ -1,0 +1,197 @@
+//! The schema check: every KHR_materials_sheen and KHR_materials_fuzz object is validated
+//! against our JSON schemas in `schema/` (compiled into the binary, or read from
+//! `--schema-dir`), built once per run. Each schema error becomes a code with a pointer into the
+//! document. The published schemas do not forbid unknown properties, so those are found here by
+//! comparing keys with the properties the schemas define, and reported as warnings.
+
+use super::{layer_objects, Context, Rule};
+use crate::asset::pointer;
+use crate::diagnostics::{codes, Code, Diagnostic};
+use crate::layers;
+use jsonschema::error::ValidationErrorKind;
+use serde_json::Value;
+use std::collections::{BTreeSet, HashMap};
+use std::path::Path;
+use std::sync::Arc;
+
+/// Our schema files, by file name, as compiled into the binary.
+pub const BUILTIN: &[(&str, &str)] = &[
+    ("material.KHR_materials_sheen.schema.json", include_str!("../../schema/material.KHR_materials_sheen.schema.json")),
+    ("material.KHR_materials_fuzz.schema.json", include_str!("../../schema/material.KHR_materials_fuzz.schema.json")),
+    ("textureInfo.schema.json", include_str!("../../schema/textureInfo.schema.json")),
+    ("glTFProperty.schema.json", include_str!("../../schema/glTFProperty.schema.json")),
+    ("glTFid.schema.json", include_str!("../../schema/glTFid.schema.json")),
+    ("extension.schema.json", include_str!("../../schema/extension.schema.json")),
+    ("extras.schema.json", include_str!("../../schema/extras.schema.json")),
+];
+
+#[derive(Debug, thiserror::Error)]
+pub enum SchemaError {
+    #[error("cannot read schema {path}: {source}")]
+    Read { path: String, source: std::io::Error },
+    #[error("schema {name} is not valid JSON: {source}")]
+    Json { name: String, source: serde_json::Error },
+    #[error("schema {name} does not compile: {message}")]
+    Compile { name: String, message: String },
+}
+
+/// Known property names of an object schema, and the same for properties that are objects
+/// with their own known properties (textureInfo).
+#[derive(Debug, Default)]
+struct PropertyTree {
+    known: BTreeSet<String>,
+    children: HashMap<String, PropertyTree>,
+}
+
+struct LayerSchema {
+    validator: jsonschema::Validator,
+    properties: PropertyTree,
+}
+
+/// The compiled schemas for one run.
+pub struct Schemas {
+    sheen: LayerSchema,
+    fuzz: LayerSchema,
+}
+
+/// Serves `$ref`s from the in-memory schema files, by the reference's last path segment.
+struct FileRetriever(Arc<HashMap<String, Value>>);
+
+impl jsonschema::Retrieve for FileRetriever {
+    fn retrieve(&self, uri: &jsonschema::Uri<String>) -> Result<Value, Box<dyn std::error::Error + Send + Sync>> {
+        let name = uri.path().as_str().rsplit('/').next().unwrap_or_default();
+        self.0.get(name).cloned().ok_or_else(|| format!("no schema file named '{name}'").into())
+    }
+}
+
+impl Schemas {
+    /// The schemas compiled into velvet.
+    pub fn builtin() -> Schemas {
+        let files = BUILTIN
+            .iter()
+            .map(|(name, text)| (name.to_string(), serde_json::from_str(text).expect("built-in schemas are valid JSON")))
+            .collect();
+        Schemas::compile(files).expect("built-in schemas compile")
+    }
+
+    /// The built-in schemas with every file present in `dir` (same file names) replacing its
+    /// built-in twin.
+    pub fn with_overrides(dir: &Path) -> Result<Schemas, SchemaError> {
+        let mut files = HashMap::new();
+        std::fs::read_dir(dir).map_err(|source| SchemaError::Read { path: dir.display().to_string(), source })?;
+        for (name, text) in BUILTIN {
+            let path = dir.join(name);
+            let (text, name) = if path.is_file() {
+                let text = std::fs::read_to_string(&path)
+                    .map_err(|source| SchemaError::Read { path: path.display().to_string(), source })?;
+                (text, path.display().to_string())
+            } else {
+                (text.to_string(), name.to_string())
+            };
+            let value = serde_json::from_str(&text).map_err(|source| SchemaError::Json { name: name.clone(), source })?;
+            files.insert(path.file_name().unwrap().to_string_lossy().into_owned(), value);
+        }
+        Schemas::compile(files)
+    }
+
+    fn compile(files: HashMap<String, Value>) -> Result<Schemas, SchemaError> {
+        let files = Arc::new(files);
+        let layer = |name: &str| -> Result<LayerSchema, SchemaError> {
+            let schema = &files[name];
+            let validator = jsonschema::options()
+                .with_draft(jsonschema::Draft::Draft4)
+                .with_retriever(FileRetriever(files.clone()))
+                .build(schema)
+                .map_err(|e| SchemaError::Compile { name: name.to_string(), message: e.to_string() })?;
+            Ok(LayerSchema { validator, properties: property_tree(schema, &files, 0) })
+        };
+        Ok(Schemas {
+            sheen: layer("material.KHR_materials_sheen.schema.json")?,
+            fuzz: layer("material.KHR_materials_fuzz.schema.json")?,
+        })
+    }
+}
+
+/// Collects the properties a schema defines, through `allOf` and `$ref`.
+fn collect(schema: &Value, files: &HashMap<String, Value>, depth: usize, out: &mut Vec<(String, Value)>) {
+    if depth > 16 {
+        return;
+    }
+    if let Some(target) = schema.get("$ref").and_then(Value::as_str) {
+        let name = target.rsplit('/').next().unwrap_or(target);
+        if let Some(referenced) = files.get(name) {
+            collect(referenced, files, depth + 1, out);
+        }
+    }
+    for part in schema.get("allOf").and_then(Value::as_array).into_iter().flatten() {
+        collect(part, files, depth + 1, out);
+    }
+    if let Some(props) = schema.get("properties").and_then(Value::as_object) {
+        out.extend(props.iter().map(|(k, v)| (k.clone(), v.clone())));
+    }
+}
+
+fn property_tree(schema: &Value, files: &HashMap<String, Value>, depth: usize) -> PropertyTree {
+    let mut props = Vec::new();
+    collect(schema, files, depth, &mut props);
+    let mut tree = PropertyTree::default();
+    for (name, sub) in props {
+        tree.known.insert(name.clone());
+        if depth < 4 {
+            let child = property_tree(&sub, files, depth + 1);
+            // Only objects with a closed set of known properties are checked (not extensions
+            // or extras, whose keys are open).
+            if !child.known.is_empty() {
+                tree.children.insert(name, child);
+            }
+        }
+    }
+    tree
+}
+
+fn unexpected(value: &Value, tree: &PropertyTree, at: &str, out: &mut Vec<Diagnostic>) {
+    let Some(obj) = value.as_object() else { return };
+    for (key, child) in obj {
+        let here = pointer::join(at, key);
+        if !tree.known.contains(key) {
+            out.push(Diagnostic::new(&codes::UNEXPECTED_PROPERTY, &here, format!("unexpected property '{key}'")));
+        } else if let Some(sub) = tree.children.get(key) {
+            unexpected(child, sub, &here, out);
+        }
+    }
+}
+
+fn code_for(kind: &ValidationErrorKind) -> &'static Code {
+    match kind {
+        ValidationErrorKind::Type { .. } => &codes::TYPE_MISMATCH,
+        ValidationErrorKind::Minimum { .. }
+        | ValidationErrorKind::Maximum { .. }
+        | ValidationErrorKind::ExclusiveMinimum { .. }
+        | ValidationErrorKind::ExclusiveMaximum { .. } => &codes::VALUE_NOT_IN_RANGE,
+        ValidationErrorKind::MinItems { .. } | ValidationErrorKind::MaxItems { .. } => &codes::ARRAY_LENGTH_NOT_IN_LIST,
+        ValidationErrorKind::Required { .. } => &codes::UNDEFINED_PROPERTY,
+        ValidationErrorKind::Enum { .. } | ValidationErrorKind::Constant { .. } => &codes::VALUE_NOT_IN_LIST,
+        ValidationErrorKind::AdditionalProperties { .. } => &codes::UNEXPECTED_PROPERTY,
+        _ => &codes::SCHEMA_MISMATCH,
+    }
+}
+
+pub struct SchemaCheck;
+
+impl Rule for SchemaCheck {
+    fn codes(&self) -> &'static [&'static Code] {
+        codes::SCHEMA
+    }
+
+    fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
+        for layer in layer_objects(cx.json()) {
+            let schema = if layer.extension == layers::SHEEN { &cx.schemas.sheen } else { &cx.schemas.fuzz };
+            for error in schema.validator.iter_errors(layer.value) {
+                let code = code_for(error.kind());
+                let at = format!("{}{}", layer.pointer, error.instance_path().as_str());
+                out.push(Diagnostic::new(code, at, error.to_string()));
+            }
+            unexpected(layer.value, &schema.properties, &layer.pointer, out);
+        }
+    }
+}

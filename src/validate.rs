@@ -1,0 +1,181 @@
+//! The validate pipeline: find the files, load each, run every registered rule, apply the run's
+//! settings, and place each finding in the source text. Files run in parallel; each file's
+//! report is independent of the others.
+
+use crate::asset::{self, discover, position::Position, Container};
+use crate::diagnostics::{Diagnostic, Settings, Severity};
+use crate::layers;
+use crate::rules::{self, schema::Schemas, Context};
+use rayon::prelude::*;
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+
+/// A finding with where it stands in the file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Finding {
+    pub diagnostic: Diagnostic,
+    /// Line and column in the JSON text (for a .glb, within the JSON chunk), when the pointer
+    /// names a value.
+    pub position: Option<Position>,
+}
+
+/// Counts per severity, before the issue cap.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Counts {
+    pub errors: usize,
+    pub warnings: usize,
+    pub infos: usize,
+    pub hints: usize,
+}
+
+impl Counts {
+    fn add(&mut self, severity: Severity) {
+        match severity {
+            Severity::Error => self.errors += 1,
+            Severity::Warning => self.warnings += 1,
+            Severity::Info => self.infos += 1,
+            Severity::Hint => self.hints += 1,
+        }
+    }
+}
+
+/// What the report's `info` section says about an asset.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AssetInfo {
+    pub version: Option<String>,
+    pub generator: Option<String>,
+    pub extensions_used: Vec<String>,
+    pub extensions_required: Vec<String>,
+    pub material_count: usize,
+    pub sheen_material_count: usize,
+    pub fuzz_material_count: usize,
+}
+
+/// The report for one file.
+#[derive(Debug, Clone)]
+pub struct FileReport {
+    pub path: PathBuf,
+    pub container: Option<Container>,
+    /// Byte offset of the JSON text in the file (for GLB positions).
+    pub json_offset: usize,
+    pub findings: Vec<Finding>,
+    pub counts: Counts,
+    pub truncated: bool,
+    pub info: Option<AssetInfo>,
+}
+
+impl FileReport {
+    /// True when a finding is at or above the run's fail-on severity.
+    pub fn fails(&self, settings: &Settings) -> bool {
+        self.findings.iter().any(|f| settings.fail_on.fails(f.diagnostic.severity))
+    }
+}
+
+/// A validator for one run: schemas compiled once, settings applied to every file.
+pub struct Validator {
+    pub schemas: Schemas,
+    pub settings: Settings,
+}
+
+impl Validator {
+    pub fn new(schemas: Schemas, settings: Settings) -> Validator {
+        Validator { schemas, settings }
+    }
+
+    /// Validates every asset found under `inputs`, in parallel, in input order.
+    pub fn validate_inputs(&self, inputs: &[PathBuf]) -> Vec<FileReport> {
+        let (files, walk_errors) = discover::collect(inputs);
+        let mut reports: Vec<FileReport> = walk_errors
+            .into_iter()
+            .map(|(path, e)| {
+                let d = Diagnostic::new(&crate::diagnostics::codes::IO_ERROR, "", format!("cannot read folder {}: {e}", path.display()));
+                self.finish(path, None, 0, vec![d], None)
+            })
+            .collect();
+        reports.extend(files.par_iter().map(|p| self.validate_file(p)).collect::<Vec<_>>());
+        reports
+    }
+
+    /// Validates one file.
+    pub fn validate_file(&self, path: &Path) -> FileReport {
+        let loaded = asset::load(path);
+        self.validate_loaded(path, loaded)
+    }
+
+    /// Validates a file already loaded (or that failed to load).
+    pub fn validate_loaded(&self, path: &Path, loaded: asset::Loaded) -> FileReport {
+        let mut diagnostics = loaded.diagnostics;
+        let Some(asset) = loaded.asset else {
+            return self.finish(path.to_path_buf(), None, 0, diagnostics, None);
+        };
+        let cx = Context { asset: &asset, schemas: &self.schemas };
+        for rule in rules::REGISTRY {
+            rule.check(&cx, &mut diagnostics);
+        }
+        let info = asset_info(&asset.json);
+        let mut report = self.finish(path.to_path_buf(), Some(asset.container), asset.json_offset, diagnostics, Some(info));
+        if !report.findings.is_empty() {
+            let positions = asset::position::locate(&asset.json_text, report.findings.iter().map(|f| f.diagnostic.pointer.as_str()));
+            for f in &mut report.findings {
+                if !f.diagnostic.pointer.is_empty() {
+                    f.position = positions.get(&f.diagnostic.pointer).copied();
+                }
+            }
+        }
+        report
+    }
+
+    fn finish(
+        &self,
+        path: PathBuf,
+        container: Option<Container>,
+        json_offset: usize,
+        mut diagnostics: Vec<Diagnostic>,
+        info: Option<AssetInfo>,
+    ) -> FileReport {
+        let settings = &self.settings;
+        diagnostics.retain(|d| !settings.ignore.contains(d.code));
+        let mut counts = Counts::default();
+        for d in &mut diagnostics {
+            if let Some(s) = settings.severity_overrides.get(d.code) {
+                d.severity = *s;
+            }
+            counts.add(d.severity);
+        }
+        let truncated = settings.max_issues.is_some_and(|max| diagnostics.len() > max);
+        if let Some(max) = settings.max_issues {
+            diagnostics.truncate(max);
+        }
+        FileReport {
+            path,
+            container,
+            json_offset,
+            findings: diagnostics.into_iter().map(|diagnostic| Finding { diagnostic, position: None }).collect(),
+            counts,
+            truncated,
+            info,
+        }
+    }
+}
+
+fn strings(json: &Value, key: &str) -> Vec<String> {
+    json.get(key)
+        .and_then(Value::as_array)
+        .map(|a| a.iter().filter_map(Value::as_str).map(str::to_string).collect())
+        .unwrap_or_default()
+}
+
+fn asset_info(json: &Value) -> AssetInfo {
+    let materials = layers::materials(json);
+    let with = |ext: &str| materials.iter().filter(|m| layers::extensions(m).is_some_and(|e| e.contains_key(ext))).count();
+    let text = |p: &str| json.pointer(p).and_then(Value::as_str).map(str::to_string);
+    AssetInfo {
+        version: text("/asset/version"),
+        generator: text("/asset/generator"),
+        extensions_used: strings(json, "extensionsUsed"),
+        extensions_required: strings(json, "extensionsRequired"),
+        material_count: materials.len(),
+        sheen_material_count: with(layers::SHEEN),
+        fuzz_material_count: with(layers::FUZZ),
+    }
+}
