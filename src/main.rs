@@ -10,8 +10,14 @@ use velvet::rules::schema::Schemas;
 use velvet::validate::Validator;
 
 #[derive(Parser)]
-#[command(name = "velvet", version, about = "Validate, migrate and bake glTF assets that use KHR_materials_sheen and KHR_materials_fuzz")]
-#[command(after_help = "Exit status: 0 clean, 1 issues at or above --fail-on (or a file failed), 2 usage or configuration error.")]
+#[command(
+    name = "velvet",
+    version,
+    about = "Validate, migrate and bake glTF assets that use KHR_materials_sheen and KHR_materials_fuzz"
+)]
+#[command(
+    after_help = "Exit status: 0 clean, 1 issues at or above --fail-on (or a file failed), 2 usage or configuration error."
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -21,6 +27,8 @@ struct Cli {
 enum Command {
     /// Check .gltf/.glb files (and folders, recursively) against the sheen and fuzz specs.
     Validate(ValidateArgs),
+    /// Bake sheen and fuzz texture × factor into new textures, once per distinct combination.
+    Bake(BakeArgs),
     /// List every code velvet reports, with its severity and description.
     Codes {
         #[arg(long, value_enum, default_value_t = CodesFormat::Text)]
@@ -47,6 +55,48 @@ struct ValidateArgs {
     /// Read schema files from DIR instead of the built-in ones (files absent there stay built-in).
     #[arg(long, value_name = "DIR")]
     schema_dir: Option<PathBuf>,
+}
+
+#[derive(clap::Args)]
+struct BakeArgs {
+    /// Files and folders to bake (folders are searched for *.gltf and *.glb).
+    #[arg(required = true)]
+    paths: Vec<PathBuf>,
+    /// The output file (one input only).
+    #[arg(short, long, value_name = "FILE", conflicts_with_all = ["out_dir", "in_place"])]
+    output: Option<PathBuf>,
+    /// A folder for the outputs, mirroring the inputs' trees.
+    #[arg(long, value_name = "DIR", conflicts_with = "in_place")]
+    out_dir: Option<PathBuf>,
+    /// Overwrite the inputs.
+    #[arg(long)]
+    in_place: bool,
+    /// Print what would be baked; write nothing.
+    #[arg(long)]
+    dry_run: bool,
+    /// .gltf: store new images as data: URIs instead of files next to the output.
+    #[arg(long)]
+    embed: bool,
+    /// Bake factors outside [0, 1] (clamped; the clamping is counted).
+    #[arg(long)]
+    allow_out_of_range: bool,
+    /// Turn a texture whose texels are all equal after baking into a factor.
+    #[arg(long)]
+    collapse_uniform: bool,
+    /// Keep JPEG textures as JPEG (lossy) instead of lossless PNG.
+    #[arg(long)]
+    keep_format: bool,
+    /// Measure and print each output's largest error in codes.
+    #[arg(long)]
+    report: bool,
+    #[arg(long, value_enum, default_value_t = BakeFormat::Text)]
+    format: BakeFormat,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum BakeFormat {
+    Text,
+    Json,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -78,6 +128,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
         Command::Validate(args) => validate(args),
+        Command::Bake(args) => bake(args),
         Command::Codes { format } => {
             print!("{}", codes_table(format));
             ExitCode::SUCCESS
@@ -90,12 +141,20 @@ fn codes_table(format: CodesFormat) -> String {
     match format {
         CodesFormat::Text => {
             let width = codes.iter().map(|c| c.name.len()).max().unwrap_or(0);
-            codes.iter().map(|c| format!("{:width$}  {:7}  {}\n", c.name, c.severity.as_str(), c.doc)).collect()
+            codes
+                .iter()
+                .map(|c| format!("{:width$}  {:7}  {}\n", c.name, c.severity.as_str(), c.doc))
+                .collect()
         }
         CodesFormat::Markdown => {
             let mut out = String::from("| code | severity | meaning |\n|---|---|---|\n");
             for c in codes {
-                out += &format!("| `{}` | {} | {} |\n", c.name, c.severity, c.doc.replace('|', "\\|"));
+                out += &format!(
+                    "| `{}` | {} | {} |\n",
+                    c.name,
+                    c.severity,
+                    c.doc.replace('|', "\\|")
+                );
             }
             out
         }
@@ -105,7 +164,9 @@ fn codes_table(format: CodesFormat) -> String {
 fn validate(args: ValidateArgs) -> ExitCode {
     for code in &args.ignore {
         if diagnostics::find_code(code).is_none() {
-            return usage_error(format!("--ignore {code}: no such code (`velvet codes` lists them)"));
+            return usage_error(format!(
+                "--ignore {code}: no such code (`velvet codes` lists them)"
+            ));
         }
     }
     let schemas = match &args.schema_dir {
@@ -134,6 +195,44 @@ fn validate(args: ValidateArgs) -> ExitCode {
     };
     print!("{text}");
     if reports.iter().any(|r| r.fails(&validator.settings)) {
+        ExitCode::from(1)
+    } else {
+        ExitCode::SUCCESS
+    }
+}
+
+fn bake(args: BakeArgs) -> ExitCode {
+    use velvet::bake::command::{self, Destination, Options, Request};
+    let destination = match (args.output, args.out_dir, args.in_place) {
+        (Some(file), _, _) => Destination::File(file),
+        (_, Some(dir), _) => Destination::Dir(dir),
+        (_, _, true) => Destination::InPlace,
+        _ => Destination::None,
+    };
+    let request = Request {
+        inputs: args.paths,
+        destination,
+        dry_run: args.dry_run,
+        options: Options {
+            plan: velvet::bake::plan::PlanOptions {
+                allow_out_of_range: args.allow_out_of_range,
+            },
+            embed: args.embed,
+            collapse_uniform: args.collapse_uniform,
+            keep_format: args.keep_format,
+            report: args.report,
+        },
+        progress: true,
+    };
+    let results = match command::run(&request) {
+        Ok(r) => r,
+        Err(e) => return usage_error(e),
+    };
+    match args.format {
+        BakeFormat::Text => print!("{}", command::render_text(&results, args.dry_run)),
+        BakeFormat::Json => print!("{}", command::render_json(&results)),
+    }
+    if results.iter().any(|r| r.failed()) {
         ExitCode::from(1)
     } else {
         ExitCode::SUCCESS

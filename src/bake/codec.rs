@@ -1,5 +1,5 @@
-//! Image codecs for baking: recognises PNG, JPEG, WebP and KTX2 by their signatures, decodes
-//! the first three into [`Pixels`] (through the `image` crate) and encodes PNG at the pixels'
+//! Image codecs for baking: decodes PNG, JPEG and WebP (recognised by the asset module's
+//! signature check) into [`Pixels`] (through the `image` crate) and encodes PNG at the pixels'
 //! depth, lossless WebP, or JPEG. KTX2 (KHR_texture_basisu) is recognised and refused: its
 //! payload is GPU block-compressed and supercompressed, and baking it would mean transcoding and
 //! re-encoding, which would change texels the recipe does not touch.
@@ -18,28 +18,16 @@ use image::{DynamicImage, ExtendedColorType, ImageEncoder, ImageReader, Limits};
 
 use super::pixels::{Depth, Layout, Pixels, Samples};
 
-/// A container format recognised from an image's first bytes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum SourceFormat {
-    /// PNG.
-    Png,
-    /// JPEG.
-    Jpeg,
-    /// WebP (EXT_texture_webp).
-    Webp,
-    /// KTX 2.0 (KHR_texture_basisu); recognised, not decoded.
-    Ktx2,
-}
+/// The container formats, recognised by the asset module from an image's first bytes.
+pub use crate::asset::resource::ImageFormat;
 
-impl SourceFormat {
-    /// The format's name for messages.
-    pub fn name(self) -> &'static str {
-        match self {
-            SourceFormat::Png => "PNG",
-            SourceFormat::Jpeg => "JPEG",
-            SourceFormat::Webp => "WebP",
-            SourceFormat::Ktx2 => "KTX2",
-        }
+/// A format's name for messages.
+pub fn format_name(format: ImageFormat) -> &'static str {
+    match format {
+        ImageFormat::Png => "PNG",
+        ImageFormat::Jpeg => "JPEG",
+        ImageFormat::Webp => "WebP",
+        ImageFormat::Ktx2 => "KTX2",
     }
 }
 
@@ -140,26 +128,9 @@ pub enum CodecError {
 pub const KTX2_REASON: &str = "KTX2 / Basis Universal data is GPU block-compressed; baking it \
      would need transcoding and lossy re-encoding, so the slot is left as it is";
 
-/// Recognises a container format from its signature.
-pub fn sniff(bytes: &[u8]) -> Option<SourceFormat> {
-    const PNG: &[u8] = b"\x89PNG\r\n\x1a\n";
-    const KTX2: &[u8] = b"\xabKTX 20\xbb\r\n\x1a\n";
-    if bytes.starts_with(PNG) {
-        Some(SourceFormat::Png)
-    } else if bytes.starts_with(&[0xff, 0xd8, 0xff]) {
-        Some(SourceFormat::Jpeg)
-    } else if bytes.len() >= 12 && &bytes[..4] == b"RIFF" && &bytes[8..12] == b"WEBP" {
-        Some(SourceFormat::Webp)
-    } else if bytes.starts_with(KTX2) {
-        Some(SourceFormat::Ktx2)
-    } else {
-        None
-    }
-}
-
 /// Decodes an image (PNG, JPEG or WebP) to pixels; KTX2 and unknown data are refused.
-pub fn decode(bytes: &[u8]) -> Result<(Pixels, SourceFormat), CodecError> {
-    let format = sniff(bytes).ok_or_else(|| {
+pub fn decode(bytes: &[u8]) -> Result<(Pixels, ImageFormat), CodecError> {
+    let format = ImageFormat::sniff(bytes).ok_or_else(|| {
         let head: Vec<String> = bytes.iter().take(8).map(|b| format!("{b:02x}")).collect();
         CodecError::Unrecognised(if head.is_empty() {
             "no bytes".to_owned()
@@ -168,10 +139,10 @@ pub fn decode(bytes: &[u8]) -> Result<(Pixels, SourceFormat), CodecError> {
         })
     })?;
     let image_format = match format {
-        SourceFormat::Png => image::ImageFormat::Png,
-        SourceFormat::Jpeg => image::ImageFormat::Jpeg,
-        SourceFormat::Webp => image::ImageFormat::WebP,
-        SourceFormat::Ktx2 => {
+        ImageFormat::Png => image::ImageFormat::Png,
+        ImageFormat::Jpeg => image::ImageFormat::Jpeg,
+        ImageFormat::Webp => image::ImageFormat::WebP,
+        ImageFormat::Ktx2 => {
             return Err(CodecError::Unsupported {
                 format: "KTX2",
                 reason: KTX2_REASON,
@@ -179,7 +150,7 @@ pub fn decode(bytes: &[u8]) -> Result<(Pixels, SourceFormat), CodecError> {
         }
     };
     let decode_error = |e: image::ImageError| CodecError::Decode {
-        format: format.name(),
+        format: format_name(format),
         message: e.to_string(),
     };
     let mut reader = ImageReader::with_format(Cursor::new(bytes), image_format);
@@ -198,13 +169,13 @@ pub fn decode(bytes: &[u8]) -> Result<(Pixels, SourceFormat), CodecError> {
         DynamicImage::ImageRgba16(b) => (Layout::Rgba, Samples::U16(b.into_raw())),
         other => {
             return Err(CodecError::Decode {
-                format: format.name(),
+                format: format_name(format),
                 message: format!("unexpected sample type {:?}", other.color()),
             })
         }
     };
     let pixels = Pixels::new(w, h, layout, samples).map_err(|e| CodecError::Decode {
-        format: format.name(),
+        format: format_name(format),
         message: e.to_string(),
     })?;
     Ok((pixels, format))
@@ -214,14 +185,14 @@ pub fn decode(bytes: &[u8]) -> Result<(Pixels, SourceFormat), CodecError> {
 /// JPEG becomes PNG (lossless) unless `keep_format`. A format that cannot hold the pixels
 /// (16-bit in WebP or JPEG, alpha in JPEG) falls back to PNG.
 pub fn output_format(
-    source: SourceFormat,
+    source: ImageFormat,
     keep_format: bool,
     layout: Layout,
     depth: Depth,
 ) -> OutputFormat {
     let wanted = match source {
-        SourceFormat::Webp => OutputFormat::WebpLossless,
-        SourceFormat::Jpeg if keep_format => OutputFormat::Jpeg,
+        ImageFormat::Webp => OutputFormat::WebpLossless,
+        ImageFormat::Jpeg if keep_format => OutputFormat::Jpeg,
         _ => OutputFormat::Png,
     };
     match wanted {
@@ -306,7 +277,7 @@ mod tests {
         let path = format!("{}/fixtures/bake/{name}", env!("CARGO_MANIFEST_DIR"));
         let bytes = std::fs::read(&path).unwrap();
         let (pixels, format) = decode(&bytes).unwrap();
-        assert_eq!(format, SourceFormat::Png);
+        assert_eq!(format, ImageFormat::Png);
         pixels
     }
 
@@ -343,7 +314,7 @@ mod tests {
                     };
                     let bytes = encode(&image, OutputFormat::Png, options).unwrap();
                     let (back, format) = decode(&bytes).unwrap();
-                    assert_eq!(format, SourceFormat::Png);
+                    assert_eq!(format, ImageFormat::Png);
                     assert_eq!(back, image, "{layout:?} {depth:?} {png:?}");
                 }
             }
@@ -356,7 +327,7 @@ mod tests {
             let image = sample_image(layout, Depth::Eight);
             let bytes =
                 encode(&image, OutputFormat::WebpLossless, EncodeOptions::default()).unwrap();
-            assert_eq!(sniff(&bytes), Some(SourceFormat::Webp));
+            assert_eq!(ImageFormat::sniff(&bytes), Some(ImageFormat::Webp));
             let (back, _) = decode(&bytes).unwrap();
             assert_eq!(back, image, "{layout:?}");
         }
@@ -369,7 +340,7 @@ mod tests {
                 Pixels::new(8, 8, layout, Samples::U8(vec![90; 64 * layout.channels()])).unwrap();
             let bytes = encode(&image, OutputFormat::Jpeg, EncodeOptions::default()).unwrap();
             let (back, format) = decode(&bytes).unwrap();
-            assert_eq!(format, SourceFormat::Jpeg);
+            assert_eq!(format, ImageFormat::Jpeg);
             assert_eq!((back.layout(), back.depth()), (layout, Depth::Eight));
             // A flat block survives JPEG to within a code.
             assert!(
@@ -412,7 +383,7 @@ mod tests {
     fn ktx2_is_recognised_and_refused_with_its_reason() {
         let mut bytes = b"\xabKTX 20\xbb\r\n\x1a\n".to_vec();
         bytes.extend([0; 64]);
-        assert_eq!(sniff(&bytes), Some(SourceFormat::Ktx2));
+        assert_eq!(ImageFormat::sniff(&bytes), Some(ImageFormat::Ktx2));
         let err = decode(&bytes).unwrap_err();
         assert_eq!(
             err,
@@ -448,18 +419,18 @@ mod tests {
         use OutputFormat::*;
         let f = output_format;
         assert_eq!(
-            f(SourceFormat::Png, false, Layout::Rgba, Depth::Sixteen),
+            f(ImageFormat::Png, false, Layout::Rgba, Depth::Sixteen),
             Png
         );
-        assert_eq!(f(SourceFormat::Jpeg, false, Layout::Rgb, Depth::Eight), Png);
-        assert_eq!(f(SourceFormat::Jpeg, true, Layout::Rgb, Depth::Eight), Jpeg);
-        assert_eq!(f(SourceFormat::Jpeg, true, Layout::Rgba, Depth::Eight), Png);
+        assert_eq!(f(ImageFormat::Jpeg, false, Layout::Rgb, Depth::Eight), Png);
+        assert_eq!(f(ImageFormat::Jpeg, true, Layout::Rgb, Depth::Eight), Jpeg);
+        assert_eq!(f(ImageFormat::Jpeg, true, Layout::Rgba, Depth::Eight), Png);
         assert_eq!(
-            f(SourceFormat::Webp, false, Layout::Rgba, Depth::Eight),
+            f(ImageFormat::Webp, false, Layout::Rgba, Depth::Eight),
             WebpLossless
         );
         assert_eq!(
-            f(SourceFormat::Webp, false, Layout::Rgba, Depth::Sixteen),
+            f(ImageFormat::Webp, false, Layout::Rgba, Depth::Sixteen),
             Png
         );
         assert_eq!(

@@ -13,7 +13,7 @@ use std::collections::HashMap;
 
 use rayon::prelude::*;
 
-use super::codec::{self, CodecError, EncodeOptions, OutputFormat, SourceFormat};
+use super::codec::{self, CodecError, EncodeOptions, ImageFormat, OutputFormat};
 use super::kernel::{self, KernelError, KernelOptions, KernelStats};
 use super::pixels::{Depth, Layout, Pixels};
 use super::recipe::{ImageId, Recipe};
@@ -124,7 +124,7 @@ pub struct Baked {
     /// Bits per channel.
     pub depth: Depth,
     /// The format of the recipe's base image.
-    pub source_format: SourceFormat,
+    pub source_format: ImageFormat,
     /// The encoded image, or `None` when it was collapsed (see `uniform`).
     pub encoded: Option<(OutputFormat, Vec<u8>)>,
     /// The codes (per stored channel) when every texel is equal and `collapse_uniform` is set.
@@ -229,7 +229,7 @@ pub fn bake(
         .collect()
 }
 
-type Decoded = Result<(Pixels, SourceFormat), BakeError>;
+type Decoded = Result<(Pixels, ImageFormat), BakeError>;
 
 fn decode_image(source: &dyn ImageSource, image: ImageId) -> Decoded {
     let bytes = source
@@ -285,7 +285,7 @@ fn bake_component(
 fn bake_one(
     recipe: &Recipe,
     images: &HashMap<ImageId, Pixels>,
-    source_format: SourceFormat,
+    source_format: ImageFormat,
     options: &BakeOptions,
 ) -> Result<Baked, BakeError> {
     let (out, stats) = kernel::apply(recipe, images, options.kernel)?;
@@ -498,7 +498,7 @@ mod tests {
         set.insert(colour_bake(0, 0.5));
         let png_out = bake(&set, &source, &BakeOptions::default());
         let baked = png_out[0].as_ref().unwrap();
-        assert_eq!(baked.source_format, SourceFormat::Jpeg);
+        assert_eq!(baked.source_format, ImageFormat::Jpeg);
         assert_eq!(baked.encoded.as_ref().unwrap().0, OutputFormat::Png);
         let options = BakeOptions {
             keep_format: true,
