@@ -340,7 +340,10 @@ pub fn apply(
         }
     }
     if let (true, Some(b)) = (bin_usable, bin.as_ref()) {
-        if let Some(buffer) = json.pointer_mut("/buffers/0") {
+        if b.is_empty() {
+            drop_empty_bin(&mut json);
+            bin = None;
+        } else if let Some(buffer) = json.pointer_mut("/buffers/0") {
             buffer["byteLength"] = Value::from(b.len());
         }
     }
@@ -415,4 +418,37 @@ fn store_image(
     *stored = file.clone();
     files.push(NewFile { name: file, bytes });
     json!({"name": name, "uri": uri})
+}
+
+/// Removes buffer 0 (the GLB's BIN chunk) once nothing is left in it and no bufferView names
+/// it (a buffer's byteLength must be at least 1), renumbering the other buffers' references.
+fn drop_empty_bin(json: &mut Value) {
+    fn buffer_refs(value: &mut Value, f: &mut dyn FnMut(&mut Value)) {
+        match value {
+            Value::Object(map) => {
+                for (k, v) in map.iter_mut() {
+                    if k == "buffer" && v.is_u64() {
+                        f(v);
+                    } else {
+                        buffer_refs(v, f);
+                    }
+                }
+            }
+            Value::Array(items) => items.iter_mut().for_each(|v| buffer_refs(v, f)),
+            _ => {}
+        }
+    }
+    let mut named = false;
+    buffer_refs(json, &mut |v| named |= v.as_u64() == Some(0));
+    if named || json.pointer("/buffers/0").is_none() {
+        return;
+    }
+    buffer_refs(json, &mut |v| *v = Value::from(v.as_u64().unwrap_or(1) - 1));
+    let root = json.as_object_mut().expect("the document is an object");
+    if let Some(Value::Array(buffers)) = root.get_mut("buffers") {
+        buffers.remove(0);
+        if buffers.is_empty() {
+            root.shift_remove("buffers");
+        }
+    }
 }

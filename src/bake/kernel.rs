@@ -184,6 +184,61 @@ impl Slot<'_> {
     }
 }
 
+/// A value with its texels replaced by slot numbers, for per-texel evaluation.
+enum Node<'a> {
+    Const(f64),
+    Slot(usize),
+    Product(Vec<Node<'a>>),
+    Max(Vec<Node<'a>>),
+    Ratio(Box<Node<'a>>, Box<Node<'a>>, f64),
+    Curve(&'a super::recipe::Curve, Box<Node<'a>>),
+}
+
+impl<'a> Node<'a> {
+    fn compile(value: &'a Value, slots: &[Slot<'_>]) -> Node<'a> {
+        let all = |terms: &'a [Value]| terms.iter().map(|t| Node::compile(t, slots)).collect();
+        match value {
+            Value::Const(k) => Node::Const(k.get()),
+            Value::Texel(t) => Node::Slot(
+                slots
+                    .iter()
+                    .position(|s| s.texel == *t)
+                    .expect("a slot per texel"),
+            ),
+            Value::Product(terms) => Node::Product(all(terms)),
+            Value::Max(terms) => Node::Max(all(terms)),
+            Value::Ratio { num, den, if_zero } => Node::Ratio(
+                Box::new(Node::compile(num, slots)),
+                Box::new(Node::compile(den, slots)),
+                if_zero.get(),
+            ),
+            Value::Curve(c, v) => Node::Curve(c, Box::new(Node::compile(v, slots))),
+        }
+    }
+
+    /// The same arithmetic as [`Value::eval`], in the same order.
+    fn eval(&self, values: &[f64]) -> f64 {
+        match self {
+            Node::Const(k) => *k,
+            Node::Slot(i) => values[*i],
+            Node::Product(terms) => terms.iter().fold(1.0, |acc, t| acc * t.eval(values)),
+            Node::Max(terms) => terms
+                .iter()
+                .map(|t| t.eval(values))
+                .fold(f64::NEG_INFINITY, f64::max),
+            Node::Ratio(num, den, if_zero) => {
+                let d = den.eval(values);
+                if d == 0.0 {
+                    *if_zero
+                } else {
+                    num.eval(values) / d
+                }
+            }
+            Node::Curve(c, v) => c.eval(v.eval(values)),
+        }
+    }
+}
+
 enum Program<'a> {
     Copy {
         src: Src<'a>,
@@ -458,20 +513,36 @@ impl<'a> Plan<'a> {
         let rows_per_band = (65536 / width.max(1)).max(1);
         let band_len = (rows_per_band * row).max(1);
         let max = self.depth.max_code();
-        let accs: Vec<Vec<Acc>> = out
-            .par_chunks_mut(band_len)
-            .enumerate()
-            .map(|(b, band)| {
-                let first_pixel = b * rows_per_band * width;
-                self.programs
-                    .iter()
-                    .enumerate()
-                    .map(|(s, (_, program))| {
-                        run_program(program, band, first_pixel, s, n, width, max)
-                    })
-                    .collect()
-            })
-            .collect();
+        let accs: Vec<Vec<Acc>> = if let Some(fused) = self.fused() {
+            run_fused(&fused, as_u8(&mut out), band_len, n);
+            vec![]
+        } else {
+            // Tables in the output's code type, converted once.
+            let tables: Vec<Vec<O>> = self
+                .programs
+                .iter()
+                .map(|(_, p)| match p {
+                    Program::Lut { table, .. } => {
+                        table.iter().map(|&c| O::from_code(u32::from(c))).collect()
+                    }
+                    _ => Vec::new(),
+                })
+                .collect();
+            out.par_chunks_mut(band_len)
+                .enumerate()
+                .map(|(b, band)| {
+                    let first_pixel = b * rows_per_band * width;
+                    self.programs
+                        .iter()
+                        .zip(&tables)
+                        .enumerate()
+                        .map(|(s, ((_, program), table))| {
+                            run_program(program, table, band, first_pixel, s, n, width, max)
+                        })
+                        .collect()
+                })
+                .collect()
+        };
         let stats = self
             .programs
             .iter()
@@ -490,8 +561,110 @@ impl<'a> Plan<'a> {
         (pixels, KernelStats { channels: stats })
     }
 
+    /// The single-pass form of an 8-bit output whose channels are all copies, constants or
+    /// unmeasured tables reading one 8-bit image of the output's size: one 256-entry table per
+    /// output channel (a copy is the identity table) and the stored channel each one reads.
+    fn fused(&self) -> Option<Fused<'a>> {
+        if self.depth != Depth::Eight {
+            return None;
+        }
+        let mut source: Option<&'a Pixels> = None;
+        let mut tables = Vec::with_capacity(self.programs.len());
+        let mut offsets = Vec::with_capacity(self.programs.len());
+        for (_, program) in &self.programs {
+            let (src, table): (Option<&Src<'a>>, [u8; 256]) = match program {
+                Program::Copy { src } => (Some(src), std::array::from_fn(|c| c as u8)),
+                Program::Lut {
+                    src,
+                    table,
+                    histogram: false,
+                    ..
+                } => (Some(src), std::array::from_fn(|c| table[c] as u8)),
+                Program::Const { code, .. } => (None, [*code as u8; 256]),
+                _ => return None,
+            };
+            match src {
+                Some(src) => {
+                    match source {
+                        Some(p) if !std::ptr::eq(p, src.pixels) => return None,
+                        _ => source = Some(src.pixels),
+                    }
+                    if src.pixels.depth() != Depth::Eight {
+                        return None;
+                    }
+                    offsets.push(src.offset);
+                }
+                None => offsets.push(0),
+            }
+            tables.push(table);
+        }
+        let pixels = source?;
+        let Samples::U8(codes) = pixels.samples() else {
+            return None;
+        };
+        Some(Fused {
+            codes,
+            stride: pixels.layout().channels(),
+            tables,
+            offsets,
+        })
+    }
+
     fn pixels(&self) -> u64 {
         u64::from(self.width) * u64::from(self.height)
+    }
+}
+
+/// The output buffer as bytes; only called for 8-bit outputs.
+fn as_u8<O: Code>(out: &mut Vec<O>) -> &mut Vec<u8> {
+    let any: &mut dyn std::any::Any = out;
+    any.downcast_mut::<Vec<u8>>().expect("an 8-bit output")
+}
+
+/// See [`Plan::fused`].
+struct Fused<'a> {
+    codes: &'a [u8],
+    stride: usize,
+    tables: Vec<[u8; 256]>,
+    offsets: Vec<usize>,
+}
+
+/// One pass over the pixels, every output channel through its table.
+fn run_fused(fused: &Fused<'_>, out: &mut [u8], band_len: usize, n: usize) {
+    fn pass<const N: usize, const S: usize>(fused: &Fused<'_>, out: &mut [u8], band_len: usize) {
+        let tables: [[u8; 256]; N] = std::array::from_fn(|c| fused.tables[c]);
+        let offsets: [usize; N] = std::array::from_fn(|c| fused.offsets[c]);
+        let pixels_per_band = band_len / N;
+        out.par_chunks_mut(band_len)
+            .enumerate()
+            .for_each(|(b, band)| {
+                let first = b * pixels_per_band;
+                let src = &fused.codes[first * S..(first + band.len() / N) * S];
+                for (d, p) in band.chunks_exact_mut(N).zip(src.chunks_exact(S)) {
+                    for c in 0..N {
+                        d[c] = tables[c][usize::from(p[offsets[c]])];
+                    }
+                }
+            });
+    }
+    match (n, fused.stride) {
+        (4, 4) => pass::<4, 4>(fused, out, band_len),
+        (3, 3) => pass::<3, 3>(fused, out, band_len),
+        (4, 3) => pass::<4, 3>(fused, out, band_len),
+        (3, 4) => pass::<3, 4>(fused, out, band_len),
+        (1, 1) => pass::<1, 1>(fused, out, band_len),
+        (2, 2) => pass::<2, 2>(fused, out, band_len),
+        (3, 1) => pass::<3, 1>(fused, out, band_len),
+        (4, 2) => pass::<4, 2>(fused, out, band_len),
+        (2, 1) => pass::<2, 1>(fused, out, band_len),
+        (1, 4) => pass::<1, 4>(fused, out, band_len),
+        (1, 3) => pass::<1, 3>(fused, out, band_len),
+        (1, 2) => pass::<1, 2>(fused, out, band_len),
+        (4, 1) => pass::<4, 1>(fused, out, band_len),
+        (2, 4) => pass::<2, 4>(fused, out, band_len),
+        (2, 3) => pass::<2, 3>(fused, out, band_len),
+        (3, 2) => pass::<3, 2>(fused, out, band_len),
+        _ => unreachable!("layouts have 1 to 4 channels"),
     }
 }
 
@@ -589,8 +762,10 @@ fn widen<O: Code>(code: u32, from: Depth, to_max: u32) -> O {
 
 /// Runs one channel's program over a band (`band` holds whole output pixels of `n` channels,
 /// starting at pixel `first`), writing stored channel `s`.
+#[allow(clippy::too_many_arguments)]
 fn run_program<O: Code>(
     program: &Program<'_>,
+    table: &[O],
     band: &mut [O],
     first: usize,
     s: usize,
@@ -625,21 +800,15 @@ fn run_program<O: Code>(
                 d[s] = code;
             }
         }
-        Program::Lut {
-            src,
-            table,
-            histogram,
-            ..
-        } => {
+        Program::Lut { src, histogram, .. } => {
             let stride = src.stride();
-            let table: Vec<O> = table.iter().map(|&c| O::from_code(u32::from(c))).collect();
             if *histogram {
                 acc.histogram = vec![0; table.len()];
             }
             match src.pixels.samples() {
                 Samples::U8(codes) => {
                     let codes = &codes[first * stride..(first + count) * stride];
-                    let table: &[O; 256] = table.as_slice().try_into().expect("256 entries");
+                    let table: &[O; 256] = table.try_into().expect("256 entries");
                     lut_band(
                         band,
                         codes,
@@ -653,7 +822,7 @@ fn run_program<O: Code>(
                 }
                 Samples::U16(codes) => {
                     let codes = &codes[first * stride..(first + count) * stride];
-                    let table: &[O; 65536] = table.as_slice().try_into().expect("65536 entries");
+                    let table: &[O; 65536] = table.try_into().expect("65536 entries");
                     lut_band(
                         band,
                         codes,
@@ -672,6 +841,7 @@ fn run_program<O: Code>(
             value,
             transfer,
         } => {
+            let node = Node::compile(value, slots);
             let mut values = vec![0.0; slots.len()];
             for (i, d) in band.chunks_exact_mut(n).enumerate() {
                 let pixel = first + i;
@@ -679,14 +849,7 @@ fn run_program<O: Code>(
                 for (v, slot) in values.iter_mut().zip(slots) {
                     *v = slot.value(x, y, width);
                 }
-                let raw = value.eval(&mut |t: &Texel| {
-                    let k = slots
-                        .iter()
-                        .position(|s| s.texel == *t)
-                        .expect("slot per texel");
-                    values[k]
-                });
-                let (code, error, clamped) = quantise(raw, *transfer, max);
+                let (code, error, clamped) = quantise(node.eval(&values), *transfer, max);
                 d[s] = O::from_code(code);
                 acc.clamped += u64::from(clamped);
                 acc.max_error = acc.max_error.max(error);
@@ -789,16 +952,17 @@ mod tests {
         HashMap::from([(IMG, image)])
     }
 
+    /// Applies a recipe measured and unmeasured (the unmeasured table path runs in one fused
+    /// pass), checks both give the same pixels, and returns the measured run.
     fn run(
         recipe: &Recipe,
         images: &HashMap<ImageId, Pixels>,
         exact: bool,
     ) -> (Pixels, KernelStats) {
-        let options = KernelOptions {
-            exact,
-            measure: true,
-        };
-        apply(recipe, images, options).unwrap()
+        let measure = |measure| apply(recipe, images, KernelOptions { exact, measure }).unwrap();
+        let (measured, plain) = (measure(true), measure(false));
+        assert_eq!(measured.0, plain.0, "measured and unmeasured runs agree");
+        measured
     }
 
     fn codes(p: &Pixels) -> Vec<u32> {
@@ -830,6 +994,24 @@ mod tests {
                 assert!(stats.max_error().unwrap() <= 0.5, "{stats:?}");
             }
         }
+    }
+
+    #[test]
+    fn one_8_bit_image_runs_in_one_fused_pass_unless_measured() {
+        let images = one(all_codes_8());
+        let recipe = colour_and_alpha(0.5, 0.5);
+        let compile = |options| Plan::compile(&recipe, &images, options).unwrap();
+        assert!(compile(KernelOptions::default()).fused().is_some());
+        let measured = KernelOptions {
+            measure: true,
+            ..KernelOptions::default()
+        };
+        assert!(compile(measured).fused().is_none());
+        let exact = KernelOptions {
+            exact: true,
+            ..KernelOptions::default()
+        };
+        assert!(compile(exact).fused().is_none());
     }
 
     #[test]

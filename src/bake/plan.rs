@@ -453,3 +453,78 @@ fn flush(groups: &mut Vec<Group>, out: &mut BakePlan) {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    fn plan_of(doc: Value) -> BakePlan {
+        let text = serde_json::to_string(&doc).unwrap();
+        let loaded =
+            crate::asset::load_bytes(std::path::Path::new("memory/plan.gltf"), text.as_bytes());
+        plan(&loaded.asset.unwrap(), PlanOptions::default())
+    }
+
+    fn doc(fuzz: Value) -> Value {
+        json!({
+            "asset": {"version": "2.0"},
+            "materials": [{"extensions": {"KHR_materials_fuzz": fuzz}}],
+            "textures": [{"source": 0}, {"source": 0}],
+            "images": [{"uri": "missing.png"}]
+        })
+    }
+
+    #[test]
+    fn slots_clashing_on_one_channel_of_one_image_get_separate_recipes() {
+        // fuzzTexture reads red linearly, fuzzColorTexture reads red as sRGB: one image, two
+        // outputs. fuzzRoughnessTexture (alpha) joins the first that has room.
+        let p = plan_of(doc(json!({
+            "fuzzFactor": 0.5, "fuzzTexture": {"index": 0},
+            "fuzzColorFactor": [0.5, 0.5, 0.5], "fuzzColorTexture": {"index": 1},
+            "fuzzRoughnessFactor": 0.25, "fuzzRoughnessTexture": {"index": 1}
+        })));
+        assert_eq!(p.recipes.len(), 2);
+        assert_eq!(p.outputs[0].labels, vec!["fuzz", "fuzzRoughness"]);
+        assert_eq!(p.outputs[1].labels, vec!["fuzzColor"]);
+        let outputs: Vec<OutputId> = p.slots.iter().map(|s| s.sources[0].output).collect();
+        assert_eq!(outputs, vec![OutputId(0), OutputId(1), OutputId(0)]);
+        let r = p.recipes.get(OutputId(0));
+        assert!(r.channel(Channel::R).is_some() && r.channel(Channel::A).is_some());
+        assert!(r.channel(Channel::G).is_none() && r.channel(Channel::B).is_none());
+    }
+
+    #[test]
+    fn identity_factors_need_nothing_and_an_absent_fuzz_roughness_is_assumed_with_a_warning() {
+        let p = plan_of(doc(json!({
+            "fuzzFactor": 1.0, "fuzzTexture": {"index": 0},
+            "fuzzRoughnessTexture": {"index": 1}
+        })));
+        assert_eq!(p.slots.len(), 1);
+        assert_eq!(p.slots[0].texture_key, "fuzzRoughnessTexture");
+        assert_eq!(p.slots[0].factor, vec![0.5]);
+        assert_eq!(p.notes.len(), 1);
+        assert_eq!(p.notes[0].level, Level::Warning);
+        assert_eq!(
+            p.notes[0].pointer,
+            "/materials/0/extensions/KHR_materials_fuzz/fuzzRoughnessFactor"
+        );
+    }
+
+    #[test]
+    fn malformed_factors_and_dangling_textures_leave_the_slot_with_a_warning() {
+        let p = plan_of(doc(json!({
+            "fuzzFactor": 0.5, "fuzzTexture": {"index": 7},
+            "fuzzColorFactor": "red", "fuzzColorTexture": {"index": 0}
+        })));
+        assert!(p.is_empty());
+        let pointers: Vec<&str> = p.notes.iter().map(|n| n.pointer.as_str()).collect();
+        assert_eq!(
+            pointers,
+            vec![
+                "/materials/0/extensions/KHR_materials_fuzz/fuzzTexture/index",
+                "/materials/0/extensions/KHR_materials_fuzz/fuzzColorFactor"
+            ]
+        );
+    }
+}
