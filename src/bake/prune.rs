@@ -209,8 +209,9 @@ fn view_range(view: &Value) -> Option<(usize, usize, usize)> {
 }
 
 /// Cuts the bytes of `drop` views (of buffer 0) that no kept view overlaps out of `bin`, in
-/// 4-byte-aligned runs so every later offset moves by a multiple of 4 and keeps its alignment;
-/// shifts the later views and updates buffer 0's byteLength. Returns the bytes cut.
+/// 4-byte-aligned runs so every later offset moves by a multiple of 4 and keeps its alignment
+/// (a run with nothing kept after it takes the chunk's tail with it); shifts the later views
+/// and updates buffer 0's byteLength. Returns the bytes cut.
 fn compact_bin(json: &mut Value, bin: &mut Vec<u8>, drop: &BTreeSet<usize>) -> usize {
     let views = json
         .get("bufferViews")
@@ -246,9 +247,26 @@ fn compact_bin(json: &mut Value, bin: &mut Vec<u8>, drop: &BTreeSet<usize>) -> u
             })
             .collect();
     }
+    // Where kept data starts after a run decides how its end aligns: with nothing kept after
+    // it, the run goes to the end of the chunk.
+    let kept_starts: Vec<usize> = views
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| !drop.contains(i))
+        .filter_map(|(_, v)| view_range(v))
+        .filter(|(buffer, _, _)| *buffer == 0)
+        .map(|(_, start, _)| start)
+        .collect();
     let mut cut: Vec<(usize, usize)> = cut
         .into_iter()
-        .map(|(s, e)| (s.div_ceil(4) * 4, (e.min(bin.len()) / 4) * 4))
+        .map(|(s, e)| {
+            let end = if kept_starts.iter().any(|&k| k >= e) {
+                (e.min(bin.len()) / 4) * 4
+            } else {
+                bin.len()
+            };
+            (s.div_ceil(4) * 4, end)
+        })
         .filter(|(s, e)| s < e)
         .collect();
     cut.sort();
