@@ -89,8 +89,18 @@ struct BakeArgs {
     /// Measure and print each output's largest error in codes.
     #[arg(long)]
     report: bool,
+    /// PNG compression effort for new images.
+    #[arg(long, value_enum, default_value_t = Compression::Fast)]
+    compression: Compression,
     #[arg(long, value_enum, default_value_t = BakeFormat::Text)]
     format: BakeFormat,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Compression {
+    Fast,
+    Balanced,
+    Best,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -221,6 +231,11 @@ fn bake(args: BakeArgs) -> ExitCode {
             collapse_uniform: args.collapse_uniform,
             keep_format: args.keep_format,
             report: args.report,
+            png: match args.compression {
+                Compression::Fast => velvet::bake::PngCompression::Fast,
+                Compression::Balanced => velvet::bake::PngCompression::Default,
+                Compression::Best => velvet::bake::PngCompression::Best,
+            },
         },
         progress: true,
     };

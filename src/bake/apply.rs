@@ -196,7 +196,7 @@ pub fn apply(
     let bin_usable = glb
         && json
             .pointer("/buffers/0")
-            .is_none_or(|b| b.get("uri").is_none());
+            .map_or(true, |b| b.get("uri").is_none());
     if let (true, Some(b)) = (bin_usable, bin.as_mut()) {
         // Drop the chunk's padding: appends start at the buffer's declared end.
         let declared = json

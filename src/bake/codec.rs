@@ -62,15 +62,16 @@ impl OutputFormat {
     }
 }
 
-/// PNG compression effort.
+/// PNG compression effort. Fast (fdeflate) is the default: on 2048² textures it encodes about
+/// 20× faster than the balanced zlib level, for files a few percent larger.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum PngCompression {
-    /// Quick and larger.
-    Fast,
-    /// Balanced (the default).
+    /// Quick and a little larger (the default).
     #[default]
+    Fast,
+    /// zlib's default level.
     Default,
-    /// Slow and smaller.
+    /// zlib's best level: slow and smallest.
     Best,
 }
 
@@ -86,7 +87,7 @@ pub struct EncodeOptions {
 impl Default for EncodeOptions {
     fn default() -> Self {
         EncodeOptions {
-            png: PngCompression::Default,
+            png: PngCompression::Fast,
             jpeg_quality: 95,
         }
     }

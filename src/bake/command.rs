@@ -16,7 +16,7 @@ use serde::Serialize;
 use serde_json::Value;
 
 use super::apply::{apply, ApplyOptions, Names, OutputReport};
-use super::codec::EncodeOptions;
+use super::codec::{EncodeOptions, PngCompression};
 use super::engine::{bake, BakeOptions, ImageSource};
 use super::kernel::KernelOptions;
 use super::plan::{plan, BakePlan, Note, PlanOptions};
@@ -50,6 +50,8 @@ pub struct Options {
     pub keep_format: bool,
     /// Measure each output's quantisation error.
     pub report: bool,
+    /// PNG compression effort.
+    pub png: PngCompression,
 }
 
 /// One `velvet bake` invocation.
@@ -218,16 +220,14 @@ fn container_extension(path: &Path) -> Option<&'static str> {
     }
 }
 
+/// Input files paired with their outputs (none in a dry run without a destination).
+pub type Jobs = Vec<(PathBuf, Option<PathBuf>)>;
+
+/// Folders that could not be read, with the error.
+pub type WalkErrors = Vec<(PathBuf, std::io::Error)>;
+
 /// Every input file with its output, or the reason the request cannot run.
-pub fn jobs(
-    request: &Request,
-) -> Result<
-    (
-        Vec<(PathBuf, Option<PathBuf>)>,
-        Vec<(PathBuf, std::io::Error)>,
-    ),
-    UsageError,
-> {
+pub fn jobs(request: &Request) -> Result<(Jobs, WalkErrors), UsageError> {
     let inputs = &request.inputs;
     let destination = &request.destination;
     if inputs.is_empty() {
@@ -528,7 +528,10 @@ fn bake_file(
             exact: false,
             measure: options.report,
         },
-        encode: EncodeOptions::default(),
+        encode: EncodeOptions {
+            png: options.png,
+            ..EncodeOptions::default()
+        },
     };
     let mut baked = Vec::with_capacity(plan.recipes.len());
     for (i, result) in bake(&plan.recipes, &AssetImages(&asset), &bake_options)

@@ -106,17 +106,37 @@ pub fn output_shape(
 /// An output code type.
 trait Code: Copy + Default + Send + Sync + 'static {
     fn from_code(code: u32) -> Self;
+    /// The buffer as bytes, for 8-bit codes.
+    fn bytes_mut(codes: &mut [Self]) -> Option<&mut [u8]>;
+    /// The buffer as [`Samples`].
+    fn into_samples(codes: Vec<Self>) -> Samples;
 }
 
 impl Code for u8 {
     fn from_code(code: u32) -> Self {
         code as u8
     }
+
+    fn bytes_mut(codes: &mut [Self]) -> Option<&mut [u8]> {
+        Some(codes)
+    }
+
+    fn into_samples(codes: Vec<Self>) -> Samples {
+        Samples::U8(codes)
+    }
 }
 
 impl Code for u16 {
     fn from_code(code: u32) -> Self {
         code as u16
+    }
+
+    fn bytes_mut(_: &mut [Self]) -> Option<&mut [u8]> {
+        None
+    }
+
+    fn into_samples(codes: Vec<Self>) -> Samples {
+        Samples::U16(codes)
     }
 }
 
@@ -513,36 +533,38 @@ impl<'a> Plan<'a> {
         let rows_per_band = (65536 / width.max(1)).max(1);
         let band_len = (rows_per_band * row).max(1);
         let max = self.depth.max_code();
-        let accs: Vec<Vec<Acc>> = if let Some(fused) = self.fused() {
-            run_fused(&fused, as_u8(&mut out), band_len, n);
-            vec![]
-        } else {
-            // Tables in the output's code type, converted once.
-            let tables: Vec<Vec<O>> = self
-                .programs
-                .iter()
-                .map(|(_, p)| match p {
-                    Program::Lut { table, .. } => {
-                        table.iter().map(|&c| O::from_code(u32::from(c))).collect()
-                    }
-                    _ => Vec::new(),
-                })
-                .collect();
-            out.par_chunks_mut(band_len)
-                .enumerate()
-                .map(|(b, band)| {
-                    let first_pixel = b * rows_per_band * width;
-                    self.programs
-                        .iter()
-                        .zip(&tables)
-                        .enumerate()
-                        .map(|(s, ((_, program), table))| {
-                            run_program(program, table, band, first_pixel, s, n, width, max)
-                        })
-                        .collect()
-                })
-                .collect()
-        };
+        let fused = self.fused();
+        let accs: Vec<Vec<Acc>> =
+            if let (Some(fused), Some(bytes)) = (&fused, O::bytes_mut(&mut out)) {
+                run_fused(fused, bytes, band_len, n);
+                vec![]
+            } else {
+                // Tables in the output's code type, converted once.
+                let tables: Vec<Vec<O>> = self
+                    .programs
+                    .iter()
+                    .map(|(_, p)| match p {
+                        Program::Lut { table, .. } => {
+                            table.iter().map(|&c| O::from_code(u32::from(c))).collect()
+                        }
+                        _ => Vec::new(),
+                    })
+                    .collect();
+                out.par_chunks_mut(band_len)
+                    .enumerate()
+                    .map(|(b, band)| {
+                        let first_pixel = b * rows_per_band * width;
+                        self.programs
+                            .iter()
+                            .zip(&tables)
+                            .enumerate()
+                            .map(|(s, ((_, program), table))| {
+                                run_program(program, table, band, first_pixel, s, n, width, max)
+                            })
+                            .collect()
+                    })
+                    .collect()
+            };
         let stats = self
             .programs
             .iter()
@@ -555,7 +577,7 @@ impl<'a> Plan<'a> {
                 finish_stats(*channel, program, acc, self.pixels())
             })
             .collect();
-        let samples = wrap_samples(out);
+        let samples = O::into_samples(out);
         let pixels = Pixels::new(self.width, self.height, self.layout, samples)
             .expect("the output buffer matches its size");
         (pixels, KernelStats { channels: stats })
@@ -615,12 +637,6 @@ impl<'a> Plan<'a> {
     }
 }
 
-/// The output buffer as bytes; only called for 8-bit outputs.
-fn as_u8<O: Code>(out: &mut Vec<O>) -> &mut Vec<u8> {
-    let any: &mut dyn std::any::Any = out;
-    any.downcast_mut::<Vec<u8>>().expect("an 8-bit output")
-}
-
 /// See [`Plan::fused`].
 struct Fused<'a> {
     codes: &'a [u8],
@@ -640,9 +656,19 @@ fn run_fused(fused: &Fused<'_>, out: &mut [u8], band_len: usize, n: usize) {
             .for_each(|(b, band)| {
                 let first = b * pixels_per_band;
                 let src = &fused.codes[first * S..(first + band.len() / N) * S];
-                for (d, p) in band.chunks_exact_mut(N).zip(src.chunks_exact(S)) {
-                    for c in 0..N {
-                        d[c] = tables[c][usize::from(p[offsets[c]])];
+                let pairs = band.chunks_exact_mut(N).zip(src.chunks_exact(S));
+                if offsets.iter().enumerate().all(|(c, &o)| o == c) {
+                    // Each channel reads its own: constant offsets unroll cleanly.
+                    for (d, p) in pairs {
+                        for c in 0..N {
+                            d[c] = tables[c][usize::from(p[c])];
+                        }
+                    }
+                } else {
+                    for (d, p) in pairs {
+                        for c in 0..N {
+                            d[c] = tables[c][usize::from(p[offsets[c]])];
+                        }
                     }
                 }
             });
@@ -665,15 +691,6 @@ fn run_fused(fused: &Fused<'_>, out: &mut [u8], band_len: usize, n: usize) {
         (2, 3) => pass::<2, 3>(fused, out, band_len),
         (3, 2) => pass::<3, 2>(fused, out, band_len),
         _ => unreachable!("layouts have 1 to 4 channels"),
-    }
-}
-
-fn wrap_samples<O: Code>(out: Vec<O>) -> Samples {
-    // The two instantiations are u8 and u16; move the vector into the matching variant.
-    let any: Box<dyn std::any::Any> = Box::new(out);
-    match any.downcast::<Vec<u8>>() {
-        Ok(v) => Samples::U8(*v),
-        Err(any) => Samples::U16(*any.downcast::<Vec<u16>>().expect("u8 or u16 codes")),
     }
 }
 
