@@ -47,41 +47,11 @@ pub struct Slot {
 }
 
 pub const SLOTS: [Slot; 5] = [
-    Slot {
-        extension: SHEEN,
-        texture: "sheenColorTexture",
-        factor: "sheenColorFactor",
-        channels: Channels::Rgb,
-        transfer: Transfer::Srgb,
-    },
-    Slot {
-        extension: SHEEN,
-        texture: "sheenRoughnessTexture",
-        factor: "sheenRoughnessFactor",
-        channels: Channels::Alpha,
-        transfer: Transfer::Linear,
-    },
-    Slot {
-        extension: FUZZ,
-        texture: "fuzzTexture",
-        factor: "fuzzFactor",
-        channels: Channels::Red,
-        transfer: Transfer::Linear,
-    },
-    Slot {
-        extension: FUZZ,
-        texture: "fuzzColorTexture",
-        factor: "fuzzColorFactor",
-        channels: Channels::Rgb,
-        transfer: Transfer::Srgb,
-    },
-    Slot {
-        extension: FUZZ,
-        texture: "fuzzRoughnessTexture",
-        factor: "fuzzRoughnessFactor",
-        channels: Channels::Alpha,
-        transfer: Transfer::Linear,
-    },
+    Slot { extension: SHEEN, texture: "sheenColorTexture", factor: "sheenColorFactor", channels: Channels::Rgb, transfer: Transfer::Srgb },
+    Slot { extension: SHEEN, texture: "sheenRoughnessTexture", factor: "sheenRoughnessFactor", channels: Channels::Alpha, transfer: Transfer::Linear },
+    Slot { extension: FUZZ, texture: "fuzzTexture", factor: "fuzzFactor", channels: Channels::Red, transfer: Transfer::Linear },
+    Slot { extension: FUZZ, texture: "fuzzColorTexture", factor: "fuzzColorFactor", channels: Channels::Rgb, transfer: Transfer::Srgb },
+    Slot { extension: FUZZ, texture: "fuzzRoughnessTexture", factor: "fuzzRoughnessFactor", channels: Channels::Alpha, transfer: Transfer::Linear },
 ];
 
 /// The slots of one extension.
@@ -138,8 +108,7 @@ impl SheenView {
         let obj = ext.as_object()?;
         Some(SheenView {
             color_factor: rgb(obj, "sheenColorFactor").unwrap_or(SHEEN_COLOR_DEFAULT),
-            roughness_factor: number(obj, "sheenRoughnessFactor")
-                .unwrap_or(SHEEN_ROUGHNESS_DEFAULT),
+            roughness_factor: number(obj, "sheenRoughnessFactor").unwrap_or(SHEEN_ROUGHNESS_DEFAULT),
             color_texture: obj.get("sheenColorTexture").and_then(TextureRef::read),
             roughness_texture: obj.get("sheenRoughnessTexture").and_then(TextureRef::read),
         })
@@ -183,8 +152,7 @@ impl FuzzView {
 
     /// The roughness velvet assumes: the written value, else the spec table's 0.5.
     pub fn roughness_or_table_default(&self) -> f64 {
-        self.roughness_factor
-            .unwrap_or(FUZZ_ROUGHNESS_DEFAULT_TABLE)
+        self.roughness_factor.unwrap_or(FUZZ_ROUGHNESS_DEFAULT_TABLE)
     }
 }
 
@@ -195,7 +163,5 @@ pub fn extensions(material: &Value) -> Option<&Map<String, Value>> {
 
 /// The materials array (empty when absent or not an array).
 pub fn materials(json: &Value) -> &[Value] {
-    json.get("materials")
-        .and_then(Value::as_array)
-        .map_or(&[], Vec::as_slice)
+    json.get("materials").and_then(Value::as_array).map_or(&[], Vec::as_slice)
 }

@@ -10,14 +10,8 @@ use velvet::rules::schema::Schemas;
 use velvet::validate::Validator;
 
 #[derive(Parser)]
-#[command(
-    name = "velvet",
-    version,
-    about = "Validate, migrate and bake glTF assets that use KHR_materials_sheen and KHR_materials_fuzz"
-)]
-#[command(
-    after_help = "Exit status: 0 clean, 1 issues at or above --fail-on (or a file failed), 2 usage or configuration error."
-)]
+#[command(name = "velvet", version, about = "Validate, migrate and bake glTF assets that use KHR_materials_sheen and KHR_materials_fuzz")]
+#[command(after_help = "Exit status: 0 clean, 1 issues at or above --fail-on (or a file failed), 2 usage or configuration error.")]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -151,20 +145,12 @@ fn codes_table(format: CodesFormat) -> String {
     match format {
         CodesFormat::Text => {
             let width = codes.iter().map(|c| c.name.len()).max().unwrap_or(0);
-            codes
-                .iter()
-                .map(|c| format!("{:width$}  {:7}  {}\n", c.name, c.severity.as_str(), c.doc))
-                .collect()
+            codes.iter().map(|c| format!("{:width$}  {:7}  {}\n", c.name, c.severity.as_str(), c.doc)).collect()
         }
         CodesFormat::Markdown => {
             let mut out = String::from("| code | severity | meaning |\n|---|---|---|\n");
             for c in codes {
-                out += &format!(
-                    "| `{}` | {} | {} |\n",
-                    c.name,
-                    c.severity,
-                    c.doc.replace('|', "\\|")
-                );
+                out += &format!("| `{}` | {} | {} |\n", c.name, c.severity, c.doc.replace('|', "\\|"));
             }
             out
         }
@@ -174,9 +160,7 @@ fn codes_table(format: CodesFormat) -> String {
 fn validate(args: ValidateArgs) -> ExitCode {
     for code in &args.ignore {
         if diagnostics::find_code(code).is_none() {
-            return usage_error(format!(
-                "--ignore {code}: no such code (`velvet codes` lists them)"
-            ));
+            return usage_error(format!("--ignore {code}: no such code (`velvet codes` lists them)"));
         }
     }
     let schemas = match &args.schema_dir {
@@ -224,9 +208,7 @@ fn bake(args: BakeArgs) -> ExitCode {
         destination,
         dry_run: args.dry_run,
         options: Options {
-            plan: velvet::bake::plan::PlanOptions {
-                allow_out_of_range: args.allow_out_of_range,
-            },
+            plan: velvet::bake::plan::PlanOptions { allow_out_of_range: args.allow_out_of_range },
             embed: args.embed,
             collapse_uniform: args.collapse_uniform,
             keep_format: args.keep_format,

@@ -36,10 +36,7 @@ pub fn split<'a>(bytes: &'a [u8], out: &mut Vec<Diagnostic>) -> Option<GlbParts<
         out.push(Diagnostic::new(
             &codes::GLB_UNEXPECTED_END,
             "",
-            format!(
-                "the file is {} bytes long; a GLB header needs 12",
-                bytes.len()
-            ),
+            format!("the file is {} bytes long; a GLB header needs 12", bytes.len()),
         ));
         return None;
     }
@@ -47,10 +44,7 @@ pub fn split<'a>(bytes: &'a [u8], out: &mut Vec<Diagnostic>) -> Option<GlbParts<
         out.push(Diagnostic::new(
             &codes::GLB_INVALID_MAGIC,
             "",
-            format!(
-                "the file starts with {:?}, not the GLB magic \"glTF\"",
-                String::from_utf8_lossy(&bytes[0..4])
-            ),
+            format!("the file starts with {:?}, not the GLB magic \"glTF\"", String::from_utf8_lossy(&bytes[0..4])),
         ));
         return None;
     }
@@ -68,10 +62,7 @@ pub fn split<'a>(bytes: &'a [u8], out: &mut Vec<Diagnostic>) -> Option<GlbParts<
         out.push(Diagnostic::new(
             &codes::GLB_LENGTH_MISMATCH,
             "",
-            format!(
-                "the GLB header declares {declared} bytes but the file has {}",
-                bytes.len()
-            ),
+            format!("the GLB header declares {declared} bytes but the file has {}", bytes.len()),
         ));
     }
     let end = bytes.len();
@@ -114,9 +105,7 @@ pub fn split<'a>(bytes: &'a [u8], out: &mut Vec<Diagnostic>) -> Option<GlbParts<
         };
         match kind {
             CHUNK_JSON if index == 0 => json = Some((data, data_end)),
-            CHUNK_BIN if index == 1 && !after_unknown && bin.is_none() => {
-                bin = Some((data, data_end))
-            }
+            CHUNK_BIN if index == 1 && !after_unknown && bin.is_none() => bin = Some((data, data_end)),
             _ if index == 0 => {
                 out.push(Diagnostic::new(
                     &codes::GLB_UNEXPECTED_FIRST_CHUNK,
@@ -138,9 +127,7 @@ pub fn split<'a>(bytes: &'a [u8], out: &mut Vec<Diagnostic>) -> Option<GlbParts<
                 out.push(Diagnostic::new(
                     &codes::GLB_UNKNOWN_CHUNK_TYPE,
                     "",
-                    format!(
-                        "chunk {index} at byte {at} has unknown type 0x{kind:08X}; it is skipped"
-                    ),
+                    format!("chunk {index} at byte {at} has unknown type 0x{kind:08X}; it is skipped"),
                 ));
             }
         }
@@ -212,10 +199,7 @@ mod tests {
         let cut = &bytes[..bytes.len() - 6];
         let mut out = Vec::new();
         let parts = split(cut, &mut out).unwrap();
-        assert_eq!(
-            codes_of(&out),
-            vec!["GLB_LENGTH_MISMATCH", "GLB_UNEXPECTED_END"]
-        );
+        assert_eq!(codes_of(&out), vec!["GLB_LENGTH_MISMATCH", "GLB_UNEXPECTED_END"]);
         assert_eq!(parts.bin.map(<[u8]>::len), Some(10));
     }
 
@@ -225,14 +209,7 @@ mod tests {
         assert!(split(b"glTF", &mut out).is_none());
         assert!(split(b"GLTF\x02\0\0\0\x0c\0\0\0", &mut out).is_none());
         assert!(split(b"glTF\x01\0\0\0\x0c\0\0\0", &mut out).is_none());
-        assert_eq!(
-            codes_of(&out),
-            vec![
-                "GLB_UNEXPECTED_END",
-                "GLB_INVALID_MAGIC",
-                "GLB_INVALID_VERSION"
-            ]
-        );
+        assert_eq!(codes_of(&out), vec!["GLB_UNEXPECTED_END", "GLB_INVALID_MAGIC", "GLB_INVALID_VERSION"]);
     }
 
     #[test]
@@ -246,10 +223,7 @@ mod tests {
         bytes[8..12].copy_from_slice(&len.to_le_bytes());
         let mut out = Vec::new();
         let parts = split(&bytes, &mut out).unwrap();
-        assert_eq!(
-            codes_of(&out),
-            vec!["GLB_CHUNK_LENGTH_UNALIGNED", "GLB_UNKNOWN_CHUNK_TYPE"]
-        );
+        assert_eq!(codes_of(&out), vec!["GLB_CHUNK_LENGTH_UNALIGNED", "GLB_UNKNOWN_CHUNK_TYPE"]);
         assert_eq!(parts.json, b"{\"a\":1}");
         assert!(parts.bin.is_none());
     }

@@ -19,10 +19,7 @@ pub struct Position {
 
 /// Locates the values named by `pointers` in `text`. Pointers that name nothing are absent
 /// from the result.
-pub fn locate<'p>(
-    text: &str,
-    pointers: impl IntoIterator<Item = &'p str>,
-) -> HashMap<String, Position> {
+pub fn locate<'p>(text: &str, pointers: impl IntoIterator<Item = &'p str>) -> HashMap<String, Position> {
     let wanted: HashSet<Vec<String>> = pointers.into_iter().map(pointer::tokens).collect();
     let mut prefixes: HashSet<Vec<String>> = HashSet::new();
     for w in &wanted {
@@ -47,12 +44,7 @@ pub fn locate<'p>(
 
 fn line_starts(text: &str) -> Vec<usize> {
     std::iter::once(0)
-        .chain(
-            text.bytes()
-                .enumerate()
-                .filter(|(_, b)| *b == b'\n')
-                .map(|(i, _)| i + 1),
-        )
+        .chain(text.bytes().enumerate().filter(|(_, b)| *b == b'\n').map(|(i, _)| i + 1))
         .collect()
 }
 
@@ -92,11 +84,7 @@ impl Scanner<'_> {
     /// Scans one value at `self.at`; records it if wanted, descends if on the way.
     fn value(&mut self) {
         if self.wanted.contains(&self.path) {
-            let pointer: String = self
-                .path
-                .iter()
-                .map(|s| format!("/{}", pointer::escape(s)))
-                .collect();
+            let pointer: String = self.path.iter().map(|s| format!("/{}", pointer::escape(s))).collect();
             let pos = self.position(self.at);
             self.found.insert(pointer, pos);
         }

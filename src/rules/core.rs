@@ -53,13 +53,7 @@ pub fn path_to_pointer(path: &str) -> String {
 
 impl Rule for CoreStructure {
     fn codes(&self) -> &'static [&'static Code] {
-        &[
-            &CORE_INVALID_VALUE,
-            &super::references::UNRESOLVED_REFERENCE,
-            &codes::UNDEFINED_PROPERTY,
-            &CORE_UNSUPPORTED,
-            &CORE_STRUCTURE_INVALID,
-        ]
+        &[&CORE_INVALID_VALUE, &super::references::UNRESOLVED_REFERENCE, &codes::UNDEFINED_PROPERTY, &CORE_UNSUPPORTED, &CORE_STRUCTURE_INVALID]
     }
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
@@ -70,14 +64,7 @@ impl Rule for CoreStructure {
                 out.push(Diagnostic::new(
                     &CORE_STRUCTURE_INVALID,
                     "",
-                    format!(
-                        "line {}, column {}: {}",
-                        e.line(),
-                        e.column(),
-                        e.to_string()
-                            .rsplit_once(" at line ")
-                            .map_or(e.to_string(), |(m, _)| m.to_string())
-                    ),
+                    format!("line {}, column {}: {}", e.line(), e.column(), e.to_string().rsplit_once(" at line ").map_or(e.to_string(), |(m, _)| m.to_string())),
                 ));
                 return;
             }
@@ -91,14 +78,8 @@ impl Rule for CoreStructure {
             }
             let pointer = path_to_pointer(path.as_str());
             let (code, message) = match error {
-                CoreError::IndexOutOfBounds => (
-                    &super::references::UNRESOLVED_REFERENCE,
-                    "index out of range".to_string(),
-                ),
-                CoreError::Missing => (
-                    &codes::UNDEFINED_PROPERTY,
-                    "required property is missing".to_string(),
-                ),
+                CoreError::IndexOutOfBounds => (&super::references::UNRESOLVED_REFERENCE, "index out of range".to_string()),
+                CoreError::Missing => (&codes::UNDEFINED_PROPERTY, "required property is missing".to_string()),
                 CoreError::Invalid => (&CORE_INVALID_VALUE, "invalid value".to_string()),
                 CoreError::Unsupported => (&CORE_UNSUPPORTED, "unsupported value".to_string()),
                 CoreError::Oversize => (&CORE_INVALID_VALUE, "value too large".to_string()),
@@ -114,14 +95,8 @@ mod tests {
 
     #[test]
     fn gltf_paths_become_pointers() {
-        assert_eq!(
-            path_to_pointer("meshes[0].primitives[12].material"),
-            "/meshes/0/primitives/12/material"
-        );
-        assert_eq!(
-            path_to_pointer("meshes[0].primitives[0].attributes[\"TEXCOORD_0\"]"),
-            "/meshes/0/primitives/0/attributes/TEXCOORD_0"
-        );
+        assert_eq!(path_to_pointer("meshes[0].primitives[12].material"), "/meshes/0/primitives/12/material");
+        assert_eq!(path_to_pointer("meshes[0].primitives[0].attributes[\"TEXCOORD_0\"]"), "/meshes/0/primitives/0/attributes/TEXCOORD_0");
         assert_eq!(path_to_pointer("asset"), "/asset");
         assert_eq!(path_to_pointer(""), "");
     }
