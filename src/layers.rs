@@ -36,6 +36,18 @@ pub enum Transfer {
     Linear,
 }
 
+impl Transfer {
+    /// A stored texel value in [0, 1] as a linear value: the sRGB decoding curve (IEC 61966-2-1,
+    /// linear segment below 0.04045) or the value itself.
+    pub fn to_linear(self, encoded: f64) -> f64 {
+        match self {
+            Transfer::Linear => encoded,
+            Transfer::Srgb if encoded <= 0.04045 => encoded / 12.92,
+            Transfer::Srgb => ((encoded + 0.055) / 1.055).powf(2.4),
+        }
+    }
+}
+
 /// One texture slot of one extension, with the factor that scales it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Slot {
@@ -47,11 +59,41 @@ pub struct Slot {
 }
 
 pub const SLOTS: [Slot; 5] = [
-    Slot { extension: SHEEN, texture: "sheenColorTexture", factor: "sheenColorFactor", channels: Channels::Rgb, transfer: Transfer::Srgb },
-    Slot { extension: SHEEN, texture: "sheenRoughnessTexture", factor: "sheenRoughnessFactor", channels: Channels::Alpha, transfer: Transfer::Linear },
-    Slot { extension: FUZZ, texture: "fuzzTexture", factor: "fuzzFactor", channels: Channels::Red, transfer: Transfer::Linear },
-    Slot { extension: FUZZ, texture: "fuzzColorTexture", factor: "fuzzColorFactor", channels: Channels::Rgb, transfer: Transfer::Srgb },
-    Slot { extension: FUZZ, texture: "fuzzRoughnessTexture", factor: "fuzzRoughnessFactor", channels: Channels::Alpha, transfer: Transfer::Linear },
+    Slot {
+        extension: SHEEN,
+        texture: "sheenColorTexture",
+        factor: "sheenColorFactor",
+        channels: Channels::Rgb,
+        transfer: Transfer::Srgb,
+    },
+    Slot {
+        extension: SHEEN,
+        texture: "sheenRoughnessTexture",
+        factor: "sheenRoughnessFactor",
+        channels: Channels::Alpha,
+        transfer: Transfer::Linear,
+    },
+    Slot {
+        extension: FUZZ,
+        texture: "fuzzTexture",
+        factor: "fuzzFactor",
+        channels: Channels::Red,
+        transfer: Transfer::Linear,
+    },
+    Slot {
+        extension: FUZZ,
+        texture: "fuzzColorTexture",
+        factor: "fuzzColorFactor",
+        channels: Channels::Rgb,
+        transfer: Transfer::Srgb,
+    },
+    Slot {
+        extension: FUZZ,
+        texture: "fuzzRoughnessTexture",
+        factor: "fuzzRoughnessFactor",
+        channels: Channels::Alpha,
+        transfer: Transfer::Linear,
+    },
 ];
 
 /// The slots of one extension.
@@ -108,7 +150,8 @@ impl SheenView {
         let obj = ext.as_object()?;
         Some(SheenView {
             color_factor: rgb(obj, "sheenColorFactor").unwrap_or(SHEEN_COLOR_DEFAULT),
-            roughness_factor: number(obj, "sheenRoughnessFactor").unwrap_or(SHEEN_ROUGHNESS_DEFAULT),
+            roughness_factor: number(obj, "sheenRoughnessFactor")
+                .unwrap_or(SHEEN_ROUGHNESS_DEFAULT),
             color_texture: obj.get("sheenColorTexture").and_then(TextureRef::read),
             roughness_texture: obj.get("sheenRoughnessTexture").and_then(TextureRef::read),
         })
@@ -152,7 +195,8 @@ impl FuzzView {
 
     /// The roughness velvet assumes: the written value, else the spec table's 0.5.
     pub fn roughness_or_table_default(&self) -> f64 {
-        self.roughness_factor.unwrap_or(FUZZ_ROUGHNESS_DEFAULT_TABLE)
+        self.roughness_factor
+            .unwrap_or(FUZZ_ROUGHNESS_DEFAULT_TABLE)
     }
 }
 
@@ -163,5 +207,24 @@ pub fn extensions(material: &Value) -> Option<&Map<String, Value>> {
 
 /// The materials array (empty when absent or not an array).
 pub fn materials(json: &Value) -> &[Value] {
-    json.get("materials").and_then(Value::as_array).map_or(&[], Vec::as_slice)
+    json.get("materials")
+        .and_then(Value::as_array)
+        .map_or(&[], Vec::as_slice)
+}
+
+#[cfg(test)]
+mod transfer_tests {
+    use super::Transfer;
+
+    #[test]
+    fn srgb_decoding_pins_its_ends_and_the_segment_threshold() {
+        assert_eq!(Transfer::Srgb.to_linear(0.0), 0.0);
+        assert!((Transfer::Srgb.to_linear(1.0) - 1.0).abs() < 1e-15);
+        // The two pieces meet at 0.04045 (to within the standard's rounding).
+        let below = Transfer::Srgb.to_linear(0.04045);
+        let above = ((0.04045f64 + 0.055) / 1.055).powf(2.4);
+        assert!((below - 0.04045 / 12.92).abs() < 1e-18 && (below - above).abs() < 1e-7);
+        assert!((Transfer::Srgb.to_linear(0.5) - 0.214_041_140_482_232_5).abs() < 1e-12);
+        assert_eq!(Transfer::Linear.to_linear(0.25), 0.25);
+    }
 }

@@ -7,7 +7,10 @@
 pub mod asset;
 pub mod bake;
 pub mod diagnostics;
+pub mod edit;
 pub mod layers;
+pub mod migrate;
 pub mod report;
 pub mod rules;
+pub mod shading;
 pub mod validate;

@@ -10,8 +10,14 @@ use velvet::rules::schema::Schemas;
 use velvet::validate::Validator;
 
 #[derive(Parser)]
-#[command(name = "velvet", version, about = "Validate, migrate and bake glTF assets that use KHR_materials_sheen and KHR_materials_fuzz")]
-#[command(after_help = "Exit status: 0 clean, 1 issues at or above --fail-on (or a file failed), 2 usage or configuration error.")]
+#[command(
+    name = "velvet",
+    version,
+    about = "Validate, migrate and bake glTF assets that use KHR_materials_sheen and KHR_materials_fuzz"
+)]
+#[command(
+    after_help = "Exit status: 0 clean, 1 issues at or above --fail-on (or a file failed), 2 usage or configuration error."
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -21,6 +27,9 @@ struct Cli {
 enum Command {
     /// Check .gltf/.glb files (and folders, recursively) against the sheen and fuzz specs.
     Validate(ValidateArgs),
+    /// Add KHR_materials_fuzz to sheen materials (keeping the sheen as the fallback), a fallback
+    /// sheen to fuzz materials, and upgrade the pre-ratification sheen draft.
+    Migrate(MigrateArgs),
     /// Bake sheen and fuzz texture × factor into new textures, once per distinct combination.
     Bake(BakeArgs),
     /// List every code velvet reports, with its severity and description.
@@ -28,6 +37,9 @@ enum Command {
         #[arg(long, value_enum, default_value_t = CodesFormat::Text)]
         format: CodesFormat,
     },
+    /// Numeric reports: what velvet's shading methods cost and how far they are off.
+    #[command(subcommand)]
+    Bench(velvet::shading::bench::BenchCommand),
 }
 
 #[derive(clap::Args)]
@@ -133,9 +145,16 @@ fn main() -> ExitCode {
     match cli.command {
         Command::Validate(args) => validate(args),
         Command::Bake(args) => bake(args),
+        Command::Migrate(args) => migrate(args),
         Command::Codes { format } => {
             print!("{}", codes_table(format));
             ExitCode::SUCCESS
+        }
+        Command::Bench(cmd) => {
+            match velvet::shading::bench::run(&cmd, &mut std::io::stdout().lock()) {
+                Ok(()) => ExitCode::SUCCESS,
+                Err(e) => usage_error(e),
+            }
         }
     }
 }
@@ -145,12 +164,20 @@ fn codes_table(format: CodesFormat) -> String {
     match format {
         CodesFormat::Text => {
             let width = codes.iter().map(|c| c.name.len()).max().unwrap_or(0);
-            codes.iter().map(|c| format!("{:width$}  {:7}  {}\n", c.name, c.severity.as_str(), c.doc)).collect()
+            codes
+                .iter()
+                .map(|c| format!("{:width$}  {:7}  {}\n", c.name, c.severity.as_str(), c.doc))
+                .collect()
         }
         CodesFormat::Markdown => {
             let mut out = String::from("| code | severity | meaning |\n|---|---|---|\n");
             for c in codes {
-                out += &format!("| `{}` | {} | {} |\n", c.name, c.severity, c.doc.replace('|', "\\|"));
+                out += &format!(
+                    "| `{}` | {} | {} |\n",
+                    c.name,
+                    c.severity,
+                    c.doc.replace('|', "\\|")
+                );
             }
             out
         }
@@ -160,7 +187,9 @@ fn codes_table(format: CodesFormat) -> String {
 fn validate(args: ValidateArgs) -> ExitCode {
     for code in &args.ignore {
         if diagnostics::find_code(code).is_none() {
-            return usage_error(format!("--ignore {code}: no such code (`velvet codes` lists them)"));
+            return usage_error(format!(
+                "--ignore {code}: no such code (`velvet codes` lists them)"
+            ));
         }
     }
     let schemas = match &args.schema_dir {
@@ -189,6 +218,86 @@ fn validate(args: ValidateArgs) -> ExitCode {
     };
     print!("{text}");
     if reports.iter().any(|r| r.fails(&validator.settings)) {
+        ExitCode::from(1)
+    } else {
+        ExitCode::SUCCESS
+    }
+}
+
+#[derive(clap::Args)]
+#[command(
+    after_help = "Exit status: 0 done, 1 a file failed (the others are still migrated), 2 usage error (nothing written)."
+)]
+struct MigrateArgs {
+    /// Files and folders to migrate (folders are searched for *.gltf and *.glb).
+    #[arg(required = true)]
+    paths: Vec<PathBuf>,
+    /// Write the one input's output here (same container as the input).
+    #[arg(short = 'o', long = "output", value_name = "FILE", conflicts_with_all = ["out_dir", "in_place"])]
+    output: Option<PathBuf>,
+    /// Write outputs under DIR, mirroring each input folder's tree.
+    #[arg(long, value_name = "DIR", conflicts_with = "in_place")]
+    out_dir: Option<PathBuf>,
+    /// Overwrite the inputs (files with nothing to migrate are not written).
+    #[arg(long)]
+    in_place: bool,
+    /// Print what would change per material; write nothing.
+    #[arg(long)]
+    dry_run: bool,
+    #[arg(long, value_enum, default_value_t = MigrateFormat::Text)]
+    format: MigrateFormat,
+    /// Decode sheen colour textures to measure what the fast conversion changes.
+    #[arg(long)]
+    report: bool,
+    /// Bake textures so that the fuzz matches the sheen texel by texel (needs the bake engine).
+    #[arg(long)]
+    exact: bool,
+    /// Regenerate the sheen fallback of materials that already have fuzz and sheen.
+    #[arg(long)]
+    refresh_fallback: bool,
+    /// Copy relative resources next to outputs in another folder instead of rewriting URIs.
+    #[arg(long)]
+    copy_resources: bool,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum MigrateFormat {
+    Text,
+    Json,
+}
+
+fn migrate(args: MigrateArgs) -> ExitCode {
+    use velvet::migrate::{self, Destination};
+    let destination = match (args.output, args.out_dir, args.in_place) {
+        (Some(file), _, _) => Destination::File(file),
+        (_, Some(dir), _) => Destination::Dir(dir),
+        (_, _, true) => Destination::InPlace,
+        _ => Destination::None,
+    };
+    let request = migrate::Request {
+        inputs: args.paths,
+        destination,
+        options: migrate::Options {
+            refresh_fallback: args.refresh_fallback,
+            report: args.report,
+            exact: args.exact,
+            copy_resources: args.copy_resources,
+        },
+        dry_run: args.dry_run,
+        progress: true,
+    };
+    let report = match migrate::run(&request) {
+        Ok(report) => report,
+        Err(e) => return usage_error(e),
+    };
+    print!(
+        "{}",
+        match args.format {
+            MigrateFormat::Text => migrate::render::text(&report),
+            MigrateFormat::Json => migrate::render::json(&report),
+        }
+    );
+    if report.failed() {
         ExitCode::from(1)
     } else {
         ExitCode::SUCCESS

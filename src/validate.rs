@@ -67,7 +67,9 @@ pub struct FileReport {
 impl FileReport {
     /// True when a finding is at or above the run's fail-on severity.
     pub fn fails(&self, settings: &Settings) -> bool {
-        self.findings.iter().any(|f| settings.fail_on.fails(f.diagnostic.severity))
+        self.findings
+            .iter()
+            .any(|f| settings.fail_on.fails(f.diagnostic.severity))
     }
 }
 
@@ -88,11 +90,20 @@ impl Validator {
         let mut reports: Vec<FileReport> = walk_errors
             .into_iter()
             .map(|(path, e)| {
-                let d = Diagnostic::new(&crate::diagnostics::codes::IO_ERROR, "", format!("cannot read folder {}: {e}", path.display()));
+                let d = Diagnostic::new(
+                    &crate::diagnostics::codes::IO_ERROR,
+                    "",
+                    format!("cannot read folder {}: {e}", path.display()),
+                );
                 self.finish(path, None, 0, vec![d], None)
             })
             .collect();
-        reports.extend(files.par_iter().map(|p| self.validate_file(p)).collect::<Vec<_>>());
+        reports.extend(
+            files
+                .par_iter()
+                .map(|p| self.validate_file(p))
+                .collect::<Vec<_>>(),
+        );
         reports
     }
 
@@ -108,14 +119,29 @@ impl Validator {
         let Some(asset) = loaded.asset else {
             return self.finish(path.to_path_buf(), None, 0, diagnostics, None);
         };
-        let cx = Context { asset: &asset, schemas: &self.schemas };
+        let cx = Context {
+            asset: &asset,
+            schemas: &self.schemas,
+        };
         for rule in rules::REGISTRY {
             rule.check(&cx, &mut diagnostics);
         }
         let info = asset_info(&asset.json);
-        let mut report = self.finish(path.to_path_buf(), Some(asset.container), asset.json_offset, diagnostics, Some(info));
+        let mut report = self.finish(
+            path.to_path_buf(),
+            Some(asset.container),
+            asset.json_offset,
+            diagnostics,
+            Some(info),
+        );
         if !report.findings.is_empty() {
-            let positions = asset::position::locate(&asset.json_text, report.findings.iter().map(|f| f.diagnostic.pointer.as_str()));
+            let positions = asset::position::locate(
+                &asset.json_text,
+                report
+                    .findings
+                    .iter()
+                    .map(|f| f.diagnostic.pointer.as_str()),
+            );
             for f in &mut report.findings {
                 if !f.diagnostic.pointer.is_empty() {
                     f.position = positions.get(&f.diagnostic.pointer).copied();
@@ -142,7 +168,9 @@ impl Validator {
             }
             counts.add(d.severity);
         }
-        let truncated = settings.max_issues.is_some_and(|max| diagnostics.len() > max);
+        let truncated = settings
+            .max_issues
+            .is_some_and(|max| diagnostics.len() > max);
         if let Some(max) = settings.max_issues {
             diagnostics.truncate(max);
         }
@@ -150,7 +178,13 @@ impl Validator {
             path,
             container,
             json_offset,
-            findings: diagnostics.into_iter().map(|diagnostic| Finding { diagnostic, position: None }).collect(),
+            findings: diagnostics
+                .into_iter()
+                .map(|diagnostic| Finding {
+                    diagnostic,
+                    position: None,
+                })
+                .collect(),
             counts,
             truncated,
             info,
@@ -161,13 +195,23 @@ impl Validator {
 fn strings(json: &Value, key: &str) -> Vec<String> {
     json.get(key)
         .and_then(Value::as_array)
-        .map(|a| a.iter().filter_map(Value::as_str).map(str::to_string).collect())
+        .map(|a| {
+            a.iter()
+                .filter_map(Value::as_str)
+                .map(str::to_string)
+                .collect()
+        })
         .unwrap_or_default()
 }
 
 fn asset_info(json: &Value) -> AssetInfo {
     let materials = layers::materials(json);
-    let with = |ext: &str| materials.iter().filter(|m| layers::extensions(m).is_some_and(|e| e.contains_key(ext))).count();
+    let with = |ext: &str| {
+        materials
+            .iter()
+            .filter(|m| layers::extensions(m).is_some_and(|e| e.contains_key(ext)))
+            .count()
+    };
     let text = |p: &str| json.pointer(p).and_then(Value::as_str).map(str::to_string);
     AssetInfo {
         version: text("/asset/version"),

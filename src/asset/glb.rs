@@ -36,7 +36,10 @@ pub fn split<'a>(bytes: &'a [u8], out: &mut Vec<Diagnostic>) -> Option<GlbParts<
         out.push(Diagnostic::new(
             &codes::GLB_UNEXPECTED_END,
             "",
-            format!("the file is {} bytes long; a GLB header needs 12", bytes.len()),
+            format!(
+                "the file is {} bytes long; a GLB header needs 12",
+                bytes.len()
+            ),
         ));
         return None;
     }
@@ -44,7 +47,10 @@ pub fn split<'a>(bytes: &'a [u8], out: &mut Vec<Diagnostic>) -> Option<GlbParts<
         out.push(Diagnostic::new(
             &codes::GLB_INVALID_MAGIC,
             "",
-            format!("the file starts with {:?}, not the GLB magic \"glTF\"", String::from_utf8_lossy(&bytes[0..4])),
+            format!(
+                "the file starts with {:?}, not the GLB magic \"glTF\"",
+                String::from_utf8_lossy(&bytes[0..4])
+            ),
         ));
         return None;
     }
@@ -62,7 +68,10 @@ pub fn split<'a>(bytes: &'a [u8], out: &mut Vec<Diagnostic>) -> Option<GlbParts<
         out.push(Diagnostic::new(
             &codes::GLB_LENGTH_MISMATCH,
             "",
-            format!("the GLB header declares {declared} bytes but the file has {}", bytes.len()),
+            format!(
+                "the GLB header declares {declared} bytes but the file has {}",
+                bytes.len()
+            ),
         ));
     }
     let end = bytes.len();
@@ -105,7 +114,9 @@ pub fn split<'a>(bytes: &'a [u8], out: &mut Vec<Diagnostic>) -> Option<GlbParts<
         };
         match kind {
             CHUNK_JSON if index == 0 => json = Some((data, data_end)),
-            CHUNK_BIN if index == 1 && !after_unknown && bin.is_none() => bin = Some((data, data_end)),
+            CHUNK_BIN if index == 1 && !after_unknown && bin.is_none() => {
+                bin = Some((data, data_end))
+            }
             _ if index == 0 => {
                 out.push(Diagnostic::new(
                     &codes::GLB_UNEXPECTED_FIRST_CHUNK,
@@ -127,7 +138,9 @@ pub fn split<'a>(bytes: &'a [u8], out: &mut Vec<Diagnostic>) -> Option<GlbParts<
                 out.push(Diagnostic::new(
                     &codes::GLB_UNKNOWN_CHUNK_TYPE,
                     "",
-                    format!("chunk {index} at byte {at} has unknown type 0x{kind:08X}; it is skipped"),
+                    format!(
+                        "chunk {index} at byte {at} has unknown type 0x{kind:08X}; it is skipped"
+                    ),
                 ));
             }
         }
@@ -139,15 +152,12 @@ pub fn split<'a>(bytes: &'a [u8], out: &mut Vec<Diagnostic>) -> Option<GlbParts<
     }
     let (json_start, json_end) = json?;
     let json_bytes = &bytes[json_start..json_end];
-    let content_end = json_bytes
-        .iter()
-        .rposition(|b| !matches!(b, b' ' | b'\t' | b'\n' | b'\r'))
-        .map_or(0, |p| p + 1);
-    if json_bytes[content_end..].iter().any(|b| *b != b' ') || json_bytes.ends_with(&[0]) {
+    // Padding must be spaces; NULs (a common exporter mistake) would also break JSON parsers.
+    if json_bytes.ends_with(&[0]) {
         out.push(Diagnostic::new(
             &codes::GLB_INVALID_PADDING,
             "",
-            "the JSON chunk is padded with something other than spaces (0x20)",
+            "the JSON chunk is padded with NUL bytes; the GLB container requires spaces (0x20)",
         ));
     }
     Some(GlbParts {
@@ -199,7 +209,10 @@ mod tests {
         let cut = &bytes[..bytes.len() - 6];
         let mut out = Vec::new();
         let parts = split(cut, &mut out).unwrap();
-        assert_eq!(codes_of(&out), vec!["GLB_LENGTH_MISMATCH", "GLB_UNEXPECTED_END"]);
+        assert_eq!(
+            codes_of(&out),
+            vec!["GLB_LENGTH_MISMATCH", "GLB_UNEXPECTED_END"]
+        );
         assert_eq!(parts.bin.map(<[u8]>::len), Some(10));
     }
 
@@ -209,7 +222,14 @@ mod tests {
         assert!(split(b"glTF", &mut out).is_none());
         assert!(split(b"GLTF\x02\0\0\0\x0c\0\0\0", &mut out).is_none());
         assert!(split(b"glTF\x01\0\0\0\x0c\0\0\0", &mut out).is_none());
-        assert_eq!(codes_of(&out), vec!["GLB_UNEXPECTED_END", "GLB_INVALID_MAGIC", "GLB_INVALID_VERSION"]);
+        assert_eq!(
+            codes_of(&out),
+            vec![
+                "GLB_UNEXPECTED_END",
+                "GLB_INVALID_MAGIC",
+                "GLB_INVALID_VERSION"
+            ]
+        );
     }
 
     #[test]
@@ -223,7 +243,10 @@ mod tests {
         bytes[8..12].copy_from_slice(&len.to_le_bytes());
         let mut out = Vec::new();
         let parts = split(&bytes, &mut out).unwrap();
-        assert_eq!(codes_of(&out), vec!["GLB_CHUNK_LENGTH_UNALIGNED", "GLB_UNKNOWN_CHUNK_TYPE"]);
+        assert_eq!(
+            codes_of(&out),
+            vec!["GLB_CHUNK_LENGTH_UNALIGNED", "GLB_UNKNOWN_CHUNK_TYPE"]
+        );
         assert_eq!(parts.json, b"{\"a\":1}");
         assert!(parts.bin.is_none());
     }

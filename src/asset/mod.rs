@@ -66,7 +66,11 @@ pub fn load(path: &Path) -> Loaded {
         Ok(bytes) => load_bytes(path, &bytes),
         Err(e) => Loaded {
             asset: None,
-            diagnostics: vec![Diagnostic::new(&codes::IO_ERROR, "", format!("cannot read {}: {e}", path.display()))],
+            diagnostics: vec![Diagnostic::new(
+                &codes::IO_ERROR,
+                "",
+                format!("cannot read {}: {e}", path.display()),
+            )],
         },
     }
 }
@@ -76,11 +80,23 @@ pub fn load(path: &Path) -> Loaded {
 pub fn load_bytes(path: &Path, bytes: &[u8]) -> Loaded {
     let mut diagnostics = Vec::new();
     let is_glb = bytes.starts_with(b"glTF")
-        || path.extension().is_some_and(|e| e.eq_ignore_ascii_case("glb"));
+        || path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("glb"));
     let (container, json_bytes, json_offset, bin) = if is_glb {
         match glb::split(bytes, &mut diagnostics) {
-            Some(parts) => (Container::Glb, parts.json, parts.json_offset, parts.bin.map(<[u8]>::to_vec)),
-            None => return Loaded { asset: None, diagnostics },
+            Some(parts) => (
+                Container::Glb,
+                parts.json,
+                parts.json_offset,
+                parts.bin.map(<[u8]>::to_vec),
+            ),
+            None => {
+                return Loaded {
+                    asset: None,
+                    diagnostics,
+                }
+            }
         }
     } else {
         (Container::Gltf, bytes, 0, None)
@@ -101,14 +117,26 @@ pub fn load_bytes(path: &Path, bytes: &[u8]) -> Loaded {
         Err(e) => {
             let at = e.valid_up_to();
             let line = json_bytes[..at].iter().filter(|b| **b == b'\n').count() + 1;
-            let line_start = json_bytes[..at].iter().rposition(|b| *b == b'\n').map_or(0, |p| p + 1);
-            let column = String::from_utf8_lossy(&json_bytes[line_start..at]).chars().count() + 1;
+            let line_start = json_bytes[..at]
+                .iter()
+                .rposition(|b| *b == b'\n')
+                .map_or(0, |p| p + 1);
+            let column = String::from_utf8_lossy(&json_bytes[line_start..at])
+                .chars()
+                .count()
+                + 1;
             diagnostics.push(Diagnostic::new(
                 &codes::INVALID_JSON,
                 "",
-                format!("invalid UTF-8 at line {line}, column {column} (byte {})", json_offset + at),
+                format!(
+                    "invalid UTF-8 at line {line}, column {column} (byte {})",
+                    json_offset + at
+                ),
             ));
-            return Loaded { asset: None, diagnostics };
+            return Loaded {
+                asset: None,
+                diagnostics,
+            };
         }
     };
     // A GLB's JSON chunk may carry NUL padding (reported by glb::split); parse past it.
@@ -119,14 +147,29 @@ pub fn load_bytes(path: &Path, bytes: &[u8]) -> Loaded {
             diagnostics.push(Diagnostic::new(
                 &codes::INVALID_JSON,
                 "",
-                format!("line {}, column {}: {}", e.line(), e.column(), strip_position(&e.to_string())),
+                format!(
+                    "line {}, column {}: {}",
+                    e.line(),
+                    e.column(),
+                    strip_position(&e.to_string())
+                ),
             ));
-            return Loaded { asset: None, diagnostics };
+            return Loaded {
+                asset: None,
+                diagnostics,
+            };
         }
     };
     if !json.is_object() {
-        diagnostics.push(Diagnostic::new(&codes::INVALID_JSON_ROOT_OBJECT, "", "the JSON root is not an object"));
-        return Loaded { asset: None, diagnostics };
+        diagnostics.push(Diagnostic::new(
+            &codes::INVALID_JSON_ROOT_OBJECT,
+            "",
+            "the JSON root is not an object",
+        ));
+        return Loaded {
+            asset: None,
+            diagnostics,
+        };
     }
     Loaded {
         asset: Some(Asset {
@@ -157,10 +200,16 @@ impl Asset {
     pub fn buffer_bytes(&self, index: usize) -> Result<Cow<'_, [u8]>, Diagnostic> {
         let pointer = format!("/buffers/{index}");
         let buffer = self.json.pointer(&pointer).ok_or_else(|| {
-            Diagnostic::new(&crate::rules::references::UNRESOLVED_REFERENCE, &pointer, format!("buffer {index} does not exist"))
+            Diagnostic::new(
+                &crate::rules::references::UNRESOLVED_REFERENCE,
+                &pointer,
+                format!("buffer {index} does not exist"),
+            )
         })?;
         match buffer.get("uri").and_then(Value::as_str) {
-            Some(uri) => self.read_uri(uri, &format!("{pointer}/uri")).map(Cow::Owned),
+            Some(uri) => self
+                .read_uri(uri, &format!("{pointer}/uri"))
+                .map(Cow::Owned),
             None => match (&self.bin, index) {
                 (Some(bin), 0) => Ok(Cow::Borrowed(bin.as_slice())),
                 _ => Err(Diagnostic::new(
@@ -176,22 +225,49 @@ impl Asset {
     pub fn image_bytes(&self, index: usize) -> Result<Cow<'_, [u8]>, Diagnostic> {
         let pointer = format!("/images/{index}");
         let image = self.json.pointer(&pointer).ok_or_else(|| {
-            Diagnostic::new(&crate::rules::references::UNRESOLVED_REFERENCE, &pointer, format!("image {index} does not exist"))
+            Diagnostic::new(
+                &crate::rules::references::UNRESOLVED_REFERENCE,
+                &pointer,
+                format!("image {index} does not exist"),
+            )
         })?;
         if let Some(uri) = image.get("uri").and_then(Value::as_str) {
-            return self.read_uri(uri, &format!("{pointer}/uri")).map(Cow::Owned);
+            return self
+                .read_uri(uri, &format!("{pointer}/uri"))
+                .map(Cow::Owned);
         }
-        let view_index = image.get("bufferView").and_then(Value::as_u64).ok_or_else(|| {
-            Diagnostic::new(&codes::IO_ERROR, &pointer, format!("image {index} has neither a uri nor a bufferView"))
-        })?;
+        let view_index = image
+            .get("bufferView")
+            .and_then(Value::as_u64)
+            .ok_or_else(|| {
+                Diagnostic::new(
+                    &codes::IO_ERROR,
+                    &pointer,
+                    format!("image {index} has neither a uri nor a bufferView"),
+                )
+            })?;
         self.buffer_view_bytes(view_index as usize, &format!("{pointer}/bufferView"))
     }
 
-    fn buffer_view_bytes(&self, view_index: usize, pointer: &str) -> Result<Cow<'_, [u8]>, Diagnostic> {
-        let view = self.json.pointer(&format!("/bufferViews/{view_index}")).ok_or_else(|| {
-            Diagnostic::new(&crate::rules::references::UNRESOLVED_REFERENCE, pointer, format!("bufferView {view_index} does not exist"))
-        })?;
-        let buffer = view.get("buffer").and_then(Value::as_u64).unwrap_or(u64::MAX) as usize;
+    fn buffer_view_bytes(
+        &self,
+        view_index: usize,
+        pointer: &str,
+    ) -> Result<Cow<'_, [u8]>, Diagnostic> {
+        let view = self
+            .json
+            .pointer(&format!("/bufferViews/{view_index}"))
+            .ok_or_else(|| {
+                Diagnostic::new(
+                    &crate::rules::references::UNRESOLVED_REFERENCE,
+                    pointer,
+                    format!("bufferView {view_index} does not exist"),
+                )
+            })?;
+        let buffer = view
+            .get("buffer")
+            .and_then(Value::as_u64)
+            .unwrap_or(u64::MAX) as usize;
         let offset = view.get("byteOffset").and_then(Value::as_u64).unwrap_or(0) as usize;
         let length = view.get("byteLength").and_then(Value::as_u64).unwrap_or(0) as usize;
         let bytes = self.buffer_bytes(buffer)?;
@@ -216,27 +292,69 @@ impl Asset {
         match resource::resolve(uri, self.base_dir(), pointer)? {
             Location::Data { bytes, .. } => Ok(bytes),
             Location::File(path) => std::fs::read(&path).map_err(|e| {
-                Diagnostic::new(&codes::IO_ERROR, pointer, format!("cannot read '{uri}' ({}): {e}", path.display()))
+                Diagnostic::new(
+                    &codes::IO_ERROR,
+                    pointer,
+                    format!("cannot read '{uri}' ({}): {e}", path.display()),
+                )
             }),
         }
+    }
+
+    /// The pixels of image `index`, decoded (PNG, JPEG or WebP). Decoding is costly: only the
+    /// steps that need texel values call this.
+    pub fn decode_image(&self, index: usize) -> Result<image::DynamicImage, Diagnostic> {
+        let bytes = self.image_bytes(index)?;
+        let pointer = format!("/images/{index}");
+        let unreadable = |detail: String| {
+            Diagnostic::new(
+                &codes::IMAGE_UNRECOGNIZED_FORMAT,
+                &pointer,
+                format!("image {index}: {detail}"),
+            )
+        };
+        let format = match resource::ImageFormat::sniff(&bytes) {
+            Some(resource::ImageFormat::Png) => image::ImageFormat::Png,
+            Some(resource::ImageFormat::Jpeg) => image::ImageFormat::Jpeg,
+            Some(resource::ImageFormat::Webp) => image::ImageFormat::WebP,
+            Some(resource::ImageFormat::Ktx2) => {
+                return Err(unreadable("KTX2 images are not decoded".to_string()))
+            }
+            None => {
+                return Err(unreadable(
+                    "not a PNG, JPEG, WebP or KTX2 image".to_string(),
+                ))
+            }
+        };
+        image::load_from_memory_with_format(&bytes, format).map_err(|e| unreadable(e.to_string()))
     }
 
     /// The header of image `index`, read once per asset. A file is opened and only its header
     /// read; embedded images are read from their bytes.
     pub fn image_header(&self, index: usize) -> Result<ImageHeader, Diagnostic> {
         let mut cache = self.image_headers.lock().unwrap_or_else(|e| e.into_inner());
-        cache.entry(index).or_insert_with(|| self.read_image_header(index)).clone()
+        cache
+            .entry(index)
+            .or_insert_with(|| self.read_image_header(index))
+            .clone()
     }
 
     fn read_image_header(&self, index: usize) -> Result<ImageHeader, Diagnostic> {
         let what = format!("image {index}");
         let pointer = format!("/images/{index}");
-        let uri = self.json.pointer(&format!("{pointer}/uri")).and_then(Value::as_str);
+        let uri = self
+            .json
+            .pointer(&format!("{pointer}/uri"))
+            .and_then(Value::as_str);
         if let Some(uri) = uri {
             let uri_pointer = format!("{pointer}/uri");
             if let Location::File(path) = resource::resolve(uri, self.base_dir(), &uri_pointer)? {
                 let file = std::fs::File::open(&path).map_err(|e| {
-                    Diagnostic::new(&codes::IO_ERROR, &uri_pointer, format!("cannot read '{uri}' ({}): {e}", path.display()))
+                    Diagnostic::new(
+                        &codes::IO_ERROR,
+                        &uri_pointer,
+                        format!("cannot read '{uri}' ({}): {e}", path.display()),
+                    )
                 })?;
                 return resource::read_header(BufReader::new(file), &pointer, &what);
             }

@@ -22,7 +22,11 @@ pub enum Location {
 pub fn resolve(uri: &str, base_dir: &Path, pointer: &str) -> Result<Location, Diagnostic> {
     if let Some(rest) = uri.strip_prefix("data:") {
         let (header, payload) = rest.split_once(',').ok_or_else(|| {
-            Diagnostic::new(&codes::INVALID_URI, pointer, "the data: URI has no ',' before its payload")
+            Diagnostic::new(
+                &codes::INVALID_URI,
+                pointer,
+                "the data: URI has no ',' before its payload",
+            )
         })?;
         let Some(media_type) = header.strip_suffix(";base64") else {
             return Err(Diagnostic::new(
@@ -33,7 +37,13 @@ pub fn resolve(uri: &str, base_dir: &Path, pointer: &str) -> Result<Location, Di
         };
         let bytes = base64::engine::general_purpose::STANDARD
             .decode(payload.trim_end())
-            .map_err(|e| Diagnostic::new(&codes::INVALID_URI, pointer, format!("the data: URI's base64 is invalid: {e}")))?;
+            .map_err(|e| {
+                Diagnostic::new(
+                    &codes::INVALID_URI,
+                    pointer,
+                    format!("the data: URI's base64 is invalid: {e}"),
+                )
+            })?;
         return Ok(Location::Data {
             media_type: media_type.to_string(),
             bytes,
@@ -48,7 +58,13 @@ pub fn resolve(uri: &str, base_dir: &Path, pointer: &str) -> Result<Location, Di
     }
     let decoded = percent_encoding::percent_decode_str(uri)
         .decode_utf8()
-        .map_err(|_| Diagnostic::new(&codes::INVALID_URI, pointer, format!("'{uri}' does not percent-decode to UTF-8")))?;
+        .map_err(|_| {
+            Diagnostic::new(
+                &codes::INVALID_URI,
+                pointer,
+                format!("'{uri}' does not percent-decode to UTF-8"),
+            )
+        })?;
     let relative = Path::new(decoded.as_ref());
     let mut depth: i64 = 0;
     for component in relative.components() {
@@ -138,7 +154,11 @@ pub fn read_header<R: std::io::BufRead + std::io::Seek>(
 ) -> Result<ImageHeader, Diagnostic> {
     use image::ImageDecoder;
     let unrecognized = |detail: String| {
-        Diagnostic::new(&codes::IMAGE_UNRECOGNIZED_FORMAT, pointer, format!("{what}: {detail}"))
+        Diagnostic::new(
+            &codes::IMAGE_UNRECOGNIZED_FORMAT,
+            pointer,
+            format!("{what}: {detail}"),
+        )
     };
     let mut magic = [0u8; 12];
     let read = read_up_to(&mut reader, &mut magic).map_err(|e| unrecognized(e.to_string()))?;
@@ -165,9 +185,17 @@ pub fn read_header<R: std::io::BufRead + std::io::Seek>(
         });
     }
     let decoder: Box<dyn ImageDecoder> = match format {
-        ImageFormat::Png => Box::new(image::codecs::png::PngDecoder::new(reader).map_err(|e| unrecognized(e.to_string()))?),
-        ImageFormat::Jpeg => Box::new(image::codecs::jpeg::JpegDecoder::new(reader).map_err(|e| unrecognized(e.to_string()))?),
-        ImageFormat::Webp => Box::new(image::codecs::webp::WebPDecoder::new(reader).map_err(|e| unrecognized(e.to_string()))?),
+        ImageFormat::Png => Box::new(
+            image::codecs::png::PngDecoder::new(reader).map_err(|e| unrecognized(e.to_string()))?,
+        ),
+        ImageFormat::Jpeg => Box::new(
+            image::codecs::jpeg::JpegDecoder::new(reader)
+                .map_err(|e| unrecognized(e.to_string()))?,
+        ),
+        ImageFormat::Webp => Box::new(
+            image::codecs::webp::WebPDecoder::new(reader)
+                .map_err(|e| unrecognized(e.to_string()))?,
+        ),
         ImageFormat::Ktx2 => unreachable!("handled above"),
     };
     let (width, height) = decoder.dimensions();
@@ -216,9 +244,20 @@ mod tests {
 
     #[test]
     fn escaping_absolute_and_remote_uris_are_refused() {
-        for uri in ["../x.png", "a/../../x.png", "/etc/passwd", "https://example.com/x.png", "C:/x.png", "file:///x"] {
+        for uri in [
+            "../x.png",
+            "a/../../x.png",
+            "/etc/passwd",
+            "https://example.com/x.png",
+            "C:/x.png",
+            "file:///x",
+        ] {
             let err = resolve(uri, base(), "/images/3/uri").unwrap_err();
-            assert_eq!((err.code, err.pointer.as_str()), ("URI_NOT_FOLLOWED", "/images/3/uri"), "{uri}");
+            assert_eq!(
+                (err.code, err.pointer.as_str()),
+                ("URI_NOT_FOLLOWED", "/images/3/uri"),
+                "{uri}"
+            );
         }
     }
 
@@ -232,7 +271,11 @@ mod tests {
             }
         );
         for uri in ["data:text/plain,hello", "data:;base64,@@@", "data:nocomma"] {
-            assert_eq!(resolve(uri, base(), "").unwrap_err().code, "INVALID_URI", "{uri}");
+            assert_eq!(
+                resolve(uri, base(), "").unwrap_err().code,
+                "INVALID_URI",
+                "{uri}"
+            );
         }
     }
 
@@ -241,25 +284,51 @@ mod tests {
         let channels = color.channel_count() as usize;
         let bytes_per = (color.bits_per_pixel() as usize / channels).div_ceil(8);
         let data = vec![0u8; 4 * channels * bytes_per];
-        image::ImageEncoder::write_image(image::codecs::png::PngEncoder::new(&mut bytes), &data, 2, 2, color).unwrap();
+        image::ImageEncoder::write_image(
+            image::codecs::png::PngEncoder::new(&mut bytes),
+            &data,
+            2,
+            2,
+            color,
+        )
+        .unwrap();
         bytes
     }
 
     #[test]
     fn png_headers_tell_alpha_and_depth() {
         use image::ExtendedColorType::*;
-        for (color, channels, alpha, bits) in [(L8, 1, false, 8), (La8, 2, true, 8), (Rgb8, 3, false, 8), (Rgba16, 4, true, 16)] {
+        for (color, channels, alpha, bits) in [
+            (L8, 1, false, 8),
+            (La8, 2, true, 8),
+            (Rgb8, 3, false, 8),
+            (Rgba16, 4, true, 16),
+        ] {
             let h = read_header(std::io::Cursor::new(png(color)), "", "image 0").unwrap();
             assert_eq!((h.format, h.width, h.height), (ImageFormat::Png, 2, 2));
-            assert_eq!((h.channels, h.has_alpha, h.bits), (Some(channels), Some(alpha), Some(bits)), "{color:?}");
+            assert_eq!(
+                (h.channels, h.has_alpha, h.bits),
+                (Some(channels), Some(alpha), Some(bits)),
+                "{color:?}"
+            );
         }
     }
 
     #[test]
     fn garbage_is_an_unrecognized_image() {
-        let err = read_header(std::io::Cursor::new(b"hello world, not an image".to_vec()), "/images/1", "image 1").unwrap_err();
+        let err = read_header(
+            std::io::Cursor::new(b"hello world, not an image".to_vec()),
+            "/images/1",
+            "image 1",
+        )
+        .unwrap_err();
         assert_eq!(err.code, "IMAGE_UNRECOGNIZED_FORMAT");
-        let err = read_header(std::io::Cursor::new(b"\x89PNG\r\n\x1a\n\0\0".to_vec()), "/images/1", "image 1").unwrap_err();
+        let err = read_header(
+            std::io::Cursor::new(b"\x89PNG\r\n\x1a\n\0\0".to_vec()),
+            "/images/1",
+            "image 1",
+        )
+        .unwrap_err();
         assert_eq!(err.code, "IMAGE_UNRECOGNIZED_FORMAT");
     }
 }

@@ -21,7 +21,10 @@ impl JsonStyle {
     pub fn detect(text: &str) -> JsonStyle {
         let trimmed = text.trim_end_matches(['\0', ' ']);
         let indent = trimmed.lines().skip(1).find_map(|line| {
-            let unit: String = line.chars().take_while(|c| *c == ' ' || *c == '\t').collect();
+            let unit: String = line
+                .chars()
+                .take_while(|c| *c == ' ' || *c == '\t')
+                .collect();
             (!unit.is_empty()).then_some(unit)
         });
         JsonStyle {
@@ -36,9 +39,11 @@ impl JsonStyle {
             Some(unit) => {
                 let formatter = serde_json::ser::PrettyFormatter::with_indent(unit.as_bytes());
                 let mut ser = serde_json::Serializer::with_formatter(&mut out, formatter);
-                json.serialize(&mut ser).expect("serialising a Value into memory cannot fail");
+                json.serialize(&mut ser)
+                    .expect("serialising a Value into memory cannot fail");
             }
-            None => serde_json::to_writer(&mut out, json).expect("serialising a Value into memory cannot fail"),
+            None => serde_json::to_writer(&mut out, json)
+                .expect("serialising a Value into memory cannot fail"),
         }
         if self.trailing_newline {
             out.push(b'\n');
@@ -71,7 +76,10 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
     };
-    let mut tmp = tempfile::Builder::new().prefix(".velvet-").suffix(".tmp").tempfile_in(dir)?;
+    let mut tmp = tempfile::Builder::new()
+        .prefix(".velvet-")
+        .suffix(".tmp")
+        .tempfile_in(dir)?;
     tmp.write_all(bytes)?;
     tmp.as_file().sync_all()?;
     if let Ok(meta) = std::fs::metadata(path) {
@@ -90,12 +98,22 @@ mod tests {
     fn style_is_detected_and_reproduced() {
         let pretty = "{\n    \"a\": [\n        1.0\n    ]\n}\n";
         let style = JsonStyle::detect(pretty);
-        assert_eq!(style, JsonStyle { indent: Some("    ".into()), trailing_newline: true });
+        assert_eq!(
+            style,
+            JsonStyle {
+                indent: Some("    ".into()),
+                trailing_newline: true
+            }
+        );
         let v: Value = serde_json::from_str(pretty).unwrap();
         assert_eq!(style.render(&v), pretty.as_bytes());
         let minified = r#"{"b":1e-5,"a":0.50}"#;
         let v: Value = serde_json::from_str(minified).unwrap();
-        assert_eq!(JsonStyle::detect(minified).render(&v), minified.as_bytes(), "numbers and key order kept");
+        assert_eq!(
+            JsonStyle::detect(minified).render(&v),
+            minified.as_bytes(),
+            "numbers and key order kept"
+        );
     }
 
     #[test]
@@ -105,7 +123,10 @@ mod tests {
         write_atomic(&target, b"first").unwrap();
         write_atomic(&target, b"second").unwrap();
         assert_eq!(std::fs::read(&target).unwrap(), b"second");
-        let names: Vec<_> = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
+        let names: Vec<_> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
         assert_eq!(names, vec![std::ffi::OsString::from("out.gltf")]);
     }
 

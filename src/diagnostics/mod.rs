@@ -98,12 +98,11 @@ impl Diagnostic {
 /// registry order. Each name appears once.
 pub fn all_codes() -> Vec<&'static Code> {
     let mut out: Vec<&'static Code> = Vec::new();
-    for code in codes::LOADER
-        .iter()
-        .chain(codes::SCHEMA)
-        .copied()
-        .chain(crate::rules::REGISTRY.iter().flat_map(|r| r.codes().iter().copied()))
-    {
+    for code in codes::LOADER.iter().chain(codes::SCHEMA).copied().chain(
+        crate::rules::REGISTRY
+            .iter()
+            .flat_map(|r| r.codes().iter().copied()),
+    ) {
         if !out.iter().any(|c| c.name == code.name) {
             out.push(code);
         }

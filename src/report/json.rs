@@ -57,5 +57,8 @@ pub fn render(reports: &[FileReport]) -> String {
 
 /// One compact JSON report per line.
 pub fn render_lines(reports: &[FileReport]) -> String {
-    reports.iter().map(|r| report_value(r).to_string() + "\n").collect()
+    reports
+        .iter()
+        .map(|r| report_value(r).to_string() + "\n")
+        .collect()
 }

@@ -15,7 +15,9 @@ pub fn render(reports: &[FileReport]) -> String {
         for f in &report.findings {
             let d = &f.diagnostic;
             let place = match (f.position, report.container) {
-                (Some(p), Some(Container::Glb)) => format!("{file}: byte {}", report.json_offset + p.offset),
+                (Some(p), Some(Container::Glb)) => {
+                    format!("{file}: byte {}", report.json_offset + p.offset)
+                }
                 (Some(p), _) => format!("{file}:{}:{}", p.line, p.column),
                 (None, _) => file.clone(),
             };
@@ -28,7 +30,10 @@ pub fn render(reports: &[FileReport]) -> String {
             let _ = writeln!(out, "{file}: further issues not shown (--max-issues)");
         }
         let c = report.counts;
-        for (t, n) in totals.iter_mut().zip([c.errors, c.warnings, c.infos, c.hints]) {
+        for (t, n) in totals
+            .iter_mut()
+            .zip([c.errors, c.warnings, c.infos, c.hints])
+        {
             *t += n;
         }
     }

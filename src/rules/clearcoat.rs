@@ -26,13 +26,21 @@ impl Rule for Clearcoat {
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
         let materials = layers::materials(cx.json());
         for layer in layer_objects(cx.json()) {
-            if !layers::extensions(&materials[layer.material]).is_some_and(|e| e.contains_key(layers::CLEARCOAT)) {
+            if !layers::extensions(&materials[layer.material])
+                .is_some_and(|e| e.contains_key(layers::CLEARCOAT))
+            {
                 continue;
             }
             let (code, message) = if layer.extension == layers::SHEEN {
-                (&SHEEN_UNDER_CLEARCOAT, "the clear coat lies over this sheen layer")
+                (
+                    &SHEEN_UNDER_CLEARCOAT,
+                    "the clear coat lies over this sheen layer",
+                )
             } else {
-                (&FUZZ_OVER_CLEARCOAT, "this fuzz layer lies over the clear coat (a sheen layer would lie under it)")
+                (
+                    &FUZZ_OVER_CLEARCOAT,
+                    "this fuzz layer lies over the clear coat (a sheen layer would lie under it)",
+                )
             };
             out.push(Diagnostic::new(code, &layer.pointer, message));
         }

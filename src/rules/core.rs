@@ -12,11 +12,6 @@ pub const CORE_INVALID_VALUE: Code = Code::new(
     Severity::Error,
     "The core glTF structure holds a value the glTF 2.0 schema does not allow.",
 );
-pub const CORE_UNSUPPORTED: Code = Code::new(
-    "CORE_UNSUPPORTED",
-    Severity::Warning,
-    "The core glTF structure uses something the glTF 2.0 specification does not support.",
-);
 pub const CORE_STRUCTURE_INVALID: Code = Code::new(
     "CORE_STRUCTURE_INVALID",
     Severity::Error,
@@ -53,7 +48,12 @@ pub fn path_to_pointer(path: &str) -> String {
 
 impl Rule for CoreStructure {
     fn codes(&self) -> &'static [&'static Code] {
-        &[&CORE_INVALID_VALUE, &super::references::UNRESOLVED_REFERENCE, &codes::UNDEFINED_PROPERTY, &CORE_UNSUPPORTED, &CORE_STRUCTURE_INVALID]
+        &[
+            &CORE_INVALID_VALUE,
+            &super::references::UNRESOLVED_REFERENCE,
+            &codes::UNDEFINED_PROPERTY,
+            &CORE_STRUCTURE_INVALID,
+        ]
     }
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
@@ -64,7 +64,14 @@ impl Rule for CoreStructure {
                 out.push(Diagnostic::new(
                     &CORE_STRUCTURE_INVALID,
                     "",
-                    format!("line {}, column {}: {}", e.line(), e.column(), e.to_string().rsplit_once(" at line ").map_or(e.to_string(), |(m, _)| m.to_string())),
+                    format!(
+                        "line {}, column {}: {}",
+                        e.line(),
+                        e.column(),
+                        e.to_string()
+                            .rsplit_once(" at line ")
+                            .map_or(e.to_string(), |(m, _)| m.to_string())
+                    ),
                 ));
                 return;
             }
@@ -78,11 +85,24 @@ impl Rule for CoreStructure {
             }
             let pointer = path_to_pointer(path.as_str());
             let (code, message) = match error {
-                CoreError::IndexOutOfBounds => (&super::references::UNRESOLVED_REFERENCE, "index out of range".to_string()),
-                CoreError::Missing => (&codes::UNDEFINED_PROPERTY, "required property is missing".to_string()),
-                CoreError::Invalid => (&CORE_INVALID_VALUE, "invalid value".to_string()),
-                CoreError::Unsupported => (&CORE_UNSUPPORTED, "unsupported value".to_string()),
-                CoreError::Oversize => (&CORE_INVALID_VALUE, "value too large".to_string()),
+                CoreError::IndexOutOfBounds => (
+                    &super::references::UNRESOLVED_REFERENCE,
+                    format!("{}: the index names no object", path.as_str()),
+                ),
+                CoreError::Missing => (
+                    &codes::UNDEFINED_PROPERTY,
+                    format!("{}: required by glTF 2.0 but missing", path.as_str()),
+                ),
+                CoreError::Invalid => (
+                    &CORE_INVALID_VALUE,
+                    format!("{}: not a value glTF 2.0 allows here", path.as_str()),
+                ),
+                CoreError::Oversize => (
+                    &CORE_INVALID_VALUE,
+                    format!("{}: too large for this platform", path.as_str()),
+                ),
+                // Only raised for extensionsRequired, which is skipped above.
+                CoreError::Unsupported => return,
             };
             out.push(Diagnostic::new(code, pointer, message));
         });
@@ -95,8 +115,14 @@ mod tests {
 
     #[test]
     fn gltf_paths_become_pointers() {
-        assert_eq!(path_to_pointer("meshes[0].primitives[12].material"), "/meshes/0/primitives/12/material");
-        assert_eq!(path_to_pointer("meshes[0].primitives[0].attributes[\"TEXCOORD_0\"]"), "/meshes/0/primitives/0/attributes/TEXCOORD_0");
+        assert_eq!(
+            path_to_pointer("meshes[0].primitives[12].material"),
+            "/meshes/0/primitives/12/material"
+        );
+        assert_eq!(
+            path_to_pointer("meshes[0].primitives[0].attributes[\"TEXCOORD_0\"]"),
+            "/meshes/0/primitives/0/attributes/TEXCOORD_0"
+        );
         assert_eq!(path_to_pointer("asset"), "/asset");
         assert_eq!(path_to_pointer(""), "");
     }

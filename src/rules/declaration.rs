@@ -26,7 +26,11 @@ pub struct Declaration;
 
 impl Rule for Declaration {
     fn codes(&self) -> &'static [&'static Code] {
-        &[&UNDECLARED_EXTENSION, &SHEEN_DECLARED_UNUSED, &FUZZ_DECLARED_UNUSED]
+        &[
+            &UNDECLARED_EXTENSION,
+            &SHEEN_DECLARED_UNUSED,
+            &FUZZ_DECLARED_UNUSED,
+        ]
     }
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
@@ -43,7 +47,10 @@ impl Rule for Declaration {
                 out.push(Diagnostic::new(
                     &UNDECLARED_EXTENSION,
                     &layer.pointer,
-                    format!("{} is used but not declared in extensionsUsed", layer.extension),
+                    format!(
+                        "{} is used but not declared in extensionsUsed",
+                        layer.extension
+                    ),
                 ));
             }
         }

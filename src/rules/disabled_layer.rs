@@ -28,11 +28,23 @@ impl Rule for DisabledLayer {
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
         for layer in layer_objects(cx.json()) {
             let (off, code, why) = if layer.extension == layers::SHEEN {
-                let Some(view) = SheenView::read(layer.value) else { continue };
-                (!view.is_on(), &SHEEN_TEXTURE_WITHOUT_EFFECT, "sheenColorFactor is [0, 0, 0]")
+                let Some(view) = SheenView::read(layer.value) else {
+                    continue;
+                };
+                (
+                    !view.is_on(),
+                    &SHEEN_TEXTURE_WITHOUT_EFFECT,
+                    "sheenColorFactor is [0, 0, 0]",
+                )
             } else {
-                let Some(view) = FuzzView::read(layer.value) else { continue };
-                (!view.is_on(), &FUZZ_TEXTURE_WITHOUT_EFFECT, "fuzzFactor is 0")
+                let Some(view) = FuzzView::read(layer.value) else {
+                    continue;
+                };
+                (
+                    !view.is_on(),
+                    &FUZZ_TEXTURE_WITHOUT_EFFECT,
+                    "fuzzFactor is 0",
+                )
             };
             if !off {
                 continue;

@@ -28,14 +28,23 @@ impl Rule for Exclusions {
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
         let materials = layers::materials(cx.json());
         for layer in layer_objects(cx.json()) {
-            let Some(exts) = layers::extensions(&materials[layer.material]) else { continue };
+            let Some(exts) = layers::extensions(&materials[layer.material]) else {
+                continue;
+            };
             for excluded in [layers::SPEC_GLOSS, layers::UNLIT] {
                 if exts.contains_key(excluded) {
-                    let code = if layer.extension == layers::SHEEN { &SHEEN_EXCLUDED } else { &FUZZ_EXCLUDED };
+                    let code = if layer.extension == layers::SHEEN {
+                        &SHEEN_EXCLUDED
+                    } else {
+                        &FUZZ_EXCLUDED
+                    };
                     out.push(Diagnostic::new(
                         code,
                         &layer.pointer,
-                        format!("{} must not be used together with {excluded} on one material", layer.extension),
+                        format!(
+                            "{} must not be used together with {excluded} on one material",
+                            layer.extension
+                        ),
                     ));
                 }
             }

@@ -29,7 +29,11 @@ pub struct Fallback;
 
 impl Rule for Fallback {
     fn codes(&self) -> &'static [&'static Code] {
-        &[&FUZZ_WITHOUT_FALLBACK, &FUZZ_WITH_SHEEN_FALLBACK, &FUZZ_FALLBACK_CONTRADICTS]
+        &[
+            &FUZZ_WITHOUT_FALLBACK,
+            &FUZZ_WITH_SHEEN_FALLBACK,
+            &FUZZ_FALLBACK_CONTRADICTS,
+        ]
     }
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
@@ -39,8 +43,12 @@ impl Rule for Fallback {
             .and_then(Value::as_array)
             .is_some_and(|a| a.iter().any(|e| e.as_str() == Some(layers::FUZZ)));
         for (i, material) in layers::materials(json).iter().enumerate() {
-            let Some(exts) = layers::extensions(material) else { continue };
-            let Some(fuzz) = exts.get(layers::FUZZ).and_then(FuzzView::read) else { continue };
+            let Some(exts) = layers::extensions(material) else {
+                continue;
+            };
+            let Some(fuzz) = exts.get(layers::FUZZ).and_then(FuzzView::read) else {
+                continue;
+            };
             let fuzz_pointer = format!("/materials/{i}/extensions/{}", layers::FUZZ);
             match exts.get(layers::SHEEN).and_then(SheenView::read) {
                 None if !fuzz_required && fuzz.is_on() => out.push(Diagnostic::new(

@@ -21,7 +21,9 @@ impl Rule for FuzzRoughnessDefault {
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
         for layer in layer_objects(cx.json()).filter(|l| l.extension == layers::FUZZ) {
-            let Some(fuzz) = FuzzView::read(layer.value) else { continue };
+            let Some(fuzz) = FuzzView::read(layer.value) else {
+                continue;
+            };
             if fuzz.is_on() && layer.value.get("fuzzRoughnessFactor").is_none() {
                 out.push(Diagnostic::new(
                     &FUZZ_ROUGHNESS_DEFAULT_AMBIGUOUS,

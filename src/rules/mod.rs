@@ -72,17 +72,22 @@ pub struct LayerObject<'a> {
 
 /// Every KHR_materials_sheen and KHR_materials_fuzz object in `materials[*].extensions`.
 pub fn layer_objects(json: &Value) -> impl Iterator<Item = LayerObject<'_>> {
-    layers::materials(json).iter().enumerate().flat_map(|(i, material)| {
-        [layers::SHEEN, layers::FUZZ].into_iter().filter_map(move |ext| {
-            let value = layers::extensions(material)?.get(ext)?;
-            Some(LayerObject {
-                material: i,
-                extension: ext,
-                value,
-                pointer: format!("/materials/{i}/extensions/{ext}"),
-            })
+    layers::materials(json)
+        .iter()
+        .enumerate()
+        .flat_map(|(i, material)| {
+            [layers::SHEEN, layers::FUZZ]
+                .into_iter()
+                .filter_map(move |ext| {
+                    let value = layers::extensions(material)?.get(ext)?;
+                    Some(LayerObject {
+                        material: i,
+                        extension: ext,
+                        value,
+                        pointer: format!("/materials/{i}/extensions/{ext}"),
+                    })
+                })
         })
-    })
 }
 
 /// A texture slot that is present on a layer object.
@@ -109,7 +114,10 @@ pub fn slot_uses<'a>(layer: &'a LayerObject<'a>) -> impl Iterator<Item = SlotUse
 /// The texCoord set a textureInfo really uses: KHR_texture_transform may override it.
 pub fn effective_tex_coord(texture_info: &Value) -> u64 {
     texture_info
-        .pointer(&format!("/extensions/{}/texCoord", layers::TEXTURE_TRANSFORM))
+        .pointer(&format!(
+            "/extensions/{}/texCoord",
+            layers::TEXTURE_TRANSFORM
+        ))
         .and_then(Value::as_u64)
         .or_else(|| texture_info.get("texCoord").and_then(Value::as_u64))
         .unwrap_or(0)
@@ -125,38 +133,15 @@ pub fn texture_sources(texture: &Value, texture_pointer: &str) -> Vec<(Option<u6
     if let Some(exts) = texture.get("extensions").and_then(Value::as_object) {
         for (name, ext) in exts {
             if let Some(source) = ext.get("source") {
-                out.push((source.as_u64(), format!("{texture_pointer}/extensions/{}/source", pointer::escape(name))));
+                out.push((
+                    source.as_u64(),
+                    format!(
+                        "{texture_pointer}/extensions/{}/source",
+                        pointer::escape(name)
+                    ),
+                ));
             }
         }
     }
     out
-}
-
-#[cfg(test)]
-pub(crate) mod testing {
-    //! Helpers for rule tests: run one rule over a JSON document.
-    use super::*;
-    use std::path::Path;
-
-    pub fn run(rule: &dyn Rule, json: &str) -> Vec<(String, String)> {
-        run_at(rule, Path::new("memory/test.gltf"), json)
-    }
-
-    pub fn run_at(rule: &dyn Rule, path: &Path, json: &str) -> Vec<(String, String)> {
-        let loaded = crate::asset::load_bytes(path, json.as_bytes());
-        let asset = loaded.asset.expect("test JSON parses");
-        let schemas = schema::Schemas::builtin();
-        let cx = Context { asset: &asset, schemas: &schemas };
-        let mut out = Vec::new();
-        rule.check(&cx, &mut out);
-        for d in &out {
-            let code = rule.codes().iter().find(|c| c.name == d.code).expect("rule emits only its own codes");
-            assert_eq!(d.severity, code.severity, "{}", d.code);
-        }
-        out.into_iter().map(|d| (d.code.to_string(), d.pointer)).collect()
-    }
-
-    pub fn pairs(items: &[(&str, &str)]) -> Vec<(String, String)> {
-        items.iter().map(|(c, p)| (c.to_string(), p.to_string())).collect()
-    }
 }

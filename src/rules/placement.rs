@@ -29,7 +29,8 @@ impl Rule for Placement {
 
 /// Whether `path` (the pointer of an object holding `extensions`) is `/materials/N`.
 fn is_material(path: &str) -> bool {
-    path.strip_prefix("/materials/").is_some_and(|rest| !rest.is_empty() && rest.bytes().all(|b| b.is_ascii_digit()))
+    path.strip_prefix("/materials/")
+        .is_some_and(|rest| !rest.is_empty() && rest.bytes().all(|b| b.is_ascii_digit()))
 }
 
 fn walk(value: &Value, path: &mut String, depth: usize, out: &mut Vec<Diagnostic>) {

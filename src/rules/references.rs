@@ -26,12 +26,17 @@ impl Rule for References {
         let mut checked_textures = std::collections::HashSet::new();
         for layer in layer_objects(json) {
             for slot in slot_uses(&layer) {
-                let Some(index) = slot.texture.index else { continue };
+                let Some(index) = slot.texture.index else {
+                    continue;
+                };
                 if index >= textures {
                     out.push(Diagnostic::new(
                         &UNRESOLVED_REFERENCE,
                         format!("{}/index", slot.pointer),
-                        format!("{} names texture {index}, but the asset has {textures} textures", slot.slot.texture),
+                        format!(
+                            "{} names texture {index}, but the asset has {textures} textures",
+                            slot.slot.texture
+                        ),
                     ));
                     continue;
                 }
@@ -39,7 +44,9 @@ impl Rule for References {
                     continue;
                 }
                 let texture_pointer = format!("/textures/{index}");
-                for (source, pointer) in texture_sources(&json["textures"][index as usize], &texture_pointer) {
+                for (source, pointer) in
+                    texture_sources(&json["textures"][index as usize], &texture_pointer)
+                {
                     match source {
                         Some(image) if image < images => {}
                         Some(image) => out.push(Diagnostic::new(

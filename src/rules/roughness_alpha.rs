@@ -42,12 +42,21 @@ impl Rule for RoughnessAlpha {
                 if slot.slot.channels != Channels::Alpha {
                     continue;
                 }
-                let Some(texture) = slot.texture.index.and_then(|t| json.get("textures")?.get(t as usize)) else {
+                let Some(texture) = slot
+                    .texture
+                    .index
+                    .and_then(|t| json.get("textures")?.get(t as usize))
+                else {
                     continue; // dangling: the references rule reports it
                 };
-                let texture_pointer = format!("/textures/{}", slot.texture.index.unwrap_or_default());
+                let texture_pointer =
+                    format!("/textures/{}", slot.texture.index.unwrap_or_default());
                 for (image, _) in texture_sources(texture, &texture_pointer) {
-                    let Some(image) = image.filter(|i| json.get("images").and_then(|a| a.get(*i as usize)).is_some()) else {
+                    let Some(image) = image.filter(|i| {
+                        json.get("images")
+                            .and_then(|a| a.get(*i as usize))
+                            .is_some()
+                    }) else {
                         continue;
                     };
                     match cx.asset.image_header(image as usize) {

@@ -16,21 +16,48 @@ use std::sync::Arc;
 
 /// Our schema files, by file name, as compiled into the binary.
 pub const BUILTIN: &[(&str, &str)] = &[
-    ("material.KHR_materials_sheen.schema.json", include_str!("../../schema/material.KHR_materials_sheen.schema.json")),
-    ("material.KHR_materials_fuzz.schema.json", include_str!("../../schema/material.KHR_materials_fuzz.schema.json")),
-    ("textureInfo.schema.json", include_str!("../../schema/textureInfo.schema.json")),
-    ("glTFProperty.schema.json", include_str!("../../schema/glTFProperty.schema.json")),
-    ("glTFid.schema.json", include_str!("../../schema/glTFid.schema.json")),
-    ("extension.schema.json", include_str!("../../schema/extension.schema.json")),
-    ("extras.schema.json", include_str!("../../schema/extras.schema.json")),
+    (
+        "material.KHR_materials_sheen.schema.json",
+        include_str!("../../schema/material.KHR_materials_sheen.schema.json"),
+    ),
+    (
+        "material.KHR_materials_fuzz.schema.json",
+        include_str!("../../schema/material.KHR_materials_fuzz.schema.json"),
+    ),
+    (
+        "textureInfo.schema.json",
+        include_str!("../../schema/textureInfo.schema.json"),
+    ),
+    (
+        "glTFProperty.schema.json",
+        include_str!("../../schema/glTFProperty.schema.json"),
+    ),
+    (
+        "glTFid.schema.json",
+        include_str!("../../schema/glTFid.schema.json"),
+    ),
+    (
+        "extension.schema.json",
+        include_str!("../../schema/extension.schema.json"),
+    ),
+    (
+        "extras.schema.json",
+        include_str!("../../schema/extras.schema.json"),
+    ),
 ];
 
 #[derive(Debug, thiserror::Error)]
 pub enum SchemaError {
     #[error("cannot read schema {path}: {source}")]
-    Read { path: String, source: std::io::Error },
+    Read {
+        path: String,
+        source: std::io::Error,
+    },
     #[error("schema {name} is not valid JSON: {source}")]
-    Json { name: String, source: serde_json::Error },
+    Json {
+        name: String,
+        source: serde_json::Error,
+    },
     #[error("schema {name} does not compile: {message}")]
     Compile { name: String, message: String },
 }
@@ -58,9 +85,15 @@ pub struct Schemas {
 struct FileRetriever(Arc<HashMap<String, Value>>);
 
 impl jsonschema::Retrieve for FileRetriever {
-    fn retrieve(&self, uri: &jsonschema::Uri<String>) -> Result<Value, Box<dyn std::error::Error + Send + Sync>> {
+    fn retrieve(
+        &self,
+        uri: &jsonschema::Uri<String>,
+    ) -> Result<Value, Box<dyn std::error::Error + Send + Sync>> {
         let name = uri.path().as_str().rsplit('/').next().unwrap_or_default();
-        self.0.get(name).cloned().ok_or_else(|| format!("no schema file named '{name}'").into())
+        self.0
+            .get(name)
+            .cloned()
+            .ok_or_else(|| format!("no schema file named '{name}'").into())
     }
 }
 
@@ -69,7 +102,12 @@ impl Schemas {
     pub fn builtin() -> Schemas {
         let files = BUILTIN
             .iter()
-            .map(|(name, text)| (name.to_string(), serde_json::from_str(text).expect("built-in schemas are valid JSON")))
+            .map(|(name, text)| {
+                (
+                    name.to_string(),
+                    serde_json::from_str(text).expect("built-in schemas are valid JSON"),
+                )
+            })
             .collect();
         Schemas::compile(files).expect("built-in schemas compile")
     }
@@ -78,18 +116,29 @@ impl Schemas {
     /// built-in twin.
     pub fn with_overrides(dir: &Path) -> Result<Schemas, SchemaError> {
         let mut files = HashMap::new();
-        std::fs::read_dir(dir).map_err(|source| SchemaError::Read { path: dir.display().to_string(), source })?;
+        std::fs::read_dir(dir).map_err(|source| SchemaError::Read {
+            path: dir.display().to_string(),
+            source,
+        })?;
         for (name, text) in BUILTIN {
             let path = dir.join(name);
             let (text, name) = if path.is_file() {
-                let text = std::fs::read_to_string(&path)
-                    .map_err(|source| SchemaError::Read { path: path.display().to_string(), source })?;
+                let text = std::fs::read_to_string(&path).map_err(|source| SchemaError::Read {
+                    path: path.display().to_string(),
+                    source,
+                })?;
                 (text, path.display().to_string())
             } else {
                 (text.to_string(), name.to_string())
             };
-            let value = serde_json::from_str(&text).map_err(|source| SchemaError::Json { name: name.clone(), source })?;
-            files.insert(path.file_name().unwrap().to_string_lossy().into_owned(), value);
+            let value = serde_json::from_str(&text).map_err(|source| SchemaError::Json {
+                name: name.clone(),
+                source,
+            })?;
+            files.insert(
+                path.file_name().unwrap().to_string_lossy().into_owned(),
+                value,
+            );
         }
         Schemas::compile(files)
     }
@@ -102,8 +151,14 @@ impl Schemas {
                 .with_draft(jsonschema::Draft::Draft4)
                 .with_retriever(FileRetriever(files.clone()))
                 .build(schema)
-                .map_err(|e| SchemaError::Compile { name: name.to_string(), message: e.to_string() })?;
-            Ok(LayerSchema { validator, properties: property_tree(schema, &files, 0) })
+                .map_err(|e| SchemaError::Compile {
+                    name: name.to_string(),
+                    message: e.to_string(),
+                })?;
+            Ok(LayerSchema {
+                validator,
+                properties: property_tree(schema, &files, 0),
+            })
         };
         Ok(Schemas {
             sheen: layer("material.KHR_materials_sheen.schema.json")?,
@@ -113,7 +168,12 @@ impl Schemas {
 }
 
 /// Collects the properties a schema defines, through `allOf` and `$ref`.
-fn collect(schema: &Value, files: &HashMap<String, Value>, depth: usize, out: &mut Vec<(String, Value)>) {
+fn collect(
+    schema: &Value,
+    files: &HashMap<String, Value>,
+    depth: usize,
+    out: &mut Vec<(String, Value)>,
+) {
     if depth > 16 {
         return;
     }
@@ -123,7 +183,12 @@ fn collect(schema: &Value, files: &HashMap<String, Value>, depth: usize, out: &m
             collect(referenced, files, depth + 1, out);
         }
     }
-    for part in schema.get("allOf").and_then(Value::as_array).into_iter().flatten() {
+    for part in schema
+        .get("allOf")
+        .and_then(Value::as_array)
+        .into_iter()
+        .flatten()
+    {
         collect(part, files, depth + 1, out);
     }
     if let Some(props) = schema.get("properties").and_then(Value::as_object) {
@@ -154,7 +219,11 @@ fn unexpected(value: &Value, tree: &PropertyTree, at: &str, out: &mut Vec<Diagno
     for (key, child) in obj {
         let here = pointer::join(at, key);
         if !tree.known.contains(key) {
-            out.push(Diagnostic::new(&codes::UNEXPECTED_PROPERTY, &here, format!("unexpected property '{key}'")));
+            out.push(Diagnostic::new(
+                &codes::UNEXPECTED_PROPERTY,
+                &here,
+                format!("unexpected property '{key}'"),
+            ));
         } else if let Some(sub) = tree.children.get(key) {
             unexpected(child, sub, &here, out);
         }
@@ -168,9 +237,13 @@ fn code_for(kind: &ValidationErrorKind) -> &'static Code {
         | ValidationErrorKind::Maximum { .. }
         | ValidationErrorKind::ExclusiveMinimum { .. }
         | ValidationErrorKind::ExclusiveMaximum { .. } => &codes::VALUE_NOT_IN_RANGE,
-        ValidationErrorKind::MinItems { .. } | ValidationErrorKind::MaxItems { .. } => &codes::ARRAY_LENGTH_NOT_IN_LIST,
+        ValidationErrorKind::MinItems { .. } | ValidationErrorKind::MaxItems { .. } => {
+            &codes::ARRAY_LENGTH_NOT_IN_LIST
+        }
         ValidationErrorKind::Required { .. } => &codes::UNDEFINED_PROPERTY,
-        ValidationErrorKind::Enum { .. } | ValidationErrorKind::Constant { .. } => &codes::VALUE_NOT_IN_LIST,
+        ValidationErrorKind::Enum { .. } | ValidationErrorKind::Constant { .. } => {
+            &codes::VALUE_NOT_IN_LIST
+        }
         ValidationErrorKind::AdditionalProperties { .. } => &codes::UNEXPECTED_PROPERTY,
         _ => &codes::SCHEMA_MISMATCH,
     }
@@ -185,7 +258,11 @@ impl Rule for SchemaCheck {
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
         for layer in layer_objects(cx.json()) {
-            let schema = if layer.extension == layers::SHEEN { &cx.schemas.sheen } else { &cx.schemas.fuzz };
+            let schema = if layer.extension == layers::SHEEN {
+                &cx.schemas.sheen
+            } else {
+                &cx.schemas.fuzz
+            };
             for error in schema.validator.iter_errors(layer.value) {
                 let code = code_for(error.kind());
                 let at = format!("{}{}", layer.pointer, error.instance_path().as_str());

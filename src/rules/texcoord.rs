@@ -26,18 +26,31 @@ impl Rule for TexCoords {
         let mut needs: HashMap<u64, Vec<(u64, String)>> = HashMap::new();
         for layer in layer_objects(json) {
             for slot in slot_uses(&layer) {
-                needs.entry(layer.material as u64).or_default().push((effective_tex_coord(slot.value), slot.pointer));
+                needs
+                    .entry(layer.material as u64)
+                    .or_default()
+                    .push((effective_tex_coord(slot.value), slot.pointer));
             }
         }
         if needs.is_empty() {
             return;
         }
-        let meshes = json.get("meshes").and_then(Value::as_array).map_or(&[][..], Vec::as_slice);
+        let meshes = json
+            .get("meshes")
+            .and_then(Value::as_array)
+            .map_or(&[][..], Vec::as_slice);
         for (m, mesh) in meshes.iter().enumerate() {
-            let primitives = mesh.get("primitives").and_then(Value::as_array).map_or(&[][..], Vec::as_slice);
+            let primitives = mesh
+                .get("primitives")
+                .and_then(Value::as_array)
+                .map_or(&[][..], Vec::as_slice);
             for (p, primitive) in primitives.iter().enumerate() {
-                let Some(material) = primitive.get("material").and_then(Value::as_u64) else { continue };
-                let Some(slots) = needs.get(&material) else { continue };
+                let Some(material) = primitive.get("material").and_then(Value::as_u64) else {
+                    continue;
+                };
+                let Some(slots) = needs.get(&material) else {
+                    continue;
+                };
                 let attributes = primitive.get("attributes").and_then(Value::as_object);
                 for (set, slot_pointer) in slots {
                     let attribute = format!("TEXCOORD_{set}");

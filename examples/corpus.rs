@@ -1,0 +1,105 @@
+//! Generates the benchmark corpus: one .gltf with many sheen/fuzz materials, and a folder of
+//! small .gltf files. Used by `benches/` (through `#[path]`) and from the command line:
+//!
+//!     cargo run --release --example corpus -- OUT_DIR [MATERIALS] [FILES]
+//!
+//! writes OUT_DIR/large.gltf (MATERIALS materials, default 20000) and OUT_DIR/small/ (FILES
+//! files, default 500). The materials cycle through the shapes real assets have: ratified sheen
+//! with and without textures, fuzz with a sheen fallback, fuzz alone, a legacy draft sheen, and
+//! a few deliberate faults so the rules have work to report.
+
+#![allow(dead_code)]
+
+use serde_json::{json, Value};
+use std::path::Path;
+
+/// Material number `i` of the generated corpus.
+pub fn material(i: usize) -> Value {
+    let c = (i % 97) as f64 / 96.0;
+    let r = (i % 13) as f64 / 12.0;
+    match i % 6 {
+        0 => json!({"name": format!("sheen{i}"), "extensions": {"KHR_materials_sheen": {
+            "sheenColorFactor": [c, 0.5 * c, 0.25], "sheenRoughnessFactor": r}}}),
+        1 => json!({"name": format!("sheenTex{i}"), "extensions": {"KHR_materials_sheen": {
+            "sheenColorFactor": [1.0, 1.0, 1.0], "sheenColorTexture": {"index": 0},
+            "sheenRoughnessFactor": r, "sheenRoughnessTexture": {"index": 0}}}}),
+        2 => json!({"name": format!("fuzz{i}"), "extensions": {
+            "KHR_materials_fuzz": {"fuzzFactor": 1.0, "fuzzColorFactor": [c, c, c], "fuzzRoughnessFactor": r},
+            "KHR_materials_sheen": {"sheenColorFactor": [c, c, c], "sheenRoughnessFactor": r}}}),
+        3 => json!({"name": format!("fuzzOnly{i}"), "extensions": {
+            "KHR_materials_fuzz": {"fuzzFactor": 0.5, "fuzzColorFactor": [0.1, 0.1, 0.1]}}}),
+        4 => json!({"name": format!("legacy{i}"), "pbrMetallicRoughness": {"roughnessFactor": r},
+            "extensions": {"KHR_materials_sheen": {"sheenFactor": 1.0, "sheenColor": [c, c, 1.0]}}}),
+        _ => json!({"name": format!("faulty{i}"), "extensions": {"KHR_materials_sheen": {
+            "sheenColorFactor": [1.5, 0.0], "sheenRoughnessFactor": "rough", "sheenColorTexture": {"index": 7}}}}),
+    }
+}
+
+/// A document with `count` generated materials and one mesh per material.
+pub fn document(count: usize) -> Value {
+    let materials: Vec<Value> = (0..count).map(material).collect();
+    let meshes: Vec<Value> = (0..count)
+        .map(|i| json!({"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1}, "material": i}]}))
+        .collect();
+    json!({
+        "asset": {"version": "2.0", "generator": "velvet benchmark corpus"},
+        "extensionsUsed": ["KHR_materials_sheen", "KHR_materials_fuzz"],
+        "materials": materials,
+        "meshes": meshes,
+        "textures": [{"source": 0}],
+        "images": [{"uri": "sheen.png"}],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
+            {"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"}
+        ],
+        "bufferViews": [{"buffer": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 24}],
+        "buffers": [{"byteLength": 60, "uri": "mesh.bin"}]
+    })
+}
+
+/// A 1×1 RGBA PNG for the shared texture.
+pub fn png() -> Vec<u8> {
+    let mut bytes = Vec::new();
+    image::ImageEncoder::write_image(
+        image::codecs::png::PngEncoder::new(&mut bytes),
+        &[200, 150, 100, 128],
+        1,
+        1,
+        image::ExtendedColorType::Rgba8,
+    )
+    .expect("encoding a 1x1 PNG cannot fail");
+    bytes
+}
+
+/// Writes `large.gltf` with `materials` materials and `small/` with `files` files of 6
+/// materials each into `dir`.
+pub fn write(dir: &Path, materials: usize, files: usize) -> std::io::Result<()> {
+    std::fs::create_dir_all(dir.join("small"))?;
+    std::fs::write(
+        dir.join("large.gltf"),
+        serde_json::to_vec_pretty(&document(materials))?,
+    )?;
+    std::fs::write(dir.join("sheen.png"), png())?;
+    std::fs::write(dir.join("small/sheen.png"), png())?;
+    for f in 0..files {
+        std::fs::write(
+            dir.join(format!("small/asset{f:04}.gltf")),
+            serde_json::to_vec_pretty(&document(6))?,
+        )?;
+    }
+    Ok(())
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let Some(dir) = args.first() else {
+        eprintln!("usage: corpus OUT_DIR [MATERIALS] [FILES]");
+        std::process::exit(2);
+    };
+    let materials = args.get(1).and_then(|a| a.parse().ok()).unwrap_or(20_000);
+    let files = args.get(2).and_then(|a| a.parse().ok()).unwrap_or(500);
+    if let Err(e) = write(Path::new(dir), materials, files) {
+        eprintln!("corpus: cannot write {dir}: {e}");
+        std::process::exit(1);
+    }
+}

@@ -1,0 +1,418 @@
+//! Edit plans and their applier, shared by the commands that change documents (migrate, bake).
+//!
+//! An [`Edit`] is a plain value — set a value at a JSON pointer, remove one, declare an
+//! extension in `extensionsUsed` — so a plan can be compared, printed for a dry run and tested
+//! before anything is applied. [`apply`] executes a plan on a document without disturbing what
+//! the plan does not name: keys keep their places (a replaced key stays where it was, a new key
+//! goes last, a removed key closes the gap without moving its neighbours) and untouched numbers
+//! keep their text.
+
+use crate::asset::pointer;
+use serde::Serialize;
+use serde_json::{Map, Value};
+use std::fmt;
+
+/// One change to a glTF document.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "op", rename_all = "kebab-case")]
+pub enum Edit {
+    /// Sets the value at `pointer`. Missing objects on the way are created; an array index may
+    /// name an existing element (replaced) or the end of the array (appended, also as `-`).
+    Set { pointer: String, value: Value },
+    /// Removes the value at `pointer` (an absent value is not an error: the plan's intent holds).
+    Remove { pointer: String },
+    /// Adds `extension` to `extensionsUsed` unless it is there; creates the array after `asset`
+    /// when the document has none.
+    DeclareUsed { extension: String },
+}
+
+impl Edit {
+    pub fn set(pointer: impl Into<String>, value: Value) -> Edit {
+        Edit::Set {
+            pointer: pointer.into(),
+            value,
+        }
+    }
+
+    pub fn remove(pointer: impl Into<String>) -> Edit {
+        Edit::Remove {
+            pointer: pointer.into(),
+        }
+    }
+
+    pub fn declare_used(extension: impl Into<String>) -> Edit {
+        Edit::DeclareUsed {
+            extension: extension.into(),
+        }
+    }
+}
+
+impl fmt::Display for Edit {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Edit::Set { pointer, value } => write!(f, "set {pointer} = {value}"),
+            Edit::Remove { pointer } => write!(f, "remove {pointer}"),
+            Edit::DeclareUsed { extension } => write!(f, "declare {extension} in /extensionsUsed"),
+        }
+    }
+}
+
+/// Why an edit could not be applied.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum EditError {
+    #[error("{pointer}: the document root cannot be replaced by an edit")]
+    Root { pointer: String },
+    #[error("{pointer}: '{token}' leads into a {kind}, which holds no members")]
+    NotAContainer {
+        pointer: String,
+        token: String,
+        kind: &'static str,
+    },
+    #[error("{pointer}: '{token}' is not an index of an array of {len}")]
+    BadIndex {
+        pointer: String,
+        token: String,
+        len: usize,
+    },
+    #[error("/extensionsUsed is not an array")]
+    ExtensionsUsedNotArray,
+}
+
+/// Applies `edits` in order; `Ok(true)` when the document changed (an edit that sets a value
+/// already there, removes an absent one or declares a declared extension changes nothing). On
+/// error the document may hold the edits before the failing one: callers discard it.
+pub fn apply(json: &mut Value, edits: &[Edit]) -> Result<bool, EditError> {
+    let mut changed = false;
+    for edit in edits {
+        changed |= match edit {
+            Edit::Set { pointer, value } => set(json, pointer, value.clone())?,
+            Edit::Remove { pointer } => remove(json, pointer)?,
+            Edit::DeclareUsed { extension } => declare_used(json, extension)?,
+        };
+    }
+    Ok(changed)
+}
+
+fn kind_of(value: &Value) -> &'static str {
+    match value {
+        Value::Null => "null",
+        Value::Bool(_) => "boolean",
+        Value::Number(_) => "number",
+        Value::String(_) => "string",
+        Value::Array(_) => "array",
+        Value::Object(_) => "object",
+    }
+}
+
+/// Index of `token` in an array of `len`; `append` allows `len` and `-` (the end).
+fn array_index(token: &str, len: usize, append: bool, path: &str) -> Result<usize, EditError> {
+    let bad = || EditError::BadIndex {
+        pointer: path.to_string(),
+        token: token.to_string(),
+        len,
+    };
+    if token == "-" {
+        return if append { Ok(len) } else { Err(bad()) };
+    }
+    // RFC 6901: no leading zeros, no sign.
+    if token.is_empty()
+        || (token.len() > 1 && token.starts_with('0'))
+        || !token.bytes().all(|b| b.is_ascii_digit())
+    {
+        return Err(bad());
+    }
+    let index: usize = token.parse().map_err(|_| bad())?;
+    if index < len || (append && index == len) {
+        Ok(index)
+    } else {
+        Err(bad())
+    }
+}
+
+/// The container that holds the last token of `path`, creating missing objects on the way.
+fn parent_mut<'a>(
+    json: &'a mut Value,
+    path: &str,
+    tokens: &[String],
+) -> Result<&'a mut Value, EditError> {
+    let mut current = json;
+    for token in tokens {
+        current = match current {
+            Value::Object(map) => map
+                .entry(token.clone())
+                .or_insert_with(|| Value::Object(Map::new())),
+            Value::Array(items) => {
+                let index = array_index(token, items.len(), false, path)?;
+                &mut items[index]
+            }
+            other => {
+                return Err(EditError::NotAContainer {
+                    pointer: path.to_string(),
+                    token: token.clone(),
+                    kind: kind_of(other),
+                })
+            }
+        };
+    }
+    Ok(current)
+}
+
+fn set(json: &mut Value, path: &str, value: Value) -> Result<bool, EditError> {
+    let tokens = pointer::tokens(path);
+    let Some((last, parents)) = tokens.split_last() else {
+        return Err(EditError::Root {
+            pointer: path.to_string(),
+        });
+    };
+    match parent_mut(json, path, parents)? {
+        // `insert` on an existing key keeps its place (the map preserves order).
+        Value::Object(map) => {
+            let changed = map.get(last) != Some(&value);
+            map.insert(last.clone(), value);
+            Ok(changed)
+        }
+        Value::Array(items) => {
+            let index = array_index(last, items.len(), true, path)?;
+            if index == items.len() {
+                items.push(value);
+                Ok(true)
+            } else {
+                let changed = items[index] != value;
+                items[index] = value;
+                Ok(changed)
+            }
+        }
+        other => Err(EditError::NotAContainer {
+            pointer: path.to_string(),
+            token: last.clone(),
+            kind: kind_of(other),
+        }),
+    }
+}
+
+fn remove(json: &mut Value, path: &str) -> Result<bool, EditError> {
+    let tokens = pointer::tokens(path);
+    let Some((last, parents)) = tokens.split_last() else {
+        return Err(EditError::Root {
+            pointer: path.to_string(),
+        });
+    };
+    let parent_pointer: String = parents
+        .iter()
+        .map(|t| format!("/{}", pointer::escape(t)))
+        .collect();
+    let Some(parent) = json.pointer_mut(&parent_pointer) else {
+        return Ok(false);
+    };
+    Ok(match parent {
+        // shift_remove: `remove` would move the last key into the gap.
+        Value::Object(map) => map.shift_remove(last).is_some(),
+        Value::Array(items) => match array_index(last, items.len(), false, path) {
+            Ok(index) => {
+                items.remove(index);
+                true
+            }
+            Err(_) => false,
+        },
+        _ => false,
+    })
+}
+
+fn declare_used(json: &mut Value, extension: &str) -> Result<bool, EditError> {
+    let Value::Object(root) = json else {
+        return Err(EditError::NotAContainer {
+            pointer: "/extensionsUsed".into(),
+            token: "extensionsUsed".into(),
+            kind: kind_of(json),
+        });
+    };
+    match root.get_mut("extensionsUsed") {
+        Some(Value::Array(used)) => {
+            if used.iter().any(|e| e.as_str() == Some(extension)) {
+                return Ok(false);
+            }
+            used.push(Value::String(extension.to_string()));
+            Ok(true)
+        }
+        Some(_) => Err(EditError::ExtensionsUsedNotArray),
+        None => {
+            // Where glTF writers put it: right after `asset` (or first when there is none).
+            let at = root.keys().position(|k| k == "asset").map_or(0, |i| i + 1);
+            root.shift_insert(
+                at,
+                "extensionsUsed".to_string(),
+                Value::Array(vec![Value::String(extension.to_string())]),
+            );
+            Ok(true)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    fn doc(text: &str) -> Value {
+        serde_json::from_str(text).unwrap()
+    }
+
+    fn text(v: &Value) -> String {
+        serde_json::to_string(v).unwrap()
+    }
+
+    #[test]
+    fn set_replaces_in_place_appends_new_keys_and_creates_objects() {
+        let mut v = doc(r#"{"a":1,"b":{"x":0.50},"c":[1,2]}"#);
+        apply(
+            &mut v,
+            &[
+                Edit::set("/a", json!(2)),
+                Edit::set("/b/y", json!([1.0])),
+                Edit::set("/d/e/f", json!("new")),
+                Edit::set("/c/1", json!(3)),
+                Edit::set("/c/2", json!(4)),
+                Edit::set("/c/-", json!(5)),
+            ],
+        )
+        .unwrap();
+        assert_eq!(
+            text(&v),
+            r#"{"a":2,"b":{"x":0.50,"y":[1.0]},"c":[1,3,4,5],"d":{"e":{"f":"new"}}}"#
+        );
+    }
+
+    #[test]
+    fn remove_keeps_the_order_of_the_other_keys_and_ignores_absent_values() {
+        let mut v = doc(r#"{"a":1,"b":2,"c":3,"d":[0,1,2]}"#);
+        apply(
+            &mut v,
+            &[
+                Edit::remove("/b"),
+                Edit::remove("/zz/y"),
+                Edit::remove("/d/0"),
+                Edit::remove("/d/9"),
+            ],
+        )
+        .unwrap();
+        assert_eq!(text(&v), r#"{"a":1,"c":3,"d":[1,2]}"#);
+    }
+
+    #[test]
+    fn escaped_tokens_name_keys_with_slash_and_tilde() {
+        let mut v = doc(r#"{"a/b":{"~":1}}"#);
+        apply(
+            &mut v,
+            &[
+                Edit::set("/a~1b/~0", json!(2)),
+                Edit::set("/a~1b/x~1y", json!(3)),
+            ],
+        )
+        .unwrap();
+        assert_eq!(text(&v), r#"{"a/b":{"~":2,"x/y":3}}"#);
+    }
+
+    #[test]
+    fn declare_used_appends_once_or_creates_the_array_after_asset() {
+        let mut v = doc(r#"{"asset":{"version":"2.0"},"extensionsUsed":["A"]}"#);
+        apply(
+            &mut v,
+            &[
+                Edit::declare_used("B"),
+                Edit::declare_used("A"),
+                Edit::declare_used("B"),
+            ],
+        )
+        .unwrap();
+        assert_eq!(
+            text(&v),
+            r#"{"asset":{"version":"2.0"},"extensionsUsed":["A","B"]}"#
+        );
+        let mut v = doc(r#"{"asset":{"version":"2.0"},"materials":[]}"#);
+        apply(&mut v, &[Edit::declare_used("B")]).unwrap();
+        assert_eq!(
+            text(&v),
+            r#"{"asset":{"version":"2.0"},"extensionsUsed":["B"],"materials":[]}"#
+        );
+    }
+
+    #[test]
+    fn apply_tells_whether_the_document_changed() {
+        let mut v = doc(r#"{"asset":{},"extensionsUsed":["A"],"a":{"x":1.0},"l":[1]}"#);
+        let no_ops = [
+            Edit::set("/a/x", json!(1.0)),
+            Edit::set("/l/0", json!(1)),
+            Edit::remove("/a/missing"),
+            Edit::remove("/l/4"),
+            Edit::declare_used("A"),
+        ];
+        assert!(!apply(&mut v, &no_ops).unwrap());
+        for edit in [
+            Edit::set("/a/x", json!(1)),
+            Edit::set("/l/-", json!(2)),
+            Edit::remove("/l/0"),
+            Edit::declare_used("B"),
+        ] {
+            assert!(
+                apply(&mut v, std::slice::from_ref(&edit)).unwrap(),
+                "{edit}"
+            );
+        }
+        assert_eq!(
+            text(&v),
+            r#"{"asset":{},"extensionsUsed":["A","B"],"a":{"x":1},"l":[2]}"#
+        );
+    }
+
+    #[test]
+    fn faults_name_the_pointer() {
+        let mut v = doc(r#"{"a":[1],"n":3,"extensionsUsed":{}}"#);
+        assert_eq!(
+            apply(&mut v, &[Edit::set("/a/5", json!(0))]).unwrap_err(),
+            EditError::BadIndex {
+                pointer: "/a/5".into(),
+                token: "5".into(),
+                len: 1
+            }
+        );
+        assert_eq!(
+            apply(&mut v, &[Edit::set("/a/01", json!(0))]).unwrap_err(),
+            EditError::BadIndex {
+                pointer: "/a/01".into(),
+                token: "01".into(),
+                len: 1
+            }
+        );
+        assert_eq!(
+            apply(&mut v, &[Edit::set("/n/x", json!(0))]).unwrap_err(),
+            EditError::NotAContainer {
+                pointer: "/n/x".into(),
+                token: "x".into(),
+                kind: "number"
+            }
+        );
+        assert_eq!(
+            apply(&mut v, &[Edit::set("", json!(0))]).unwrap_err(),
+            EditError::Root { pointer: "".into() }
+        );
+        assert_eq!(
+            apply(&mut v, &[Edit::declare_used("X")]).unwrap_err(),
+            EditError::ExtensionsUsedNotArray
+        );
+    }
+
+    #[test]
+    fn edits_print_as_one_line_each_and_serialise_with_their_op() {
+        let e = Edit::set("/materials/0/x", json!([1.0, 0.5]));
+        assert_eq!(e.to_string(), "set /materials/0/x = [1.0,0.5]");
+        assert_eq!(Edit::remove("/a").to_string(), "remove /a");
+        assert_eq!(
+            Edit::declare_used("KHR_materials_fuzz").to_string(),
+            "declare KHR_materials_fuzz in /extensionsUsed"
+        );
+        assert_eq!(
+            text(&serde_json::to_value(&e).unwrap()),
+            r#"{"op":"set","pointer":"/materials/0/x","value":[1.0,0.5]}"#
+        );
+    }
+}

@@ -1,0 +1,135 @@
+//! One file, planned then written: load, plan the materials ([`plan_document`]) and the
+//! relocation of resources ([`relocate`]), then apply the edits to a copy of the document and
+//! write it atomically.
+//!
+//! A file whose document comes out as it went in is written as the input's own bytes (and,
+//! in place, not written at all). A file the loader could not read cleanly is not migrated:
+//! rewriting it would hide the fault (a truncated BIN chunk would come out "fixed").
+
+use super::paths::{relocate, Job, Relocation};
+use super::plan::{plan_document, DocumentPlan};
+use super::Options;
+use crate::asset::{self, write, Asset};
+use crate::diagnostics::Severity;
+use crate::edit;
+use std::path::{Path, PathBuf};
+
+/// Everything known about one file before anything is written.
+#[derive(Debug)]
+pub struct FilePlan {
+    pub input: PathBuf,
+    pub output: Option<PathBuf>,
+    /// The input's bytes, written as they are when nothing changes.
+    pub bytes: Vec<u8>,
+    pub asset: Asset,
+    pub document: DocumentPlan,
+    pub relocation: Relocation,
+}
+
+impl FilePlan {
+    pub fn in_place(&self) -> bool {
+        self.output.as_deref() == Some(self.input.as_path())
+    }
+
+    /// True when the output's document differs from the input's (materials or URIs).
+    pub fn changes(&self) -> bool {
+        !self.document.is_empty() || !self.relocation.edits.is_empty()
+    }
+}
+
+/// What writing a file did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Written {
+    /// The edited document was written.
+    Changed,
+    /// Nothing changed: the input's bytes were written to the output.
+    Copied,
+    /// Nothing changed and the output is the input: nothing was written.
+    Untouched,
+}
+
+/// Loads and plans one file. Errors name the file and what is wrong.
+pub fn plan_file(job: &Job, options: &Options) -> Result<FilePlan, String> {
+    let bytes = std::fs::read(&job.input)
+        .map_err(|e| format!("cannot read {}: {e}", job.input.display()))?;
+    let loaded = asset::load_bytes(&job.input, &bytes);
+    let errors: Vec<String> = loaded
+        .diagnostics
+        .iter()
+        .filter(|d| d.severity == Severity::Error)
+        .map(|d| format!("{} ({})", d.message, d.code))
+        .collect();
+    let asset = match loaded.asset {
+        Some(asset) if errors.is_empty() => asset,
+        _ => {
+            return Err(format!(
+                "{} cannot be migrated: {}",
+                job.input.display(),
+                errors.join("; ")
+            ))
+        }
+    };
+    let document = plan_document(&asset, options);
+    let relocation = match &job.output {
+        Some(output) if output != &job.input => relocate(&asset, output, options.copy_resources)
+            .map_err(|e| format!("{}: {e}", job.input.display()))?,
+        _ => Relocation::default(),
+    };
+    Ok(FilePlan {
+        input: job.input.clone(),
+        output: job.output.clone(),
+        bytes,
+        asset,
+        document,
+        relocation,
+    })
+}
+
+fn create_parent(path: &Path) -> Result<(), String> {
+    match path.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() => std::fs::create_dir_all(dir)
+            .map_err(|e| format!("cannot create folder {}: {e}", dir.display())),
+        _ => Ok(()),
+    }
+}
+
+/// Applies a file's plan and writes its output (and resource copies). On failure the output
+/// is as it was: every write goes through a temporary file renamed into place. The document is
+/// edited where it lies (a large one is not copied), so the plan's asset holds the edited
+/// document afterwards.
+pub fn execute(plan: &mut FilePlan) -> Result<Written, String> {
+    let Some(output) = plan.output.clone() else {
+        return Err(format!("{}: no output path", plan.input.display()));
+    };
+    let edits: Vec<_> = plan
+        .document
+        .edits()
+        .chain(&plan.relocation.edits)
+        .cloned()
+        .collect();
+    let changed = edit::apply(&mut plan.asset.json, &edits)
+        .map_err(|e| format!("{}: {e}", plan.input.display()))?;
+    if !changed && plan.in_place() {
+        return Ok(Written::Untouched);
+    }
+    for copy in &plan.relocation.copies {
+        let data = std::fs::read(&copy.from)
+            .map_err(|e| format!("cannot read resource {}: {e}", copy.from.display()))?;
+        create_parent(&copy.to)?;
+        write::write_atomic(&copy.to, &data)
+            .map_err(|e| format!("cannot write resource {}: {e}", copy.to.display()))?;
+    }
+    create_parent(&output)?;
+    let bytes = if changed {
+        write::to_bytes(&plan.asset, &plan.asset.json, plan.asset.bin.as_deref())
+    } else {
+        std::mem::take(&mut plan.bytes)
+    };
+    write::write_atomic(&output, &bytes)
+        .map_err(|e| format!("cannot write {}: {e}", output.display()))?;
+    Ok(if changed {
+        Written::Changed
+    } else {
+        Written::Copied
+    })
+}

@@ -1,0 +1,233 @@
+//! Many files: refuse a bad request up front, then plan and write every file in parallel
+//! (rayon), each independently — one failing file does not stop the others — with a progress
+//! bar on a terminal, and sum up what happened.
+
+use super::apply::{execute, plan_file, Written};
+use super::note::{Conversion, Level, Note, Skip};
+use super::paths::{jobs, Destination, Job, ResourceCopy};
+use super::plan::MaterialPlan;
+use super::{Options, UsageError, BAKE_ENGINE_AVAILABLE};
+use crate::edit::Edit;
+use rayon::prelude::*;
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::io::IsTerminal;
+use std::path::PathBuf;
+
+/// One `velvet migrate` invocation.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Request {
+    pub inputs: Vec<PathBuf>,
+    pub destination: Destination,
+    pub options: Options,
+    /// Plan and report, write nothing.
+    pub dry_run: bool,
+    /// Show a progress bar (only ever drawn when stderr is a terminal).
+    pub progress: bool,
+}
+
+/// What became of one file.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+#[serde(tag = "status", rename_all = "kebab-case")]
+pub enum FileOutcome {
+    /// Migrated and written.
+    Changed,
+    /// Nothing to migrate: the input's bytes were written to the output.
+    Copied,
+    /// Nothing to migrate in place: not written.
+    Untouched,
+    /// Dry run: what would happen.
+    Planned { changes: bool },
+    /// Not migrated; nothing was written for it.
+    Failed { error: String },
+}
+
+/// The report for one file.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FileResult {
+    pub input: PathBuf,
+    pub output: Option<PathBuf>,
+    #[serde(flatten)]
+    pub outcome: FileOutcome,
+    pub materials: Vec<MaterialPlan>,
+    /// Edits outside the materials: declarations and URI rewrites.
+    pub edits: Vec<Edit>,
+    pub copies: Vec<ResourceCopy>,
+    #[serde(serialize_with = "super::plan::notes_json")]
+    pub notes: Vec<Note>,
+}
+
+impl FileResult {
+    fn failed(job: &Job, error: String) -> FileResult {
+        FileResult {
+            input: job.input.clone(),
+            output: job.output.clone(),
+            outcome: FileOutcome::Failed { error },
+            materials: Vec::new(),
+            edits: Vec::new(),
+            copies: Vec::new(),
+            notes: Vec::new(),
+        }
+    }
+}
+
+/// Totals over a run.
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize)]
+pub struct Summary {
+    pub files: usize,
+    pub changed: usize,
+    pub unchanged: usize,
+    pub failed: usize,
+    /// Dry run: files that would change.
+    pub would_change: usize,
+    pub materials_migrated: usize,
+    pub conversions: BTreeMap<Conversion, usize>,
+    pub skipped: BTreeMap<Skip, usize>,
+    pub warnings: usize,
+}
+
+/// The outcome of a run: every file in input order, and the totals.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RunReport {
+    pub dry_run: bool,
+    pub files: Vec<FileResult>,
+    pub summary: Summary,
+}
+
+impl RunReport {
+    /// True when a file failed (exit status 1).
+    pub fn failed(&self) -> bool {
+        self.summary.failed > 0
+    }
+}
+
+fn migrate_one(job: &Job, options: &Options, dry_run: bool) -> FileResult {
+    let mut plan = match plan_file(job, options) {
+        Ok(plan) => plan,
+        Err(error) => return FileResult::failed(job, error),
+    };
+    let outcome = if dry_run {
+        FileOutcome::Planned {
+            changes: plan.changes(),
+        }
+    } else {
+        match execute(&mut plan) {
+            Ok(Written::Changed) => FileOutcome::Changed,
+            Ok(Written::Copied) => FileOutcome::Copied,
+            Ok(Written::Untouched) => FileOutcome::Untouched,
+            Err(error) => FileOutcome::Failed { error },
+        }
+    };
+    let mut notes = plan.relocation.notes.clone();
+    if !plan.changes() {
+        // Relocation notes matter only when the document is rewritten.
+        notes.retain(|n| {
+            matches!(
+                n,
+                Note::ResourcesCopied { .. } | Note::ResourceMissing { .. }
+            )
+        });
+    }
+    FileResult {
+        input: plan.input.clone(),
+        output: plan.output.clone(),
+        outcome,
+        edits: plan
+            .document
+            .declarations
+            .iter()
+            .chain(&plan.relocation.edits)
+            .cloned()
+            .collect(),
+        materials: plan.document.materials,
+        copies: plan.relocation.copies,
+        notes,
+    }
+}
+
+/// Runs a request. `Err` is a usage error: nothing was read or written.
+pub fn run(request: &Request) -> Result<RunReport, UsageError> {
+    if request.options.exact && !BAKE_ENGINE_AVAILABLE {
+        return Err(UsageError::ExactUnavailable);
+    }
+    let (jobs, walk_errors) = jobs(&request.inputs, &request.destination, request.dry_run)?;
+    let bar = (request.progress && std::io::stderr().is_terminal() && jobs.len() > 1).then(|| {
+        let bar = indicatif::ProgressBar::new(jobs.len() as u64);
+        if let Ok(style) =
+            indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} files {msg}")
+        {
+            bar.set_style(style);
+        }
+        bar
+    });
+    let mut files: Vec<FileResult> = walk_errors
+        .into_iter()
+        .map(|(path, e)| {
+            FileResult::failed(
+                &Job {
+                    input: path.clone(),
+                    output: None,
+                },
+                format!("cannot read folder {}: {e}", path.display()),
+            )
+        })
+        .collect();
+    files.par_extend(jobs.par_iter().map(|job| {
+        let result = migrate_one(job, &request.options, request.dry_run);
+        if let Some(bar) = &bar {
+            bar.inc(1);
+        }
+        result
+    }));
+    if let Some(bar) = bar {
+        bar.finish_and_clear();
+    }
+    let summary = summarise(&files);
+    Ok(RunReport {
+        dry_run: request.dry_run,
+        files,
+        summary,
+    })
+}
+
+fn summarise(files: &[FileResult]) -> Summary {
+    let mut s = Summary {
+        files: files.len(),
+        ..Summary::default()
+    };
+    for file in files {
+        match &file.outcome {
+            FileOutcome::Changed => s.changed += 1,
+            FileOutcome::Copied
+            | FileOutcome::Untouched
+            | FileOutcome::Planned { changes: false } => s.unchanged += 1,
+            FileOutcome::Planned { changes: true } => s.would_change += 1,
+            FileOutcome::Failed { .. } => s.failed += 1,
+        }
+        if matches!(file.outcome, FileOutcome::Failed { .. }) {
+            continue;
+        }
+        s.warnings += file
+            .notes
+            .iter()
+            .filter(|n| n.level() == Level::Warning)
+            .count();
+        for material in &file.materials {
+            s.warnings += material
+                .notes
+                .iter()
+                .filter(|n| n.level() == Level::Warning)
+                .count();
+            if material.migrated() {
+                s.materials_migrated += 1;
+            }
+            for c in &material.conversions {
+                *s.conversions.entry(*c).or_default() += 1;
+            }
+            if let Some(why) = material.skipped {
+                *s.skipped.entry(why).or_default() += 1;
+            }
+        }
+    }
+    s
+}

@@ -1,0 +1,281 @@
+//! Fuzz → a fallback KHR_materials_sheen for loaders without fuzz (and, with
+//! `--refresh-fallback`, the same sheen regenerated where one is already there).
+//!
+//! sheenColorFactor = fuzzColorFactor × fuzzFactor (what the fuzz lobe shows);
+//! sheenRoughnessFactor comes from fuzzRoughnessFactor through [`roughness::map`], or from the
+//! draft table's default 0.5 when the fuzz leaves it out (said so). A fuzz colour texture alone
+//! is carried as the sheen colour texture (both sRGB, both scaled by the factor: exact); a fuzz
+//! roughness texture likewise (both alpha). A fuzz intensity texture would have to be baked
+//! into the colour (fuzzColor × fuzzIntensity); without the bake engine, or when the two
+//! textures use different texCoord sets or transforms and cannot be combined, the colour falls
+//! back to the factors, reported.
+//!
+//! Sheen only adds light, while fuzz blends towards its colour: dark fuzz over a bright base
+//! darkens it, which no sheen can show. Per unit of layer reflectance the fallback is brighter
+//! by fuzzFactor × (1 − max3(fuzzColor)) × max3(baseColor); that is reported when it exceeds
+//! [`DARK_FUZZ_THRESHOLD`]. Black fuzz would give a switched-off sheen, which is no fallback
+//! (and contradicts the active fuzz): none is written, said so.
+
+use super::note::{Conversion, Note, Skip};
+use super::plan::{number_like, MaterialCx, MaterialPlan};
+use super::roughness::{self, Direction};
+use crate::asset::pointer;
+use crate::edit::Edit;
+use crate::layers::{self, max3, FuzzView};
+use crate::rules::effective_tex_coord;
+use serde_json::{Map, Value};
+
+/// Differences below this share of the layer's reflectance (about 2.5 steps of an 8-bit
+/// channel) are not reported as dark fuzz.
+pub const DARK_FUZZ_THRESHOLD: f64 = 0.01;
+
+/// The properties a fallback sheen has, in the spec's order; refreshing sets or removes each.
+const SHEEN_PROPERTIES: [&str; 4] = [
+    "sheenColorFactor",
+    "sheenColorTexture",
+    "sheenRoughnessFactor",
+    "sheenRoughnessTexture",
+];
+
+/// `value` written with the text of the first of `originals` that already holds it.
+fn number_from(originals: &[Option<&Value>], value: f64) -> Value {
+    originals
+        .iter()
+        .flatten()
+        .find(|v| v.as_f64() == Some(value))
+        .map_or_else(|| number_like(None, value), |v| (*v).clone())
+}
+
+/// Why two textureInfos cannot be combined texel by texel into one texture, if they cannot.
+fn incompatible(a: &Value, b: &Value) -> Option<String> {
+    let (set_a, set_b) = (effective_tex_coord(a), effective_tex_coord(b));
+    if set_a != set_b {
+        return Some(format!("texCoord {set_a} and {set_b}"));
+    }
+    let transform = |t: &Value| {
+        t.pointer(&format!("/extensions/{}", layers::TEXTURE_TRANSFORM))
+            .cloned()
+    };
+    if !same_json(
+        &transform(a).unwrap_or(Value::Null),
+        &transform(b).unwrap_or(Value::Null),
+    ) {
+        return Some(format!("different {} values", layers::TEXTURE_TRANSFORM));
+    }
+    None
+}
+
+/// Relative difference under which two numbers count as the same value: the rounding of the
+/// divisions and products a round trip sheen → fuzz → sheen makes (a few ulps), far below
+/// anything visible.
+const SAME_VALUE_TOLERANCE: f64 = 1e-12;
+
+/// JSON equality where numbers compare by value (1 equals 1.0, and values within
+/// [`SAME_VALUE_TOLERANCE`] of each other are equal), so that refreshing a fallback made by
+/// velvet itself finds it up to date.
+pub fn same_json(a: &Value, b: &Value) -> bool {
+    match (a, b) {
+        (Value::Number(x), Value::Number(y)) => match (x.as_f64(), y.as_f64()) {
+            (Some(x), Some(y)) => {
+                (x - y).abs() <= SAME_VALUE_TOLERANCE * x.abs().max(y.abs()).max(1.0)
+            }
+            _ => x == y,
+        },
+        (Value::Array(x), Value::Array(y)) => {
+            x.len() == y.len() && x.iter().zip(y).all(|(x, y)| same_json(x, y))
+        }
+        (Value::Object(x), Value::Object(y)) => {
+            x.len() == y.len()
+                && x.iter()
+                    .all(|(k, v)| y.get(k).is_some_and(|w| same_json(v, w)))
+        }
+        _ => a == b,
+    }
+}
+
+/// The sheen that stands for `fuzz` on `cx`'s material, and what the user should know.
+pub fn sheen_for(cx: &MaterialCx, fuzz: &Value) -> (Map<String, Value>, Vec<Note>) {
+    let view = FuzzView::read(fuzz).expect("the planner passes objects only");
+    let mut notes = Vec::new();
+    let factor_raw = fuzz.get("fuzzFactor");
+    let color_raw = fuzz.get("fuzzColorFactor").and_then(Value::as_array);
+    let color: Vec<Value> = (0..3)
+        .map(|i| {
+            let value = (view.color_factor[i] * view.factor).clamp(0.0, 1.0);
+            number_from(&[color_raw.and_then(|c| c.get(i)), factor_raw], value)
+        })
+        .collect();
+    let roughness_raw = fuzz
+        .get("fuzzRoughnessFactor")
+        .filter(|v| v.as_f64().is_some());
+    if view.roughness_factor.is_none() {
+        notes.push(Note::FuzzRoughnessDefault {
+            assumed: layers::FUZZ_ROUGHNESS_DEFAULT_TABLE,
+        });
+    }
+    let roughness = roughness::map(view.roughness_or_table_default(), Direction::FuzzToSheen);
+
+    let mut sheen = Map::new();
+    sheen.insert("sheenColorFactor".into(), Value::Array(color));
+    let intensity_texture = fuzz.get("fuzzTexture").filter(|v| v.is_object());
+    let color_texture = fuzz.get("fuzzColorTexture").filter(|v| v.is_object());
+    match (intensity_texture, color_texture) {
+        (None, Some(texture)) => {
+            sheen.insert("sheenColorTexture".into(), texture.clone());
+        }
+        (Some(_), None) => notes.push(Note::FuzzTextureNeedsBake {
+            texture: "fuzzTexture".into(),
+        }),
+        (Some(intensity), Some(colour)) => notes.push(match incompatible(intensity, colour) {
+            Some(reason) => Note::FuzzTexturesIncompatible { reason },
+            None => Note::FuzzTextureNeedsBake {
+                texture: "fuzzTexture with fuzzColorTexture".into(),
+            },
+        }),
+        (None, None) => {}
+    }
+    sheen.insert(
+        "sheenRoughnessFactor".into(),
+        number_like(roughness_raw, roughness),
+    );
+    if let Some(texture) = fuzz.get("fuzzRoughnessTexture").filter(|v| v.is_object()) {
+        sheen.insert("sheenRoughnessTexture".into(), texture.clone());
+    }
+
+    if cx.has_extension(layers::CLEARCOAT) {
+        notes.push(Note::ClearcoatOrder { fallback: true });
+    }
+    if view.is_on() {
+        let base = cx
+            .material
+            .pointer("/pbrMetallicRoughness/baseColorFactor")
+            .and_then(Value::as_array)
+            .filter(|a| a.len() == 4)
+            .and_then(|a| Some([a[0].as_f64()?, a[1].as_f64()?, a[2].as_f64()?]))
+            .unwrap_or([1.0; 3]);
+        let (fuzz_max, base_max) = (max3(view.color_factor), max3(base));
+        let difference = view.factor * (1.0 - fuzz_max).max(0.0) * base_max;
+        if difference > DARK_FUZZ_THRESHOLD {
+            notes.push(Note::DarkFuzz {
+                difference,
+                fuzz_color_max: fuzz_max,
+                base_color_max: base_max,
+            });
+        }
+    }
+    (sheen, notes)
+}
+
+/// True when a sheen with these properties is switched off (sheenColorFactor all zero).
+fn switched_off(sheen: &Map<String, Value>) -> bool {
+    sheen["sheenColorFactor"]
+        .as_array()
+        .is_some_and(|c| c.iter().all(|v| v.as_f64() == Some(0.0)))
+}
+
+/// Adds a fallback sheen to a material that has fuzz only.
+pub fn add(cx: &MaterialCx, fuzz: &Value, plan: &mut MaterialPlan) {
+    if !FuzzView::read(fuzz).is_some_and(|f| f.is_on()) {
+        plan.skip(Skip::FuzzOff, Note::FuzzOff);
+        return;
+    }
+    let (sheen, notes) = sheen_for(cx, fuzz);
+    plan.notes.extend(notes);
+    if switched_off(&sheen) {
+        // A switched-off sheen next to an active fuzz is no fallback, and contradicts it.
+        plan.skip(Skip::BlackFuzz, Note::BlackFuzz);
+        return;
+    }
+    plan.edits.push(Edit::set(
+        cx.extension_pointer(layers::SHEEN),
+        Value::Object(sheen),
+    ));
+    plan.conversions.push(Conversion::FallbackSheen);
+}
+
+/// Regenerates the sheen of a material that has both: each property is set when it differs
+/// and removed when the fuzz gives none; the sheen's other members (extras, extensions) stay.
+pub fn refresh(cx: &MaterialCx, sheen: &Value, fuzz: &Value, plan: &mut MaterialPlan) {
+    let (target, notes) = sheen_for(cx, fuzz);
+    plan.notes.extend(notes);
+    if switched_off(&target) && FuzzView::read(fuzz).is_some_and(|f| f.is_on()) {
+        plan.skip(Skip::BlackFuzz, Note::BlackFuzz);
+        return;
+    }
+    let base = cx.extension_pointer(layers::SHEEN);
+    let mut edits = Vec::new();
+    for property in super::legacy::legacy_properties(sheen) {
+        edits.push(Edit::remove(pointer::join(&base, property)));
+    }
+    for property in SHEEN_PROPERTIES {
+        // An absent factor stands for its default: a sheen that leaves out a roughness of 0
+        // already says what the fuzz gives.
+        let default = match property {
+            "sheenColorFactor" => Some(serde_json::json!(layers::SHEEN_COLOR_DEFAULT)),
+            "sheenRoughnessFactor" => Some(serde_json::json!(layers::SHEEN_ROUGHNESS_DEFAULT)),
+            _ => None,
+        };
+        let now = sheen.get(property).cloned().or(default);
+        match (now.as_ref(), target.get(property)) {
+            (Some(now), Some(wanted)) if same_json(now, wanted) => {}
+            (_, Some(wanted)) => {
+                edits.push(Edit::set(pointer::join(&base, property), wanted.clone()))
+            }
+            // Only textures are ever absent from the target, and they have no default.
+            (Some(_), None) => edits.push(Edit::remove(pointer::join(&base, property))),
+            (None, None) => {}
+        }
+    }
+    if edits.is_empty() {
+        plan.skip(Skip::FallbackUpToDate, Note::FallbackUpToDate);
+    } else {
+        plan.edits.extend(edits);
+        plan.conversions.push(Conversion::RefreshedFallback);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    #[test]
+    fn numbers_compare_by_value_and_objects_ignore_key_order() {
+        let a: Value = serde_json::from_str(r#"{"x":[1,0.50],"y":{"k":2}}"#).unwrap();
+        let b: Value = serde_json::from_str(r#"{"y":{"k":2.0},"x":[1.0,0.5]}"#).unwrap();
+        assert!(same_json(&a, &b));
+        assert!(!same_json(&a, &json!({"x": [1, 0.5], "y": {"k": 3}})));
+        assert!(!same_json(&json!([1, 2]), &json!([1, 2, 3])));
+        // A round trip through fuzz: 0.45 / 0.72 × 0.72 is 0.44999999999999996.
+        assert_eq!(0.45 / 0.72 * 0.72, 0.449_999_999_999_999_96);
+        assert!(same_json(&json!(0.45 / 0.72 * 0.72), &json!(0.45)));
+        assert!(!same_json(&json!(0.1), &json!(0.1 + 1e-9)));
+    }
+
+    #[test]
+    fn textures_combine_only_with_the_same_set_and_transform() {
+        let plain = json!({"index": 0});
+        let set1 = json!({"index": 1, "texCoord": 1});
+        let moved =
+            json!({"index": 1, "extensions": {"KHR_texture_transform": {"offset": [0.5, 0]}}});
+        let moved_to_set1 =
+            json!({"index": 1, "extensions": {"KHR_texture_transform": {"texCoord": 1}}});
+        assert_eq!(
+            incompatible(&plain, &json!({"index": 3, "texCoord": 0})),
+            None
+        );
+        assert_eq!(
+            incompatible(&plain, &set1).as_deref(),
+            Some("texCoord 0 and 1")
+        );
+        assert_eq!(
+            incompatible(&plain, &moved).as_deref(),
+            Some("different KHR_texture_transform values")
+        );
+        // The transform's texCoord overrides the textureInfo's.
+        assert_eq!(
+            incompatible(&plain, &moved_to_set1).as_deref(),
+            Some("texCoord 0 and 1")
+        );
+    }
+}

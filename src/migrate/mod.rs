@@ -1,0 +1,75 @@
+//! `velvet migrate`: sheen → fuzz with the sheen kept as the fallback, a fallback sheen for
+//! fuzz, and the upgrade of the pre-ratification sheen draft.
+//!
+//! The flow is one way. [`plan`] decides, per material, which conversion applies and turns it
+//! into [`Edit`]s and [`Note`]s (plain values: a dry run prints them, tests compare them);
+//! [`paths`] decides where each output goes and which relative URIs or resources must follow
+//! it; [`apply`] executes a file's plan and writes it atomically; [`batch`] runs many files in
+//! parallel and sums up. Each conversion rule is one file: [`sheen_to_fuzz`], [`fallback`],
+//! [`legacy`]. The roughness choice between the layers lives in [`roughness`] alone.
+
+pub mod apply;
+pub mod batch;
+pub mod fallback;
+pub mod legacy;
+pub mod measure;
+pub mod note;
+pub mod paths;
+pub mod plan;
+pub mod render;
+pub mod roughness;
+pub mod sheen_to_fuzz;
+
+pub use batch::{run, FileOutcome, FileResult, Request, RunReport, Summary};
+pub use note::{Conversion, Level, Note, Skip};
+pub use paths::Destination;
+pub use plan::{plan_document, DocumentPlan, MaterialPlan};
+
+pub use crate::edit::Edit;
+
+/// How materials are converted. The defaults are the fast, factor-only conversions.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Options {
+    /// Regenerate the sheen of materials that have both fuzz and sheen from their fuzz.
+    pub refresh_fallback: bool,
+    /// Decode sheen colour textures to measure what fast mode changes (and only then).
+    pub report: bool,
+    /// Bake textures so that lobe and attenuation match texel by texel (needs the bake engine).
+    pub exact: bool,
+    /// Copy relative resources next to an output in another folder instead of rewriting URIs.
+    pub copy_resources: bool,
+}
+
+/// Whether this build carries the texture bake engine that `--exact` and texture fallbacks
+/// need. Until it does, `--exact` is refused and fuzz textures fall back to factors (reported).
+pub const BAKE_ENGINE_AVAILABLE: bool = false;
+
+/// A request velvet cannot carry out as given (exit status 2): nothing is read or written.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum UsageError {
+    #[error("--exact bakes textures with the bake engine, which this build of velvet does not include; run without --exact (the fast mode reports what it changes, --report measures it)")]
+    ExactUnavailable,
+    #[error("say where the output goes: -o FILE (one input), --out-dir DIR or --in-place (or use --dry-run)")]
+    NoDestination,
+    #[error("-o names one output file, but {0} inputs were given; use --out-dir DIR for several")]
+    OutputForMany(usize),
+    #[error("-o names one output file, but {0} is a folder; use --out-dir DIR")]
+    OutputForFolder(String),
+    #[error("-o {output}: the input {input} is a {container} file and the output keeps its container; name the output *.{extension}")]
+    ContainerMismatch {
+        input: String,
+        output: String,
+        container: &'static str,
+        extension: &'static str,
+    },
+    #[error("the output {output} is the input {input}; use --in-place to overwrite inputs")]
+    OutputIsInput { output: String, input: String },
+    #[error("{first} and {second} would both be written to {output}")]
+    OutputCollision {
+        output: String,
+        first: String,
+        second: String,
+    },
+    #[error("no inputs given")]
+    NoInputs,
+}

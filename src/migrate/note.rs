@@ -1,0 +1,288 @@
+//! What a migration says: the conversions done on a material, why a material was skipped, and
+//! the notes that tell a user what changed in appearance or could not be carried over.
+//!
+//! Notes are values with their data (numbers, names), so tests compare them exactly and the
+//! JSON output carries the numbers; [`Note::message`] words them for people, in one place.
+
+use serde::Serialize;
+use serde_json::Value;
+
+/// A conversion applied to one material.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Conversion {
+    /// Draft sheen (sheenFactor, sheenColor, sheenTexture) rewritten as ratified sheen.
+    LegacyUpgrade,
+    /// Ratified sheen kept as the fallback and KHR_materials_fuzz added.
+    SheenToFuzz,
+    /// Fuzz without sheen: a fallback KHR_materials_sheen added.
+    FallbackSheen,
+    /// Fuzz and sheen: the sheen regenerated from the fuzz (--refresh-fallback).
+    RefreshedFallback,
+}
+
+impl Conversion {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Conversion::LegacyUpgrade => "legacy sheen → ratified sheen",
+            Conversion::SheenToFuzz => "sheen → fuzz",
+            Conversion::FallbackSheen => "fuzz → fallback sheen",
+            Conversion::RefreshedFallback => "fallback sheen refreshed",
+        }
+    }
+}
+
+/// Why a material with sheen or fuzz was left as it was.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Skip {
+    /// sheenColorFactor is [0, 0, 0]: the sheen layer is off, there is nothing to carry.
+    SheenOff,
+    /// fuzzFactor is 0: the fuzz layer is off, no fallback is needed.
+    FuzzOff,
+    /// Fuzz and sheen are both there (use --refresh-fallback to regenerate the sheen).
+    BothPresent,
+    /// --refresh-fallback found the sheen already equal to what the fuzz gives.
+    FallbackUpToDate,
+    /// The material uses KHR_materials_unlit, which excludes both layers.
+    Unlit,
+    /// The material uses KHR_materials_pbrSpecularGlossiness, which excludes both layers.
+    SpecularGlossiness,
+    /// The fuzz colour is black: no sheen can stand for it (sheen only adds light).
+    BlackFuzz,
+    /// A layer's value is not a JSON object.
+    Malformed,
+}
+
+impl Skip {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Skip::SheenOff => "sheen switched off",
+            Skip::FuzzOff => "fuzz switched off",
+            Skip::BothPresent => "fuzz and sheen already present",
+            Skip::FallbackUpToDate => "fallback sheen already up to date",
+            Skip::Unlit => "uses KHR_materials_unlit",
+            Skip::SpecularGlossiness => "uses KHR_materials_pbrSpecularGlossiness",
+            Skip::BlackFuzz => "black fuzz, which no sheen can show",
+            Skip::Malformed => "layer is not a JSON object",
+        }
+    }
+}
+
+/// How much a note matters: `Warning` when appearance or data is not carried over exactly.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Level {
+    Info,
+    Warning,
+}
+
+/// One thing a user should know about a material's or a file's migration.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "code", rename_all = "kebab-case")]
+pub enum Note {
+    /// The sheen layer is off; no fuzz is added.
+    SheenOff,
+    /// The fuzz layer is off; no fallback is added.
+    FuzzOff,
+    /// Both layers present and --refresh-fallback not given.
+    BothPresent,
+    /// --refresh-fallback: the sheen already is what the fuzz gives.
+    FallbackUpToDate,
+    /// Excluded by unlit or specular-glossiness.
+    Excluded { extension: String },
+    /// The layer is not a JSON object.
+    Malformed { extension: String },
+    /// Fast mode: the sheen colour texture became the fuzz colour texture as it is.
+    ColorTextureAsIs { w: f64 },
+    /// --report: the attenuation difference of fast mode, measured over the texture's texels.
+    AttenuationMeasured {
+        image: usize,
+        texels: u64,
+        w: f64,
+        max: f64,
+        mean: f64,
+    },
+    /// --report: the measurement could not be made.
+    MeasureFailed { reason: String },
+    /// Fuzz lies over a clear coat where sheen lay under it.
+    ClearcoatOrder { fallback: bool },
+    /// fuzzRoughnessFactor absent: the table default was used for the fallback.
+    FuzzRoughnessDefault { assumed: f64 },
+    /// A fuzz texture needs a bake to become part of the sheen colour texture.
+    FuzzTextureNeedsBake { texture: String },
+    /// fuzzTexture and fuzzColorTexture cannot be combined into one texture.
+    FuzzTexturesIncompatible { reason: String },
+    /// Black fuzz on an active layer: a fallback sheen would be switched off.
+    BlackFuzz,
+    /// Dark fuzz over a bright base: the fallback sheen only adds light.
+    DarkFuzz {
+        difference: f64,
+        fuzz_color_max: f64,
+        base_color_max: f64,
+    },
+    /// Legacy sheenColor × sheenFactor left [0, 1] and was clamped.
+    LegacyClamped {
+        product: [f64; 3],
+        clamped: [f64; 3],
+    },
+    /// Legacy sheen roughness followed a metallicRoughnessTexture (green): needs a bake.
+    LegacyRoughnessTexture { texture: Value },
+    /// Legacy sheenTexture's intensity (alpha) is not applied by sheenColorTexture.
+    LegacyTextureIntensity,
+    /// Legacy properties next to ratified ones: the ratified ones stand.
+    LegacyMixed { properties: Vec<String> },
+    /// A texture that could not be carried over.
+    TextureDropped { property: String, reason: String },
+    /// Relative URIs rewritten so that the output finds the input's resources.
+    UrisRewritten { count: usize, leaves_folder: bool },
+    /// Resources copied next to the output.
+    ResourcesCopied { count: usize },
+    /// A resource to copy is missing; its URI is left as it was.
+    ResourceMissing { uri: String },
+}
+
+fn rgb(c: [f64; 3]) -> String {
+    format!("[{:?}, {:?}, {:?}]", c[0], c[1], c[2])
+}
+
+impl Note {
+    pub fn level(&self) -> Level {
+        match self {
+            Note::SheenOff
+            | Note::FuzzOff
+            | Note::BothPresent
+            | Note::FallbackUpToDate
+            | Note::ColorTextureAsIs { .. }
+            | Note::AttenuationMeasured { .. }
+            | Note::ClearcoatOrder { .. }
+            | Note::FuzzRoughnessDefault { .. }
+            | Note::ResourcesCopied { .. } => Level::Info,
+            Note::UrisRewritten { leaves_folder, .. } => {
+                if *leaves_folder {
+                    Level::Warning
+                } else {
+                    Level::Info
+                }
+            }
+            Note::Excluded { .. }
+            | Note::Malformed { .. }
+            | Note::MeasureFailed { .. }
+            | Note::FuzzTextureNeedsBake { .. }
+            | Note::FuzzTexturesIncompatible { .. }
+            | Note::DarkFuzz { .. }
+            | Note::BlackFuzz
+            | Note::LegacyClamped { .. }
+            | Note::LegacyRoughnessTexture { .. }
+            | Note::LegacyTextureIntensity
+            | Note::LegacyMixed { .. }
+            | Note::TextureDropped { .. }
+            | Note::ResourceMissing { .. } => Level::Warning,
+        }
+    }
+
+    pub fn message(&self) -> String {
+        match self {
+            Note::SheenOff => "sheenColorFactor is [0, 0, 0]: the sheen layer is off, so no fuzz is added".into(),
+            Note::FuzzOff => "fuzzFactor is 0: the fuzz layer is off, so no fallback sheen is added".into(),
+            Note::BothPresent => {
+                "already has KHR_materials_fuzz and a KHR_materials_sheen fallback: left alone (--refresh-fallback regenerates the sheen from the fuzz)".into()
+            }
+            Note::FallbackUpToDate => "the sheen fallback already is what the fuzz gives: nothing to refresh".into(),
+            Note::Excluded { extension } => {
+                format!("uses {extension}, which excludes sheen and fuzz: not migrated (remove one or the other)")
+            }
+            Note::Malformed { extension } => format!("{extension} is not a JSON object: not migrated (`velvet validate` reports it)"),
+            Note::ColorTextureAsIs { w } => format!(
+                "sheenColorTexture became fuzzColorTexture as it is: the lobe colour is exact, but the base is now attenuated by fuzzFactor {w:?} instead of the per-texel maximum of the sheen colour (--report measures the difference)"
+            ),
+            Note::AttenuationMeasured { image, texels, w, max, mean } => format!(
+                "attenuation difference |{w:?} − max3(sheenColor)| over the {texels} texels of image {image}: max {max:.4}, mean {mean:.4}"
+            ),
+            Note::MeasureFailed { reason } => format!("the attenuation difference could not be measured: {reason}"),
+            Note::ClearcoatOrder { fallback: false } => {
+                "the material has KHR_materials_clearcoat: the fuzz lies over the coat, while the sheen lay under it; the look changes where the coat is strong".into()
+            }
+            Note::ClearcoatOrder { fallback: true } => {
+                "the material has KHR_materials_clearcoat: the fallback sheen lies under the coat, while the fuzz lies over it; the look differs where the coat is strong".into()
+            }
+            Note::FuzzRoughnessDefault { assumed } => format!(
+                "fuzzRoughnessFactor is absent: the fallback uses the draft's table default {assumed:?} (its schema says {:?}); the fuzz is left as it is",
+                crate::layers::FUZZ_ROUGHNESS_DEFAULT_SCHEMA
+            ),
+            Note::FuzzTextureNeedsBake { texture } => format!(
+                "{texture} needs a bake into the sheen colour texture (fuzzColor × fuzzIntensity), which this build does not include: the fallback sheen uses the factors instead"
+            ),
+            Note::FuzzTexturesIncompatible { reason } => format!(
+                "fuzzTexture and fuzzColorTexture cannot be combined into one sheen colour texture ({reason}): the fallback sheen uses the factors instead"
+            ),
+            Note::DarkFuzz { difference, fuzz_color_max, base_color_max } => format!(
+                "the fuzz (max colour {fuzz_color_max:?}) is darker than the base (max colour {base_color_max:?}): sheen only adds light, so where the fuzz darkens the base, loaders without fuzz show it brighter by up to {difference:.4} of the layer's reflectance (from the factors; textures can make it larger)"
+            ),
+            Note::BlackFuzz => {
+                "the fuzz colour is black: a sheen of that colour is switched off, so no sheen can stand for it; no fallback is written (loaders without fuzz show no layer)".into()
+            }
+            Note::LegacyClamped { product, clamped } => format!(
+                "sheenColor × sheenFactor = {} lies outside [0, 1]: sheenColorFactor is clamped to {}",
+                rgb(*product),
+                rgb(*clamped)
+            ),
+            Note::LegacyRoughnessTexture { texture } => format!(
+                "the draft sheen's roughness followed the material's roughness, which reads the green channel of metallicRoughnessTexture {texture}; sheenRoughnessTexture reads alpha, so carrying the texture needs a bake that this build does not include: sheenRoughnessFactor is the roughnessFactor alone"
+            ),
+            Note::LegacyTextureIntensity => {
+                "sheenTexture became sheenColorTexture: its colour (RGB) is carried, but the draft's intensity in its alpha channel is not applied (that needs a bake)".into()
+            }
+            Note::LegacyMixed { properties } => format!(
+                "draft properties ({}) sit next to ratified ones: ratified loaders use the ratified ones, so those are migrated and the draft ones are left as they are",
+                properties.join(", ")
+            ),
+            Note::TextureDropped { property, reason } => format!("{property} is not carried over: {reason}"),
+            Note::UrisRewritten { count, leaves_folder } => {
+                let mut m = format!("{count} relative URI{} rewritten so that the output finds the input's resources", if *count == 1 { "" } else { "s" });
+                if *leaves_folder {
+                    m += "; they lead out of the output's folder, which velvet itself does not follow (--copy-resources makes a self-contained output)";
+                }
+                m
+            }
+            Note::ResourcesCopied { count } => format!("{count} resource{} copied next to the output", if *count == 1 { "" } else { "s" }),
+            Note::ResourceMissing { uri } => format!("resource '{uri}' does not exist: not copied, its URI is left as it was"),
+        }
+    }
+
+    /// The note as JSON: its code and data, with `level` and `message` added.
+    pub fn to_json(&self) -> Value {
+        let mut value = serde_json::to_value(self).expect("notes serialise");
+        if let Value::Object(map) = &mut value {
+            map.insert(
+                "level".into(),
+                serde_json::to_value(self.level()).expect("levels serialise"),
+            );
+            map.insert("message".into(), Value::String(self.message()));
+        }
+        value
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn notes_serialise_with_code_data_level_and_message() {
+        let note = Note::DarkFuzz {
+            difference: 0.5,
+            fuzz_color_max: 0.5,
+            base_color_max: 1.0,
+        };
+        let v = note.to_json();
+        assert_eq!(v["code"], "dark-fuzz");
+        assert_eq!(v["level"], "warning");
+        assert_eq!(v["difference"].as_f64(), Some(0.5));
+        assert!(v["message"]
+            .as_str()
+            .unwrap()
+            .contains("brighter by up to 0.5000"));
+        assert_eq!(Note::SheenOff.to_json()["code"], "sheen-off");
+    }
+}

@@ -1,0 +1,352 @@
+//! Where outputs go, and what must follow them.
+//!
+//! [`jobs`] pairs every input file with its output: `-o` for one input, `--out-dir` mirroring
+//! each input folder's tree, or `--in-place`. It refuses, before anything is read or written,
+//! an output that is an input (unless in place), two inputs written to one output, and `-o`
+//! with another container than the input's.
+//!
+//! [`relocate`] keeps an output in another folder loadable: each relative buffer or image URI
+//! is rewritten to lead back to the input's folder, or, with `--copy-resources`, the resource
+//! is copied to the same relative place next to the output and its URI kept. `data:` URIs,
+//! URIs with a scheme and absolute paths need neither.
+
+use super::note::Note;
+use super::UsageError;
+use crate::asset::{discover, resource, Asset};
+use crate::edit::Edit;
+use percent_encoding::{utf8_percent_encode, AsciiSet, NON_ALPHANUMERIC};
+use serde::Serialize;
+use serde_json::Value;
+use std::collections::HashMap;
+use std::io;
+use std::path::{Component, Path, PathBuf};
+
+/// Where migrated files are written.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Destination {
+    /// Nowhere (a dry run only).
+    None,
+    /// Over each input.
+    InPlace,
+    /// One output file for one input file.
+    File(PathBuf),
+    /// A folder that mirrors the inputs' trees.
+    Dir(PathBuf),
+}
+
+/// One input and where its output goes (`None` in a dry run without a destination).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Job {
+    pub input: PathBuf,
+    pub output: Option<PathBuf>,
+}
+
+/// The absolute path a path names, with links resolved as far as the path exists (the rest is
+/// appended lexically), so that two spellings of one file compare equal.
+pub fn identity(path: &Path) -> PathBuf {
+    if let Ok(canonical) = path.canonicalize() {
+        return canonical;
+    }
+    let absolute = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
+    let mut existing = absolute.as_path();
+    let mut rest = Vec::new();
+    while let (Some(parent), Some(name)) = (existing.parent(), existing.file_name()) {
+        rest.push(name.to_os_string());
+        existing = parent;
+        if let Ok(canonical) = existing.canonicalize() {
+            return rest.iter().rev().fold(canonical, |p, n| p.join(n));
+        }
+    }
+    absolute
+}
+
+fn container_extension(path: &Path) -> Option<&'static str> {
+    match path.extension()?.to_str()?.to_ascii_lowercase().as_str() {
+        "gltf" => Some("gltf"),
+        "glb" => Some("glb"),
+        _ => None,
+    }
+}
+
+/// Folders that could not be walked, with their error.
+pub type WalkErrors = Vec<(PathBuf, io::Error)>;
+
+/// Pairs every input file (folders walked) with its output, or refuses the request.
+/// Folders that cannot be read are returned with their error.
+pub fn jobs(
+    inputs: &[PathBuf],
+    destination: &Destination,
+    dry_run: bool,
+) -> Result<(Vec<Job>, WalkErrors), UsageError> {
+    if inputs.is_empty() {
+        return Err(UsageError::NoInputs);
+    }
+    if *destination == Destination::None && !dry_run {
+        return Err(UsageError::NoDestination);
+    }
+    if let Destination::File(output) = destination {
+        if inputs.len() != 1 {
+            return Err(UsageError::OutputForMany(inputs.len()));
+        }
+        if inputs[0].is_dir() {
+            return Err(UsageError::OutputForFolder(inputs[0].display().to_string()));
+        }
+        if let Some(extension) = container_extension(&inputs[0]) {
+            if container_extension(output) != Some(extension) {
+                return Err(UsageError::ContainerMismatch {
+                    input: inputs[0].display().to_string(),
+                    output: output.display().to_string(),
+                    container: if extension == "glb" { "GLB" } else { ".gltf" },
+                    extension,
+                });
+            }
+        }
+    }
+    let mut jobs = Vec::new();
+    let mut walk_errors = Vec::new();
+    for input in inputs {
+        let (files, errors) = discover::collect(std::slice::from_ref(input));
+        walk_errors.extend(errors);
+        for file in files {
+            let output = match destination {
+                Destination::None => None,
+                Destination::InPlace => Some(file.clone()),
+                Destination::File(output) => Some(output.clone()),
+                Destination::Dir(dir) => Some(match file.strip_prefix(input) {
+                    Ok(relative) if !relative.as_os_str().is_empty() => dir.join(relative),
+                    _ => dir.join(file.file_name().unwrap_or(file.as_os_str())),
+                }),
+            };
+            jobs.push(Job {
+                input: file,
+                output,
+            });
+        }
+    }
+    if *destination != Destination::InPlace {
+        let inputs: HashMap<PathBuf, &Path> = jobs
+            .iter()
+            .map(|j| (identity(&j.input), j.input.as_path()))
+            .collect();
+        for job in &jobs {
+            let Some(output) = &job.output else { continue };
+            if let Some(input) = inputs.get(&identity(output)) {
+                return Err(UsageError::OutputIsInput {
+                    output: output.display().to_string(),
+                    input: input.display().to_string(),
+                });
+            }
+        }
+    }
+    let mut seen: HashMap<PathBuf, &Path> = HashMap::new();
+    for job in &jobs {
+        let Some(output) = &job.output else { continue };
+        if let Some(first) = seen.insert(identity(output), &job.input) {
+            return Err(UsageError::OutputCollision {
+                output: output.display().to_string(),
+                first: first.display().to_string(),
+                second: job.input.display().to_string(),
+            });
+        }
+    }
+    Ok((jobs, walk_errors))
+}
+
+/// A resource to copy next to an output.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct ResourceCopy {
+    pub uri: String,
+    pub from: PathBuf,
+    pub to: PathBuf,
+}
+
+/// What an output in another folder needs: URI rewrites (as edits), copies, and notes.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Relocation {
+    pub edits: Vec<Edit>,
+    pub copies: Vec<ResourceCopy>,
+    pub notes: Vec<Note>,
+}
+
+/// Characters a path segment of a URI keeps as they are (RFC 3986 unreserved and sub-delims,
+/// with ':' and '@'); everything else is percent-encoded.
+const SEGMENT: &AsciiSet = &NON_ALPHANUMERIC
+    .remove(b'-')
+    .remove(b'.')
+    .remove(b'_')
+    .remove(b'~')
+    .remove(b'!')
+    .remove(b'$')
+    .remove(b'&')
+    .remove(b'\'')
+    .remove(b'(')
+    .remove(b')')
+    .remove(b'*')
+    .remove(b'+')
+    .remove(b',')
+    .remove(b';')
+    .remove(b'=')
+    .remove(b':')
+    .remove(b'@');
+
+/// The relative URI prefix that leads from folder `from` to folder `to` ("" when they are the
+/// same, else ending in '/'), or `None` when no relative path joins them (other drives).
+pub fn relative_prefix(from: &Path, to: &Path) -> Option<String> {
+    let (from, to) = (identity(from), identity(to));
+    let from: Vec<Component> = from.components().collect();
+    let to: Vec<Component> = to.components().collect();
+    if from.first() != to.first() {
+        return None;
+    }
+    let common = from.iter().zip(&to).take_while(|(a, b)| a == b).count();
+    let mut prefix = "../".repeat(from.len() - common);
+    for component in &to[common..] {
+        let Component::Normal(name) = component else {
+            return None;
+        };
+        prefix += &utf8_percent_encode(&name.to_string_lossy(), SEGMENT).to_string();
+        prefix.push('/');
+    }
+    Some(prefix)
+}
+
+/// A URI that is a relative path (not data:, no scheme, not absolute).
+fn is_relative_path(uri: &str) -> bool {
+    if uri.starts_with("data:") || uri.starts_with('/') || uri.starts_with('\\') {
+        return false;
+    }
+    match uri.split_once(':') {
+        // A scheme (or a drive letter) comes before any '/', '?' or '#'.
+        Some((scheme, _)) => scheme.contains(['/', '?', '#']),
+        None => true,
+    }
+}
+
+/// What an output written to `output` needs so that `asset`'s relative resources still load.
+pub fn relocate(asset: &Asset, output: &Path, copy_resources: bool) -> Result<Relocation, String> {
+    let from_dir = asset.base_dir();
+    let to_dir = match output.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let mut relocation = Relocation::default();
+    if identity(from_dir) == identity(to_dir) {
+        return Ok(relocation);
+    }
+    let mut prefix: Option<String> = None;
+    let mut rewritten = 0;
+    for kind in ["buffers", "images"] {
+        let Some(items) = asset.json.get(kind).and_then(Value::as_array) else {
+            continue;
+        };
+        for (i, item) in items.iter().enumerate() {
+            let Some(uri) = item
+                .get("uri")
+                .and_then(Value::as_str)
+                .filter(|u| is_relative_path(u))
+            else {
+                continue;
+            };
+            let pointer = format!("/{kind}/{i}/uri");
+            if copy_resources {
+                // Only resources inside the input's folder are copied: a copy must not land
+                // outside the output's folder. The others are rewritten.
+                if let Ok(resource::Location::File(from)) =
+                    resource::resolve(uri, from_dir, &pointer)
+                {
+                    if !from.is_file() {
+                        relocation.notes.push(Note::ResourceMissing {
+                            uri: uri.to_string(),
+                        });
+                    } else if !relocation.copies.iter().any(|c| c.uri == uri) {
+                        let relative = from.strip_prefix(from_dir).map_err(|_| {
+                            format!("'{uri}' does not resolve inside {}", from_dir.display())
+                        })?;
+                        relocation.copies.push(ResourceCopy {
+                            uri: uri.to_string(),
+                            from: from.clone(),
+                            to: to_dir.join(relative),
+                        });
+                    }
+                    continue;
+                }
+            }
+            if prefix.is_none() {
+                prefix = Some(relative_prefix(to_dir, from_dir).ok_or_else(|| {
+                    format!(
+                        "no relative path leads from {} to {}; use --copy-resources",
+                        to_dir.display(),
+                        from_dir.display()
+                    )
+                })?);
+            }
+            let prefix = prefix.as_deref().unwrap_or_default();
+            relocation
+                .edits
+                .push(Edit::set(pointer, Value::String(format!("{prefix}{uri}"))));
+            rewritten += 1;
+        }
+    }
+    if rewritten > 0 {
+        let leaves_folder = relocation.edits.iter().any(
+            |e| matches!(e, Edit::Set { value: Value::String(u), .. } if u.starts_with("../")),
+        );
+        relocation.notes.push(Note::UrisRewritten {
+            count: rewritten,
+            leaves_folder,
+        });
+    }
+    if !relocation.copies.is_empty() {
+        relocation.notes.push(Note::ResourcesCopied {
+            count: relocation.copies.len(),
+        });
+    }
+    Ok(relocation)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn prefixes_climb_then_descend_with_encoded_names() {
+        let dir = tempfile::tempdir().unwrap();
+        let base = dir.path();
+        std::fs::create_dir_all(base.join("in/my chair")).unwrap();
+        std::fs::create_dir_all(base.join("out/a")).unwrap();
+        assert_eq!(
+            relative_prefix(&base.join("out/a"), &base.join("in/my chair")).unwrap(),
+            "../../in/my%20chair/"
+        );
+        assert_eq!(
+            relative_prefix(&base.join("in"), &base.join("in/my chair")).unwrap(),
+            "my%20chair/"
+        );
+        assert_eq!(
+            relative_prefix(&base.join("in"), &base.join("in")).unwrap(),
+            ""
+        );
+        // A folder that does not exist yet is placed lexically.
+        assert_eq!(
+            relative_prefix(&base.join("new/deep"), &base.join("in")).unwrap(),
+            "../../in/"
+        );
+    }
+
+    #[test]
+    fn only_relative_paths_are_relocated() {
+        for uri in ["a.bin", "tex/My%20Image.png", "../up.png", "./a:b.png"] {
+            assert!(is_relative_path(uri), "{uri}");
+        }
+        for uri in [
+            "data:application/octet-stream;base64,AA==",
+            "https://x/y.png",
+            "/abs/x.png",
+            "C:/x.png",
+            "file:///x",
+            "a:b/c",
+        ] {
+            assert!(!is_relative_path(uri), "{uri}");
+        }
+    }
+}

@@ -1,0 +1,258 @@
+//! Planning: for each material with sheen or fuzz, which conversion applies (or why none does),
+//! as edits and notes; then the declarations the document needs. Nothing here writes: the plan
+//! is a value that `apply` executes and `render` prints.
+
+use super::note::{Conversion, Note, Skip};
+use super::{fallback, legacy, sheen_to_fuzz, Options};
+use crate::asset::Asset;
+use crate::edit::Edit;
+use crate::layers;
+use serde::Serialize;
+use serde_json::Value;
+
+/// What happens to one material.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MaterialPlan {
+    pub index: usize,
+    pub name: Option<String>,
+    /// The conversions applied, in order (a draft sheen is upgraded before it becomes fuzz).
+    pub conversions: Vec<Conversion>,
+    /// Why nothing was done, when nothing was.
+    pub skipped: Option<Skip>,
+    pub edits: Vec<Edit>,
+    #[serde(serialize_with = "notes_json")]
+    pub notes: Vec<Note>,
+}
+
+pub(crate) fn notes_json<S: serde::Serializer>(notes: &[Note], s: S) -> Result<S::Ok, S::Error> {
+    use serde::ser::SerializeSeq;
+    let mut seq = s.serialize_seq(Some(notes.len()))?;
+    for note in notes {
+        seq.serialize_element(&note.to_json())?;
+    }
+    seq.end()
+}
+
+impl MaterialPlan {
+    fn new(index: usize, material: &Value) -> MaterialPlan {
+        MaterialPlan {
+            index,
+            name: material
+                .get("name")
+                .and_then(Value::as_str)
+                .map(str::to_string),
+            conversions: Vec::new(),
+            skipped: None,
+            edits: Vec::new(),
+            notes: Vec::new(),
+        }
+    }
+
+    /// Ends the plan with nothing done and why.
+    pub(crate) fn skip(&mut self, why: Skip, note: Note) {
+        if self.conversions.is_empty() {
+            self.skipped = Some(why);
+        }
+        self.notes.push(note);
+    }
+
+    pub fn migrated(&self) -> bool {
+        !self.conversions.is_empty()
+    }
+}
+
+/// What a conversion sees of one material.
+pub struct MaterialCx<'a> {
+    pub asset: &'a Asset,
+    pub index: usize,
+    pub material: &'a Value,
+    pub options: &'a Options,
+}
+
+impl MaterialCx<'_> {
+    pub fn json(&self) -> &Value {
+        &self.asset.json
+    }
+
+    /// Pointer to `extension` on this material.
+    pub fn extension_pointer(&self, extension: &str) -> String {
+        format!("/materials/{}/extensions/{extension}", self.index)
+    }
+
+    pub fn has_extension(&self, extension: &str) -> bool {
+        layers::extensions(self.material).is_some_and(|e| e.contains_key(extension))
+    }
+}
+
+/// The plan of one document: the materials' plans and the declarations they need.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct DocumentPlan {
+    pub materials: Vec<MaterialPlan>,
+    /// `extensionsUsed` additions.
+    pub declarations: Vec<Edit>,
+}
+
+impl DocumentPlan {
+    /// Every edit, materials first, in the order they are applied.
+    pub fn edits(&self) -> impl Iterator<Item = &Edit> {
+        self.materials
+            .iter()
+            .flat_map(|m| m.edits.iter())
+            .chain(&self.declarations)
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.edits().next().is_none()
+    }
+}
+
+/// Plans the migration of every material of `asset`.
+pub fn plan_document(asset: &Asset, options: &Options) -> DocumentPlan {
+    let materials: Vec<MaterialPlan> = (0..layers::materials(&asset.json).len())
+        .filter_map(|i| plan_material(asset, i, options))
+        .collect();
+    let declared: Vec<&str> = asset
+        .json
+        .get("extensionsUsed")
+        .and_then(Value::as_array)
+        .map(|a| a.iter().filter_map(Value::as_str).collect())
+        .unwrap_or_default();
+    let any = |wanted: &[Conversion]| {
+        materials
+            .iter()
+            .any(|m| m.conversions.iter().any(|c| wanted.contains(c)))
+    };
+    let mut declarations = Vec::new();
+    // extensionsRequired is never touched: fuzz is optional, sheen is its fallback.
+    if any(&[Conversion::SheenToFuzz]) && !declared.contains(&layers::FUZZ) {
+        declarations.push(Edit::declare_used(layers::FUZZ));
+    }
+    if any(&[
+        Conversion::FallbackSheen,
+        Conversion::RefreshedFallback,
+        Conversion::LegacyUpgrade,
+    ]) && !declared.contains(&layers::SHEEN)
+    {
+        declarations.push(Edit::declare_used(layers::SHEEN));
+    }
+    DocumentPlan {
+        materials,
+        declarations,
+    }
+}
+
+/// The plan of material `index`, or `None` when it has neither sheen nor fuzz.
+pub fn plan_material(asset: &Asset, index: usize, options: &Options) -> Option<MaterialPlan> {
+    let material = layers::materials(&asset.json).get(index)?;
+    let exts = layers::extensions(material)?;
+    let (sheen, fuzz) = (exts.get(layers::SHEEN), exts.get(layers::FUZZ));
+    if sheen.is_none() && fuzz.is_none() {
+        return None;
+    }
+    let mut plan = MaterialPlan::new(index, material);
+    for (extension, why) in [
+        (layers::UNLIT, Skip::Unlit),
+        (layers::SPEC_GLOSS, Skip::SpecularGlossiness),
+    ] {
+        if exts.contains_key(extension) {
+            plan.skip(
+                why,
+                Note::Excluded {
+                    extension: extension.to_string(),
+                },
+            );
+            return Some(plan);
+        }
+    }
+    for (name, value) in [(layers::SHEEN, sheen), (layers::FUZZ, fuzz)] {
+        if value.is_some_and(|v| !v.is_object()) {
+            plan.skip(
+                Skip::Malformed,
+                Note::Malformed {
+                    extension: name.to_string(),
+                },
+            );
+            return Some(plan);
+        }
+    }
+    let cx = MaterialCx {
+        asset,
+        index,
+        material,
+        options,
+    };
+    match (sheen, fuzz) {
+        (Some(sheen), None) => {
+            let sheen = match legacy::upgrade(&cx, sheen, &mut plan) {
+                Some(upgraded) => upgraded,
+                None => sheen_to_fuzz::Sheen::read(sheen),
+            };
+            sheen_to_fuzz::convert(&cx, &sheen, &mut plan);
+        }
+        (None, Some(fuzz)) => fallback::add(&cx, fuzz, &mut plan),
+        (Some(sheen), Some(fuzz)) if options.refresh_fallback => {
+            fallback::refresh(&cx, sheen, fuzz, &mut plan)
+        }
+        (Some(_), Some(_)) => plan.skip(Skip::BothPresent, Note::BothPresent),
+        (None, None) => unreachable!("checked above"),
+    }
+    Some(plan)
+}
+
+/// A number for the output: `original` itself (its text kept) when it already has this value,
+/// else the value written anew.
+pub(crate) fn number_like(original: Option<&Value>, value: f64) -> Value {
+    match original {
+        Some(v) if v.as_f64() == Some(value) => v.clone(),
+        _ => Value::from(value),
+    }
+}
+
+/// The texCoord set a textureInfo reads, and the first primitive drawn with `material` that
+/// lacks it, if any (carrying such a texture into a slot velvet checks would add an error).
+pub(crate) fn primitive_lacking_tex_coord(
+    json: &Value,
+    material: usize,
+    texture_info: &Value,
+) -> Option<String> {
+    let set = crate::rules::effective_tex_coord(texture_info);
+    let attribute = format!("TEXCOORD_{set}");
+    let meshes = json.get("meshes").and_then(Value::as_array)?;
+    for (m, mesh) in meshes.iter().enumerate() {
+        let Some(primitives) = mesh.get("primitives").and_then(Value::as_array) else {
+            continue;
+        };
+        for (p, primitive) in primitives.iter().enumerate() {
+            if primitive.get("material").and_then(Value::as_u64) != Some(material as u64) {
+                continue;
+            }
+            let attributes = primitive.get("attributes");
+            if attributes.and_then(|a| a.get(&attribute)).is_none() {
+                return Some(format!("mesh {m} primitive {p} has no {attribute}"));
+            }
+        }
+    }
+    None
+}
+
+/// Why a textureInfo cannot be carried into a checked slot, if it cannot: its index names no
+/// texture, or a primitive lacks its texCoord set.
+pub(crate) fn texture_unusable(
+    json: &Value,
+    material: usize,
+    texture_info: &Value,
+) -> Option<String> {
+    let textures = json
+        .get("textures")
+        .and_then(Value::as_array)
+        .map_or(0, Vec::len);
+    match texture_info.get("index").and_then(Value::as_u64) {
+        Some(i) if (i as usize) < textures => {
+            primitive_lacking_tex_coord(json, material, texture_info)
+        }
+        Some(i) => Some(format!(
+            "its index {i} names no texture (the asset has {textures})"
+        )),
+        None => Some("it has no valid index".to_string()),
+    }
+}

@@ -1,0 +1,211 @@
+//! Ratified sheen → fuzz, keeping the sheen unchanged as the fallback for loaders without fuzz.
+//!
+//! Sheen's colour is both the lobe's colour and its strength: the base is attenuated by
+//! max3(sheenColor). Fuzz separates the two, so with w = max3(sheenColorFactor):
+//! fuzzFactor = w and fuzzColorFactor = sheenColorFactor / w give the same lobe colour
+//! (fuzzColor · w = sheenColor) and the same attenuation. w = 0 is a switched-off sheen: nothing
+//! is added. fuzzRoughnessFactor is always written (the draft's default is ambiguous) and comes
+//! from [`roughness::map`]. The roughness texture is carried as it is (both read alpha).
+//!
+//! A sheen colour texture becomes the fuzz colour texture as it is (fast mode): the lobe stays
+//! exact texel by texel, but the attenuation now follows w, not the per-texel maximum of the
+//! sheen colour. `--report` measures that difference by decoding the texture; `--exact` would
+//! bake a fuzz texture and a normalised colour texture instead.
+
+use super::measure;
+use super::note::{Conversion, Note, Skip};
+use super::plan::{number_like, MaterialCx, MaterialPlan};
+use super::roughness::{self, Direction};
+use crate::edit::Edit;
+use crate::layers::{self, max3};
+use serde_json::{Map, Value};
+
+/// A ratified sheen as the conversion needs it: values with the JSON text they came in (so
+/// that unchanged numbers keep it), and the textureInfo objects as they are.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Sheen {
+    pub color: [f64; 3],
+    pub color_values: [Value; 3],
+    pub roughness: f64,
+    pub roughness_value: Value,
+    pub color_texture: Option<Value>,
+    pub roughness_texture: Option<Value>,
+}
+
+impl Sheen {
+    /// Reads a ratified KHR_materials_sheen object, with the spec's defaults (a malformed
+    /// value reads as its default: the schema check reports it).
+    pub fn read(ext: &Value) -> Sheen {
+        let view = layers::SheenView::read(ext).unwrap_or(layers::SheenView {
+            color_factor: layers::SHEEN_COLOR_DEFAULT,
+            roughness_factor: layers::SHEEN_ROUGHNESS_DEFAULT,
+            color_texture: None,
+            roughness_texture: None,
+        });
+        let raw = ext.get("sheenColorFactor").and_then(Value::as_array);
+        let color_values =
+            std::array::from_fn(|i| number_like(raw.and_then(|a| a.get(i)), view.color_factor[i]));
+        Sheen {
+            color: view.color_factor,
+            color_values,
+            roughness: view.roughness_factor,
+            roughness_value: number_like(ext.get("sheenRoughnessFactor"), view.roughness_factor),
+            color_texture: ext
+                .get("sheenColorTexture")
+                .filter(|v| v.is_object())
+                .cloned(),
+            roughness_texture: ext
+                .get("sheenRoughnessTexture")
+                .filter(|v| v.is_object())
+                .cloned(),
+        }
+    }
+}
+
+/// The KHR_materials_fuzz object that stands for `sheen`, or `None` when the sheen is off.
+/// Keys follow the draft's parameter table.
+pub fn fuzz_for(sheen: &Sheen) -> Option<Map<String, Value>> {
+    let w = max3(sheen.color);
+    if !w.is_finite() || w <= 0.0 {
+        return None;
+    }
+    let strongest = (0..3)
+        .find(|i| sheen.color[*i] == w)
+        .expect("w is one of the components");
+    let mut fuzz = Map::new();
+    fuzz.insert("fuzzFactor".into(), sheen.color_values[strongest].clone());
+    let color: Vec<Value> = (0..3)
+        .map(|i| number_like(Some(&sheen.color_values[i]), sheen.color[i] / w))
+        .collect();
+    fuzz.insert("fuzzColorFactor".into(), Value::Array(color));
+    if let Some(texture) = &sheen.color_texture {
+        fuzz.insert("fuzzColorTexture".into(), texture.clone());
+    }
+    let r = roughness::map(sheen.roughness, Direction::SheenToFuzz);
+    fuzz.insert(
+        "fuzzRoughnessFactor".into(),
+        number_like(Some(&sheen.roughness_value), r),
+    );
+    if let Some(texture) = &sheen.roughness_texture {
+        fuzz.insert("fuzzRoughnessTexture".into(), texture.clone());
+    }
+    Some(fuzz)
+}
+
+/// Adds the fuzz that stands for `sheen` to the material, with its notes.
+pub fn convert(cx: &MaterialCx, sheen: &Sheen, plan: &mut MaterialPlan) {
+    let Some(fuzz) = fuzz_for(sheen) else {
+        plan.skip(Skip::SheenOff, Note::SheenOff);
+        return;
+    };
+    let w = max3(sheen.color);
+    plan.edits.push(Edit::set(
+        cx.extension_pointer(layers::FUZZ),
+        Value::Object(fuzz),
+    ));
+    plan.conversions.push(Conversion::SheenToFuzz);
+    if cx.has_extension(layers::CLEARCOAT) {
+        plan.notes.push(Note::ClearcoatOrder { fallback: false });
+    }
+    if let Some(texture) = &sheen.color_texture {
+        plan.notes.push(Note::ColorTextureAsIs { w });
+        if cx.options.report {
+            plan.notes.push(
+                match measure::attenuation(cx.asset, texture, sheen.color, w) {
+                    Ok(m) => Note::AttenuationMeasured {
+                        image: m.image,
+                        texels: m.texels,
+                        w,
+                        max: m.max,
+                        mean: m.mean,
+                    },
+                    Err(reason) => Note::MeasureFailed { reason },
+                },
+            );
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    fn fuzz_text(sheen: Value) -> Option<String> {
+        fuzz_for(&Sheen::read(&sheen)).map(|m| serde_json::to_string(&Value::Object(m)).unwrap())
+    }
+
+    #[test]
+    fn colour_splits_into_strength_and_normalised_colour() {
+        let sheen: Value = serde_json::from_str(
+            r#"{"sheenColorFactor":[0.9,0.45,0],"sheenRoughnessFactor":0.25}"#,
+        )
+        .unwrap();
+        assert_eq!(
+            fuzz_text(sheen).unwrap(),
+            r#"{"fuzzFactor":0.9,"fuzzColorFactor":[1.0,0.5,0],"fuzzRoughnessFactor":0.25}"#
+        );
+    }
+
+    #[test]
+    fn full_strength_keeps_the_colour_text_and_roughness_default_is_written() {
+        let sheen: Value = serde_json::from_str(r#"{"sheenColorFactor":[1,0,0.75]}"#).unwrap();
+        assert_eq!(
+            fuzz_text(sheen).unwrap(),
+            r#"{"fuzzFactor":1,"fuzzColorFactor":[1,0,0.75],"fuzzRoughnessFactor":0.0}"#
+        );
+    }
+
+    #[test]
+    fn switched_off_sheen_gives_no_fuzz() {
+        assert_eq!(
+            fuzz_text(json!({"sheenColorFactor": [0.0, 0.0, 0.0], "sheenRoughnessFactor": 0.5})),
+            None
+        );
+        assert_eq!(
+            fuzz_text(json!({"sheenRoughnessFactor": 0.5})),
+            None,
+            "the default colour is black"
+        );
+    }
+
+    #[test]
+    fn textures_are_carried_with_their_extensions() {
+        let tex = json!({"index": 2, "texCoord": 1, "extensions": {"KHR_texture_transform": {"scale": [30.0, -30.0]}}});
+        let sheen = json!({"sheenColorFactor": [0.5, 0.5, 0.5], "sheenColorTexture": tex, "sheenRoughnessTexture": tex});
+        let fuzz = fuzz_for(&Sheen::read(&sheen)).unwrap();
+        assert_eq!(fuzz["fuzzColorTexture"], tex);
+        assert_eq!(fuzz["fuzzRoughnessTexture"], tex);
+        assert_eq!(
+            fuzz.keys().collect::<Vec<_>>(),
+            [
+                "fuzzFactor",
+                "fuzzColorFactor",
+                "fuzzColorTexture",
+                "fuzzRoughnessFactor",
+                "fuzzRoughnessTexture"
+            ]
+        );
+    }
+
+    #[test]
+    fn lobe_colour_is_preserved_exactly_enough() {
+        for c in [
+            [0.9, 0.7, 0.6],
+            [0.05, 0.17, 0.5],
+            [1e-6, 0.0, 3e-7],
+            [0.12, 0.12, 0.13],
+        ] {
+            let fuzz = fuzz_for(&Sheen::read(&json!({ "sheenColorFactor": c }))).unwrap();
+            let w = fuzz["fuzzFactor"].as_f64().unwrap();
+            for i in 0..3 {
+                let colour = fuzz["fuzzColorFactor"][i].as_f64().unwrap();
+                assert!(colour <= 1.0);
+                assert!(
+                    (colour * w - c[i]).abs() <= 1e-15 * c[i].max(1e-300),
+                    "{c:?}"
+                );
+            }
+        }
+    }
+}

@@ -1,0 +1,509 @@
+//! The speed-against-error report of the albedo methods: time per evaluation measured in the run,
+//! and the max and mean absolute error against quadrature over a dense grid, split into the
+//! ordinary region (μ ≥ 0.1, r ≥ 0.25) and the hard region (the rest); and the per-point CSV
+//! that lets anyone check velvet's numbers against their own.
+//!
+//! The reference values are computed once per run (in parallel) and shared by every method's
+//! error; the quadrature's time per evaluation is the mean of those same evaluations, each timed
+//! on its own thread. The other methods are timed single-threaded over the grid, repeated until
+//! the measurement lasts long enough to be stable; the tables' generation is timed separately.
+
+use super::albedo::{
+    albedo_quadrature, is_ordinary, AlbedoMethod, QUADRATURE_BOUND, QUADRATURE_TOL,
+};
+use super::charlie::Visibility;
+use super::{sheen_albedo, table};
+use rayon::prelude::*;
+use std::fmt;
+use std::hint::black_box;
+use std::time::{Duration, Instant};
+
+/// Points per axis of the report's grid: μ and r = 0, 1/64, …, 1 (0 and 1 exactly included).
+pub const REPORT_GRID: usize = 65;
+
+/// The shortest time one timing round of a fast method runs.
+const MIN_TIMING: Duration = Duration::from_millis(1);
+
+/// Timing rounds per fast method; the fastest counts. Short rounds, many of them: on a busy
+/// machine some round runs without being preempted, and the minimum finds it.
+const TIMING_ROUNDS: usize = 50;
+
+/// Grid points at which quadrature is timed (every k-th point of the grid, about this many).
+const QUADRATURE_TIMING_POINTS: usize = 256;
+
+/// Timings per quadrature point; the fastest counts, for the same reason.
+const QUADRATURE_TIMING_REPEATS: usize = 3;
+
+/// Absolute errors over one region.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ErrorStats {
+    /// Largest absolute error.
+    pub max: f64,
+    /// Mean absolute error.
+    pub mean: f64,
+    /// Where the largest error is, (μ, r).
+    pub worst_at: (f64, f64),
+    /// Number of grid points in the region.
+    pub points: usize,
+}
+
+/// One method's line of the report.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MethodResult {
+    /// The method.
+    pub method: AlbedoMethod,
+    /// Mean time per evaluation, in nanoseconds.
+    pub nanos_per_eval: f64,
+    /// One-time cost before the first evaluation (generating a table), if any.
+    pub setup: Option<Duration>,
+    /// Errors against quadrature in the ordinary region (None for quadrature, the reference).
+    pub ordinary: Option<ErrorStats>,
+    /// Errors against quadrature in the hard region (None for quadrature, the reference).
+    pub hard: Option<ErrorStats>,
+}
+
+/// The whole report.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AccuracyReport {
+    /// Points per axis of the grid.
+    pub grid: usize,
+    /// Threads that computed the reference grid and the tables.
+    pub threads: usize,
+    /// The largest error estimate the integrator reported over the grid.
+    pub quadrature_max_estimate: f64,
+    /// Grid points where the integrator did not reach its tolerance.
+    pub quadrature_not_converged: usize,
+    /// One line per method, in [`AlbedoMethod::ALL`] order.
+    pub methods: Vec<MethodResult>,
+}
+
+/// The grid coordinates 0, 1/(n−1), …, 1.
+fn axis(n: usize) -> Vec<f64> {
+    (0..n).map(|i| i as f64 / (n - 1) as f64).collect()
+}
+
+/// Runs the report over an n×n grid (n ≥ 2); [`REPORT_GRID`] is the default.
+pub fn accuracy_report(n: usize) -> AccuracyReport {
+    assert!(n >= 2, "the grid needs at least 2 points per axis");
+    let ax = axis(n);
+    let points: Vec<(f64, f64)> = ax
+        .iter()
+        .flat_map(|&r| ax.iter().map(move |&mu| (mu, r)))
+        .collect();
+
+    // Reference values, computed once and shared by every method's errors.
+    let reference: Vec<(f64, f64, bool)> = points
+        .par_iter()
+        .map(|&(mu, r)| {
+            let est = albedo_quadrature(mu, r, Visibility::Charlie, QUADRATURE_TOL);
+            (est.value, est.error, est.converged)
+        })
+        .collect();
+    let mut methods = vec![MethodResult {
+        method: AlbedoMethod::Quadrature,
+        nanos_per_eval: quadrature_time_per_eval(&points),
+        setup: None,
+        ordinary: None,
+        hard: None,
+    }];
+
+    for method in [AlbedoMethod::Lut16, AlbedoMethod::Lut32, AlbedoMethod::Fit] {
+        let t = Instant::now();
+        match method {
+            AlbedoMethod::Lut16 => drop(table::lut16()),
+            AlbedoMethod::Lut32 => drop(table::lut32()),
+            _ => {}
+        }
+        let setup =
+            matches!(method, AlbedoMethod::Lut16 | AlbedoMethod::Lut32).then(|| t.elapsed());
+        let values: Vec<f64> = points
+            .iter()
+            .map(|&(mu, r)| sheen_albedo(mu, r, method))
+            .collect();
+        let errors: Vec<f64> = values
+            .iter()
+            .zip(&reference)
+            .map(|(v, q)| (v - q.0).abs())
+            .collect();
+        methods.push(MethodResult {
+            method,
+            nanos_per_eval: time_per_eval(method, &points),
+            setup,
+            ordinary: Some(stats(&points, &errors, true)),
+            hard: Some(stats(&points, &errors, false)),
+        });
+    }
+
+    AccuracyReport {
+        grid: n,
+        threads: rayon::current_num_threads(),
+        quadrature_max_estimate: reference.iter().map(|x| x.1).fold(0.0, f64::max),
+        quadrature_not_converged: reference.iter().filter(|x| !x.2).count(),
+        methods,
+    }
+}
+
+/// Nanoseconds per quadrature, single-threaded: the mean over every k-th grid point (about
+/// [`QUADRATURE_TIMING_POINTS`] of them) of the fastest of [`QUADRATURE_TIMING_REPEATS`] timings.
+/// The cost varies across the grid (the hard region needs more cells), so the sample spans it.
+fn quadrature_time_per_eval(points: &[(f64, f64)]) -> f64 {
+    let step = points.len().div_ceil(QUADRATURE_TIMING_POINTS).max(1);
+    let sample: Vec<(f64, f64)> = points.iter().copied().step_by(step).collect();
+    let total: f64 = sample
+        .iter()
+        .map(|&(mu, r)| {
+            (0..QUADRATURE_TIMING_REPEATS)
+                .map(|_| {
+                    let t = Instant::now();
+                    black_box(albedo_quadrature(
+                        black_box(mu),
+                        black_box(r),
+                        Visibility::Charlie,
+                        QUADRATURE_TOL,
+                    ));
+                    t.elapsed().as_nanos() as f64
+                })
+                .fold(f64::INFINITY, f64::min)
+        })
+        .sum();
+    total / sample.len() as f64
+}
+
+/// Nanoseconds per call of `sheen_albedo(μ, r, method)` over the grid, single-threaded: the
+/// fastest of [`TIMING_ROUNDS`] rounds of at least [`MIN_TIMING`] each, so that other work on the
+/// machine inflates the figure as little as possible.
+fn time_per_eval(method: AlbedoMethod, points: &[(f64, f64)]) -> f64 {
+    (0..TIMING_ROUNDS)
+        .map(|_| {
+            let mut calls = 0u64;
+            let t = Instant::now();
+            while t.elapsed() < MIN_TIMING {
+                for &(mu, r) in points {
+                    black_box(sheen_albedo(black_box(mu), black_box(r), method));
+                }
+                calls += points.len() as u64;
+            }
+            t.elapsed().as_nanos() as f64 / calls as f64
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+fn stats(points: &[(f64, f64)], errors: &[f64], ordinary: bool) -> ErrorStats {
+    let mut s = ErrorStats {
+        max: 0.0,
+        mean: 0.0,
+        worst_at: (f64::NAN, f64::NAN),
+        points: 0,
+    };
+    let mut sum = 0.0;
+    for (&(mu, r), &e) in points.iter().zip(errors) {
+        if is_ordinary(mu, r) != ordinary {
+            continue;
+        }
+        s.points += 1;
+        sum += e;
+        if e > s.max || s.worst_at.0.is_nan() {
+            s.max = e;
+            s.worst_at = (mu, r);
+        }
+    }
+    if s.points > 0 {
+        s.mean = sum / s.points as f64;
+    }
+    s
+}
+
+/// A duration per evaluation in the unit that keeps three or four digits.
+fn format_nanos(ns: f64) -> String {
+    if ns < 1e3 {
+        format!("{ns:.1} ns")
+    } else if ns < 1e6 {
+        format!("{:.1} µs", ns / 1e3)
+    } else {
+        format!("{:.1} ms", ns / 1e6)
+    }
+}
+
+impl fmt::Display for AccuracyReport {
+    /// The report as a Markdown table with a short preamble and footnote.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let n = self.grid;
+        let (ord, hard) = self
+            .methods
+            .get(1)
+            .and_then(|m| Some((m.ordinary?.points, m.hard?.points)))
+            .unwrap_or((0, 0));
+        writeln!(
+            f,
+            "Sheen albedo E(μ, r), Charlie visibility: each method against adaptive quadrature."
+        )?;
+        writeln!(
+            f,
+            "Grid {n}×{n} (μ, r = 0, 1/{}, …, 1); ordinary region μ ≥ 0.1 and r ≥ 0.25 ({ord} points), hard region the rest ({hard} points).",
+            n - 1
+        )?;
+        writeln!(f)?;
+        let header = [
+            "method",
+            "time/eval",
+            "setup",
+            "ordinary max",
+            "ordinary mean",
+            "hard max",
+            "hard mean",
+            "stated bound (ordinary)",
+        ];
+        let mut rows: Vec<[String; 8]> = Vec::new();
+        for m in &self.methods {
+            let cell = |s: Option<ErrorStats>, max: bool| match s {
+                Some(s) => format!("{:.2e}", if max { s.max } else { s.mean }),
+                None => "reference".to_string(),
+            };
+            rows.push([
+                m.method.name().to_string(),
+                format_nanos(m.nanos_per_eval),
+                m.setup
+                    .map_or("–".to_string(), |d| format!("{:.2} s", d.as_secs_f64())),
+                cell(m.ordinary, true),
+                cell(m.ordinary, false),
+                cell(m.hard, true),
+                cell(m.hard, false),
+                format!("{:e}", m.method.ordinary_bound()),
+            ]);
+        }
+        let widths: Vec<usize> = (0..8)
+            .map(|c| {
+                rows.iter()
+                    .map(|r| r[c].chars().count())
+                    .chain([header[c].chars().count()])
+                    .max()
+                    .unwrap_or(0)
+            })
+            .collect();
+        let line = |f: &mut fmt::Formatter<'_>, cells: &[String]| -> fmt::Result {
+            write!(f, "|")?;
+            for (c, s) in cells.iter().enumerate() {
+                write!(f, " {s:<w$} |", w = widths[c])?;
+            }
+            writeln!(f)
+        };
+        line(f, &header.map(String::from))?;
+        line(
+            f,
+            &widths.iter().map(|w| "-".repeat(*w)).collect::<Vec<_>>(),
+        )?;
+        for r in &rows {
+            line(f, r)?;
+        }
+        writeln!(f)?;
+        writeln!(
+            f,
+            "Quadrature: tolerance {QUADRATURE_TOL:.0e}, stated bound {QUADRATURE_BOUND:.0e}; its own error estimate is at most {:.1e} over the grid ({} points short of the tolerance).",
+            self.quadrature_max_estimate, self.quadrature_not_converged
+        )?;
+        writeln!(
+            f,
+            "Times measured in this run, single-threaded, the fastest of repeated timings: quadrature at every k-th grid point (about {QUADRATURE_TIMING_POINTS}), the others over the whole grid; setup = generating the table (on {} threads).",
+            self.threads
+        )?;
+        for m in &self.methods {
+            if let (Some(o), Some(h)) = (m.ordinary, m.hard) {
+                writeln!(
+                    f,
+                    "{}: worst ordinary point (μ, r) = ({}, {}), worst hard point ({}, {}).",
+                    m.method.name(),
+                    o.worst_at.0,
+                    o.worst_at.1,
+                    h.worst_at.0,
+                    h.worst_at.1
+                )?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A bad line in a points file.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct PointsError {
+    /// 1-based line number.
+    pub line: usize,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl fmt::Display for PointsError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "line {}: {}", self.line, self.message)
+    }
+}
+
+/// Parses CSV text with the header `mu,r` and one `mu,r` pair per line, both numbers in [0, 1].
+/// Blank lines are skipped. The format has two numeric fields and no quoting, so splitting on
+/// commas is the whole of it (no CSV crate needed).
+pub fn parse_points(text: &str) -> Result<Vec<(f64, f64)>, PointsError> {
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| (i + 1, l.trim()))
+        .filter(|(_, l)| !l.is_empty());
+    match lines.next() {
+        None => {
+            return Err(PointsError {
+                line: 1,
+                message: "empty file: expected the header `mu,r`".into(),
+            })
+        }
+        Some((n, header)) => {
+            let names: Vec<&str> = header
+                .trim_start_matches('\u{feff}')
+                .split(',')
+                .map(str::trim)
+                .collect();
+            if names != ["mu", "r"] {
+                return Err(PointsError {
+                    line: n,
+                    message: format!("expected the header `mu,r`, found `{header}`"),
+                });
+            }
+        }
+    }
+    lines
+        .map(|(n, l)| {
+            let fields: Vec<&str> = l.split(',').map(str::trim).collect();
+            if fields.len() != 2 {
+                return Err(PointsError {
+                    line: n,
+                    message: format!("expected 2 fields (mu,r), found {}", fields.len()),
+                });
+            }
+            let value = |name: &str, s: &str| -> Result<f64, PointsError> {
+                let v: f64 = s.parse().map_err(|_| PointsError {
+                    line: n,
+                    message: format!("{name} `{s}` is not a number"),
+                })?;
+                if !(0.0..=1.0).contains(&v) {
+                    return Err(PointsError {
+                        line: n,
+                        message: format!("{name} {s} is outside [0, 1]"),
+                    });
+                }
+                Ok(v)
+            };
+            Ok((value("mu", fields[0])?, value("r", fields[1])?))
+        })
+        .collect()
+}
+
+/// The CSV `mu,r,quadrature,lut16,lut32,fit` with one row per point, numbers in Rust's shortest
+/// round-trip form.
+pub fn points_csv(points: &[(f64, f64)]) -> String {
+    let rows: Vec<String> = points
+        .par_iter()
+        .map(|&(mu, r)| {
+            let v = AlbedoMethod::ALL.map(|m| sheen_albedo(mu, r, m));
+            format!("{mu},{r},{},{},{},{}\n", v[0], v[1], v[2], v[3])
+        })
+        .collect();
+    let mut out = String::from("mu,r,quadrature,lut16,lut32,fit\n");
+    out.extend(rows);
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn points_parse_with_header_blank_lines_crlf_and_bom() {
+        let text = "\u{feff}mu,r\r\n0.5,0.25\r\n\r\n 1 , 0 \n0,1\n";
+        assert_eq!(
+            parse_points(text).unwrap(),
+            vec![(0.5, 0.25), (1.0, 0.0), (0.0, 1.0)]
+        );
+        assert_eq!(parse_points("mu,r\n").unwrap(), vec![]);
+    }
+
+    #[test]
+    fn bad_points_name_the_line_and_the_problem() {
+        let err = |t: &str| parse_points(t).unwrap_err();
+        assert_eq!(
+            err(""),
+            PointsError {
+                line: 1,
+                message: "empty file: expected the header `mu,r`".into()
+            }
+        );
+        assert_eq!(
+            err("r,mu\n0,0\n").to_string(),
+            "line 1: expected the header `mu,r`, found `r,mu`"
+        );
+        assert_eq!(err("0.5,0.5\n").line, 1, "a header is required");
+        assert_eq!(
+            err("mu,r\n0.5,0.5\n0.1\n").to_string(),
+            "line 3: expected 2 fields (mu,r), found 1"
+        );
+        assert_eq!(
+            err("mu,r\n0.5,0.5,1\n").to_string(),
+            "line 2: expected 2 fields (mu,r), found 3"
+        );
+        assert_eq!(
+            err("mu,r\nabc,0.5\n").to_string(),
+            "line 2: mu `abc` is not a number"
+        );
+        assert_eq!(
+            err("mu,r\n0.5,1.5\n").to_string(),
+            "line 2: r 1.5 is outside [0, 1]"
+        );
+        assert_eq!(
+            err("mu,r\n\n\nNaN,0.5\n").to_string(),
+            "line 4: mu NaN is outside [0, 1]"
+        );
+        assert_eq!(
+            err("mu,r\n-0.1,0.5\n").to_string(),
+            "line 2: mu -0.1 is outside [0, 1]"
+        );
+    }
+
+    #[test]
+    fn points_csv_has_the_header_and_every_method_per_row() {
+        let csv = points_csv(&[(0.5, 0.5), (1.0, 0.25)]);
+        let lines: Vec<&str> = csv.lines().collect();
+        assert_eq!(lines[0], "mu,r,quadrature,lut16,lut32,fit");
+        assert_eq!(lines.len(), 3);
+        let row: Vec<f64> = lines[1].split(',').map(|s| s.parse().unwrap()).collect();
+        assert_eq!(&row[..2], &[0.5, 0.5]);
+        for (k, m) in AlbedoMethod::ALL.iter().enumerate() {
+            assert_eq!(row[2 + k], sheen_albedo(0.5, 0.5, *m), "{}", m.name());
+        }
+    }
+
+    #[test]
+    fn small_report_has_every_method_and_splits_the_regions() {
+        let report = accuracy_report(9);
+        assert_eq!(report.methods.len(), 4);
+        assert_eq!(report.quadrature_not_converged, 0);
+        assert!(report.quadrature_max_estimate <= QUADRATURE_TOL);
+        // Axis 0, 1/8, …, 1: μ ≥ 0.1 has 8 values, r ≥ 0.25 has 7.
+        let lut = report.methods[1];
+        assert_eq!(lut.ordinary.unwrap().points, 8 * 7);
+        assert_eq!(lut.hard.unwrap().points, 81 - 56);
+        for m in &report.methods {
+            assert!(m.nanos_per_eval > 0.0);
+            if let Some(o) = m.ordinary {
+                assert!(
+                    o.max <= m.method.ordinary_bound(),
+                    "{}: {}",
+                    m.method.name(),
+                    o.max
+                );
+                assert!(o.mean <= o.max);
+            }
+        }
+        let text = report.to_string();
+        assert!(text.contains("| method "));
+        for m in AlbedoMethod::ALL {
+            assert!(text.contains(&format!("| {} ", m.name())), "{text}");
+        }
+    }
+}

@@ -1,0 +1,880 @@
+//! `velvet migrate` end to end: golden outputs and reports for every fixture in
+//! fixtures/migrate (run with VELVET_BLESS=1 to rewrite them after a reviewed change), GLB
+//! packing, byte identity when nothing changes, refused requests, a batch with failures, URI
+//! relocation, validation after migration, and the command's exit statuses.
+
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use velvet::asset::glb;
+use velvet::diagnostics::Severity;
+use velvet::migrate::{
+    self, render, Conversion, Destination, FileOutcome, Note, Options, Request, Skip, UsageError,
+};
+use velvet::rules::schema::Schemas;
+use velvet::validate::Validator;
+
+fn fixtures() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/migrate")
+}
+
+/// The input fixtures, sorted: every *.gltf that is not a golden output.
+fn cases() -> Vec<PathBuf> {
+    let mut cases: Vec<PathBuf> = std::fs::read_dir(fixtures())
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| {
+            p.extension().is_some_and(|e| e == "gltf")
+                && !p.to_string_lossy().ends_with(".expected.gltf")
+        })
+        .collect();
+    cases.sort();
+    assert!(
+        cases.len() >= 10,
+        "fixtures/migrate holds the conversion cases"
+    );
+    cases
+}
+
+fn stem(path: &Path) -> String {
+    path.file_stem().unwrap().to_string_lossy().into_owned()
+}
+
+/// The options a fixture runs with, from its optional `<case>.args` (one flag per line).
+fn options_for(case: &Path) -> Options {
+    let mut options = Options::default();
+    if let Ok(text) = std::fs::read_to_string(case.with_extension("args")) {
+        for flag in text.lines().map(str::trim).filter(|l| !l.is_empty()) {
+            match flag {
+                "--report" => options.report = true,
+                "--refresh-fallback" => options.refresh_fallback = true,
+                "--copy-resources" => options.copy_resources = true,
+                other => panic!("{}: unknown flag {other}", case.display()),
+            }
+        }
+    }
+    options
+}
+
+/// Asserts that the file at `path` holds `expected`, showing both as text when not.
+#[track_caller]
+fn assert_file(path: &Path, expected: &[u8]) {
+    let actual = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    assert!(
+        actual == expected,
+        "{} differs:\n--- expected\n{}\n--- actual\n{}",
+        path.display(),
+        String::from_utf8_lossy(expected),
+        String::from_utf8_lossy(&actual)
+    );
+}
+
+fn request(inputs: Vec<PathBuf>, destination: Destination, options: Options) -> Request {
+    Request {
+        inputs,
+        destination,
+        options,
+        dry_run: false,
+        progress: false,
+    }
+}
+
+fn blessing() -> bool {
+    std::env::var_os("VELVET_BLESS").is_some()
+}
+
+/// Compares `actual` with the golden file at `path`, or writes it when blessing.
+fn golden(path: &Path, actual: &[u8]) {
+    if blessing() {
+        std::fs::write(path, actual).unwrap();
+        return;
+    }
+    let expected = std::fs::read(path).unwrap_or_else(|e| {
+        panic!(
+            "{}: {e} (run with VELVET_BLESS=1 to create it)",
+            path.display()
+        )
+    });
+    assert!(
+        expected == actual,
+        "{} differs:\n--- expected\n{}\n--- actual\n{}",
+        path.display(),
+        String::from_utf8_lossy(&expected),
+        String::from_utf8_lossy(actual)
+    );
+}
+
+/// Migrates one fixture into a temporary folder; returns (folder, output path, result).
+fn migrate_case(case: &Path) -> (tempfile::TempDir, PathBuf, migrate::FileResult) {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in").join(case.file_name().unwrap());
+    std::fs::create_dir_all(input.parent().unwrap()).unwrap();
+    std::fs::copy(case, &input).unwrap();
+    let out_dir = dir.path().join("out");
+    let report = migrate::run(&request(
+        vec![input.parent().unwrap().to_path_buf()],
+        Destination::Dir(out_dir.clone()),
+        options_for(case),
+    ))
+    .unwrap();
+    assert_eq!(report.files.len(), 1);
+    let result = report.files.into_iter().next().unwrap();
+    (dir, out_dir.join(case.file_name().unwrap()), result)
+}
+
+#[test]
+fn every_fixture_gives_its_golden_output_and_report() {
+    for case in cases() {
+        let (_dir, output, mut result) = migrate_case(&case);
+        let input_bytes = std::fs::read(&case).unwrap();
+        let output_bytes =
+            std::fs::read(&output).unwrap_or_else(|e| panic!("{}: no output: {e}", case.display()));
+        let expected = case.with_extension("expected.gltf");
+        if result.outcome == FileOutcome::Copied {
+            assert_eq!(
+                output_bytes,
+                input_bytes,
+                "{}: nothing to migrate, so the bytes are the input's",
+                case.display()
+            );
+            assert!(
+                !expected.exists() || blessing(),
+                "{}: an unchanged case has no golden output",
+                case.display()
+            );
+            if blessing() {
+                let _ = std::fs::remove_file(&expected);
+            }
+        } else {
+            assert_eq!(result.outcome, FileOutcome::Changed, "{}", case.display());
+            golden(&expected, &output_bytes);
+        }
+        result.input = PathBuf::from(case.file_name().unwrap());
+        result.output = None;
+        golden(
+            &case.with_extension("report.txt"),
+            render::file_text(&result, true).as_bytes(),
+        );
+    }
+}
+
+#[test]
+fn unchanged_files_are_the_cases_with_nothing_to_migrate() {
+    let unchanged: Vec<String> = cases()
+        .iter()
+        .filter(|c| migrate_case(c).2.outcome == FileOutcome::Copied)
+        .map(|c| stem(c))
+        .collect();
+    assert_eq!(unchanged, ["both", "excluded", "no-layers", "sheen-off"]);
+}
+
+#[test]
+fn migrating_an_output_again_changes_nothing() {
+    for case in cases() {
+        let (dir, output, _) = migrate_case(&case);
+        for refresh_fallback in [false, true] {
+            // Inputs whose own fallback is stale (both), or that keep draft properties beside
+            // ratified ones (legacy), are what a refresh changes.
+            if refresh_fallback && ["both", "legacy"].contains(&stem(&case).as_str()) {
+                continue;
+            }
+            let options = Options {
+                refresh_fallback,
+                ..Options::default()
+            };
+            let again = dir.path().join(format!("again-{refresh_fallback}.gltf"));
+            let report = migrate::run(&request(
+                vec![output.clone()],
+                Destination::File(again.clone()),
+                options,
+            ))
+            .unwrap();
+            assert_eq!(
+                report.files[0].outcome,
+                FileOutcome::Copied,
+                "{} (refresh {refresh_fallback})",
+                case.display()
+            );
+            assert_file(&again, &std::fs::read(&output).unwrap());
+        }
+    }
+}
+
+fn errors(path: &Path) -> Vec<(String, String)> {
+    let validator = Validator::new(Schemas::builtin(), velvet::diagnostics::Settings::default());
+    let report = validator.validate_file(path);
+    let mut errors: Vec<(String, String)> = report
+        .findings
+        .iter()
+        .filter(|f| f.diagnostic.severity == Severity::Error)
+        .map(|f| (f.diagnostic.code.to_string(), f.diagnostic.pointer.clone()))
+        .collect();
+    errors.sort();
+    errors
+}
+
+#[test]
+fn validation_after_migration_finds_no_new_error_in_any_fixture() {
+    let mut clean_inputs = 0;
+    for case in cases() {
+        let (_dir, output, _) = migrate_case(&case);
+        let before = errors(&case);
+        let after = errors(&output);
+        let new: Vec<_> = after.iter().filter(|e| !before.contains(e)).collect();
+        assert!(
+            new.is_empty(),
+            "{}: migration added errors {new:?}",
+            case.display()
+        );
+        if before.is_empty() {
+            clean_inputs += 1;
+            assert!(after.is_empty(), "{}", case.display());
+        }
+    }
+    // The check is not vacuous: most fixtures are valid to begin with.
+    assert!(clean_inputs >= 9, "{clean_inputs}");
+}
+
+#[test]
+fn material_outcomes_name_conversions_and_skips() {
+    let case = fixtures().join("legacy.gltf");
+    let (_dir, _, result) = migrate_case(&case);
+    let outcomes: Vec<(Vec<Conversion>, Option<Skip>)> = result
+        .materials
+        .iter()
+        .map(|m| (m.conversions.clone(), m.skipped))
+        .collect();
+    assert_eq!(
+        outcomes,
+        [
+            (
+                vec![Conversion::LegacyUpgrade, Conversion::SheenToFuzz],
+                None
+            ),
+            (
+                vec![Conversion::LegacyUpgrade, Conversion::SheenToFuzz],
+                None
+            ),
+            (vec![Conversion::LegacyUpgrade], None),
+            (vec![Conversion::SheenToFuzz], None),
+            (
+                vec![Conversion::LegacyUpgrade, Conversion::SheenToFuzz],
+                None
+            ),
+        ]
+    );
+    assert!(result.materials[0].notes.contains(&Note::LegacyClamped {
+        product: [1.6, 1.0, 0.4],
+        clamped: [1.0, 1.0, 0.4]
+    }));
+    assert!(result.materials[2].notes.contains(&Note::SheenOff));
+}
+
+#[test]
+fn glb_in_gives_glb_out_with_padded_chunks_and_the_same_bin() {
+    let dir = tempfile::tempdir().unwrap();
+    // A GLB's JSON chunk carries no trailing newline (loaders take one for bad padding).
+    let text = std::fs::read_to_string(fixtures().join("sheen-factors.gltf")).unwrap();
+    let json = text.trim_end().as_bytes();
+    let bin = [1u8, 2, 3, 4, 5];
+    let input = dir.path().join("chair.glb");
+    std::fs::write(&input, glb::join(json, Some(&bin))).unwrap();
+    let output = dir.path().join("out.glb");
+    let report = migrate::run(&request(
+        vec![input.clone()],
+        Destination::File(output.clone()),
+        Options::default(),
+    ))
+    .unwrap();
+    assert_eq!(report.files[0].outcome, FileOutcome::Changed);
+    let bytes = std::fs::read(&output).unwrap();
+    assert_eq!(
+        u32::from_le_bytes(bytes[8..12].try_into().unwrap()) as usize,
+        bytes.len(),
+        "header length"
+    );
+    let json_len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+    assert_eq!(json_len % 4, 0);
+    let bin_len =
+        u32::from_le_bytes(bytes[20 + json_len..24 + json_len].try_into().unwrap()) as usize;
+    assert_eq!((bin_len, bytes.len()), (8, 20 + json_len + 8 + 8));
+    let mut diagnostics = Vec::new();
+    let parts = glb::split(&bytes, &mut diagnostics).unwrap();
+    assert!(diagnostics.is_empty(), "{diagnostics:?}");
+    let expected = std::fs::read_to_string(fixtures().join("sheen-factors.expected.gltf")).unwrap();
+    assert_eq!(
+        String::from_utf8_lossy(parts.json).trim_end_matches(' '),
+        expected.trim_end()
+    );
+    assert_eq!(parts.bin.unwrap(), [1, 2, 3, 4, 5, 0, 0, 0]);
+}
+
+#[test]
+fn glb_with_nothing_to_migrate_is_copied_byte_identical() {
+    let dir = tempfile::tempdir().unwrap();
+    let json = std::fs::read(fixtures().join("sheen-off.gltf")).unwrap();
+    let input = dir.path().join("off.glb");
+    let original = glb::join(&json, Some(&[9, 9, 9, 9]));
+    std::fs::write(&input, &original).unwrap();
+    let output = dir.path().join("copy.glb");
+    let report = migrate::run(&request(
+        vec![input],
+        Destination::File(output.clone()),
+        Options::default(),
+    ))
+    .unwrap();
+    assert_eq!(report.files[0].outcome, FileOutcome::Copied);
+    assert_eq!(std::fs::read(&output).unwrap(), original);
+}
+
+#[test]
+fn in_place_with_nothing_to_migrate_does_not_write() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("off.gltf");
+    std::fs::copy(fixtures().join("sheen-off.gltf"), &input).unwrap();
+    let old = std::time::SystemTime::UNIX_EPOCH + std::time::Duration::from_secs(1_000_000);
+    std::fs::File::options()
+        .write(true)
+        .open(&input)
+        .unwrap()
+        .set_modified(old)
+        .unwrap();
+    let report = migrate::run(&request(
+        vec![input.clone()],
+        Destination::InPlace,
+        Options::default(),
+    ))
+    .unwrap();
+    assert_eq!(report.files[0].outcome, FileOutcome::Untouched);
+    assert_eq!(
+        std::fs::metadata(&input).unwrap().modified().unwrap(),
+        old,
+        "the file was not rewritten"
+    );
+    assert_eq!(
+        std::fs::read(&input).unwrap(),
+        std::fs::read(fixtures().join("sheen-off.gltf")).unwrap()
+    );
+}
+
+#[test]
+fn in_place_rewrites_the_input_with_its_migration() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("sheen-factors.gltf");
+    std::fs::copy(fixtures().join("sheen-factors.gltf"), &input).unwrap();
+    let report = migrate::run(&request(
+        vec![input.clone()],
+        Destination::InPlace,
+        Options::default(),
+    ))
+    .unwrap();
+    assert_eq!(report.files[0].outcome, FileOutcome::Changed);
+    assert_file(
+        &input,
+        &std::fs::read(fixtures().join("sheen-factors.expected.gltf")).unwrap(),
+    );
+    let names: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(names.len(), 1, "no temporary file is left: {names:?}");
+}
+
+/// Every file under `dir` with its bytes, sorted.
+fn snapshot(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for entry in std::fs::read_dir(&d).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                stack.push(path);
+            } else {
+                let bytes = std::fs::read(&path).unwrap();
+                out.push((path, bytes));
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+#[test]
+fn refused_requests_write_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = dir.path().join("a.gltf");
+    let b = dir.path().join("sub/b.gltf");
+    std::fs::create_dir_all(b.parent().unwrap()).unwrap();
+    std::fs::copy(fixtures().join("sheen-factors.gltf"), &a).unwrap();
+    std::fs::copy(fixtures().join("sheen-factors.gltf"), &b).unwrap();
+    let before = snapshot(dir.path());
+    let cases: Vec<(Request, UsageError)> = vec![
+        (
+            request(
+                vec![a.clone()],
+                Destination::File(dir.path().join("./a.gltf")),
+                Options::default(),
+            ),
+            UsageError::OutputIsInput {
+                output: dir.path().join("./a.gltf").display().to_string(),
+                input: a.display().to_string(),
+            },
+        ),
+        (
+            request(
+                vec![dir.path().join("sub")],
+                Destination::Dir(dir.path().join("sub")),
+                Options::default(),
+            ),
+            UsageError::OutputIsInput {
+                output: b.display().to_string(),
+                input: b.display().to_string(),
+            },
+        ),
+        (
+            request(
+                vec![dir.path().to_path_buf()],
+                Destination::Dir(dir.path().join("sub/..")),
+                Options::default(),
+            ),
+            UsageError::OutputIsInput {
+                output: dir.path().join("sub/../a.gltf").display().to_string(),
+                input: a.display().to_string(),
+            },
+        ),
+        (
+            request(
+                vec![a.clone(), b.clone()],
+                Destination::File(dir.path().join("x.gltf")),
+                Options::default(),
+            ),
+            UsageError::OutputForMany(2),
+        ),
+        (
+            request(
+                vec![dir.path().join("sub")],
+                Destination::File(dir.path().join("x.gltf")),
+                Options::default(),
+            ),
+            UsageError::OutputForFolder(dir.path().join("sub").display().to_string()),
+        ),
+        (
+            request(
+                vec![a.clone()],
+                Destination::File(dir.path().join("x.glb")),
+                Options::default(),
+            ),
+            UsageError::ContainerMismatch {
+                input: a.display().to_string(),
+                output: dir.path().join("x.glb").display().to_string(),
+                container: ".gltf",
+                extension: "gltf",
+            },
+        ),
+        (
+            request(
+                vec![a.clone(), dir.path().join("sub/../a.gltf")],
+                Destination::Dir(dir.path().join("out")),
+                Options::default(),
+            ),
+            UsageError::OutputCollision {
+                output: dir.path().join("out/a.gltf").display().to_string(),
+                first: a.display().to_string(),
+                second: dir.path().join("sub/../a.gltf").display().to_string(),
+            },
+        ),
+        (
+            request(vec![a.clone()], Destination::None, Options::default()),
+            UsageError::NoDestination,
+        ),
+        (
+            request(vec![], Destination::InPlace, Options::default()),
+            UsageError::NoInputs,
+        ),
+        (
+            request(
+                vec![a.clone()],
+                Destination::Dir(dir.path().join("out")),
+                Options {
+                    exact: true,
+                    ..Options::default()
+                },
+            ),
+            UsageError::ExactUnavailable,
+        ),
+    ];
+    for (req, expected) in cases {
+        assert_eq!(migrate::run(&req).unwrap_err(), expected);
+    }
+    assert_eq!(snapshot(dir.path()), before, "nothing was written");
+}
+
+#[test]
+fn a_failing_file_does_not_stop_the_batch_and_leaves_outputs_and_inputs_intact() {
+    let dir = tempfile::tempdir().unwrap();
+    let inputs = dir.path().join("in");
+    std::fs::create_dir_all(inputs.join("deep")).unwrap();
+    let sheen = std::fs::read(fixtures().join("sheen-factors.gltf")).unwrap();
+    std::fs::write(inputs.join("a.gltf"), &sheen).unwrap();
+    std::fs::write(inputs.join("b.gltf"), &sheen[..sheen.len() / 2]).unwrap(); // truncated JSON
+    std::fs::write(inputs.join("c.gltf"), &sheen).unwrap();
+    std::fs::write(inputs.join("deep/d.gltf"), &sheen).unwrap();
+    let out = dir.path().join("out");
+    std::fs::create_dir_all(&out).unwrap();
+    // An earlier run's output for b, which this run must not damage.
+    std::fs::write(out.join("b.gltf"), b"earlier output").unwrap();
+    // c's output cannot be written: a folder stands in its place.
+    std::fs::create_dir_all(out.join("c.gltf/occupied")).unwrap();
+    let inputs_before = snapshot(&inputs);
+
+    let report = migrate::run(&request(
+        vec![inputs.clone()],
+        Destination::Dir(out.clone()),
+        Options::default(),
+    ))
+    .unwrap();
+    let outcomes: Vec<(String, bool)> = report
+        .files
+        .iter()
+        .map(|f| {
+            (
+                f.input.strip_prefix(&inputs).unwrap().display().to_string(),
+                matches!(f.outcome, FileOutcome::Failed { .. }),
+            )
+        })
+        .collect();
+    assert_eq!(
+        outcomes,
+        [
+            ("a.gltf".into(), false),
+            ("b.gltf".into(), true),
+            ("c.gltf".into(), true),
+            ("deep/d.gltf".into(), false)
+        ]
+    );
+    let FileOutcome::Failed { error } = &report.files[1].outcome else {
+        unreachable!()
+    };
+    assert!(
+        error.contains("b.gltf") && error.contains("INVALID_JSON"),
+        "{error}"
+    );
+    let FileOutcome::Failed { error } = &report.files[2].outcome else {
+        unreachable!()
+    };
+    assert!(
+        error.starts_with(&format!("cannot write {}", out.join("c.gltf").display())),
+        "{error}"
+    );
+    assert!(report.failed());
+    assert_eq!((report.summary.changed, report.summary.failed), (2, 2));
+
+    let expected = std::fs::read(fixtures().join("sheen-factors.expected.gltf")).unwrap();
+    assert_file(&out.join("a.gltf"), &expected);
+    assert_file(&out.join("deep/d.gltf"), &expected);
+    assert_file(&out.join("b.gltf"), b"earlier output");
+    assert!(out.join("c.gltf/occupied").is_dir());
+    assert_eq!(snapshot(&inputs), inputs_before, "inputs are untouched");
+    let leftovers: Vec<_> = snapshot(&out)
+        .into_iter()
+        .filter(|(p, _)| p.to_string_lossy().contains(".velvet-"))
+        .collect();
+    assert!(
+        leftovers.is_empty(),
+        "no temporary files remain: {leftovers:?}"
+    );
+}
+
+#[test]
+fn in_place_batch_with_a_broken_file_migrates_the_others() {
+    let dir = tempfile::tempdir().unwrap();
+    let sheen = std::fs::read(fixtures().join("sheen-factors.gltf")).unwrap();
+    std::fs::write(dir.path().join("a.gltf"), &sheen).unwrap();
+    std::fs::write(dir.path().join("b.glb"), b"glTF\x02\0\0\0\x10\0\0\0").unwrap();
+    let report = migrate::run(&request(
+        vec![dir.path().to_path_buf()],
+        Destination::InPlace,
+        Options::default(),
+    ))
+    .unwrap();
+    assert!(matches!(
+        report.files[1].outcome,
+        FileOutcome::Failed { .. }
+    ));
+    assert_file(
+        &dir.path().join("a.gltf"),
+        &std::fs::read(fixtures().join("sheen-factors.expected.gltf")).unwrap(),
+    );
+    assert_eq!(
+        std::fs::read(dir.path().join("b.glb")).unwrap(),
+        b"glTF\x02\0\0\0\x10\0\0\0"
+    );
+}
+
+/// A .gltf with a buffer and an image beside it (one in a subfolder, one with a space).
+fn asset_with_resources(dir: &Path) -> PathBuf {
+    let folder = dir.join("assets/chair");
+    std::fs::create_dir_all(folder.join("tex")).unwrap();
+    std::fs::write(folder.join("chair.bin"), [0u8; 4]).unwrap();
+    std::fs::write(folder.join("tex/My Sheen.png"), b"png bytes").unwrap();
+    let json = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_materials_sheen"],
+        "buffers": [{"uri": "chair.bin", "byteLength": 4}],
+        "images": [{"uri": "tex/My%20Sheen.png"}, {"uri": "data:image/png;base64,AAAA"}],
+        "materials": [{"extensions": {"KHR_materials_sheen": {"sheenColorFactor": [0.5, 0.5, 0.5]}}}]
+    });
+    let path = folder.join("chair.gltf");
+    std::fs::write(&path, serde_json::to_string_pretty(&json).unwrap()).unwrap();
+    path
+}
+
+fn uris(path: &Path) -> Vec<String> {
+    let json: Value = serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap();
+    ["/buffers/0/uri", "/images/0/uri", "/images/1/uri"]
+        .iter()
+        .map(|p| json.pointer(p).unwrap().as_str().unwrap().to_string())
+        .collect()
+}
+
+#[test]
+fn outputs_in_another_folder_rewrite_relative_uris_to_the_inputs_resources() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = asset_with_resources(dir.path());
+    let out = dir.path().join("migrated");
+    let report = migrate::run(&request(
+        vec![dir.path().join("assets")],
+        Destination::Dir(out.clone()),
+        Options::default(),
+    ))
+    .unwrap();
+    let output = out.join("chair/chair.gltf");
+    assert_eq!(report.files[0].outcome, FileOutcome::Changed);
+    assert_eq!(
+        uris(&output),
+        [
+            "../../assets/chair/chair.bin",
+            "../../assets/chair/tex/My%20Sheen.png",
+            "data:image/png;base64,AAAA"
+        ]
+    );
+    assert!(report.files[0].notes.contains(&Note::UrisRewritten {
+        count: 2,
+        leaves_folder: true
+    }));
+    // The rewritten URIs lead to the very files the input uses.
+    let bin = output
+        .parent()
+        .unwrap()
+        .join("../../assets/chair/chair.bin");
+    assert_eq!(
+        bin.canonicalize().unwrap(),
+        input
+            .parent()
+            .unwrap()
+            .join("chair.bin")
+            .canonicalize()
+            .unwrap()
+    );
+    let image = output
+        .parent()
+        .unwrap()
+        .join("../../assets/chair/tex/My Sheen.png");
+    assert_eq!(std::fs::read(image).unwrap(), b"png bytes");
+}
+
+#[test]
+fn copy_resources_keeps_uris_and_copies_the_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = asset_with_resources(dir.path());
+    let output = dir.path().join("elsewhere/chair.gltf");
+    let options = Options {
+        copy_resources: true,
+        ..Options::default()
+    };
+    let report = migrate::run(&request(
+        vec![input],
+        Destination::File(output.clone()),
+        options,
+    ))
+    .unwrap();
+    assert_eq!(report.files[0].outcome, FileOutcome::Changed);
+    assert_eq!(
+        uris(&output),
+        [
+            "chair.bin",
+            "tex/My%20Sheen.png",
+            "data:image/png;base64,AAAA"
+        ]
+    );
+    assert_eq!(
+        std::fs::read(dir.path().join("elsewhere/chair.bin")).unwrap(),
+        [0u8; 4]
+    );
+    assert_eq!(
+        std::fs::read(dir.path().join("elsewhere/tex/My Sheen.png")).unwrap(),
+        b"png bytes"
+    );
+    assert!(report.files[0]
+        .notes
+        .contains(&Note::ResourcesCopied { count: 2 }));
+}
+
+#[test]
+fn output_beside_the_input_keeps_uris_as_they_are() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = asset_with_resources(dir.path());
+    let output = input.with_file_name("chair.fuzz.gltf");
+    migrate::run(&request(
+        vec![input],
+        Destination::File(output.clone()),
+        Options::default(),
+    ))
+    .unwrap();
+    assert_eq!(
+        uris(&output),
+        [
+            "chair.bin",
+            "tex/My%20Sheen.png",
+            "data:image/png;base64,AAAA"
+        ]
+    );
+}
+
+#[test]
+fn textures_are_decoded_only_for_the_report() {
+    let dir = tempfile::tempdir().unwrap();
+    let json = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_materials_sheen"],
+        "textures": [{"source": 0}],
+        "images": [{"uri": "data:image/png;base64,bm90IGFuIGltYWdl"}],
+        "materials": [{"extensions": {"KHR_materials_sheen": {"sheenColorFactor": [1, 1, 1], "sheenColorTexture": {"index": 0}}}}]
+    });
+    let input = dir.path().join("broken-image.gltf");
+    std::fs::write(&input, json.to_string()).unwrap();
+    let measured = |report: bool| {
+        let mut req = request(
+            vec![input.clone()],
+            Destination::None,
+            Options {
+                report,
+                ..Options::default()
+            },
+        );
+        req.dry_run = true;
+        migrate::run(&req).unwrap().files[0].materials[0]
+            .notes
+            .clone()
+    };
+    assert_eq!(measured(false), [Note::ColorTextureAsIs { w: 1.0 }]);
+    let notes = measured(true);
+    assert!(
+        matches!(&notes[1], Note::MeasureFailed { reason } if reason.contains("image 0")),
+        "{notes:?}"
+    );
+}
+
+#[test]
+fn dry_run_prints_the_plan_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("sheen-factors.gltf");
+    std::fs::copy(fixtures().join("sheen-factors.gltf"), &input).unwrap();
+    let mut req = request(
+        vec![input.clone()],
+        Destination::Dir(dir.path().join("out")),
+        Options::default(),
+    );
+    req.dry_run = true;
+    let report = migrate::run(&req).unwrap();
+    assert!(!dir.path().join("out").exists());
+    assert_eq!(
+        report.files[0].outcome,
+        FileOutcome::Planned { changes: true }
+    );
+    let text = render::text(&report);
+    assert!(
+        text.contains("  material 0 \"champagne\": sheen → fuzz\n"),
+        "{text}"
+    );
+    assert!(text.contains(
+        "    set /materials/0/extensions/KHR_materials_fuzz = {\"fuzzFactor\":0.9,\"fuzzColorFactor\":[1.0,0.7777777777777777,0.6666666666666666],\"fuzzRoughnessFactor\":0.6}\n"
+    ), "{text}");
+    assert!(
+        text.contains("  declare KHR_materials_fuzz in /extensionsUsed\n"),
+        "{text}"
+    );
+    assert!(text.ends_with("1 file: 1 would change, 0 unchanged, 0 failed\nmaterials: 3 migrated (3 sheen → fuzz); 0 skipped; 0 warnings\n"), "{text}");
+    let json: Value = serde_json::from_str(&render::json(&report)).unwrap();
+    assert_eq!(json["files"][0]["status"], "planned");
+    assert_eq!(json["files"][0]["materials"][0]["edits"][0]["op"], "set");
+    assert_eq!(
+        json["files"][0]["edits"][0],
+        serde_json::json!({"op": "declare-used", "extension": "KHR_materials_fuzz"})
+    );
+    assert_eq!(json["summary"]["conversions"]["sheen-to-fuzz"], 3);
+}
+
+fn velvet(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_velvet"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn the_command_exits_0_when_done_1_when_a_file_failed_2_on_usage_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let inputs = dir.path().join("in");
+    std::fs::create_dir_all(&inputs).unwrap();
+    let good = inputs.join("good.gltf");
+    std::fs::copy(fixtures().join("fuzz-only.gltf"), &good).unwrap();
+    let out = dir.path().join("out");
+    let (code, stdout, _) = velvet(&[
+        "migrate",
+        good.to_str().unwrap(),
+        "--out-dir",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stdout}");
+    assert!(stdout.contains("materials: 4 migrated (4 fuzz → fallback sheen); 2 skipped (1 fuzz switched off, 1 black fuzz, which no sheen can show)"), "{stdout}");
+
+    std::fs::write(inputs.join("bad.gltf"), "{").unwrap();
+    let (code, stdout, _) = velvet(&[
+        "migrate",
+        inputs.to_str().unwrap(),
+        "--out-dir",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 1, "{stdout}");
+    assert!(stdout.contains("bad.gltf: FAILED: "), "{stdout}");
+
+    let (code, _, stderr) = velvet(&["migrate", good.to_str().unwrap(), "--exact", "--in-place"]);
+    assert_eq!(code, 2);
+    assert!(stderr.contains("--exact bakes textures with the bake engine, which this build of velvet does not include"), "{stderr}");
+    let (code, _, stderr) = velvet(&[
+        "migrate",
+        good.to_str().unwrap(),
+        "-o",
+        good.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2);
+    assert!(stderr.contains("is the input"), "{stderr}");
+    let (code, _, _) = velvet(&[
+        "migrate",
+        good.to_str().unwrap(),
+        "-o",
+        "x.gltf",
+        "--in-place",
+    ]);
+    assert_eq!(code, 2, "clap refuses conflicting destinations");
+    assert_eq!(
+        std::fs::read(&good).unwrap(),
+        std::fs::read(fixtures().join("fuzz-only.gltf")).unwrap()
+    );
+}

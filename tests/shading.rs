@@ -1,0 +1,101 @@
+//! The shading API as other modules call it, and `velvet bench accuracy` as users run it.
+
+use std::process::Command;
+use velvet::shading::layering::{sheen_to_fuzz_attenuation_difference, FuzzParams, SheenParams};
+use velvet::shading::{sheen_albedo, AlbedoMethod};
+
+fn velvet(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_velvet"))
+        .args(args)
+        .output()
+        .expect("run velvet")
+}
+
+#[test]
+fn every_method_answers_through_one_signature() {
+    let q = sheen_albedo(0.5, 0.5, AlbedoMethod::Quadrature);
+    for m in AlbedoMethod::ALL {
+        let v = sheen_albedo(0.5, 0.5, m);
+        assert!(
+            (v - q).abs() <= m.ordinary_bound(),
+            "{}: {v} vs {q}",
+            m.name()
+        );
+    }
+}
+
+#[test]
+fn sheen_to_fuzz_difference_is_zero_for_the_stand_in_at_equal_settings() {
+    let cmp = sheen_to_fuzz_attenuation_difference(
+        SheenParams {
+            color_max3: 0.6,
+            roughness: 0.4,
+        },
+        FuzzParams {
+            weight: 0.6,
+            roughness: 0.4,
+        },
+    );
+    assert_eq!(cmp.max_difference, 0.0);
+    assert_eq!(cmp.curve.len(), 65);
+}
+
+#[test]
+fn points_file_gives_csv_with_one_row_per_point() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("points.csv");
+    std::fs::write(&file, "mu,r\n0,0\n0.5,0.5\n1,1\n").unwrap();
+    let out = velvet(&["bench", "accuracy", "--points", file.to_str().unwrap()]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines[0], "mu,r,quadrature,lut16,lut32,fit");
+    assert_eq!(lines.len(), 4);
+    // r = 0 exactly: the quadrature gives the α → 0 limit, 0.
+    assert!(lines[1].starts_with("0,0,0,"), "{}", lines[1]);
+    for line in &lines[1..] {
+        let values: Vec<f64> = line.split(',').map(|s| s.parse().unwrap()).collect();
+        assert_eq!(values.len(), 6);
+        assert!(values.iter().all(|v| v.is_finite()));
+    }
+}
+
+#[test]
+fn a_bad_points_row_exits_2_naming_the_file_and_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("bad.csv");
+    std::fs::write(&file, "mu,r\n0.5,0.5\n0.5;0.5\n").unwrap();
+    let out = velvet(&["bench", "accuracy", "--points", file.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(out.stdout.is_empty());
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(
+        err,
+        format!(
+            "velvet: {}: line 3: expected 2 fields (mu,r), found 1\n",
+            file.display()
+        )
+    );
+}
+
+#[test]
+fn a_missing_points_file_exits_2_naming_it() {
+    let out = velvet(&["bench", "accuracy", "--points", "no-such-points.csv"]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        err.starts_with("velvet: no-such-points.csv: cannot read: "),
+        "{err}"
+    );
+}
+
+#[test]
+fn points_and_plot_together_are_a_usage_error() {
+    let out = velvet(&["bench", "accuracy", "--points", "a.csv", "--plot", "b.svg"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("cannot be used with"));
+}

@@ -1,0 +1,361 @@
+//! Integration tests for `velvet validate`: every code has a fixture pair under
+//! fixtures/validate/<CODE>/ (triggers + clean twin) with golden expected findings beside them;
+//! GLB twins give the same findings as their .gltf; the command's formats and exit codes.
+//!
+//! Set VELVET_UPDATE_GOLDEN=1 to rewrite the golden files after a deliberate change.
+
+use serde_json::{json, Value};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use velvet::diagnostics::{all_codes, Settings};
+use velvet::rules::schema::Schemas;
+use velvet::validate::{FileReport, Validator};
+
+const FIXTURES: &str = "fixtures/validate";
+
+fn validator_for(case: &Path) -> Validator {
+    let schema_dir = case.join("schema");
+    let schemas = if schema_dir.is_dir() {
+        Schemas::with_overrides(&schema_dir).unwrap()
+    } else {
+        Schemas::builtin()
+    };
+    Validator::new(schemas, Settings::default())
+}
+
+fn findings(report: &FileReport) -> Value {
+    Value::Array(
+        report
+            .findings
+            .iter()
+            .map(|f| {
+                let d = &f.diagnostic;
+                json!({"code": d.code, "severity": d.severity.as_str(), "pointer": d.pointer, "message": d.message})
+            })
+            .collect(),
+    )
+}
+
+fn input(case: &Path, stem: &str) -> PathBuf {
+    ["gltf", "glb"]
+        .iter()
+        .map(|ext| case.join(format!("{stem}.{ext}")))
+        .find(|p| p.exists())
+        .unwrap_or_else(|| panic!("{} has no {stem}.gltf or {stem}.glb", case.display()))
+}
+
+fn check_golden(case: &Path, stem: &str, actual: &Value) {
+    let golden = case.join(format!("{stem}.expected.json"));
+    if std::env::var_os("VELVET_UPDATE_GOLDEN").is_some() {
+        std::fs::write(
+            &golden,
+            serde_json::to_string_pretty(actual).unwrap() + "\n",
+        )
+        .unwrap();
+    }
+    let expected: Value = serde_json::from_str(
+        &std::fs::read_to_string(&golden).unwrap_or_else(|e| panic!("{}: {e}", golden.display())),
+    )
+    .unwrap();
+    assert_eq!(
+        actual,
+        &expected,
+        "{} differs from its golden findings",
+        golden.display()
+    );
+}
+
+fn cases() -> Vec<PathBuf> {
+    let mut cases: Vec<PathBuf> = std::fs::read_dir(FIXTURES)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.is_dir())
+        .collect();
+    cases.sort();
+    cases
+}
+
+#[test]
+fn every_code_has_a_fixture_that_triggers_it_and_a_clean_twin_that_does_not() {
+    for case in cases() {
+        let code = case.file_name().unwrap().to_str().unwrap().to_string();
+        let validator = validator_for(&case);
+        for (stem, should_contain) in [("triggers", true), ("clean", false)] {
+            let report = validator.validate_file(&input(&case, stem));
+            let actual = findings(&report);
+            check_golden(&case, stem, &actual);
+            let has = report.findings.iter().any(|f| f.diagnostic.code == code);
+            assert_eq!(
+                has,
+                should_contain,
+                "{code}: {stem} {}",
+                if should_contain {
+                    "does not trigger it"
+                } else {
+                    "triggers it"
+                }
+            );
+        }
+        let clean = validator.validate_file(&input(&case, "clean"));
+        assert_eq!(
+            clean.counts.errors,
+            0,
+            "{code}: the clean twin has errors: {:?}",
+            findings(&clean)
+        );
+    }
+}
+
+#[test]
+fn every_registered_code_has_a_fixture_folder() {
+    let folders: Vec<String> = cases()
+        .iter()
+        .map(|c| c.file_name().unwrap().to_string_lossy().into_owned())
+        .collect();
+    let missing: Vec<&str> = all_codes()
+        .iter()
+        .map(|c| c.name)
+        .filter(|n| !folders.iter().any(|f| f == n))
+        .collect();
+    assert!(missing.is_empty(), "codes without a fixture: {missing:?}");
+}
+
+/// Packs a .gltf fixture into a .glb beside copies of its resources.
+fn as_glb(gltf: &Path, dir: &Path) -> PathBuf {
+    for entry in std::fs::read_dir(gltf.parent().unwrap()).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_file() {
+            std::fs::copy(&path, dir.join(path.file_name().unwrap())).unwrap();
+        }
+    }
+    let text = std::fs::read(gltf).unwrap();
+    let out = dir.join(gltf.with_extension("glb").file_name().unwrap());
+    std::fs::write(&out, velvet::asset::glb::join(&text, None)).unwrap();
+    out
+}
+
+#[test]
+fn glb_twins_report_the_same_codes_and_pointers_as_their_gltf() {
+    let validator = Validator::new(Schemas::builtin(), Settings::default());
+    let key = |r: &FileReport| -> Vec<(String, String)> {
+        r.findings
+            .iter()
+            .map(|f| (f.diagnostic.code.to_string(), f.diagnostic.pointer.clone()))
+            .collect()
+    };
+    for code in [
+        "KHR_MATERIALS_SHEEN_ROUGHNESS_TEXTURE_WITHOUT_ALPHA",
+        "UNRESOLVED_REFERENCE",
+        "MESH_PRIMITIVE_TOO_FEW_TEXCOORDS",
+        "KHR_MATERIALS_FUZZ_FALLBACK_CONTRADICTS",
+        "UNEXPECTED_PROPERTY",
+        "VALUE_NOT_IN_RANGE",
+    ] {
+        let gltf = Path::new(FIXTURES).join(code).join("triggers.gltf");
+        let dir = tempfile::tempdir().unwrap();
+        let glb = as_glb(&gltf, dir.path());
+        let from_gltf = validator.validate_file(&gltf);
+        let from_glb = validator.validate_file(&glb);
+        assert!(!key(&from_gltf).is_empty());
+        assert_eq!(key(&from_glb), key(&from_gltf), "{code}");
+        // Positions in a GLB are byte offsets into the file, past the 20-byte headers.
+        let first = &from_glb.findings[0];
+        if let Some(p) = first.position {
+            let text = std::fs::read(&glb).unwrap();
+            assert_eq!(
+                text[from_glb.json_offset + p.offset],
+                std::fs::read(&gltf).unwrap()[p.offset]
+            );
+        }
+    }
+}
+
+fn velvet(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_velvet"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8(out.stdout).unwrap(),
+        String::from_utf8(out.stderr).unwrap(),
+    )
+}
+
+#[test]
+fn exit_status_follows_fail_on() {
+    let hint_only = "fixtures/validate/KHR_MATERIALS_FUZZ_WITHOUT_FALLBACK/triggers.gltf";
+    let warning = "fixtures/validate/KHR_MATERIALS_SHEEN_LEGACY_DRAFT/triggers.gltf";
+    let error = "fixtures/validate/UNDECLARED_EXTENSION/triggers.gltf";
+    assert_eq!(velvet(&["validate", hint_only]).0, 0);
+    assert_eq!(velvet(&["validate", warning]).0, 0);
+    assert_eq!(velvet(&["validate", "--fail-on", "warning", warning]).0, 1);
+    assert_eq!(velvet(&["validate", error]).0, 1);
+    assert_eq!(
+        velvet(&["validate", "--ignore", "UNDECLARED_EXTENSION", error]).0,
+        0
+    );
+    assert_eq!(
+        velvet(&[
+            "validate",
+            "--fail-on",
+            "info",
+            "fixtures/validate/KHR_MATERIALS_SHEEN_UNDER_CLEARCOAT/triggers.gltf"
+        ])
+        .0,
+        1
+    );
+}
+
+#[test]
+fn usage_errors_exit_2_with_a_message() {
+    let (status, _, err) = velvet(&["validate", "--ignore", "NO_SUCH_CODE", "fixtures"]);
+    assert_eq!(status, 2);
+    assert!(err.contains("NO_SUCH_CODE"), "{err}");
+    assert_eq!(velvet(&["validate"]).0, 2);
+    let (status, _, err) = velvet(&["validate", "--schema-dir", "no/such/dir", "fixtures"]);
+    assert_eq!(status, 2);
+    assert!(err.contains("no/such/dir"), "{err}");
+}
+
+#[test]
+fn text_output_places_findings_at_line_and_column() {
+    let (status, out, _) = velvet(&[
+        "validate",
+        "fixtures/validate/VALUE_NOT_IN_RANGE/triggers.gltf",
+    ]);
+    assert_eq!(status, 1);
+    let expected = "fixtures/validate/VALUE_NOT_IN_RANGE/triggers.gltf:15:13: error VALUE_NOT_IN_RANGE: 1.5 is greater than the maximum of 1.0\n    at /materials/0/extensions/KHR_materials_sheen/sheenColorFactor/0\n1 file checked: 1 error, 0 warnings, 0 info, 0 hints\n";
+    assert_eq!(out, expected);
+}
+
+#[test]
+fn json_output_has_the_khronos_report_shape_and_truncates() {
+    let (_, out, _) = velvet(&[
+        "validate",
+        "--format",
+        "json",
+        "--max-issues",
+        "1",
+        "fixtures/validate/UNEXPECTED_PROPERTY/triggers.gltf",
+    ]);
+    let report: Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(
+        report["uri"],
+        "fixtures/validate/UNEXPECTED_PROPERTY/triggers.gltf"
+    );
+    assert_eq!(report["mimeType"], "model/gltf+json");
+    assert_eq!(report["issues"]["numWarnings"], 2);
+    assert_eq!(report["issues"]["truncated"], true);
+    assert_eq!(
+        report["issues"]["messages"],
+        json!([{"code": "UNEXPECTED_PROPERTY", "message": "unexpected property 'sheenColour'", "severity": 1,
+                "pointer": "/materials/0/extensions/KHR_materials_sheen/sheenColour"}])
+    );
+    assert_eq!(report["info"]["sheenMaterialCount"], 1);
+    assert_eq!(
+        report["info"]["extensionsUsed"],
+        json!(["KHR_materials_sheen"])
+    );
+}
+
+#[test]
+fn several_files_give_an_array_or_json_lines() {
+    let a = "fixtures/validate/TYPE_MISMATCH/clean.gltf";
+    let b = "fixtures/validate/INVALID_JSON/triggers.gltf";
+    let (status, out, _) = velvet(&["validate", "--format", "json", a, b]);
+    assert_eq!(status, 1);
+    let reports: Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(reports.as_array().unwrap().len(), 2);
+    assert_eq!(reports[1]["issues"]["messages"][0]["code"], "INVALID_JSON");
+    assert!(
+        reports[1].get("info").is_none(),
+        "an unparsable file has no info"
+    );
+    let (_, out, _) = velvet(&["validate", "--format", "jsonl", a, b]);
+    let lines: Vec<Value> = out
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(lines.len(), 2);
+    assert_eq!(lines[0]["issues"]["numErrors"], 0);
+}
+
+#[test]
+fn folders_are_searched_recursively_and_a_missing_file_does_not_stop_the_run() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir_all(dir.path().join("a/b")).unwrap();
+    std::fs::copy(
+        "fixtures/validate/TYPE_MISMATCH/clean.gltf",
+        dir.path().join("a/b/one.GLTF"),
+    )
+    .unwrap();
+    std::fs::copy(
+        "fixtures/validate/GLB_INVALID_MAGIC/clean.glb",
+        dir.path().join("a/two.glb"),
+    )
+    .unwrap();
+    std::fs::write(dir.path().join("a/notes.txt"), "not an asset").unwrap();
+    let missing = dir.path().join("missing.gltf");
+    let (status, out, _) = velvet(&[
+        "validate",
+        "--format",
+        "jsonl",
+        dir.path().to_str().unwrap(),
+        missing.to_str().unwrap(),
+    ]);
+    assert_eq!(status, 1);
+    let lines: Vec<Value> = out
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    let uris: Vec<String> = lines
+        .iter()
+        .map(|l| {
+            l["uri"]
+                .as_str()
+                .unwrap()
+                .rsplit('/')
+                .next()
+                .unwrap()
+                .to_string()
+        })
+        .collect();
+    assert_eq!(uris, ["one.GLTF", "two.glb", "missing.gltf"]);
+    assert_eq!(lines[2]["issues"]["messages"][0]["code"], "IO_ERROR");
+    assert_eq!(lines[0]["issues"]["numErrors"], 0);
+    assert_eq!(lines[1]["issues"]["numErrors"], 0);
+}
+
+#[test]
+fn codes_command_lists_every_registered_code_once() {
+    let (status, out, _) = velvet(&["codes"]);
+    assert_eq!(status, 0);
+    let names: Vec<&str> = out
+        .lines()
+        .map(|l| l.split_whitespace().next().unwrap())
+        .collect();
+    let registry: Vec<&str> = all_codes().iter().map(|c| c.name).collect();
+    assert_eq!(names, registry);
+    let line = out
+        .lines()
+        .find(|l| l.starts_with("KHR_MATERIALS_FUZZ_ROUGHNESS_DEFAULT_AMBIGUOUS "))
+        .unwrap();
+    assert_eq!(line.split_whitespace().nth(1), Some("hint"), "{line}");
+}
+
+#[test]
+fn readme_codes_table_is_the_registry() {
+    let readme = std::fs::read_to_string("README.md").unwrap();
+    let start = readme
+        .find("<!-- codes:start -->\n")
+        .expect("README has the codes table markers")
+        + "<!-- codes:start -->\n".len();
+    let end = readme.find("<!-- codes:end -->").unwrap();
+    let (_, table, _) = velvet(&["codes", "--format", "markdown"]);
+    assert_eq!(
+        &readme[start..end],
+        table,
+        "regenerate with `velvet codes --format markdown`"
+    );
+}
