@@ -64,6 +64,9 @@ struct ValidateArgs {
 }
 
 #[derive(clap::Args)]
+#[command(
+    after_help = "Exit status: 0 done, 1 a file failed (the others are still baked), 2 usage error (nothing written)."
+)]
 struct BakeArgs {
     /// Files and folders to bake (folders are searched for *.gltf and *.glb).
     #[arg(required = true)]
@@ -98,6 +101,9 @@ struct BakeArgs {
     /// PNG compression effort for new images.
     #[arg(long, value_enum, default_value_t = Compression::Fast)]
     compression: Compression,
+    /// Copy relative resources next to outputs in another folder instead of rewriting URIs.
+    #[arg(long)]
+    copy_resources: bool,
     #[arg(long, value_enum, default_value_t = BakeFormat::Text)]
     format: BakeFormat,
 }
@@ -317,7 +323,9 @@ fn bake(args: BakeArgs) -> ExitCode {
         destination,
         dry_run: args.dry_run,
         options: Options {
-            plan: velvet::bake::plan::PlanOptions { allow_out_of_range: args.allow_out_of_range },
+            plan: velvet::bake::plan::PlanOptions {
+                allow_out_of_range: args.allow_out_of_range,
+            },
             embed: args.embed,
             collapse_uniform: args.collapse_uniform,
             keep_format: args.keep_format,
@@ -327,6 +335,7 @@ fn bake(args: BakeArgs) -> ExitCode {
                 Compression::Balanced => velvet::bake::PngCompression::Default,
                 Compression::Best => velvet::bake::PngCompression::Best,
             },
+            copy_resources: args.copy_resources,
         },
         progress: true,
     };

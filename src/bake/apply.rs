@@ -20,7 +20,7 @@ use super::plan::{BakePlan, Level, Note, SlotPlan};
 use super::prune::{prune, Dropped};
 use super::recipe::Channel;
 use super::srgb;
-use crate::asset::{Asset, Container};
+use crate::asset::Container;
 use crate::layers::Channels;
 
 /// How outputs are stored.
@@ -179,19 +179,22 @@ fn factor_json(values: &[f64]) -> Value {
     }
 }
 
-/// Applies `plan` with its bake results (`baked[id]` for each output id) to `asset`.
+/// Applies `plan` with its bake results (`baked[id]` for each output id) to a document (as
+/// loaded, or with its URIs already relocated) and its GLB BIN chunk.
+#[allow(clippy::too_many_arguments)]
 pub fn apply(
-    asset: &Asset,
+    mut json: Value,
+    mut bin: Option<Vec<u8>>,
+    container: Container,
     plan: &BakePlan,
     baked: &[Baked],
     options: ApplyOptions,
     names: &mut dyn Names,
 ) -> Applied {
-    let mut json = asset.json.clone();
-    let mut bin = asset.bin.clone();
+    let source_json = json.clone();
     let mut files = Vec::new();
     let mut notes = Vec::new();
-    let glb = asset.container == Container::Glb;
+    let glb = container == Container::Glb;
     // A GLB stores new images in its BIN chunk, which is buffer 0 unless buffer 0 has a URI.
     let bin_usable = glb
         && json
@@ -212,7 +215,7 @@ pub fn apply(
         .enumerate()
         .map(|(i, b)| {
             let info = &plan.outputs[i];
-            let base = image_base_name(&asset.json, info.image);
+            let base = image_base_name(&source_json, info.image);
             OutputReport {
                 output: OutputId(i),
                 source_image: info.image,

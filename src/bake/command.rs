@@ -1,14 +1,16 @@
-//! `velvet bake` over many files: pairs inputs with outputs (`-o`, `--out-dir`, `--in-place`,
-//! or a dry run), refuses a bad request before anything is read, then loads, plans, bakes,
-//! applies and writes each file independently and in parallel. One failing file does not stop
-//! the others; nothing is written for a file that fails, and every write is atomic (a temporary
-//! file renamed into place). An input is never written unless `--in-place` is asked, and a file
-//! with nothing to bake is copied byte for byte (or, in place, not written at all).
+//! `velvet bake` over many files, with the output rules of `velvet migrate` (its
+//! [`paths`](crate::migrate::paths) module pairs inputs with outputs and refuses a bad request
+//! before anything is read, and relocates the relative URIs of an output written to another
+//! folder): each file is loaded, planned, baked, applied and written independently and in
+//! parallel. One failing file does not stop the others; nothing is written for a file that
+//! fails, and every write is atomic (a temporary file renamed into place). An input is never
+//! written unless `--in-place` is asked, and a file with nothing to bake is copied byte for
+//! byte (or, in place, not written at all). A file the loader reports errors for is not baked.
 
 use std::borrow::Cow;
 use std::collections::{HashMap, HashSet};
 use std::io::IsTerminal;
-use std::path::{Component, Path, PathBuf};
+use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
 use rayon::prelude::*;
@@ -22,20 +24,12 @@ use super::kernel::KernelOptions;
 use super::plan::{plan, BakePlan, Note, PlanOptions};
 use super::prune::Dropped;
 use super::recipe::ImageId;
-use crate::asset::{self, discover, resource, write, Asset, Container};
+use crate::asset::{self, resource, write, Asset};
+use crate::diagnostics::Severity;
+use crate::migrate::paths::{identity, jobs, relocate, Job, Relocation};
 
-/// Where outputs go.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub enum Destination {
-    /// Nowhere: only with `dry_run`.
-    None,
-    /// Over each input.
-    InPlace,
-    /// One output file for one input file.
-    File(PathBuf),
-    /// A folder mirroring the inputs' trees.
-    Dir(PathBuf),
-}
+pub use crate::migrate::paths::Destination;
+pub use crate::migrate::UsageError;
 
 /// What a run does besides where it writes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -52,6 +46,8 @@ pub struct Options {
     pub report: bool,
     /// PNG compression effort.
     pub png: PngCompression,
+    /// Copy relative resources next to an output in another folder instead of rewriting URIs.
+    pub copy_resources: bool,
 }
 
 /// One `velvet bake` invocation.
@@ -67,53 +63,6 @@ pub struct Request {
     pub options: Options,
     /// Draw a progress bar on a terminal.
     pub progress: bool,
-}
-
-/// A request that cannot run.
-#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-pub enum UsageError {
-    /// No input.
-    #[error("no input files")]
-    NoInputs,
-    /// Neither an output nor a dry run.
-    #[error("say where outputs go: -o FILE, --out-dir DIR or --in-place (or --dry-run)")]
-    NoDestination,
-    /// `-o` for several inputs.
-    #[error("-o names one output but {0} inputs were given; use --out-dir")]
-    OutputForMany(usize),
-    /// `-o` for a folder.
-    #[error("-o names one output but {0} is a folder; use --out-dir")]
-    OutputForFolder(String),
-    /// An output that is an input.
-    #[error("the output {output} is the input {input}; use --in-place to overwrite inputs")]
-    OutputIsInput {
-        /// The output.
-        output: String,
-        /// The input it equals.
-        input: String,
-    },
-    /// Two inputs to one output.
-    #[error("{first} and {second} would both be written to {output}")]
-    OutputCollision {
-        /// The output.
-        output: String,
-        /// One input.
-        first: String,
-        /// Another input.
-        second: String,
-    },
-    /// `-o` with another container.
-    #[error("{input} is a {container} file; the output {output} must end in .{extension}")]
-    ContainerMismatch {
-        /// The input.
-        input: String,
-        /// The output.
-        output: String,
-        /// GLB or .gltf.
-        container: &'static str,
-        /// The extension the output needs.
-        extension: &'static str,
-    },
 }
 
 /// What became of one file.
@@ -193,114 +142,6 @@ impl FileResult {
     }
 }
 
-/// The absolute form of a path with links resolved as far as it exists, so that two
-/// spellings of one file compare equal.
-fn identity(path: &Path) -> PathBuf {
-    if let Ok(c) = path.canonicalize() {
-        return c;
-    }
-    let absolute = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
-    let mut existing = absolute.as_path();
-    let mut rest = Vec::new();
-    while let (Some(parent), Some(name)) = (existing.parent(), existing.file_name()) {
-        rest.push(name.to_os_string());
-        existing = parent;
-        if let Ok(c) = existing.canonicalize() {
-            return rest.iter().rev().fold(c, |p, n| p.join(n));
-        }
-    }
-    absolute
-}
-
-fn container_extension(path: &Path) -> Option<&'static str> {
-    match path.extension()?.to_str()?.to_ascii_lowercase().as_str() {
-        "gltf" => Some("gltf"),
-        "glb" => Some("glb"),
-        _ => None,
-    }
-}
-
-/// Input files paired with their outputs (none in a dry run without a destination).
-pub type Jobs = Vec<(PathBuf, Option<PathBuf>)>;
-
-/// Folders that could not be read, with the error.
-pub type WalkErrors = Vec<(PathBuf, std::io::Error)>;
-
-/// Every input file with its output, or the reason the request cannot run.
-pub fn jobs(request: &Request) -> Result<(Jobs, WalkErrors), UsageError> {
-    let inputs = &request.inputs;
-    let destination = &request.destination;
-    if inputs.is_empty() {
-        return Err(UsageError::NoInputs);
-    }
-    if *destination == Destination::None && !request.dry_run {
-        return Err(UsageError::NoDestination);
-    }
-    if let Destination::File(output) = destination {
-        if inputs.len() != 1 {
-            return Err(UsageError::OutputForMany(inputs.len()));
-        }
-        if inputs[0].is_dir() {
-            return Err(UsageError::OutputForFolder(inputs[0].display().to_string()));
-        }
-        if let Some(extension) = container_extension(&inputs[0]) {
-            if container_extension(output) != Some(extension) {
-                return Err(UsageError::ContainerMismatch {
-                    input: inputs[0].display().to_string(),
-                    output: output.display().to_string(),
-                    container: if extension == "glb" { "GLB" } else { ".gltf" },
-                    extension,
-                });
-            }
-        }
-    }
-    let mut jobs = Vec::new();
-    let mut walk_errors = Vec::new();
-    for input in inputs {
-        let (files, errors) = discover::collect(std::slice::from_ref(input));
-        walk_errors.extend(errors);
-        for file in files {
-            let output = match destination {
-                Destination::None => None,
-                Destination::InPlace => Some(file.clone()),
-                Destination::File(output) => Some(output.clone()),
-                Destination::Dir(dir) => Some(match file.strip_prefix(input) {
-                    Ok(relative) if !relative.as_os_str().is_empty() => dir.join(relative),
-                    _ => dir.join(file.file_name().unwrap_or(file.as_os_str())),
-                }),
-            };
-            jobs.push((file, output));
-        }
-    }
-    if *destination != Destination::InPlace {
-        let by_identity: HashMap<PathBuf, &Path> = jobs
-            .iter()
-            .map(|(i, _)| (identity(i), i.as_path()))
-            .collect();
-        for (_, output) in &jobs {
-            let Some(output) = output else { continue };
-            if let Some(input) = by_identity.get(&identity(output)) {
-                return Err(UsageError::OutputIsInput {
-                    output: output.display().to_string(),
-                    input: input.display().to_string(),
-                });
-            }
-        }
-    }
-    let mut seen: HashMap<PathBuf, &Path> = HashMap::new();
-    for (input, output) in &jobs {
-        let Some(output) = output else { continue };
-        if let Some(first) = seen.insert(identity(output), input) {
-            return Err(UsageError::OutputCollision {
-                output: output.display().to_string(),
-                first: first.display().to_string(),
-                second: input.display().to_string(),
-            });
-        }
-    }
-    Ok((jobs, walk_errors))
-}
-
 /// Serves an asset's images to the engine.
 struct AssetImages<'a>(&'a Asset);
 
@@ -347,84 +188,6 @@ impl Names for FileNames<'_> {
     }
 }
 
-/// Characters kept as they are in a URI path segment.
-const SEGMENT: &percent_encoding::AsciiSet = &percent_encoding::NON_ALPHANUMERIC
-    .remove(b'-')
-    .remove(b'.')
-    .remove(b'_')
-    .remove(b'~');
-
-/// The URI prefix leading from folder `from` to folder `to` ("" when equal, else ending in
-/// '/'), or `None` when no relative path joins them.
-fn relative_prefix(from: &Path, to: &Path) -> Option<String> {
-    let (from, to) = (identity(from), identity(to));
-    let from: Vec<Component> = from.components().collect();
-    let to: Vec<Component> = to.components().collect();
-    if from.first() != to.first() {
-        return None;
-    }
-    let common = from.iter().zip(&to).take_while(|(a, b)| a == b).count();
-    let mut prefix = "../".repeat(from.len() - common);
-    for component in &to[common..] {
-        let Component::Normal(name) = component else {
-            return None;
-        };
-        prefix +=
-            &percent_encoding::utf8_percent_encode(&name.to_string_lossy(), SEGMENT).to_string();
-        prefix.push('/');
-    }
-    Some(prefix)
-}
-
-/// Pointers of the document's relative-path URIs (buffers and images), with their values.
-fn relative_uris(json: &Value) -> Vec<(String, String)> {
-    let mut out = Vec::new();
-    for key in ["buffers", "images"] {
-        for (i, item) in json
-            .get(key)
-            .and_then(Value::as_array)
-            .into_iter()
-            .flatten()
-            .enumerate()
-        {
-            let Some(uri) = item.get("uri").and_then(Value::as_str) else {
-                continue;
-            };
-            if matches!(
-                resource::resolve(uri, Path::new(""), ""),
-                Ok(resource::Location::File(_))
-            ) {
-                out.push((format!("/{key}/{i}/uri"), uri.to_owned()));
-            }
-        }
-    }
-    out
-}
-
-/// Rewrites the relative URIs of a .gltf written to `out_dir` so that they still lead to the
-/// input's resources in `in_dir`. Returns false when no relative path joins the folders.
-fn rebase_uris(json: &mut Value, in_dir: &Path, out_dir: &Path, skip: &HashSet<String>) -> bool {
-    let uris = relative_uris(json);
-    if uris.iter().all(|(_, u)| skip.contains(u)) {
-        return true;
-    }
-    let Some(prefix) = relative_prefix(out_dir, in_dir) else {
-        return false;
-    };
-    if prefix.is_empty() {
-        return true;
-    }
-    for (pointer, uri) in uris {
-        if skip.contains(&uri) {
-            continue;
-        }
-        if let Some(v) = json.pointer_mut(&pointer) {
-            *v = Value::from(format!("{prefix}{uri}"));
-        }
-    }
-    true
-}
-
 fn folder_of(path: &Path) -> PathBuf {
     match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
@@ -448,22 +211,40 @@ fn slot_reports(plan: &BakePlan, names: &[String]) -> Vec<SlotReport> {
         .collect()
 }
 
-/// Bakes one file.
-fn bake_file(
-    input: &Path,
-    output: Option<&Path>,
-    request: &Request,
-    claims: &Claims,
-) -> FileResult {
-    let fail = |error: String| FileResult::new(input, output, Outcome::Failed { error });
-    let loaded = asset::load(input);
-    let Some(asset) = loaded.asset else {
-        let reasons: Vec<String> = loaded
-            .diagnostics
-            .iter()
-            .map(|d| d.message.clone())
-            .collect();
-        return fail(format!("cannot load: {}", reasons.join("; ")));
+fn create_parent(path: &Path) -> Result<(), String> {
+    match path.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() => std::fs::create_dir_all(dir)
+            .map_err(|e| format!("cannot create folder {}: {e}", dir.display())),
+        _ => Ok(()),
+    }
+}
+
+/// Writes a relocation's resource copies.
+fn copy_resources(relocation: &Relocation) -> Result<(), String> {
+    for copy in &relocation.copies {
+        let data = std::fs::read(&copy.from)
+            .map_err(|e| format!("cannot read resource {}: {e}", copy.from.display()))?;
+        create_parent(&copy.to)?;
+        write::write_atomic(&copy.to, &data)
+            .map_err(|e| format!("cannot write resource {}: {e}", copy.to.display()))?;
+    }
+    Ok(())
+}
+
+/// Bakes one file; errors name what is wrong (the caller adds the file).
+fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult, String> {
+    let input = job.input.as_path();
+    let bytes = std::fs::read(input).map_err(|e| format!("cannot read: {e}"))?;
+    let loaded = asset::load_bytes(input, &bytes);
+    let errors: Vec<String> = loaded
+        .diagnostics
+        .iter()
+        .filter(|d| d.severity == Severity::Error)
+        .map(|d| format!("{} ({})", d.message, d.code))
+        .collect();
+    let asset = match loaded.asset {
+        Some(asset) if errors.is_empty() => asset,
+        _ => return Err(format!("cannot be baked: {}", errors.join("; "))),
     };
     let options = request.options;
     let plan = plan(&asset, options.plan);
@@ -472,54 +253,43 @@ fn bake_file(
         .iter()
         .map(|o| format!("image {}: {}", o.image, o.labels.join(" + ")))
         .collect();
+    let relocation = match &job.output {
+        Some(output) if output != &job.input => relocate(&asset, output, options.copy_resources)?,
+        _ => Relocation::default(),
+    };
     if request.dry_run {
         let mut result = FileResult::new(
             input,
-            output,
+            job.output.as_deref(),
             Outcome::Planned {
                 changes: !plan.is_empty(),
             },
         );
         result.slots = slot_reports(&plan, &planned_names);
         result.notes = plan.notes;
-        return result;
+        return Ok(result);
     }
-    let output = output.expect("a destination is set outside dry runs");
-    let same_place = identity(output) == identity(input);
-    let in_dir = folder_of(input);
-    let out_dir = folder_of(output);
+    let output = job.output.as_deref().ok_or("no output path")?;
+    // The document as it will stand next to the output, before baking.
+    let mut json = asset.json.clone();
+    crate::edit::apply(&mut json, &relocation.edits).map_err(|e| e.to_string())?;
     if plan.is_empty() {
         let mut result = FileResult::new(input, Some(output), Outcome::Untouched);
         result.notes = plan.notes;
-        if same_place {
-            return result;
+        if output == input {
+            return Ok(result);
         }
-        // A .gltf moved to another folder needs its relative URIs to follow.
-        let mut json = asset.json.clone();
-        let bytes = if asset.container == Container::Gltf
-            && identity(&in_dir) != identity(&out_dir)
-            && !relative_uris(&json).is_empty()
-        {
-            if !rebase_uris(&mut json, &in_dir, &out_dir, &HashSet::new()) {
-                return fail(format!(
-                    "no relative path leads from {} to the input's resources",
-                    out_dir.display()
-                ));
-            }
-            write::to_bytes(&asset, &json, asset.bin.as_deref())
+        copy_resources(&relocation)?;
+        create_parent(output)?;
+        let out_bytes = if json == asset.json {
+            bytes
         } else {
-            match std::fs::read(input) {
-                Ok(b) => b,
-                Err(e) => return fail(format!("cannot read: {e}")),
-            }
+            write::to_bytes(&asset, &json, asset.bin.as_deref())
         };
-        if let Err(e) =
-            std::fs::create_dir_all(&out_dir).and_then(|_| write::write_atomic(output, &bytes))
-        {
-            return fail(format!("cannot write {}: {e}", output.display()));
-        }
+        write::write_atomic(output, &out_bytes)
+            .map_err(|e| format!("cannot write {}: {e}", output.display()))?;
         result.outcome = Outcome::Copied;
-        return result;
+        return Ok(result);
     }
     let bake_options = BakeOptions {
         keep_format: options.keep_format,
@@ -534,27 +304,28 @@ fn bake_file(
         },
     };
     let mut baked = Vec::with_capacity(plan.recipes.len());
-    for (i, result) in bake(&plan.recipes, &AssetImages(&asset), &bake_options)
-        .into_iter()
-        .enumerate()
-    {
-        match result {
-            Ok(b) => baked.push(b),
-            Err(e) => {
-                return fail(format!(
-                    "cannot bake {}: {e}",
-                    planned_names.get(i).map_or("an output", String::as_str)
-                ))
-            }
-        }
+    let results = bake(&plan.recipes, &AssetImages(&asset), &bake_options);
+    for (name, result) in planned_names.iter().zip(results) {
+        baked.push(result.map_err(|e| format!("cannot bake {name}: {e}"))?);
     }
-    // Names the document already uses next to the output.
-    let taken: HashSet<PathBuf> = relative_uris(&asset.json)
-        .into_iter()
-        .filter_map(|(_, uri)| match resource::resolve(&uri, &in_dir, "") {
+    // File names next to the output that the document already uses.
+    let out_dir = folder_of(output);
+    let taken: HashSet<PathBuf> = ["buffers", "images"]
+        .iter()
+        .flat_map(|kind| {
+            asset
+                .json
+                .get(*kind)
+                .and_then(Value::as_array)
+                .into_iter()
+                .flatten()
+        })
+        .filter_map(|item| item.get("uri").and_then(Value::as_str))
+        .filter_map(|uri| match resource::resolve(uri, asset.base_dir(), "") {
             Ok(resource::Location::File(p)) => Some(identity(&p)),
             _ => None,
         })
+        .chain(relocation.copies.iter().map(|c| identity(&c.to)))
         .chain([identity(output), identity(input)])
         .collect();
     let mut names = FileNames {
@@ -563,7 +334,9 @@ fn bake_file(
         taken,
     };
     let applied = apply(
-        &asset,
+        json,
+        asset.bin.clone(),
+        asset.container,
         &plan,
         &baked,
         ApplyOptions {
@@ -571,44 +344,20 @@ fn bake_file(
         },
         &mut names,
     );
-    let mut json = applied.json;
-    if asset.container == Container::Gltf {
-        let new_uris: HashSet<String> =
-            json.get("images")
-                .and_then(Value::as_array)
-                .into_iter()
-                .flatten()
-                .filter_map(|i| i.get("uri").and_then(Value::as_str))
-                .filter(|u| {
-                    applied.files.iter().any(|f| {
-                        percent_encoding::percent_decode_str(u).decode_utf8_lossy() == f.name
-                    })
-                })
-                .map(str::to_owned)
-                .collect();
-        if !rebase_uris(&mut json, &in_dir, &out_dir, &new_uris) {
-            return fail(format!(
-                "no relative path leads from {} to the input's resources",
-                out_dir.display()
-            ));
-        }
-    }
-    let bytes = write::to_bytes(&asset, &json, applied.bin.as_deref());
-    if let Err(e) = std::fs::create_dir_all(&out_dir) {
-        return fail(format!("cannot create {}: {e}", out_dir.display()));
-    }
+    copy_resources(&relocation)?;
+    std::fs::create_dir_all(&out_dir)
+        .map_err(|e| format!("cannot create folder {}: {e}", out_dir.display()))?;
     for file in &applied.files {
         let path = out_dir.join(&file.name);
         if std::fs::read(&path).is_ok_and(|b| b == file.bytes) {
             continue;
         }
-        if let Err(e) = write::write_atomic(&path, &file.bytes) {
-            return fail(format!("cannot write {}: {e}", path.display()));
-        }
+        write::write_atomic(&path, &file.bytes)
+            .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
     }
-    if let Err(e) = write::write_atomic(output, &bytes) {
-        return fail(format!("cannot write {}: {e}", output.display()));
-    }
+    let out_bytes = write::to_bytes(&asset, &applied.json, applied.bin.as_deref());
+    write::write_atomic(output, &out_bytes)
+        .map_err(|e| format!("cannot write {}: {e}", output.display()))?;
     let names: Vec<String> = applied.outputs.iter().map(|o| o.name.clone()).collect();
     let mut result = FileResult::new(input, Some(output), Outcome::Changed);
     result.slots = slot_reports(&plan, &names);
@@ -619,12 +368,12 @@ fn bake_file(
     result.dropped_images = images;
     result.dropped_bin_bytes = bin_bytes;
     result.notes = plan.notes.into_iter().chain(applied.notes).collect();
-    result
+    Ok(result)
 }
 
 /// Runs a request: every file in parallel; folders that cannot be read become failed results.
 pub fn run(request: &Request) -> Result<Vec<FileResult>, UsageError> {
-    let (jobs, walk_errors) = jobs(request)?;
+    let (jobs, walk_errors) = jobs(&request.inputs, &request.destination, request.dry_run)?;
     let claims = Claims::default();
     let bar = (request.progress && jobs.len() > 1 && std::io::stderr().is_terminal())
         .then(|| indicatif::ProgressBar::new(jobs.len() as u64));
@@ -642,12 +391,14 @@ pub fn run(request: &Request) -> Result<Vec<FileResult>, UsageError> {
         .collect();
     results.extend(
         jobs.par_iter()
-            .map(|(input, output)| {
-                let r = bake_file(input, output.as_deref(), request, &claims);
+            .map(|job| {
+                let result = bake_file(job, request, &claims).unwrap_or_else(|error| {
+                    FileResult::new(&job.input, job.output.as_deref(), Outcome::Failed { error })
+                });
                 if let Some(bar) = &bar {
                     bar.inc(1);
                 }
-                r
+                result
             })
             .collect::<Vec<_>>(),
     );
