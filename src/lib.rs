@@ -5,6 +5,7 @@
 //! ([`report`]). The binary in `main.rs` only parses arguments and maps outcomes to exit codes.
 
 pub mod asset;
+pub mod bake;
 pub mod cli_docs;
 pub mod config;
 pub mod diagnostics;

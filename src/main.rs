@@ -49,6 +49,8 @@ enum Command {
         #[command(flatten)]
         settings: SettingsArgs,
     },
+    /// Bake sheen and fuzz texture × factor into new textures, once per distinct combination.
+    Bake(BakeArgs),
     /// List every code velvet reports, with its severity and description.
     Codes {
         #[arg(long, value_enum, default_value_t = CodesFormat::Text)]
@@ -106,6 +108,64 @@ struct ValidateArgs {
     schema_dir: Option<PathBuf>,
 }
 
+#[derive(clap::Args)]
+#[command(
+    after_help = "Exit status: 0 done, 1 a file failed (the others are still baked), 2 usage error (nothing written)."
+)]
+struct BakeArgs {
+    /// Files and folders to bake (folders are searched for *.gltf and *.glb).
+    #[arg(required = true)]
+    paths: Vec<PathBuf>,
+    /// The output file (one input only).
+    #[arg(short, long, value_name = "FILE", conflicts_with_all = ["out_dir", "in_place"])]
+    output: Option<PathBuf>,
+    /// A folder for the outputs, mirroring the inputs' trees.
+    #[arg(long, value_name = "DIR", conflicts_with = "in_place")]
+    out_dir: Option<PathBuf>,
+    /// Overwrite the inputs.
+    #[arg(long)]
+    in_place: bool,
+    /// Print what would be baked; write nothing.
+    #[arg(long)]
+    dry_run: bool,
+    /// .gltf: store new images as data: URIs instead of files next to the output.
+    #[arg(long)]
+    embed: bool,
+    /// Bake factors outside [0, 1] (clamped; the clamping is counted).
+    #[arg(long)]
+    allow_out_of_range: bool,
+    /// Turn a texture whose texels are all equal after baking into a factor.
+    #[arg(long)]
+    collapse_uniform: bool,
+    /// Keep JPEG textures as JPEG (lossy) instead of lossless PNG.
+    #[arg(long)]
+    keep_format: bool,
+    /// Measure and print each output's largest error in codes.
+    #[arg(long)]
+    report: bool,
+    /// PNG compression effort for new images.
+    #[arg(long, value_enum, default_value_t = Compression::Fast)]
+    compression: Compression,
+    /// Copy relative resources next to outputs in another folder instead of rewriting URIs.
+    #[arg(long)]
+    copy_resources: bool,
+    #[arg(long, value_enum, default_value_t = BakeFormat::Text)]
+    format: BakeFormat,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Compression {
+    Fast,
+    Balanced,
+    Best,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum BakeFormat {
+    Text,
+    Json,
+}
+
 #[derive(Clone, Copy, ValueEnum)]
 enum CodesFormat {
     Text,
@@ -135,6 +195,7 @@ fn main() -> ExitCode {
         Command::Validate(args) => validate(args, cli.color, cli.quiet),
         Command::Migrate(args) => migrate(args, cli.quiet),
         Command::Config { path, settings } => show_config(path, settings),
+        Command::Bake(args) => bake(args, cli.quiet),
         Command::Codes { format } => {
             emit(codes_table(format).as_bytes());
             ExitCode::SUCCESS
@@ -341,6 +402,50 @@ fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
         }
     );
     if report.failed() || (args.check && report.summary.would_change > 0) {
+        ExitCode::from(1)
+    } else {
+        ExitCode::SUCCESS
+    }
+}
+
+fn bake(args: BakeArgs, quiet: bool) -> ExitCode {
+    use velvet::bake::command::{self, Destination, Options, Request};
+    let destination = match (args.output, args.out_dir, args.in_place) {
+        (Some(file), _, _) => Destination::File(file),
+        (_, Some(dir), _) => Destination::Dir(dir),
+        (_, _, true) => Destination::InPlace,
+        _ => Destination::None,
+    };
+    let request = Request {
+        inputs: args.paths,
+        destination,
+        dry_run: args.dry_run,
+        options: Options {
+            plan: velvet::bake::plan::PlanOptions {
+                allow_out_of_range: args.allow_out_of_range,
+            },
+            embed: args.embed,
+            collapse_uniform: args.collapse_uniform,
+            keep_format: args.keep_format,
+            report: args.report,
+            png: match args.compression {
+                Compression::Fast => velvet::bake::PngCompression::Fast,
+                Compression::Balanced => velvet::bake::PngCompression::Default,
+                Compression::Best => velvet::bake::PngCompression::Best,
+            },
+            copy_resources: args.copy_resources,
+        },
+        progress: !quiet,
+    };
+    let results = match command::run(&request) {
+        Ok(r) => r,
+        Err(e) => return usage_error(e),
+    };
+    match args.format {
+        BakeFormat::Text => print!("{}", command::render_text(&results, args.dry_run)),
+        BakeFormat::Json => print!("{}", command::render_json(&results)),
+    }
+    if results.iter().any(|r| r.failed()) {
         ExitCode::from(1)
     } else {
         ExitCode::SUCCESS

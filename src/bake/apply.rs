@@ -1,0 +1,457 @@
+//! Applying a bake plan to a document: new images (GLB: bufferViews appended to the BIN chunk,
+//! 4-byte aligned; .gltf: files next to the output, or `data:` URIs when embedding), new
+//! textures that keep the old ones' samplers, names and extensions with their sources replaced,
+//! textureInfos pointed at them (texCoord and KHR_texture_transform untouched), factors set to
+//! the identity explicitly, uniform outputs collapsed into factors when asked, and then the
+//! replaced textures and images that nothing references any more dropped.
+//!
+//! This step decides file names but writes nothing: the caller gets the document, the BIN
+//! chunk and the files to write, and says through [`Names`] which file names are free.
+
+use std::collections::{BTreeSet, HashMap};
+
+use base64::Engine;
+use serde::Serialize;
+use serde_json::{json, Value};
+
+use super::codec::OutputFormat;
+use super::engine::{Baked, OutputId};
+use super::plan::{BakePlan, Level, Note, SlotPlan};
+use super::prune::{prune, Dropped};
+use super::recipe::Channel;
+use super::srgb;
+use crate::asset::Container;
+use crate::layers::Channels;
+
+/// How outputs are stored.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ApplyOptions {
+    /// .gltf: store new images as `data:` URIs instead of files.
+    pub embed: bool,
+}
+
+/// Which file names next to the output may be used.
+pub trait Names {
+    /// Whether `name` may hold `bytes`: nothing else claims it (the caller may also accept a
+    /// file that already holds exactly these bytes). A `true` answer claims the name.
+    fn claim(&mut self, name: &str, bytes: &[u8]) -> bool;
+}
+
+/// A new image file to write next to a .gltf output.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct NewFile {
+    /// The file name (also the URI, percent-encoded).
+    pub name: String,
+    /// The encoded image.
+    pub bytes: Vec<u8>,
+}
+
+/// What became of one output.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct OutputReport {
+    /// The output's id in the plan.
+    #[serde(skip)]
+    pub output: OutputId,
+    /// The image baked.
+    pub source_image: usize,
+    /// What the output holds.
+    pub name: String,
+    /// The new image's index in the written document; `None` when collapsed into factors.
+    pub image: Option<usize>,
+    /// Where its bytes went (file name, `data:` or `bufferView`).
+    pub stored: String,
+    /// Size and format.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Bits per channel.
+    pub bits: u32,
+    /// `image/png`, `image/webp`, `image/jpeg`; `None` when collapsed.
+    pub mime_type: Option<&'static str>,
+    /// Encoded size in bytes.
+    pub bytes: usize,
+    /// Texels clamped (factors outside [0, 1]).
+    pub clamped: u64,
+    /// Largest quantisation error in codes, when measured.
+    pub max_error: Option<f64>,
+}
+
+/// The edited asset.
+#[derive(Clone, Debug)]
+pub struct Applied {
+    /// The new document.
+    pub json: Value,
+    /// The new BIN chunk (GLB).
+    pub bin: Option<Vec<u8>>,
+    /// Files to write next to the output (.gltf).
+    pub files: Vec<NewFile>,
+    /// One entry per output.
+    pub outputs: Vec<OutputReport>,
+    /// What was dropped.
+    pub dropped: Dropped,
+    /// Remarks made while applying.
+    pub notes: Vec<Note>,
+}
+
+const PATH_SEGMENT: &percent_encoding::AsciiSet = &percent_encoding::NON_ALPHANUMERIC
+    .remove(b'-')
+    .remove(b'.')
+    .remove(b'_')
+    .remove(b'~');
+
+/// The name an image goes by: its `name`, else its URI's file stem, else `image<N>`.
+fn image_base_name(json: &Value, image: usize) -> String {
+    let entry = &json["images"][image];
+    if let Some(name) = entry
+        .get("name")
+        .and_then(Value::as_str)
+        .filter(|n| !n.is_empty())
+    {
+        return name.to_owned();
+    }
+    if let Some(uri) = entry
+        .get("uri")
+        .and_then(Value::as_str)
+        .filter(|u| !u.starts_with("data:"))
+    {
+        let decoded = percent_encoding::percent_decode_str(uri).decode_utf8_lossy();
+        let file = decoded.rsplit('/').next().unwrap_or("");
+        let stem = file.rsplit_once('.').map_or(file, |(s, _)| s);
+        if !stem.is_empty() {
+            return stem.to_owned();
+        }
+    }
+    format!("image{image}")
+}
+
+/// A file name made safe: path separators and control characters become '_'.
+fn file_safe(name: &str) -> String {
+    name.chars()
+        .map(|c| {
+            if c == '/' || c == '\\' || c.is_control() || c == ':' {
+                '_'
+            } else {
+                c
+            }
+        })
+        .collect()
+}
+
+/// The factor values a uniform output gives one slot, if every output of the slot is uniform
+/// and they agree.
+fn uniform_factor(slot: &SlotPlan, baked: &[Baked]) -> Option<Vec<f64>> {
+    let mut agreed: Option<Vec<f64>> = None;
+    for source in &slot.sources {
+        let b = &baked[source.output.0];
+        let codes = b.uniform.as_ref()?;
+        let max = f64::from(b.depth.max_code());
+        let code = |c: Channel| -> f64 {
+            match b.layout.storage_index(c) {
+                Some(i) => f64::from(codes[i]) / max,
+                None => 1.0,
+            }
+        };
+        let values: Vec<f64> = match crate::layers::SLOTS
+            .iter()
+            .find(|s| s.texture == slot.texture_key)
+            .map(|s| s.channels)
+        {
+            Some(Channels::Rgb) => [Channel::R, Channel::G, Channel::B]
+                .into_iter()
+                .map(|c| srgb::decode(code(c)))
+                .collect(),
+            Some(Channels::Alpha) => vec![code(Channel::A)],
+            _ => vec![code(Channel::R)],
+        };
+        match &agreed {
+            Some(a) if *a != values => return None,
+            _ => agreed = Some(values),
+        }
+    }
+    agreed
+}
+
+fn factor_json(values: &[f64]) -> Value {
+    if values.len() == 3 {
+        json!(values)
+    } else {
+        json!(values[0])
+    }
+}
+
+/// Applies `plan` with its bake results (`baked[id]` for each output id) to a document (as
+/// loaded, or with its URIs already relocated) and its GLB BIN chunk.
+#[allow(clippy::too_many_arguments)]
+pub fn apply(
+    mut json: Value,
+    mut bin: Option<Vec<u8>>,
+    container: Container,
+    plan: &BakePlan,
+    baked: &[Baked],
+    options: ApplyOptions,
+    names: &mut dyn Names,
+) -> Applied {
+    let source_json = json.clone();
+    let mut files = Vec::new();
+    let mut notes = Vec::new();
+    let glb = container == Container::Glb;
+    // A GLB stores new images in its BIN chunk, which is buffer 0 unless buffer 0 has a URI.
+    let bin_usable = glb
+        && json
+            .pointer("/buffers/0")
+            .map_or(true, |b| b.get("uri").is_none());
+    if let (true, Some(b)) = (bin_usable, bin.as_mut()) {
+        // Drop the chunk's padding: appends start at the buffer's declared end.
+        let declared = json
+            .pointer("/buffers/0/byteLength")
+            .and_then(Value::as_u64);
+        if let Some(len) = declared {
+            b.truncate(len as usize);
+        }
+    }
+    let mut image_of: HashMap<OutputId, usize> = HashMap::new();
+    let mut outputs: Vec<OutputReport> = baked
+        .iter()
+        .enumerate()
+        .map(|(i, b)| {
+            let info = &plan.outputs[i];
+            let base = image_base_name(&source_json, info.image);
+            OutputReport {
+                output: OutputId(i),
+                source_image: info.image,
+                name: format!("{base}.{}", info.labels.join(".")),
+                image: None,
+                stored: "collapsed into factors".to_owned(),
+                width: b.width,
+                height: b.height,
+                bits: b.depth.bits(),
+                mime_type: None,
+                bytes: 0,
+                clamped: b.stats.clamped(),
+                max_error: b.stats.max_error(),
+            }
+        })
+        .collect();
+    let mut new_texture_of: HashMap<(usize, Vec<(String, usize)>), usize> = HashMap::new();
+    let mut replaced_textures = BTreeSet::new();
+    let mut replaced_images = BTreeSet::new();
+
+    for slot in &plan.slots {
+        replaced_textures.insert(slot.texture);
+        replaced_images.extend(slot.sources.iter().map(|s| s.image));
+        if let Some(values) = uniform_factor(slot, baked) {
+            if let Some(layer) = json
+                .pointer_mut(&slot.layer_pointer)
+                .and_then(Value::as_object_mut)
+            {
+                layer.shift_remove(slot.texture_key);
+                layer.insert(slot.factor_key.to_owned(), factor_json(&values));
+            }
+            notes.push(Note {
+                level: Level::Info,
+                pointer: slot.texture_pointer(),
+                message: format!(
+                    "every texel of the baked {} is equal: the texture is dropped and {} = {}",
+                    slot.texture_key,
+                    slot.factor_key,
+                    factor_json(&values)
+                ),
+            });
+            continue;
+        }
+        // One new image per output, made when first needed.
+        let mut sources = Vec::new();
+        for source in &slot.sources {
+            let id = source.output;
+            let image = match image_of.get(&id) {
+                Some(&i) => i,
+                None => {
+                    let b = &baked[id.0];
+                    let (format, bytes) =
+                        b.encoded.clone().expect("a non-uniform output is encoded");
+                    let report = &mut outputs[id.0];
+                    let entry = store_image(
+                        &mut json,
+                        &mut bin,
+                        bin_usable,
+                        glb,
+                        options.embed,
+                        &report.name,
+                        format,
+                        bytes,
+                        names,
+                        &mut files,
+                        &mut report.stored,
+                    );
+                    report.mime_type = Some(format.mime_type());
+                    report.bytes = b.encoded.as_ref().map_or(0, |(_, e)| e.len());
+                    let images = json
+                        .as_object_mut()
+                        .expect("the document is an object")
+                        .entry("images")
+                        .or_insert_with(|| json!([]));
+                    let list = images.as_array_mut().expect("images is an array");
+                    list.push(entry);
+                    let index = list.len() - 1;
+                    report.image = Some(index);
+                    image_of.insert(id, index);
+                    index
+                }
+            };
+            sources.push((source.within_texture.clone(), image));
+        }
+        let key = (slot.texture, sources.clone());
+        let texture = match new_texture_of.get(&key) {
+            Some(&t) => t,
+            None => {
+                let mut texture = json["textures"][slot.texture].clone();
+                for (within, image) in &sources {
+                    if let Some(v) = texture.pointer_mut(within) {
+                        *v = Value::from(*image);
+                    }
+                }
+                let list = json["textures"]
+                    .as_array_mut()
+                    .expect("textures is an array");
+                list.push(texture);
+                let index = list.len() - 1;
+                new_texture_of.insert(key, index);
+                index
+            }
+        };
+        if let Some(info) = json.pointer_mut(&slot.texture_pointer()) {
+            info["index"] = Value::from(texture);
+        }
+        if let Some(layer) = json
+            .pointer_mut(&slot.layer_pointer)
+            .and_then(Value::as_object_mut)
+        {
+            layer.insert(slot.factor_key.to_owned(), slot.identity());
+        }
+    }
+    let dropped = prune(
+        &mut json,
+        if bin_usable { bin.as_mut() } else { None },
+        &replaced_textures,
+        &replaced_images,
+    );
+    // Image indices moved with the drop: report the final ones.
+    for report in &mut outputs {
+        if let Some(i) = report.image {
+            let before = dropped.images.iter().filter(|&&d| d < i).count();
+            report.image = Some(i - before);
+        }
+    }
+    if let (true, Some(b)) = (bin_usable, bin.as_ref()) {
+        if b.is_empty() {
+            drop_empty_bin(&mut json);
+            bin = None;
+        } else if let Some(buffer) = json.pointer_mut("/buffers/0") {
+            buffer["byteLength"] = Value::from(b.len());
+        }
+    }
+    Applied {
+        json,
+        bin,
+        files,
+        outputs,
+        dropped,
+        notes,
+    }
+}
+
+/// Stores one encoded image and returns its `images` entry.
+#[allow(clippy::too_many_arguments)]
+fn store_image(
+    json: &mut Value,
+    bin: &mut Option<Vec<u8>>,
+    bin_usable: bool,
+    glb: bool,
+    embed: bool,
+    name: &str,
+    format: OutputFormat,
+    bytes: Vec<u8>,
+    names: &mut dyn Names,
+    files: &mut Vec<NewFile>,
+    stored: &mut String,
+) -> Value {
+    if glb && bin_usable {
+        let data = bin.get_or_insert_with(Vec::new);
+        while data.len() % 4 != 0 {
+            data.push(0);
+        }
+        let offset = data.len();
+        data.extend_from_slice(&bytes);
+        let root = json.as_object_mut().expect("the document is an object");
+        let buffers = root.entry("buffers").or_insert_with(|| json!([]));
+        if buffers.as_array().is_some_and(Vec::is_empty) {
+            buffers
+                .as_array_mut()
+                .expect("buffers is an array")
+                .push(json!({"byteLength": 0}));
+        }
+        let views = root
+            .entry("bufferViews")
+            .or_insert_with(|| json!([]))
+            .as_array_mut()
+            .expect("bufferViews is an array");
+        views.push(json!({"buffer": 0, "byteOffset": offset, "byteLength": bytes.len()}));
+        let view = views.len() - 1;
+        *stored = format!("bufferView {view}");
+        return json!({"name": name, "mimeType": format.mime_type(), "bufferView": view});
+    }
+    if glb || embed {
+        let data = base64::engine::general_purpose::STANDARD.encode(&bytes);
+        *stored = "data: URI".to_owned();
+        return json!({"name": name, "uri": format!("data:{};base64,{data}", format.mime_type())});
+    }
+    let stem = file_safe(name);
+    let ext = format.extension();
+    let file = (1..)
+        .map(|n| {
+            if n == 1 {
+                format!("{stem}.{ext}")
+            } else {
+                format!("{stem}.{n}.{ext}")
+            }
+        })
+        .find(|candidate| names.claim(candidate, &bytes))
+        .expect("some name is free");
+    let uri = percent_encoding::utf8_percent_encode(&file, PATH_SEGMENT).to_string();
+    *stored = file.clone();
+    files.push(NewFile { name: file, bytes });
+    json!({"name": name, "uri": uri})
+}
+
+/// Removes buffer 0 (the GLB's BIN chunk) once nothing is left in it and no bufferView names
+/// it (a buffer's byteLength must be at least 1), renumbering the other buffers' references.
+fn drop_empty_bin(json: &mut Value) {
+    fn buffer_refs(value: &mut Value, f: &mut dyn FnMut(&mut Value)) {
+        match value {
+            Value::Object(map) => {
+                for (k, v) in map.iter_mut() {
+                    if k == "buffer" && v.is_u64() {
+                        f(v);
+                    } else {
+                        buffer_refs(v, f);
+                    }
+                }
+            }
+            Value::Array(items) => items.iter_mut().for_each(|v| buffer_refs(v, f)),
+            _ => {}
+        }
+    }
+    let mut named = false;
+    buffer_refs(json, &mut |v| named |= v.as_u64() == Some(0));
+    if named || json.pointer("/buffers/0").is_none() {
+        return;
+    }
+    buffer_refs(json, &mut |v| *v = Value::from(v.as_u64().unwrap_or(1) - 1));
+    let root = json.as_object_mut().expect("the document is an object");
+    if let Some(Value::Array(buffers)) = root.get_mut("buffers") {
+        buffers.remove(0);
+        if buffers.is_empty() {
+            root.shift_remove("buffers");
+        }
+    }
+}

@@ -1,0 +1,531 @@
+//! `velvet bake` over many files, with the output rules of `velvet migrate` (its
+//! [`paths`](crate::migrate::paths) module pairs inputs with outputs and refuses a bad request
+//! before anything is read, and relocates the relative URIs of an output written to another
+//! folder): each file is loaded, planned, baked, applied and written independently and in
+//! parallel. One failing file does not stop the others; nothing is written for a file that
+//! fails, and every write is atomic (a temporary file renamed into place). An input is never
+//! written unless `--in-place` is asked, and a file with nothing to bake is copied byte for
+//! byte (or, in place, not written at all). A file the loader reports errors for is not baked.
+
+use std::borrow::Cow;
+use std::collections::{HashMap, HashSet};
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+use rayon::prelude::*;
+use serde::Serialize;
+use serde_json::Value;
+
+use super::apply::{apply, ApplyOptions, Names, OutputReport};
+use super::codec::{EncodeOptions, PngCompression};
+use super::engine::{bake, BakeOptions, ImageSource};
+use super::kernel::KernelOptions;
+use super::plan::{plan, BakePlan, Note, PlanOptions};
+use super::prune::Dropped;
+use super::recipe::ImageId;
+use crate::asset::{self, resource, write, Asset};
+use crate::diagnostics::Severity;
+use crate::migrate::paths::{identity, jobs, relocate, Job, Relocation};
+
+pub use crate::migrate::paths::Destination;
+pub use crate::migrate::UsageError;
+
+/// What a run does besides where it writes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Options {
+    /// Planning choices.
+    pub plan: PlanOptions,
+    /// .gltf: embed new images as `data:` URIs.
+    pub embed: bool,
+    /// Turn textures whose texels are all equal after baking into factors.
+    pub collapse_uniform: bool,
+    /// Keep JPEG as JPEG instead of lossless PNG.
+    pub keep_format: bool,
+    /// Measure each output's quantisation error.
+    pub report: bool,
+    /// PNG compression effort.
+    pub png: PngCompression,
+    /// Copy relative resources next to an output in another folder instead of rewriting URIs.
+    pub copy_resources: bool,
+}
+
+/// One `velvet bake` invocation.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Request {
+    /// Files and folders (walked for .gltf and .glb).
+    pub inputs: Vec<PathBuf>,
+    /// Where outputs go.
+    pub destination: Destination,
+    /// Plan and report; write nothing.
+    pub dry_run: bool,
+    /// Everything else.
+    pub options: Options,
+    /// Draw a progress bar on a terminal.
+    pub progress: bool,
+}
+
+/// What became of one file.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+#[serde(tag = "status", rename_all = "kebab-case")]
+pub enum Outcome {
+    /// Baked and written.
+    Changed,
+    /// Nothing to bake: the input's bytes were written to the output.
+    Copied,
+    /// Nothing to bake in place: not written.
+    Untouched,
+    /// Dry run.
+    Planned {
+        /// Whether a real run would change the file.
+        changes: bool,
+    },
+    /// Not baked; nothing written for it.
+    Failed {
+        /// Why.
+        error: String,
+    },
+}
+
+/// One baked slot, for reports.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SlotReport {
+    /// Material index.
+    pub material: usize,
+    /// Pointer to the textureInfo.
+    pub pointer: String,
+    /// The factor baked in.
+    pub factor: Vec<f64>,
+    /// The outputs it reads (names).
+    pub outputs: Vec<String>,
+}
+
+/// The report for one file.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FileResult {
+    /// The input.
+    pub input: PathBuf,
+    /// The output, if any.
+    pub output: Option<PathBuf>,
+    /// What happened.
+    #[serde(flatten)]
+    pub outcome: Outcome,
+    /// Slots baked (or planned).
+    pub slots: Vec<SlotReport>,
+    /// Outputs written (empty in a dry run).
+    pub outputs: Vec<OutputReport>,
+    /// Images dropped (indices in the input).
+    pub dropped_images: Vec<usize>,
+    /// Bytes cut from the GLB BIN chunk.
+    pub dropped_bin_bytes: usize,
+    /// Remarks.
+    pub notes: Vec<Note>,
+}
+
+impl FileResult {
+    fn new(input: &Path, output: Option<&Path>, outcome: Outcome) -> FileResult {
+        FileResult {
+            input: input.to_path_buf(),
+            output: output.map(Path::to_path_buf),
+            outcome,
+            slots: Vec::new(),
+            outputs: Vec::new(),
+            dropped_images: Vec::new(),
+            dropped_bin_bytes: 0,
+            notes: Vec::new(),
+        }
+    }
+
+    /// Whether the file failed.
+    pub fn failed(&self) -> bool {
+        matches!(self.outcome, Outcome::Failed { .. })
+    }
+}
+
+/// Serves an asset's images to the engine.
+struct AssetImages<'a>(&'a Asset);
+
+impl ImageSource for AssetImages<'_> {
+    fn image_bytes(&self, image: ImageId) -> Result<Cow<'_, [u8]>, String> {
+        self.0.image_bytes(image.0).map_err(|d| d.message)
+    }
+}
+
+/// File names claimed in one run, across files (several assets may write into one folder).
+#[derive(Default)]
+struct Claims {
+    claimed: Mutex<HashMap<PathBuf, Vec<u8>>>,
+}
+
+/// The names one output may use: not a file the document references, not the document
+/// itself, and either new or already holding exactly the bytes to be written.
+struct FileNames<'a> {
+    claims: &'a Claims,
+    dir: PathBuf,
+    taken: HashSet<PathBuf>,
+}
+
+impl Names for FileNames<'_> {
+    fn claim(&mut self, name: &str, bytes: &[u8]) -> bool {
+        let path = identity(&self.dir.join(name));
+        if self.taken.contains(&path) {
+            return false;
+        }
+        let mut claimed = self
+            .claims
+            .claimed
+            .lock()
+            .unwrap_or_else(|e| e.into_inner());
+        if let Some(existing) = claimed.get(&path) {
+            return existing == bytes;
+        }
+        if path.exists() && std::fs::read(&path).map_or(true, |b| b != bytes) {
+            return false;
+        }
+        claimed.insert(path.clone(), bytes.to_vec());
+        self.taken.insert(path);
+        true
+    }
+}
+
+fn folder_of(path: &Path) -> PathBuf {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    }
+}
+
+fn slot_reports(plan: &BakePlan, names: &[String]) -> Vec<SlotReport> {
+    plan.slots
+        .iter()
+        .map(|s| SlotReport {
+            material: s.material,
+            pointer: s.texture_pointer(),
+            factor: s.factor.clone(),
+            outputs: s
+                .sources
+                .iter()
+                .map(|src| names[src.output.0].clone())
+                .collect(),
+        })
+        .collect()
+}
+
+fn create_parent(path: &Path) -> Result<(), String> {
+    match path.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() => std::fs::create_dir_all(dir)
+            .map_err(|e| format!("cannot create folder {}: {e}", dir.display())),
+        _ => Ok(()),
+    }
+}
+
+/// Writes a relocation's resource copies.
+fn copy_resources(relocation: &Relocation) -> Result<(), String> {
+    for copy in &relocation.copies {
+        let data = std::fs::read(&copy.from)
+            .map_err(|e| format!("cannot read resource {}: {e}", copy.from.display()))?;
+        create_parent(&copy.to)?;
+        write::write_atomic(&copy.to, &data)
+            .map_err(|e| format!("cannot write resource {}: {e}", copy.to.display()))?;
+    }
+    Ok(())
+}
+
+/// Bakes one file; errors name what is wrong (the caller adds the file).
+fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult, String> {
+    let input = job.input.as_path();
+    let bytes = std::fs::read(input).map_err(|e| format!("cannot read: {e}"))?;
+    let loaded = asset::load_bytes(input, &bytes);
+    let errors: Vec<String> = loaded
+        .diagnostics
+        .iter()
+        .filter(|d| d.severity == Severity::Error)
+        .map(|d| format!("{} ({})", d.message, d.code))
+        .collect();
+    let asset = match loaded.asset {
+        Some(asset) if errors.is_empty() => asset,
+        _ => return Err(format!("cannot be baked: {}", errors.join("; "))),
+    };
+    let options = request.options;
+    let plan = plan(&asset, options.plan);
+    let planned_names: Vec<String> = plan
+        .outputs
+        .iter()
+        .map(|o| format!("image {}: {}", o.image, o.labels.join(" + ")))
+        .collect();
+    let relocation = match &job.output {
+        Some(output) if output != &job.input => relocate(&asset, output, options.copy_resources)?,
+        _ => Relocation::default(),
+    };
+    if request.dry_run {
+        let mut result = FileResult::new(
+            input,
+            job.output.as_deref(),
+            Outcome::Planned {
+                changes: !plan.is_empty(),
+            },
+        );
+        result.slots = slot_reports(&plan, &planned_names);
+        result.notes = plan.notes;
+        return Ok(result);
+    }
+    let output = job.output.as_deref().ok_or("no output path")?;
+    // The document as it will stand next to the output, before baking.
+    let mut json = asset.json.clone();
+    crate::edit::apply(&mut json, &relocation.edits).map_err(|e| e.to_string())?;
+    if plan.is_empty() {
+        let mut result = FileResult::new(input, Some(output), Outcome::Untouched);
+        result.notes = plan.notes;
+        if output == input {
+            return Ok(result);
+        }
+        copy_resources(&relocation)?;
+        create_parent(output)?;
+        let out_bytes = if json == asset.json {
+            bytes
+        } else {
+            write::to_bytes(&asset, &json, asset.bin.as_deref())
+        };
+        write::write_atomic(output, &out_bytes)
+            .map_err(|e| format!("cannot write {}: {e}", output.display()))?;
+        result.outcome = Outcome::Copied;
+        return Ok(result);
+    }
+    let bake_options = BakeOptions {
+        keep_format: options.keep_format,
+        collapse_uniform: options.collapse_uniform,
+        kernel: KernelOptions {
+            exact: false,
+            measure: options.report,
+        },
+        encode: EncodeOptions {
+            png: options.png,
+            ..EncodeOptions::default()
+        },
+    };
+    let mut baked = Vec::with_capacity(plan.recipes.len());
+    let results = bake(&plan.recipes, &AssetImages(&asset), &bake_options);
+    for (name, result) in planned_names.iter().zip(results) {
+        baked.push(result.map_err(|e| format!("cannot bake {name}: {e}"))?);
+    }
+    // File names next to the output that the document already uses.
+    let out_dir = folder_of(output);
+    let taken: HashSet<PathBuf> = ["buffers", "images"]
+        .iter()
+        .flat_map(|kind| {
+            asset
+                .json
+                .get(*kind)
+                .and_then(Value::as_array)
+                .into_iter()
+                .flatten()
+        })
+        .filter_map(|item| item.get("uri").and_then(Value::as_str))
+        .filter_map(|uri| match resource::resolve(uri, asset.base_dir(), "") {
+            Ok(resource::Location::File(p)) => Some(identity(&p)),
+            _ => None,
+        })
+        .chain(relocation.copies.iter().map(|c| identity(&c.to)))
+        .chain([identity(output), identity(input)])
+        .collect();
+    let mut names = FileNames {
+        claims,
+        dir: out_dir.clone(),
+        taken,
+    };
+    let applied = apply(
+        json,
+        asset.bin.clone(),
+        asset.container,
+        &plan,
+        &baked,
+        ApplyOptions {
+            embed: options.embed,
+        },
+        &mut names,
+    );
+    copy_resources(&relocation)?;
+    std::fs::create_dir_all(&out_dir)
+        .map_err(|e| format!("cannot create folder {}: {e}", out_dir.display()))?;
+    for file in &applied.files {
+        let path = out_dir.join(&file.name);
+        if std::fs::read(&path).is_ok_and(|b| b == file.bytes) {
+            continue;
+        }
+        write::write_atomic(&path, &file.bytes)
+            .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    }
+    let out_bytes = write::to_bytes(&asset, &applied.json, applied.bin.as_deref());
+    write::write_atomic(output, &out_bytes)
+        .map_err(|e| format!("cannot write {}: {e}", output.display()))?;
+    let names: Vec<String> = applied.outputs.iter().map(|o| o.name.clone()).collect();
+    let mut result = FileResult::new(input, Some(output), Outcome::Changed);
+    result.slots = slot_reports(&plan, &names);
+    result.outputs = applied.outputs;
+    let Dropped {
+        images, bin_bytes, ..
+    } = applied.dropped;
+    result.dropped_images = images;
+    result.dropped_bin_bytes = bin_bytes;
+    result.notes = plan.notes.into_iter().chain(applied.notes).collect();
+    Ok(result)
+}
+
+/// Runs a request: every file in parallel; folders that cannot be read become failed results.
+pub fn run(request: &Request) -> Result<Vec<FileResult>, UsageError> {
+    let (jobs, walk_errors) = jobs(&request.inputs, &request.destination, request.dry_run)?;
+    let claims = Claims::default();
+    let bar = (request.progress && jobs.len() > 1 && std::io::stderr().is_terminal())
+        .then(|| indicatif::ProgressBar::new(jobs.len() as u64));
+    let mut results: Vec<FileResult> = walk_errors
+        .into_iter()
+        .map(|(path, e)| {
+            FileResult::new(
+                &path,
+                None,
+                Outcome::Failed {
+                    error: format!("cannot read folder: {e}"),
+                },
+            )
+        })
+        .collect();
+    results.extend(
+        jobs.par_iter()
+            .map(|job| {
+                let result = bake_file(job, request, &claims).unwrap_or_else(|error| {
+                    FileResult::new(&job.input, job.output.as_deref(), Outcome::Failed { error })
+                });
+                if let Some(bar) = &bar {
+                    bar.inc(1);
+                }
+                result
+            })
+            .collect::<Vec<_>>(),
+    );
+    if let Some(bar) = bar {
+        bar.finish_and_clear();
+    }
+    Ok(results)
+}
+
+/// Totals over a run.
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct Summary {
+    /// Files seen.
+    pub files: usize,
+    /// Files baked and written.
+    pub changed: usize,
+    /// Files with nothing to bake.
+    pub unchanged: usize,
+    /// Files that failed.
+    pub failed: usize,
+    /// Slots baked.
+    pub slots: usize,
+    /// Outputs written.
+    pub textures: usize,
+}
+
+/// Sums up results.
+pub fn summary(results: &[FileResult]) -> Summary {
+    let mut s = Summary {
+        files: results.len(),
+        ..Summary::default()
+    };
+    for r in results {
+        match &r.outcome {
+            Outcome::Changed => s.changed += 1,
+            Outcome::Planned { changes: true } => s.changed += 1,
+            Outcome::Failed { .. } => s.failed += 1,
+            _ => s.unchanged += 1,
+        }
+        s.slots += r.slots.len();
+        s.textures += r.outputs.len();
+    }
+    s
+}
+
+/// The text report.
+pub fn render_text(results: &[FileResult], dry_run: bool) -> String {
+    use std::fmt::Write as _;
+    let mut out = String::new();
+    for r in results {
+        let target = r
+            .output
+            .as_ref()
+            .filter(|o| **o != r.input)
+            .map(|o| format!(" -> {}", o.display()))
+            .unwrap_or_default();
+        let status = match &r.outcome {
+            Outcome::Changed => "baked".to_owned(),
+            Outcome::Copied => "nothing to bake (copied)".to_owned(),
+            Outcome::Untouched => "nothing to bake".to_owned(),
+            Outcome::Planned { changes: true } => "would bake".to_owned(),
+            Outcome::Planned { changes: false } => "nothing to bake".to_owned(),
+            Outcome::Failed { error } => format!("failed: {error}"),
+        };
+        let _ = writeln!(out, "{}{target}: {status}", r.input.display());
+        for s in &r.slots {
+            let _ = writeln!(
+                out,
+                "  {}: factor {:?} -> {}",
+                s.pointer,
+                s.factor,
+                s.outputs.join(", ")
+            );
+        }
+        for o in &r.outputs {
+            let mut line = format!(
+                "  output {}: {}x{} {}-bit {}, {}",
+                o.name,
+                o.width,
+                o.height,
+                o.bits,
+                o.mime_type.unwrap_or("-"),
+                o.stored
+            );
+            if let Some(e) = o.max_error {
+                let _ = write!(line, ", max error {e:.4} codes");
+            }
+            if o.clamped > 0 {
+                let _ = write!(line, ", {} texels clamped", o.clamped);
+            }
+            let _ = writeln!(out, "{line}");
+        }
+        if !r.dropped_images.is_empty() {
+            let _ = writeln!(
+                out,
+                "  dropped images {:?} ({} bytes cut from the BIN chunk)",
+                r.dropped_images, r.dropped_bin_bytes
+            );
+        }
+        for n in &r.notes {
+            let level = match n.level {
+                super::plan::Level::Info => "info",
+                super::plan::Level::Warning => "warning",
+            };
+            let _ = writeln!(out, "  {level} {}: {}", n.pointer, n.message);
+        }
+    }
+    let s = summary(results);
+    let _ = writeln!(
+        out,
+        "{} file(s): {} {}, {} unchanged, {} failed; {} slot(s), {} texture(s) written",
+        s.files,
+        s.changed,
+        if dry_run { "to bake" } else { "baked" },
+        s.unchanged,
+        s.failed,
+        s.slots,
+        s.textures
+    );
+    out
+}
+
+/// The JSON report.
+pub fn render_json(results: &[FileResult]) -> String {
+    let report = serde_json::json!({
+        "files": results,
+        "summary": summary(results),
+    });
+    serde_json::to_string_pretty(&report).expect("reports serialise") + "\n"
+}
