@@ -13,7 +13,8 @@ use crate::asset::Container;
 use crate::diagnostics::{self, Severity};
 use crate::validate::FileReport;
 use percent_encoding::{utf8_percent_encode, AsciiSet, NON_ALPHANUMERIC};
-use serde_json::{json, Map, Value};
+use serde::Serialize;
+use serde_json::Value;
 use std::collections::HashMap;
 use std::path::{Component, Path};
 
@@ -66,97 +67,227 @@ pub fn artifact_uri(path: &Path) -> (String, bool) {
     (uri, false)
 }
 
-fn artifact_location(path: &Path) -> Value {
-    match artifact_uri(path) {
-        (uri, true) => json!({ "uri": uri, "uriBaseId": "%SRCROOT%" }),
-        (uri, false) => json!({ "uri": uri }),
+// The log's shape as types: serialised straight to text, borrowing the reports' strings (a
+// `serde_json::Value` tree of tens of thousands of results doubled a run's peak memory).
+
+#[derive(Serialize)]
+struct Log<'a> {
+    #[serde(rename = "$schema")]
+    schema: &'static str,
+    version: &'static str,
+    runs: [Run<'a>; 1],
+}
+
+#[derive(Serialize)]
+#[serde(rename_all = "camelCase")]
+struct Run<'a> {
+    tool: Tool,
+    invocations: [Invocation<'a>; 1],
+    column_kind: &'static str,
+    results: Vec<SarifResult<'a>>,
+}
+
+#[derive(Serialize)]
+struct Tool {
+    driver: Driver,
+}
+
+#[derive(Serialize)]
+#[serde(rename_all = "camelCase")]
+struct Driver {
+    name: &'static str,
+    version: &'static str,
+    semantic_version: &'static str,
+    information_uri: &'static str,
+    rules: Vec<Rule>,
+}
+
+#[derive(Serialize)]
+#[serde(rename_all = "camelCase")]
+struct Rule {
+    id: &'static str,
+    short_description: Text<'static>,
+    default_configuration: Configuration,
+}
+
+#[derive(Serialize)]
+struct Text<'a> {
+    text: &'a str,
+}
+
+#[derive(Serialize)]
+struct Configuration {
+    level: &'static str,
+}
+
+#[derive(Serialize)]
+#[serde(rename_all = "camelCase")]
+struct Invocation<'a> {
+    execution_successful: bool,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    tool_execution_notifications: Vec<Notification<'a>>,
+}
+
+#[derive(Serialize)]
+struct Notification<'a> {
+    level: &'static str,
+    message: Text<'static>,
+    locations: [Location<'a>; 1],
+}
+
+#[derive(Serialize)]
+#[serde(rename_all = "camelCase")]
+struct SarifResult<'a> {
+    rule_id: &'a str,
+    rule_index: i64,
+    level: &'static str,
+    message: Text<'a>,
+    locations: [Location<'a>; 1],
+    properties: Properties<'a>,
+}
+
+#[derive(Serialize)]
+#[serde(rename_all = "camelCase")]
+struct Location<'a> {
+    physical_location: PhysicalLocation<'a>,
+}
+
+#[derive(Serialize)]
+#[serde(rename_all = "camelCase")]
+struct PhysicalLocation<'a> {
+    artifact_location: &'a ArtifactLocation,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    region: Option<Region>,
+}
+
+#[derive(Serialize)]
+#[serde(rename_all = "camelCase")]
+struct ArtifactLocation {
+    uri: String,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    uri_base_id: Option<&'static str>,
+}
+
+#[derive(Serialize)]
+#[serde(untagged, rename_all_fields = "camelCase")]
+enum Region {
+    /// A value in a .gltf: line and column (code points).
+    Text {
+        start_line: usize,
+        start_column: usize,
+    },
+    /// A value in a .glb: its byte offset in the file.
+    Binary { byte_offset: usize },
+}
+
+#[derive(Serialize)]
+struct Properties<'a> {
+    pointer: &'a str,
+}
+
+fn artifact_location(path: &Path) -> ArtifactLocation {
+    let (uri, relative) = artifact_uri(path);
+    ArtifactLocation {
+        uri,
+        uri_base_id: relative.then_some("%SRCROOT%"),
     }
 }
 
-/// The SARIF log for `reports`.
-pub fn document(reports: &[FileReport]) -> Value {
+fn log<'a>(reports: &'a [FileReport], artifacts: &'a [ArtifactLocation]) -> Log<'a> {
     let codes = diagnostics::all_codes();
     let index: HashMap<&str, usize> = codes.iter().enumerate().map(|(i, c)| (c.name, i)).collect();
-    let rules: Vec<Value> = codes
+    let rules = codes
         .iter()
-        .map(|c| {
-            json!({
-                "id": c.name,
-                "shortDescription": { "text": c.doc },
-                "defaultConfiguration": { "level": level(c.severity) },
-            })
+        .map(|c| Rule {
+            id: c.name,
+            short_description: Text { text: c.doc },
+            default_configuration: Configuration {
+                level: level(c.severity),
+            },
         })
         .collect();
     let mut results = Vec::new();
     let mut notifications = Vec::new();
-    for report in reports {
-        let location = artifact_location(&report.path);
+    for (report, artifact) in reports.iter().zip(artifacts) {
         for f in &report.findings {
             let d = &f.diagnostic;
-            let mut physical = Map::new();
-            physical.insert("artifactLocation".into(), location.clone());
-            match (f.position, report.container) {
-                (Some(p), Some(Container::Glb)) => {
-                    physical.insert(
-                        "region".into(),
-                        json!({ "byteOffset": report.json_offset + p.offset }),
-                    );
-                }
-                (Some(p), _) => {
-                    physical.insert(
-                        "region".into(),
-                        json!({ "startLine": p.line, "startColumn": p.column }),
-                    );
-                }
-                (None, _) => {}
-            }
-            // Every emitted code is registered; -1 is SARIF's "not in the rules array".
-            let rule_index = index.get(d.code).map_or(-1, |&i| i as i64);
-            results.push(json!({
-                "ruleId": d.code,
-                "ruleIndex": rule_index,
-                "level": level(d.severity),
-                "message": { "text": d.message },
-                "locations": [{ "physicalLocation": physical }],
-                "properties": { "pointer": d.pointer },
-            }));
+            let region = f.position.map(|p| match report.container {
+                Some(Container::Glb) => Region::Binary {
+                    byte_offset: report.json_offset + p.offset,
+                },
+                _ => Region::Text {
+                    start_line: p.line,
+                    start_column: p.column,
+                },
+            });
+            results.push(SarifResult {
+                rule_id: d.code,
+                // Every emitted code is registered; -1 is SARIF's "not in the rules array".
+                rule_index: index.get(d.code).map_or(-1, |&i| i as i64),
+                level: level(d.severity),
+                message: Text { text: &d.message },
+                locations: [Location {
+                    physical_location: PhysicalLocation {
+                        artifact_location: artifact,
+                        region,
+                    },
+                }],
+                properties: Properties {
+                    pointer: &d.pointer,
+                },
+            });
         }
         if report.truncated {
-            notifications.push(json!({
-                "level": "note",
-                "message": { "text": "further issues not shown (max-issues)" },
-                "locations": [{ "physicalLocation": { "artifactLocation": location } }],
-            }));
+            notifications.push(Notification {
+                level: "note",
+                message: Text {
+                    text: "further issues not shown (max-issues)",
+                },
+                locations: [Location {
+                    physical_location: PhysicalLocation {
+                        artifact_location: artifact,
+                        region: None,
+                    },
+                }],
+            });
         }
     }
-    let mut invocation = json!({ "executionSuccessful": true });
-    if !notifications.is_empty() {
-        invocation["toolExecutionNotifications"] = Value::Array(notifications);
-    }
-    json!({
-        "$schema": SCHEMA_URI,
-        "version": "2.1.0",
-        "runs": [{
-            "tool": {
-                "driver": {
-                    "name": "velvet",
-                    "version": env!("CARGO_PKG_VERSION"),
-                    "semanticVersion": env!("CARGO_PKG_VERSION"),
-                    "informationUri": env!("CARGO_PKG_REPOSITORY"),
-                    "rules": rules,
-                }
+    Log {
+        schema: SCHEMA_URI,
+        version: "2.1.0",
+        runs: [Run {
+            tool: Tool {
+                driver: Driver {
+                    name: "velvet",
+                    version: env!("CARGO_PKG_VERSION"),
+                    semantic_version: env!("CARGO_PKG_VERSION"),
+                    information_uri: env!("CARGO_PKG_REPOSITORY"),
+                    rules,
+                },
             },
-            "invocations": [invocation],
-            "columnKind": "unicodeCodePoints",
-            "results": results,
-        }]
-    })
+            invocations: [Invocation {
+                execution_successful: true,
+                tool_execution_notifications: notifications,
+            }],
+            column_kind: "unicodeCodePoints",
+            results,
+        }],
+    }
+}
+
+/// The SARIF log for `reports` as a JSON value.
+pub fn document(reports: &[FileReport]) -> Value {
+    let artifacts: Vec<ArtifactLocation> =
+        reports.iter().map(|r| artifact_location(&r.path)).collect();
+    serde_json::to_value(log(reports, &artifacts)).expect("a SARIF log serialises")
 }
 
 /// The SARIF log as pretty-printed JSON.
 pub fn render(reports: &[FileReport]) -> String {
+    let artifacts: Vec<ArtifactLocation> =
+        reports.iter().map(|r| artifact_location(&r.path)).collect();
     let mut text =
-        serde_json::to_string_pretty(&document(reports)).expect("a SARIF log serialises");
+        serde_json::to_string_pretty(&log(reports, &artifacts)).expect("a SARIF log serialises");
     text.push('\n');
     text
 }
