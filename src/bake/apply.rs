@@ -179,15 +179,16 @@ fn factor_json(values: &[f64]) -> Value {
     }
 }
 
-/// Applies `plan` with its bake results (`baked[id]` for each output id) to a document (as
-/// loaded, or with its URIs already relocated) and its GLB BIN chunk.
+/// Applies `plan` with its bake results (`baked[id]` for each output id; their encoded bytes
+/// are moved out) to a document (as loaded, or with its URIs already relocated) and its GLB
+/// BIN chunk.
 #[allow(clippy::too_many_arguments)]
 pub fn apply(
     mut json: Value,
     mut bin: Option<Vec<u8>>,
     container: Container,
     plan: &BakePlan,
-    baked: &[Baked],
+    baked: &mut [Baked],
     options: ApplyOptions,
     names: &mut dyn Names,
 ) -> Applied {
@@ -266,9 +267,12 @@ pub fn apply(
             let image = match image_of.get(&id) {
                 Some(&i) => i,
                 None => {
-                    let b = &baked[id.0];
-                    let (format, bytes) =
-                        b.encoded.clone().expect("a non-uniform output is encoded");
+                    // The bytes move into the document: each output is held once.
+                    let (format, bytes) = baked[id.0]
+                        .encoded
+                        .take()
+                        .expect("a non-uniform output is encoded");
+                    let size = bytes.len();
                     let report = &mut outputs[id.0];
                     let entry = store_image(
                         &mut json,
@@ -284,7 +288,7 @@ pub fn apply(
                         &mut report.stored,
                     );
                     report.mime_type = Some(format.mime_type());
-                    report.bytes = b.encoded.as_ref().map_or(0, |(_, e)| e.len());
+                    report.bytes = size;
                     let images = json
                         .as_object_mut()
                         .expect("the document is an object")
@@ -335,11 +339,17 @@ pub fn apply(
         &replaced_textures,
         &replaced_images,
     );
-    // Image indices moved with the drop: report the final ones.
+    // Image and bufferView indices moved with the drop: report the final ones.
     for report in &mut outputs {
         if let Some(i) = report.image {
             let before = dropped.images.iter().filter(|&&d| d < i).count();
             report.image = Some(i - before);
+            if let Some(view) = json
+                .pointer(&format!("/images/{}/bufferView", i - before))
+                .and_then(Value::as_u64)
+            {
+                report.stored = format!("bufferView {view}");
+            }
         }
     }
     if let (true, Some(b)) = (bin_usable, bin.as_ref()) {

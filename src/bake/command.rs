@@ -242,7 +242,7 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
         .filter(|d| d.severity == Severity::Error)
         .map(|d| format!("{} ({})", d.message, d.code))
         .collect();
-    let asset = match loaded.asset {
+    let mut asset = match loaded.asset {
         Some(asset) if errors.is_empty() => asset,
         _ => return Err(format!("cannot be baked: {}", errors.join("; "))),
     };
@@ -291,6 +291,7 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
         result.outcome = Outcome::Copied;
         return Ok(result);
     }
+    drop(bytes);
     let bake_options = BakeOptions {
         keep_format: options.keep_format,
         collapse_uniform: options.collapse_uniform,
@@ -333,12 +334,13 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
         dir: out_dir.clone(),
         taken,
     };
+    let bin = asset.bin.take();
     let applied = apply(
         json,
-        asset.bin.clone(),
+        bin,
         asset.container,
         &plan,
-        &baked,
+        &mut baked,
         ApplyOptions {
             embed: options.embed,
         },
