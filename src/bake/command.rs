@@ -7,7 +7,6 @@
 //! written unless `--in-place` is asked, and a file with nothing to bake is copied byte for
 //! byte (or, in place, not written at all). A file the loader reports errors for is not baked.
 
-use std::borrow::Cow;
 use std::collections::{HashMap, HashSet};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -19,12 +18,11 @@ use serde_json::Value;
 
 use super::apply::{apply, ApplyOptions, Names, OutputReport};
 use super::codec::{EncodeOptions, PngCompression};
-use super::engine::{bake, BakeOptions, ImageSource};
+use super::engine::{bake, BakeOptions};
 use super::kernel::KernelOptions;
 use super::plan::{plan, BakePlan, Note, PlanOptions};
 use super::prune::Dropped;
-use super::recipe::ImageId;
-use crate::asset::{self, resource, write, Asset};
+use crate::asset::{self, resource, write};
 use crate::diagnostics::Severity;
 use crate::migrate::paths::{identity, jobs, relocate, Job, Relocation};
 
@@ -139,15 +137,6 @@ impl FileResult {
     /// Whether the file failed.
     pub fn failed(&self) -> bool {
         matches!(self.outcome, Outcome::Failed { .. })
-    }
-}
-
-/// Serves an asset's images to the engine.
-struct AssetImages<'a>(&'a Asset);
-
-impl ImageSource for AssetImages<'_> {
-    fn image_bytes(&self, image: ImageId) -> Result<Cow<'_, [u8]>, String> {
-        self.0.image_bytes(image.0).map_err(|d| d.message)
     }
 }
 
@@ -305,7 +294,7 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
         },
     };
     let mut baked = Vec::with_capacity(plan.recipes.len());
-    let results = bake(&plan.recipes, &AssetImages(&asset), &bake_options);
+    let results = bake(&plan.recipes, &asset, &bake_options);
     for (name, result) in planned_names.iter().zip(results) {
         baked.push(result.map_err(|e| format!("cannot bake {name}: {e}"))?);
     }

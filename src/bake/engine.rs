@@ -36,6 +36,13 @@ where
     }
 }
 
+/// An asset serves its images by index: from a URI, a `data:` URI or a bufferView.
+impl ImageSource for crate::asset::Asset {
+    fn image_bytes(&self, image: ImageId) -> Result<Cow<'_, [u8]>, String> {
+        crate::asset::Asset::image_bytes(self, image.0).map_err(|d| d.message)
+    }
+}
+
 impl ImageSource for HashMap<ImageId, Vec<u8>> {
     fn image_bytes(&self, image: ImageId) -> Result<Cow<'_, [u8]>, String> {
         self.get(&image)
