@@ -390,6 +390,15 @@ fn glb_images_go_to_aligned_buffer_views_and_a_dropped_source_leaves_the_bin() {
         .outputs
         .iter()
         .all(|o| o.max_error.is_some_and(|e| e <= 0.5)));
+    let stored: Vec<(Option<usize>, &str)> = result
+        .outputs
+        .iter()
+        .map(|o| (o.image, o.stored.as_str()))
+        .collect();
+    assert_eq!(
+        stored,
+        vec![(Some(1), "bufferView 1"), (Some(2), "bufferView 2")]
+    );
 
     let loaded = asset::load(&output);
     assert!(loaded.diagnostics.is_empty(), "{:?}", loaded.diagnostics);

@@ -179,27 +179,23 @@ fn factor_json(values: &[f64]) -> Value {
     }
 }
 
-/// Applies `plan` with its bake results (`baked[id]` for each output id) to a document (as
-/// loaded, or with its URIs already relocated) and its GLB BIN chunk.
+/// Applies `plan` with its bake results (`baked[id]` for each output id; their encoded bytes
+/// are moved out) to a document (as loaded, or with its URIs already relocated) and its GLB
+/// BIN chunk.
 #[allow(clippy::too_many_arguments)]
 pub fn apply(
     mut json: Value,
     mut bin: Option<Vec<u8>>,
     container: Container,
     plan: &BakePlan,
-    baked: &[Baked],
+    baked: &mut [Baked],
     options: ApplyOptions,
     names: &mut dyn Names,
 ) -> Applied {
     let source_json = json.clone();
     let mut files = Vec::new();
     let mut notes = Vec::new();
-    let glb = container == Container::Glb;
-    // A GLB stores new images in its BIN chunk, which is buffer 0 unless buffer 0 has a URI.
-    let bin_usable = glb
-        && json
-            .pointer("/buffers/0")
-            .map_or(true, |b| b.get("uri").is_none());
+    let bin_usable = bin_usable(&json, container);
     if let (true, Some(b)) = (bin_usable, bin.as_mut()) {
         // Drop the chunk's padding: appends start at the buffer's declared end.
         let declared = json
@@ -266,33 +262,27 @@ pub fn apply(
             let image = match image_of.get(&id) {
                 Some(&i) => i,
                 None => {
-                    let b = &baked[id.0];
-                    let (format, bytes) =
-                        b.encoded.clone().expect("a non-uniform output is encoded");
+                    // The bytes move into the document: each output is held once.
+                    let (format, bytes) = baked[id.0]
+                        .encoded
+                        .take()
+                        .expect("a non-uniform output is encoded");
+                    let size = bytes.len();
                     let report = &mut outputs[id.0];
-                    let entry = store_image(
+                    let (index, stored) = add_image(
                         &mut json,
                         &mut bin,
-                        bin_usable,
-                        glb,
+                        container,
                         options.embed,
                         &report.name,
                         format,
                         bytes,
                         names,
                         &mut files,
-                        &mut report.stored,
                     );
+                    report.stored = stored;
                     report.mime_type = Some(format.mime_type());
-                    report.bytes = b.encoded.as_ref().map_or(0, |(_, e)| e.len());
-                    let images = json
-                        .as_object_mut()
-                        .expect("the document is an object")
-                        .entry("images")
-                        .or_insert_with(|| json!([]));
-                    let list = images.as_array_mut().expect("images is an array");
-                    list.push(entry);
-                    let index = list.len() - 1;
+                    report.bytes = size;
                     report.image = Some(index);
                     image_of.insert(id, index);
                     index
@@ -335,11 +325,17 @@ pub fn apply(
         &replaced_textures,
         &replaced_images,
     );
-    // Image indices moved with the drop: report the final ones.
+    // Image and bufferView indices moved with the drop: report the final ones.
     for report in &mut outputs {
         if let Some(i) = report.image {
             let before = dropped.images.iter().filter(|&&d| d < i).count();
             report.image = Some(i - before);
+            if let Some(view) = json
+                .pointer(&format!("/images/{}/bufferView", i - before))
+                .and_then(Value::as_u64)
+            {
+                report.stored = format!("bufferView {view}");
+            }
         }
     }
     if let (true, Some(b)) = (bin_usable, bin.as_ref()) {
@@ -360,35 +356,45 @@ pub fn apply(
     }
 }
 
-/// Stores one encoded image and returns its `images` entry.
+/// Whether a GLB stores new images in its BIN chunk: buffer 0 is the chunk unless it has a URI.
+fn bin_usable(json: &Value, container: Container) -> bool {
+    container == Container::Glb
+        && json
+            .pointer("/buffers/0")
+            .map_or(true, |b| b.get("uri").is_none())
+}
+
+/// Adds one encoded image to a document and returns its index in `images` and where its bytes
+/// went: in a GLB, a new bufferView at the 4-byte-aligned end of the BIN chunk (`bin`, created
+/// with its buffer when absent); in a .gltf, a file next to the output (named `<name>.<ext>`,
+/// or `<name>.<n>.<ext>` when `names` refuses a name; returned in `files` for the caller to
+/// write), or a `data:` URI when `embed` (or when a GLB's buffer 0 is not its BIN chunk).
 #[allow(clippy::too_many_arguments)]
-fn store_image(
+pub fn add_image(
     json: &mut Value,
     bin: &mut Option<Vec<u8>>,
-    bin_usable: bool,
-    glb: bool,
+    container: Container,
     embed: bool,
     name: &str,
     format: OutputFormat,
     bytes: Vec<u8>,
     names: &mut dyn Names,
     files: &mut Vec<NewFile>,
-    stored: &mut String,
-) -> Value {
-    if glb && bin_usable {
+) -> (usize, String) {
+    let glb = container == Container::Glb;
+    let (entry, stored) = if bin_usable(json, container) {
         let data = bin.get_or_insert_with(Vec::new);
         while data.len() % 4 != 0 {
             data.push(0);
         }
         let offset = data.len();
         data.extend_from_slice(&bytes);
+        let end = data.len();
         let root = json.as_object_mut().expect("the document is an object");
         let buffers = root.entry("buffers").or_insert_with(|| json!([]));
-        if buffers.as_array().is_some_and(Vec::is_empty) {
-            buffers
-                .as_array_mut()
-                .expect("buffers is an array")
-                .push(json!({"byteLength": 0}));
+        match buffers.as_array_mut().expect("buffers is an array") {
+            list if list.is_empty() => list.push(json!({"byteLength": end})),
+            list => list[0]["byteLength"] = Value::from(end),
         }
         let views = root
             .entry("bufferViews")
@@ -397,30 +403,45 @@ fn store_image(
             .expect("bufferViews is an array");
         views.push(json!({"buffer": 0, "byteOffset": offset, "byteLength": bytes.len()}));
         let view = views.len() - 1;
-        *stored = format!("bufferView {view}");
-        return json!({"name": name, "mimeType": format.mime_type(), "bufferView": view});
-    }
-    if glb || embed {
+        (
+            json!({"name": name, "mimeType": format.mime_type(), "bufferView": view}),
+            format!("bufferView {view}"),
+        )
+    } else if glb || embed {
         let data = base64::engine::general_purpose::STANDARD.encode(&bytes);
-        *stored = "data: URI".to_owned();
-        return json!({"name": name, "uri": format!("data:{};base64,{data}", format.mime_type())});
-    }
-    let stem = file_safe(name);
-    let ext = format.extension();
-    let file = (1..)
-        .map(|n| {
-            if n == 1 {
-                format!("{stem}.{ext}")
-            } else {
-                format!("{stem}.{n}.{ext}")
-            }
-        })
-        .find(|candidate| names.claim(candidate, &bytes))
-        .expect("some name is free");
-    let uri = percent_encoding::utf8_percent_encode(&file, PATH_SEGMENT).to_string();
-    *stored = file.clone();
-    files.push(NewFile { name: file, bytes });
-    json!({"name": name, "uri": uri})
+        (
+            json!({"name": name, "uri": format!("data:{};base64,{data}", format.mime_type())}),
+            "data: URI".to_owned(),
+        )
+    } else {
+        let stem = file_safe(name);
+        let ext = format.extension();
+        let file = (1..)
+            .map(|n| {
+                if n == 1 {
+                    format!("{stem}.{ext}")
+                } else {
+                    format!("{stem}.{n}.{ext}")
+                }
+            })
+            .find(|candidate| names.claim(candidate, &bytes))
+            .expect("some name is free");
+        let uri = percent_encoding::utf8_percent_encode(&file, PATH_SEGMENT).to_string();
+        files.push(NewFile {
+            name: file.clone(),
+            bytes,
+        });
+        (json!({"name": name, "uri": uri}), file)
+    };
+    let images = json
+        .as_object_mut()
+        .expect("the document is an object")
+        .entry("images")
+        .or_insert_with(|| json!([]))
+        .as_array_mut()
+        .expect("images is an array");
+    images.push(entry);
+    (images.len() - 1, stored)
 }
 
 /// Removes buffer 0 (the GLB's BIN chunk) once nothing is left in it and no bufferView names

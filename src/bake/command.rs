@@ -7,7 +7,6 @@
 //! written unless `--in-place` is asked, and a file with nothing to bake is copied byte for
 //! byte (or, in place, not written at all). A file the loader reports errors for is not baked.
 
-use std::borrow::Cow;
 use std::collections::{HashMap, HashSet};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -19,12 +18,11 @@ use serde_json::Value;
 
 use super::apply::{apply, ApplyOptions, Names, OutputReport};
 use super::codec::{EncodeOptions, PngCompression};
-use super::engine::{bake, BakeOptions, ImageSource};
+use super::engine::{bake, BakeOptions};
 use super::kernel::KernelOptions;
 use super::plan::{plan, BakePlan, Note, PlanOptions};
 use super::prune::Dropped;
-use super::recipe::ImageId;
-use crate::asset::{self, resource, write, Asset};
+use crate::asset::{self, resource, write};
 use crate::diagnostics::Severity;
 use crate::migrate::paths::{identity, jobs, relocate, Job, Relocation};
 
@@ -142,15 +140,6 @@ impl FileResult {
     }
 }
 
-/// Serves an asset's images to the engine.
-struct AssetImages<'a>(&'a Asset);
-
-impl ImageSource for AssetImages<'_> {
-    fn image_bytes(&self, image: ImageId) -> Result<Cow<'_, [u8]>, String> {
-        self.0.image_bytes(image.0).map_err(|d| d.message)
-    }
-}
-
 /// File names claimed in one run, across files (several assets may write into one folder).
 #[derive(Default)]
 struct Claims {
@@ -242,7 +231,7 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
         .filter(|d| d.severity == Severity::Error)
         .map(|d| format!("{} ({})", d.message, d.code))
         .collect();
-    let asset = match loaded.asset {
+    let mut asset = match loaded.asset {
         Some(asset) if errors.is_empty() => asset,
         _ => return Err(format!("cannot be baked: {}", errors.join("; "))),
     };
@@ -291,6 +280,7 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
         result.outcome = Outcome::Copied;
         return Ok(result);
     }
+    drop(bytes);
     let bake_options = BakeOptions {
         keep_format: options.keep_format,
         collapse_uniform: options.collapse_uniform,
@@ -304,7 +294,7 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
         },
     };
     let mut baked = Vec::with_capacity(plan.recipes.len());
-    let results = bake(&plan.recipes, &AssetImages(&asset), &bake_options);
+    let results = bake(&plan.recipes, &asset, &bake_options);
     for (name, result) in planned_names.iter().zip(results) {
         baked.push(result.map_err(|e| format!("cannot bake {name}: {e}"))?);
     }
@@ -333,12 +323,13 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
         dir: out_dir.clone(),
         taken,
     };
+    let bin = asset.bin.take();
     let applied = apply(
         json,
-        asset.bin.clone(),
+        bin,
         asset.container,
         &plan,
-        &baked,
+        &mut baked,
         ApplyOptions {
             embed: options.embed,
         },

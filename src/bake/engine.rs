@@ -6,7 +6,10 @@
 //! its decoded pixels dropped before the worker takes the next component. So the memory in use
 //! is about the decoded images of the components in flight (one per worker, more only when a
 //! worker waiting inside a component's parallel kernel picks up another), not the sum of all
-//! images. Encoded outputs are returned to the caller, who writes them.
+//! images. An image that one recipe alone reads is handed to that recipe, whose kernel then
+//! rewrites it in place when it can (same layout and depth, table channels), so the common
+//! single-texture bake holds one decoded buffer, not two. Encoded outputs are returned to the
+//! caller, who writes them.
 
 use std::borrow::Cow;
 use std::collections::HashMap;
@@ -30,6 +33,13 @@ where
 {
     fn image_bytes(&self, image: ImageId) -> Result<Cow<'_, [u8]>, String> {
         self(image).map(Cow::Owned)
+    }
+}
+
+/// An asset serves its images by index: from a URI, a `data:` URI or a bufferView.
+impl ImageSource for crate::asset::Asset {
+    fn image_bytes(&self, image: ImageId) -> Result<Cow<'_, [u8]>, String> {
+        crate::asset::Asset::image_bytes(self, image.0).map_err(|d| d.message)
     }
 }
 
@@ -268,14 +278,36 @@ fn bake_component(
             }
         }
     }
-    component
-        .par_iter()
-        .map(|&i| {
+    // An image that one recipe alone reads is handed to it, so the kernel can rewrite it in
+    // place instead of allocating an output beside it.
+    let mut readers: HashMap<ImageId, usize> = HashMap::new();
+    for &i in component {
+        for image in recipes[i].images() {
+            *readers.entry(image).or_default() += 1;
+        }
+    }
+    let mut owned: HashMap<usize, Pixels> = HashMap::new();
+    for &i in component {
+        let images = recipes[i].images();
+        if let [only] = images[..] {
+            if readers[&only] == 1 {
+                if let Some(p) = pixels.remove(&only) {
+                    owned.insert(i, p);
+                }
+            }
+        }
+    }
+    let mut work: Vec<(usize, Option<Pixels>)> =
+        component.iter().map(|&i| (i, owned.remove(&i))).collect();
+    work.par_drain(..)
+        .map(|(i, own)| {
             let recipe = &recipes[i];
             let failed = recipe.images().into_iter().find_map(|im| failures.get(&im));
-            let result = match failed {
-                Some(e) => Err(e.clone()),
-                None => bake_one(recipe, &pixels, formats[&recipe.base()], options),
+            let format = formats.get(&recipe.base()).copied();
+            let result = match (failed, format) {
+                (Some(e), _) => Err(e.clone()),
+                (None, Some(format)) => bake_one(recipe, &pixels, own, format, options),
+                (None, None) => unreachable!("a decoded image has a format"),
             };
             (i, result)
         })
@@ -285,10 +317,14 @@ fn bake_component(
 fn bake_one(
     recipe: &Recipe,
     images: &HashMap<ImageId, Pixels>,
+    owned: Option<Pixels>,
     source_format: ImageFormat,
     options: &BakeOptions,
 ) -> Result<Baked, BakeError> {
-    let (out, stats) = kernel::apply(recipe, images, options.kernel)?;
+    let (out, stats) = match owned {
+        Some(image) => kernel::apply_owned(recipe, image, options.kernel)?,
+        None => kernel::apply(recipe, images, options.kernel)?,
+    };
     let uniform = if options.collapse_uniform {
         out.uniform()
     } else {

@@ -94,6 +94,74 @@ pub fn apply(
     })
 }
 
+/// Applies a recipe that reads only its base image, taking the image: when the output keeps
+/// the image's layout and depth and every channel is a copy, a constant or an unmeasured table
+/// (the fused case), the codes are rewritten where they lie, so no second buffer is allocated.
+/// Otherwise this is [`apply`].
+pub fn apply_owned(
+    recipe: &Recipe,
+    image: Pixels,
+    options: KernelOptions,
+) -> Result<(Pixels, KernelStats), KernelError> {
+    let base = recipe.base();
+    let images = HashMap::from([(base, image)]);
+    let in_place = {
+        let plan = Plan::compile(recipe, &images, options)?;
+        let image = &images[&base];
+        match plan.fused() {
+            Some(f) if plan.layout == image.layout() && plan.depth == image.depth() => {
+                let stats = plan
+                    .programs
+                    .iter()
+                    .map(|(channel, program)| {
+                        finish_stats(*channel, program, Acc::default(), plan.pixels())
+                    })
+                    .collect();
+                Some((f.tables, f.offsets, stats))
+            }
+            _ => None,
+        }
+    };
+    let Some((tables, offsets, stats)) = in_place else {
+        return apply(recipe, &images, options);
+    };
+    let image = images.into_values().next().expect("the base image");
+    let (width, height, layout) = (image.width(), image.height(), image.layout());
+    let Samples::U8(mut codes) = image.into_samples() else {
+        unreachable!("the fused case is 8-bit")
+    };
+    run_in_place(&mut codes, &tables, &offsets);
+    let pixels =
+        Pixels::new(width, height, layout, Samples::U8(codes)).expect("the buffer keeps its size");
+    Ok((pixels, KernelStats { channels: stats }))
+}
+
+/// The fused pass over a buffer whose pixels it rewrites (output layout = input layout).
+fn run_in_place(codes: &mut [u8], tables: &[[u8; 256]], offsets: &[usize]) {
+    fn pass<const N: usize>(codes: &mut [u8], tables: &[[u8; 256]], offsets: &[usize]) {
+        let tables: [[u8; 256]; N] = std::array::from_fn(|c| tables[c]);
+        let offsets: [usize; N] = std::array::from_fn(|c| offsets[c]);
+        let own = offsets.iter().enumerate().all(|(c, &o)| o == c);
+        codes.par_chunks_mut(N * 65536).for_each(|band| {
+            for p in band.chunks_exact_mut(N) {
+                // Every source code of the pixel is read before any is written.
+                let src: [u8; N] = std::array::from_fn(|c| p[c]);
+                for c in 0..N {
+                    let from = if own { c } else { offsets[c] };
+                    p[c] = tables[c][usize::from(src[from])];
+                }
+            }
+        });
+    }
+    match tables.len() {
+        1 => pass::<1>(codes, tables, offsets),
+        2 => pass::<2>(codes, tables, offsets),
+        3 => pass::<3>(codes, tables, offsets),
+        4 => pass::<4>(codes, tables, offsets),
+        _ => unreachable!("layouts have 1 to 4 channels"),
+    }
+}
+
 /// The output layout, size and depth `recipe` gives on `images`, without computing pixels.
 pub fn output_shape(
     recipe: &Recipe,
@@ -1029,6 +1097,39 @@ mod tests {
             ..KernelOptions::default()
         };
         assert!(compile(exact).fused().is_none());
+    }
+
+    #[test]
+    fn applying_to_an_owned_image_gives_the_same_pixels_and_stats() {
+        let recipes = [
+            colour_and_alpha(0.5, 0.25),
+            Recipe::new(IMG).with(Channel::A, ChannelRecipe::Copy(IMG, Channel::G)),
+            colour_and_alpha(2.0, 1.0),
+        ];
+        for image in [all_codes_8(), all_codes_16()] {
+            for recipe in &recipes {
+                for options in [
+                    KernelOptions::default(),
+                    KernelOptions {
+                        exact: false,
+                        measure: true,
+                    },
+                ] {
+                    let shared = apply(recipe, &one(image.clone()), options).unwrap();
+                    let owned = apply_owned(recipe, image.clone(), options).unwrap();
+                    assert_eq!(shared, owned);
+                }
+            }
+        }
+        let grey = Pixels::new(2, 1, Layout::Grey, Samples::U8(vec![100, 200])).unwrap();
+        let recipe = Recipe::new(IMG).with(Channel::A, ChannelRecipe::Copy(IMG, Channel::R));
+        let (out, _) = apply_owned(&recipe, grey, KernelOptions::default()).unwrap();
+        assert_eq!(
+            out.layout(),
+            Layout::GreyAlpha,
+            "a new layout is not done in place"
+        );
+        assert_eq!(codes(&out), vec![100, 100, 200, 200]);
     }
 
     #[test]

@@ -288,14 +288,15 @@ fn compact_bin(json: &mut Value, bin: &mut Vec<u8>, drop: &BTreeSet<usize>) -> u
             .map(|(s, e)| e - s)
             .sum()
     };
-    let mut kept = Vec::with_capacity(bin.len());
-    let mut at = 0;
-    for &(s, e) in &merged {
-        kept.extend_from_slice(&bin[at..s]);
-        at = e;
+    // Move the kept runs down where they lie (no second buffer).
+    let mut write = merged[0].0;
+    for (k, &(_, e)) in merged.iter().enumerate() {
+        let next = merged.get(k + 1).map_or(bin.len(), |m| m.0);
+        bin.copy_within(e..next, write);
+        write += next - e;
     }
-    kept.extend_from_slice(&bin[at..]);
-    let removed = bin.len() - kept.len();
+    let removed = bin.len() - write;
+    bin.truncate(write);
     if let Some(Value::Array(views)) = json.get_mut("bufferViews") {
         for (i, view) in views.iter_mut().enumerate() {
             if drop.contains(&i) {
@@ -313,7 +314,6 @@ fn compact_bin(json: &mut Value, bin: &mut Vec<u8>, drop: &BTreeSet<usize>) -> u
         let old = length.as_u64().unwrap_or(0) as usize;
         *length = Value::from(old.saturating_sub(removed));
     }
-    *bin = kept;
     removed
 }
 
