@@ -38,6 +38,8 @@ pub struct Options {
     pub exact: bool,
     /// Copy relative resources next to an output in another folder instead of rewriting URIs.
     pub copy_resources: bool,
+    /// Limits and URI policy for reading inputs and their resources.
+    pub load: crate::asset::LoadOptions,
 }
 
 /// Whether this build carries the texture bake engine that `--exact` and texture fallbacks
