@@ -343,16 +343,31 @@ fn validate(args: ValidateArgs, color: ColorChoice, quiet: bool) -> ExitCode {
     let validator =
         Validator::new(schemas, Settings::default()).with_load_options(args.load.options());
     let progress = report::progress_bar(quiet);
-    let outcome =
-        match velvet::run::validate(&validator, &args.paths, &mut resolver, progress.as_ref()) {
-            Ok(o) => o,
-            Err(e) => return usage_error(e),
-        };
     let options = report::Options {
         color: args.format == Format::Text && color.for_stdout(),
         quiet,
     };
-    emit(report::render(args.format, &outcome.reports, &options).as_bytes());
+    // Each file's report is written as soon as it is done (see report::Stream).
+    let stdout = std::io::BufWriter::new(std::io::stdout().lock());
+    let mut stream = report::Stream::new(args.format, options, stdout);
+    let outcome = match velvet::run::validate_each(
+        &validator,
+        &args.paths,
+        &mut resolver,
+        progress.as_ref(),
+        &mut |r| match &progress {
+            // The bar is cleared while the report is written, so the two do not mix.
+            Some(bar) => bar.suspend(|| {
+                stream.push(r);
+                stream.flush();
+            }),
+            None => stream.push(r),
+        },
+    ) {
+        Ok(o) => o,
+        Err(e) => return usage_error(e),
+    };
+    stream.finish();
     if outcome.failed {
         ExitCode::from(1)
     } else {

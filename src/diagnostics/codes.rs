@@ -105,6 +105,7 @@ pub const BUFFER_BYTE_LENGTH_MISMATCH: Code = Code::new(
     Error,
     "A buffer's data (GLB BIN chunk, data: URI or file) is shorter than its byteLength.",
 );
+/// Reported by the image-size rule from headers, and by the decoders that refuse such images.
 pub const IMAGE_TOO_LARGE: Code = Code::new(
     "IMAGE_TOO_LARGE",
     Error,
@@ -132,7 +133,6 @@ pub const LOADER: &[&Code] = &[
     &BUFFER_VIEW_OUT_OF_RANGE,
     &BUFFER_BYTE_LENGTH_MISMATCH,
     &IMAGE_UNRECOGNIZED_FORMAT,
-    &IMAGE_TOO_LARGE,
 ];
 
 pub const TYPE_MISMATCH: Code = Code::new(

@@ -84,6 +84,79 @@ pub fn render(format: Format, reports: &[FileReport], options: &Options) -> Stri
     }
 }
 
+/// Writes a run's reports as they come. Text, JSON Lines and GitHub commands are written one
+/// file at a time and only the totals are kept, so a run over many files holds one file's
+/// report at a time, not all of them; the JSON report (an object for one file, an array for
+/// several) and SARIF (one log for the run) are documents of the whole run, written at the end.
+/// Write errors (a closed pipe) are ignored: the run's outcome is its exit status.
+pub struct Stream<W: std::io::Write> {
+    format: Format,
+    options: Options,
+    out: W,
+    kept: Vec<FileReport>,
+    files: usize,
+    totals: [usize; 4],
+}
+
+impl<W: std::io::Write> Stream<W> {
+    pub fn new(format: Format, options: Options, out: W) -> Stream<W> {
+        Stream {
+            format,
+            options,
+            out,
+            kept: Vec::new(),
+            files: 0,
+            totals: [0; 4],
+        }
+    }
+
+    /// Takes the next file's report (in input order).
+    pub fn push(&mut self, report: FileReport) {
+        self.files += 1;
+        let c = report.counts;
+        for (t, n) in self
+            .totals
+            .iter_mut()
+            .zip([c.errors, c.warnings, c.infos, c.hints])
+        {
+            *t += n;
+        }
+        let one = std::slice::from_ref(&report);
+        let text = match self.format {
+            Format::Text => text::render_with(
+                one,
+                &Options {
+                    quiet: true,
+                    ..self.options
+                },
+            ),
+            Format::Jsonl => json::render_lines(one),
+            Format::Github => github::render(one),
+            Format::Json | Format::Sarif => {
+                self.kept.push(report);
+                return;
+            }
+        };
+        let _ = self.out.write_all(text.as_bytes());
+    }
+
+    /// Writes out what is buffered.
+    pub fn flush(&mut self) {
+        let _ = self.out.flush();
+    }
+
+    /// Writes what ends the output: the summary line, or the whole-run document.
+    pub fn finish(mut self) {
+        let text = match self.format {
+            Format::Text if !self.options.quiet => text::summary(self.files, self.totals),
+            Format::Json | Format::Sarif => render(self.format, &self.kept, &self.options),
+            _ => String::new(),
+        };
+        let _ = self.out.write_all(text.as_bytes());
+        let _ = self.out.flush();
+    }
+}
+
 /// A progress bar on standard error, or `None` when standard error is not a terminal or the
 /// run is quiet (so logs and pipes never see one). Built only when asked for.
 pub fn progress_bar(quiet: bool) -> Option<indicatif::ProgressBar> {

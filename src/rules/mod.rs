@@ -12,6 +12,7 @@ pub mod disabled_layer;
 pub mod exclusions;
 pub mod fallback;
 pub mod fuzz_roughness_default;
+pub mod image_size;
 pub mod legacy_sheen;
 pub mod placement;
 pub mod references;
@@ -55,6 +56,7 @@ pub static REGISTRY: &[&dyn Rule] = &[
     &texcoord::TexCoords,
     &disabled_layer::DisabledLayer,
     &roughness_alpha::RoughnessAlpha,
+    &image_size::ImageSize,
     &fallback::Fallback,
     &fuzz_roughness_default::FuzzRoughnessDefault,
     &legacy_sheen::LegacySheen,
