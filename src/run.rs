@@ -33,7 +33,9 @@ pub fn validate(
     progress: Option<&indicatif::ProgressBar>,
 ) -> Result<Outcome, ConfigError> {
     let mut reports = Vec::new();
-    let each = validate_each(validator, inputs, resolver, progress, &mut |r| reports.push(r))?;
+    let each = validate_each(validator, inputs, resolver, progress, &mut |r| {
+        reports.push(r)
+    })?;
     Ok(Outcome {
         reports,
         excluded: each.excluded,

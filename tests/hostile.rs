@@ -237,7 +237,9 @@ fn deep_nesting_is_refused_at_the_limit_without_exhausting_the_stack() {
         format!("line 1, column {column}: the JSON nests deeper than 64 arrays and objects (raise the limit with --max-json-depth, at most 127)")
     );
     // 64 levels in all load under the default; 127 under the highest limit.
-    assert!(asset::load_bytes(path, nested(63).as_bytes()).asset.is_some());
+    assert!(asset::load_bytes(path, nested(63).as_bytes())
+        .asset
+        .is_some());
     assert_eq!(
         codes(&asset::load_bytes(path, nested(64).as_bytes()).diagnostics),
         ["JSON_TOO_DEEP"]
@@ -246,9 +248,11 @@ fn deep_nesting_is_refused_at_the_limit_without_exhausting_the_stack() {
         max_json_depth: limits::JSON_DEPTH_CEILING,
         ..LoadOptions::default()
     };
-    assert!(asset::load_bytes_with(path, nested(126).as_bytes(), &highest)
-        .asset
-        .is_some());
+    assert!(
+        asset::load_bytes_with(path, nested(126).as_bytes(), &highest)
+            .asset
+            .is_some()
+    );
 
     // Every rule, on a worker thread, over the deepest document the flag allows.
     let dir = tempfile::tempdir().unwrap();
@@ -373,8 +377,15 @@ fn a_forged_100000_square_png_is_refused_before_any_pixel_buffer_is_allocated() 
     let a = asset::load(&path).asset.unwrap();
     let (result, largest) = largest_allocation(|| a.decode_image(0));
     let err = result.unwrap_err();
-    assert_eq!((err.code, err.pointer.as_str()), ("IMAGE_TOO_LARGE", "/images/0"));
-    assert!(err.message.contains("--max-image-pixels"), "{}", err.message);
+    assert_eq!(
+        (err.code, err.pointer.as_str()),
+        ("IMAGE_TOO_LARGE", "/images/0")
+    );
+    assert!(
+        err.message.contains("--max-image-pixels"),
+        "{}",
+        err.message
+    );
     assert!(largest < 1 << 20, "{largest}");
 
     // `velvet bake` fails that file, names the image, the limit and the flag, and writes
@@ -582,9 +593,15 @@ fn writing_never_follows_outside_uris_and_outputs_stay_in_the_out_dir() {
     let migrated: Value =
         serde_json::from_slice(&std::fs::read(out_dir.join("migrated/chair.gltf")).unwrap())
             .unwrap();
-    assert_eq!(migrated["images"][0]["uri"], "../../assets/../shared/tex.png");
+    assert_eq!(
+        migrated["images"][0]["uri"],
+        "../../assets/../shared/tex.png"
+    );
     // Both outputs load with the flag.
-    for output in [out_dir.join("chair.gltf"), out_dir.join("migrated/chair.gltf")] {
+    for output in [
+        out_dir.join("chair.gltf"),
+        out_dir.join("migrated/chair.gltf"),
+    ] {
         let (status, out, _) = velvet(&["validate", "--allow-outside-uris", s(&output)]);
         assert_eq!(status, 0, "{out}");
     }
@@ -653,7 +670,11 @@ fn an_injected_write_error_leaves_no_partial_output_and_the_inputs_untouched() {
     assert_eq!(status, Some(1), "{out}");
     let (outputs, temporaries) = complete_outputs(&out_dir, &expected);
     assert_eq!(outputs.len(), 2, "{out}");
-    assert_eq!(temporaries, Vec::<PathBuf>::new(), "a failed write cleans up");
+    assert_eq!(
+        temporaries,
+        Vec::<PathBuf>::new(),
+        "a failed write cleans up"
+    );
     assert_eq!(out.matches(": injected write fault").count(), 4, "{out}");
     assert!(out.contains(", 4 failed"), "{out}");
     assert_eq!(tree(&input), inputs_before);
@@ -681,7 +702,10 @@ fn an_interrupted_batch_leaves_only_complete_outputs() {
     assert_eq!(status, None, "killed by a signal: {out}");
     let (outputs, temporaries) = complete_outputs(&out_dir, &expected);
     assert!(outputs.len() <= 3, "{outputs:?}");
-    assert!(!temporaries.is_empty(), "the interrupted write was mid-file");
+    assert!(
+        !temporaries.is_empty(),
+        "the interrupted write was mid-file"
+    );
     assert_eq!(tree(&input), inputs_before);
     // A rerun completes the batch; the leftover temporaries are hidden and never taken for
     // assets.
@@ -906,8 +930,14 @@ fn files_that_vanish_or_dangle_get_a_clear_error_and_the_run_goes_on() {
     let out_dir = dir.path().join("out");
     let (status, out, _) = velvet(&["migrate", s(&folder), "--out-dir", s(&out_dir)]);
     assert_eq!(status, 1, "{out}");
-    assert!(out.contains("dangling.gltf cannot be migrated: cannot read"), "{out}");
-    assert!(out.contains("b.gltf cannot be migrated: line 1, column 16"), "{out}");
+    assert!(
+        out.contains("dangling.gltf cannot be migrated: cannot read"),
+        "{out}"
+    );
+    assert!(
+        out.contains("b.gltf cannot be migrated: line 1, column 16"),
+        "{out}"
+    );
     assert_eq!(
         tree(&out_dir).into_keys().collect::<Vec<_>>(),
         [PathBuf::from("c.gltf")]
@@ -918,11 +948,16 @@ fn files_that_vanish_or_dangle_get_a_clear_error_and_the_run_goes_on() {
 fn a_resource_that_is_not_a_regular_file_is_not_read() {
     let dir = tempfile::tempdir().unwrap();
     std::os::unix::fs::symlink("/dev/zero", dir.path().join("zero.bin")).unwrap();
-    let doc = json!({"asset": {"version": "2.0"}, "buffers": [{"byteLength": 4, "uri": "zero.bin"}]});
+    let doc =
+        json!({"asset": {"version": "2.0"}, "buffers": [{"byteLength": 4, "uri": "zero.bin"}]});
     let path = dir.path().join("a.gltf");
     write(&path, doc.to_string());
     let a = asset::load(&path).asset.unwrap();
     let err = a.buffer_bytes(0).unwrap_err();
     assert_eq!(err.code, "IO_ERROR");
-    assert!(err.message.ends_with("not a regular file"), "{}", err.message);
+    assert!(
+        err.message.ends_with("not a regular file"),
+        "{}",
+        err.message
+    );
 }

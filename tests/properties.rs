@@ -57,7 +57,11 @@ fn colour() -> impl Strategy<Value = [f64; 3]> {
 
 /// A textureInfo for texture 0 (RGBA) or 1 (RGB); roughness slots need alpha, so take 0.
 fn texture_info(alpha_needed: bool) -> impl Strategy<Value = Value> {
-    let index = if alpha_needed { Just(0u64).boxed() } else { (0u64..=1).boxed() };
+    let index = if alpha_needed {
+        Just(0u64).boxed()
+    } else {
+        (0u64..=1).boxed()
+    };
     (index, any::<bool>()).prop_map(|(index, transform)| {
         let mut info = json!({"index": index});
         if transform {
@@ -286,7 +290,12 @@ fn validation_errors(path: &Path) -> Vec<String> {
         .findings
         .iter()
         .filter(|f| f.diagnostic.severity == Severity::Error)
-        .map(|f| format!("{} {}: {}", f.diagnostic.code, f.diagnostic.pointer, f.diagnostic.message))
+        .map(|f| {
+            format!(
+                "{} {}: {}",
+                f.diagnostic.code, f.diagnostic.pointer, f.diagnostic.message
+            )
+        })
         .collect()
 }
 
@@ -399,7 +408,13 @@ proptest! {
 /// recommended), and the core structure check refused arrays and scalars.
 #[test]
 fn extras_of_every_json_type_are_valid() {
-    for extras in [json!([1, "a"]), json!(7), json!("text"), json!(null), json!({"a": []})] {
+    for extras in [
+        json!([1, "a"]),
+        json!(7),
+        json!("text"),
+        json!(null),
+        json!({"a": []}),
+    ] {
         let doc = json!({
             "asset": {"version": "2.0", "extras": extras},
             "materials": [{"extras": extras}],

@@ -27,12 +27,7 @@ fuzz_target!(|data: &[u8]| {
         quiet: false,
     };
     let reports = [report];
-    for format in [
-        Format::Text,
-        Format::Json,
-        Format::Sarif,
-        Format::Github,
-    ] {
+    for format in [Format::Text, Format::Json, Format::Sarif, Format::Github] {
         let _ = report::render(format, &reports, &options);
     }
 });

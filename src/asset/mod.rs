@@ -143,7 +143,10 @@ pub fn load_bytes_with(path: &Path, bytes: &[u8], options: &LoadOptions) -> Load
     } else {
         (Container::Gltf, bytes, 0, None)
     };
-    let json_len = json_bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(json_bytes).len() as u64;
+    let json_len = json_bytes
+        .strip_prefix(b"\xEF\xBB\xBF")
+        .unwrap_or(json_bytes)
+        .len() as u64;
     if json_len > options.max_document_bytes {
         diagnostics.push(Diagnostic::new(
             &codes::DOCUMENT_TOO_LARGE,
@@ -442,7 +445,11 @@ impl Asset {
                 format!("image {index}: {detail}"),
             )
         };
-        let header = resource::read_header(Cursor::new(bytes.as_ref()), &pointer, &format!("image {index}"))?;
+        let header = resource::read_header(
+            Cursor::new(bytes.as_ref()),
+            &pointer,
+            &format!("image {index}"),
+        )?;
         if let Some(message) = self.options.image_too_large(header.width, header.height) {
             return Err(Diagnostic::new(
                 &codes::IMAGE_TOO_LARGE,

@@ -366,7 +366,11 @@ mod tests {
             );
         }
         // Remote schemes and other hosts are never fetched.
-        for uri in ["https://example.com/x.png", "file://server/share/x.png", "C:/x.png"] {
+        for uri in [
+            "https://example.com/x.png",
+            "file://server/share/x.png",
+            "C:/x.png",
+        ] {
             let refused = resolve_with(uri, base(), "", true).unwrap_err();
             assert_eq!(refused.code, "URI_NOT_FOLLOWED", "{uri}");
         }
@@ -375,8 +379,15 @@ mod tests {
     #[test]
     fn only_regular_files_are_read() {
         let err = read_file(Path::new("/dev/zero"), "zero.bin", "/buffers/0/uri").unwrap_err();
-        assert_eq!((err.code, err.pointer.as_str()), ("IO_ERROR", "/buffers/0/uri"));
-        assert!(err.message.contains("not a regular file"), "{}", err.message);
+        assert_eq!(
+            (err.code, err.pointer.as_str()),
+            ("IO_ERROR", "/buffers/0/uri")
+        );
+        assert!(
+            err.message.contains("not a regular file"),
+            "{}",
+            err.message
+        );
     }
 
     #[test]

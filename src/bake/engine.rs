@@ -274,7 +274,12 @@ fn bake_component(
     images.dedup();
     let decoded: Vec<(ImageId, Decoded)> = images
         .par_iter()
-        .map(|&image| (image, decode_image(source, image, options.max_image_pixels.0)))
+        .map(|&image| {
+            (
+                image,
+                decode_image(source, image, options.max_image_pixels.0),
+            )
+        })
         .collect();
     let mut pixels = HashMap::new();
     let mut formats = HashMap::new();

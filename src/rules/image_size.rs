@@ -24,8 +24,7 @@ impl Rule for ImageSize {
                 let Some(index) = slot.texture.index else {
                     continue;
                 };
-                let Some(texture) = json.get("textures").and_then(|t| t.get(index as usize))
-                else {
+                let Some(texture) = json.get("textures").and_then(|t| t.get(index as usize)) else {
                     continue;
                 };
                 for (image, _) in texture_sources(texture, &format!("/textures/{index}")) {
@@ -41,7 +40,10 @@ impl Rule for ImageSize {
             let Ok(header) = cx.asset.image_header(image as usize) else {
                 continue;
             };
-            if let Some(message) = cx.asset.options.image_too_large(header.width, header.height)
+            if let Some(message) = cx
+                .asset
+                .options
+                .image_too_large(header.width, header.height)
             {
                 out.push(Diagnostic::new(
                     &codes::IMAGE_TOO_LARGE,
