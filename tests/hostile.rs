@@ -961,3 +961,91 @@ fn a_resource_that_is_not_a_regular_file_is_not_read() {
         err.message
     );
 }
+
+// ---------------------------------------------------------------------------------------------
+// Inputs found by fuzzing (fixtures/hostile/<target>-*.gltf|glb; docs/fuzzing.md tells which
+// run found each)
+
+fn error_findings(report: &velvet::validate::FileReport) -> Vec<(&str, &str)> {
+    report
+        .findings
+        .iter()
+        .filter(|f| f.diagnostic.severity == velvet::diagnostics::Severity::Error)
+        .map(|f| (f.diagnostic.code, f.diagnostic.pointer.as_str()))
+        .collect()
+}
+
+#[test]
+fn fuzz_validate_a_position_naming_no_accessor_is_a_dangling_reference() {
+    // The gltf crate's core check looked the POSITION accessor up without checking the index.
+    let validator = Validator::new(Schemas::builtin(), Settings::default());
+    let report = validator.validate_file(&fixture("validate-dangling-position-accessor.gltf"));
+    let positions: Vec<_> = error_findings(&report)
+        .into_iter()
+        .filter(|(_, p)| p.ends_with("/attributes/POSITION"))
+        .collect();
+    assert_eq!(
+        positions,
+        [
+            (
+                "UNRESOLVED_REFERENCE",
+                "/meshes/0/primitives/0/attributes/POSITION"
+            ),
+            (
+                "UNRESOLVED_REFERENCE",
+                "/meshes/1/primitives/0/attributes/POSITION"
+            ),
+        ]
+    );
+    assert_eq!(report.counts.errors, 11);
+    // The smallest such document: that reference is its only fault.
+    let loaded = asset::load_bytes(
+        Path::new("memory/a.gltf"),
+        br#"{"asset":{"version":"2.0"},"meshes":[{"primitives":[{"attributes":{"POSITION":5}}]}]}"#,
+    );
+    let report = validator.validate_loaded(Path::new("memory/a.gltf"), loaded);
+    assert_eq!(
+        error_findings(&report),
+        [(
+            "UNRESOLVED_REFERENCE",
+            "/meshes/0/primitives/0/attributes/POSITION"
+        )]
+    );
+    assert_eq!(
+        report.findings[0].diagnostic.message,
+        "meshes[0].primitives[0].attributes[\"POSITION\"]: the index names no object"
+    );
+}
+
+#[test]
+fn bake_leaves_a_document_whose_arrays_are_not_arrays_of_objects() {
+    let dir = tempfile::tempdir().unwrap();
+    let rgba = png(2, 2, image::ExtendedColorType::Rgba8);
+    for (key, value) in [
+        ("buffers", json!([5])),
+        ("buffers", json!({})),
+        ("bufferViews", json!("x")),
+        ("textures", json!([{"source": 0}, 7])),
+    ] {
+        let mut doc = sheen_document("unused");
+        doc["images"] = json!([{"bufferView": 0, "mimeType": "image/png"}]);
+        doc["bufferViews"] = json!([{"buffer": 0, "byteLength": rgba.len()}]);
+        doc["buffers"] = json!([{"byteLength": rgba.len()}]);
+        doc[key] = value;
+        let input = dir.path().join(format!("{key}.glb"));
+        write(&input, glb::join(doc.to_string().as_bytes(), Some(&rgba)));
+        let output = dir.path().join(format!("{key}.out.glb"));
+        let (status, out, _) = velvet(&["bake", s(&input), "-o", s(&output)]);
+        assert_eq!(status, 0, "{out}");
+        assert!(
+            out.contains(&format!(
+                "warning /{key}: {key} is not an array of objects, as glTF requires; nothing is baked"
+            )),
+            "{out}"
+        );
+        assert_eq!(
+            std::fs::read(&output).unwrap(),
+            std::fs::read(&input).unwrap()
+        );
+    }
+}

@@ -238,10 +238,29 @@ struct Group {
     members: Vec<(usize, usize)>,
 }
 
+/// The top-level arrays a bake reads and extends: each, when present, must be an array of
+/// objects. A document where one is not does not have glTF's structure (the core check reports
+/// it); baking it would mean guessing where new images and bufferViews go.
+const EDITED_ARRAYS: [&str; 4] = ["buffers", "bufferViews", "images", "textures"];
+
 /// Plans the bake of one asset.
 pub fn plan(asset: &Asset, options: PlanOptions) -> BakePlan {
     let json = &asset.json;
     let mut out = BakePlan::default();
+    for key in EDITED_ARRAYS {
+        let Some(value) = json.get(key) else { continue };
+        if !value
+            .as_array()
+            .is_some_and(|items| items.iter().all(Value::is_object))
+        {
+            out.notes.push(Note::new(
+                Level::Warning,
+                &format!("/{key}"),
+                format!("{key} is not an array of objects, as glTF requires; nothing is baked"),
+            ));
+            return out;
+        }
+    }
     let textures = json.get("textures").and_then(Value::as_array);
     let image_count = json
         .get("images")
