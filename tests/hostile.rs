@@ -896,7 +896,7 @@ fn files_that_vanish_or_dangle_get_a_clear_error_and_the_run_goes_on() {
     );
 
     // Files deleted or cut short between discovery and loading.
-    let (files, errors) = velvet::asset::discover::collect(&[folder.clone()]);
+    let (files, errors) = velvet::asset::discover::collect(std::slice::from_ref(&folder));
     assert!(errors.is_empty());
     assert_eq!(files.len(), 4);
     std::fs::remove_file(folder.join("a.gltf")).unwrap();

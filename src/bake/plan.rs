@@ -255,7 +255,7 @@ pub fn plan(asset: &Asset, options: PlanOptions) -> BakePlan {
         {
             out.notes.push(Note::new(
                 Level::Warning,
-                &format!("/{key}"),
+                format!("/{key}"),
                 format!("{key} is not an array of objects, as glTF requires; nothing is baked"),
             ));
             return out;
