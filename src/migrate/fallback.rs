@@ -18,7 +18,7 @@
 
 use super::note::{Conversion, Note, Skip};
 use super::plan::{number_like, MaterialCx, MaterialPlan};
-use super::roughness::{self, Direction};
+use super::roughness::{self, Direction, RoughnessMapping};
 use crate::asset::pointer;
 use crate::edit::Edit;
 use crate::layers::{self, max3, FuzzView};
@@ -113,7 +113,11 @@ pub fn sheen_for(cx: &MaterialCx, fuzz: &Value) -> (Map<String, Value>, Vec<Note
             assumed: layers::FUZZ_ROUGHNESS_DEFAULT_TABLE,
         });
     }
-    let roughness = roughness::map(view.roughness_or_table_default(), Direction::FuzzToSheen);
+    let roughness = roughness::map(
+        view.roughness_or_table_default(),
+        Direction::FuzzToSheen,
+        RoughnessMapping::Identity,
+    );
 
     let mut sheen = Map::new();
     sheen.insert("sheenColorFactor".into(), Value::Array(color));

@@ -15,7 +15,7 @@
 use super::measure;
 use super::note::{Conversion, Note, Skip};
 use super::plan::{number_like, MaterialCx, MaterialPlan};
-use super::roughness::{self, Direction};
+use super::roughness::{self, Direction, RoughnessMapping};
 use crate::edit::Edit;
 use crate::layers::{self, max3};
 use serde_json::{Map, Value};
@@ -81,7 +81,11 @@ pub fn fuzz_for(sheen: &Sheen) -> Option<Map<String, Value>> {
     if let Some(texture) = &sheen.color_texture {
         fuzz.insert("fuzzColorTexture".into(), texture.clone());
     }
-    let r = roughness::map(sheen.roughness, Direction::SheenToFuzz);
+    let r = roughness::map(
+        sheen.roughness,
+        Direction::SheenToFuzz,
+        RoughnessMapping::Identity,
+    );
     fuzz.insert(
         "fuzzRoughnessFactor".into(),
         number_like(Some(&sheen.roughness_value), r),

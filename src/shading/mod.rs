@@ -12,6 +12,8 @@ pub mod fit;
 pub mod fuzz;
 mod fuzz_table;
 pub mod layering;
+pub mod mapping;
+mod mapping_table;
 pub mod plot;
 pub mod quadrature;
 pub mod table;
