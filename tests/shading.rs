@@ -57,7 +57,10 @@ fn sheen_to_fuzz_difference_uses_the_fuzz_model_and_the_mapping_narrows_it() {
             roughness: 0.4,
         },
     );
-    assert!(fitted.rms < 0.5 * identity.rms, "{fitted:?} vs {identity:?}");
+    assert!(
+        fitted.rms < 0.5 * identity.rms,
+        "{fitted:?} vs {identity:?}"
+    );
     assert!(fitted.max_ordinary < identity.max_ordinary);
 }
 

@@ -85,8 +85,14 @@ mod tests {
     #[test]
     fn identity_copies_the_value() {
         for r in [0.0, 0.3, 0.5, 1.0] {
-            assert_eq!(map(r, Direction::SheenToFuzz, RoughnessMapping::Identity), r);
-            assert_eq!(map(r, Direction::FuzzToSheen, RoughnessMapping::Identity), r);
+            assert_eq!(
+                map(r, Direction::SheenToFuzz, RoughnessMapping::Identity),
+                r
+            );
+            assert_eq!(
+                map(r, Direction::FuzzToSheen, RoughnessMapping::Identity),
+                r
+            );
         }
     }
 
@@ -128,7 +134,10 @@ mod tests {
                 assert_eq!(worst, 0.0, "{d:?} {m:?}");
             }
         }
-        assert_eq!(curve(Direction::SheenToFuzz, RoughnessMapping::Fitted).len(), 257);
+        assert_eq!(
+            curve(Direction::SheenToFuzz, RoughnessMapping::Fitted).len(),
+            257
+        );
         assert_ne!(
             curve(Direction::SheenToFuzz, RoughnessMapping::Fitted),
             curve(Direction::FuzzToSheen, RoughnessMapping::Fitted)

@@ -320,7 +320,11 @@ impl fmt::Display for AccuracyReport {
 }
 
 /// Writes a Markdown table, columns padded to their widest cell.
-fn markdown_table(f: &mut fmt::Formatter<'_>, header: &[&str], rows: &[Vec<String>]) -> fmt::Result {
+fn markdown_table(
+    f: &mut fmt::Formatter<'_>,
+    header: &[&str],
+    rows: &[Vec<String>],
+) -> fmt::Result {
     let widths: Vec<usize> = (0..header.len())
         .map(|c| {
             rows.iter()
@@ -568,14 +572,22 @@ pub fn mapping_accuracy(n: usize) -> [MappingAccuracy; 2] {
                         nodes[cell] >= POOR_MATCH_BELOW && nodes[cell + 1] >= POOR_MATCH_BELOW
                     }
                 };
-                (x, (v - best.roughness).abs(), rms - best.rms, nanos, matched)
+                (
+                    x,
+                    (v - best.roughness).abs(),
+                    rms - best.rms,
+                    nanos,
+                    matched,
+                )
             })
             .collect();
         let deviation = |matched: bool| {
             let set: Vec<_> = results.iter().filter(|r| r.4 == matched).collect();
-            let worst = set
-                .iter()
-                .fold((f64::NAN, 0.0f64), |w, r| if r.1 >= w.1 { (r.0, r.1) } else { w });
+            let worst =
+                set.iter().fold(
+                    (f64::NAN, 0.0f64),
+                    |w, r| if r.1 >= w.1 { (r.0, r.1) } else { w },
+                );
             Deviation {
                 max: worst.1,
                 mean: set.iter().map(|r| r.1).sum::<f64>() / set.len().max(1) as f64,
@@ -599,7 +611,10 @@ pub struct MappingReport<'a>(pub &'a [MappingAccuracy]);
 
 impl fmt::Display for MappingReport<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let points = self.0.first().map_or(0, |m| m.matched.points + m.poor.points);
+        let points = self
+            .0
+            .first()
+            .map_or(0, |m| m.matched.points + m.poor.points);
         writeln!(
             f,
             "Roughness mapping: the shipped 257-node tables against the reference optimum (E and R by quadrature at every step), at {points} roughness values between table nodes."
@@ -943,7 +958,10 @@ mod tests {
         assert!(report.hard.max <= TABLE_BOUND_HARD, "{report:?}");
         assert!(report.table_nanos > 0.0 && report.quadrature_nanos > report.table_nanos);
         let text = report.to_string();
-        assert!(text.contains("| quadrature ") && text.contains("| table "), "{text}");
+        assert!(
+            text.contains("| quadrature ") && text.contains("| table "),
+            "{text}"
+        );
     }
 
     #[test]

@@ -2,8 +2,8 @@
 //! the outcome to an exit code; everything here is callable from tests.
 
 use super::accuracy::{
-    accuracy_report, fuzz_accuracy, mapping_accuracy, mapping_comparison, parse_points,
-    points_csv, MappingReport, PointsError, REPORT_GRID,
+    accuracy_report, fuzz_accuracy, mapping_accuracy, mapping_comparison, parse_points, points_csv,
+    MappingReport, PointsError, REPORT_GRID,
 };
 use super::plot::{accuracy_svg, mapping_svg, MappingCurves};
 use std::io::{self, Write};

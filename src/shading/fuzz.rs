@@ -224,10 +224,7 @@ impl FuzzCos {
     }
 
     fn multiple(&self, c: f64) -> f64 {
-        self.ms_scale
-            * (-self.ms_decay * c.hypot(self.mu)).exp()
-            * ms_angular(self.sigma, c)
-            * c
+        self.ms_scale * (-self.ms_decay * c.hypot(self.mu)).exp() * ms_angular(self.sigma, c) * c
     }
 
     /// The integrand at light cosine c and cos²(φ/2), φ the azimuth between the two directions.
@@ -300,7 +297,6 @@ pub fn reflectance_quadrature(mu: f64, alpha: f64, parts: Scattering, tol: f64) 
     hemisphere_albedo(&FuzzCos::new(mu, alpha, parts), tol)
 }
 
-
 /// The ways velvet computes R(μ, α), both behind [`fuzz_reflectance`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum ReflectanceMethod {
@@ -313,7 +309,8 @@ pub enum ReflectanceMethod {
 
 impl ReflectanceMethod {
     /// Both methods, in the order the accuracy report lists them.
-    pub const ALL: [ReflectanceMethod; 2] = [ReflectanceMethod::Quadrature, ReflectanceMethod::Table];
+    pub const ALL: [ReflectanceMethod; 2] =
+        [ReflectanceMethod::Quadrature, ReflectanceMethod::Table];
 
     /// The method's name in reports.
     pub fn name(self) -> &'static str {
@@ -449,7 +446,11 @@ mod tests {
     }
 
     fn direction(cos_theta: f64) -> [f64; 3] {
-        [((1.0 - cos_theta) * (1.0 + cos_theta)).sqrt(), 0.0, cos_theta]
+        [
+            ((1.0 - cos_theta) * (1.0 + cos_theta)).sqrt(),
+            0.0,
+            cos_theta,
+        ]
     }
 
     fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
@@ -474,7 +475,10 @@ mod tests {
                 );
                 let want = projected_area(c, sigma);
                 assert!(converged || c == 0.5, "σ={sigma}, cosθ={c}");
-                assert!((got - want).abs() < 1e-5, "σ={sigma}, cosθ={c}: {got} vs {want}");
+                assert!(
+                    (got - want).abs() < 1e-5,
+                    "σ={sigma}, cosθ={c}: {got} vs {want}"
+                );
             }
         }
     }
@@ -503,8 +507,14 @@ mod tests {
     fn the_fit_spline_passes_through_its_control_values_with_a_continuous_slope() {
         for k in 0..=10 {
             let sigma = k as f64 / 10.0;
-            assert!((ms_decay(sigma) - M_CONTROL[k + 1]).abs() < 1e-12, "m({sigma})");
-            assert!((ms_log_scale(sigma) - B_CONTROL[k + 1]).abs() < 1e-12, "b({sigma})");
+            assert!(
+                (ms_decay(sigma) - M_CONTROL[k + 1]).abs() < 1e-12,
+                "m({sigma})"
+            );
+            assert!(
+                (ms_log_scale(sigma) - B_CONTROL[k + 1]).abs() < 1e-12,
+                "b({sigma})"
+            );
         }
         let h = 1e-7;
         for k in 1..10 {
@@ -512,7 +522,10 @@ mod tests {
             for f in [ms_decay as fn(f64) -> f64, ms_log_scale] {
                 let left = (f(knot) - f(knot - h)) / h;
                 let right = (f(knot + h) - f(knot)) / h;
-                assert!((left - right).abs() < 1e-4 * left.abs().max(1.0), "at {knot}");
+                assert!(
+                    (left - right).abs() < 1e-4 * left.abs().max(1.0),
+                    "at {knot}"
+                );
             }
         }
         // F(σ, c): β at c = 0, 1 at c = 1, β = max(0.55, 0.44 + 0.42σ).
@@ -537,7 +550,10 @@ mod tests {
                     64,
                 );
             let got = r(mu, 1.0, Scattering::Single);
-            assert!((got - slab).abs() < REFLECTANCE_BOUND, "μ={mu}: {got} vs {slab}");
+            assert!(
+                (got - slab).abs() < REFLECTANCE_BOUND,
+                "μ={mu}: {got} vs {slab}"
+            );
         }
     }
 
@@ -559,7 +575,10 @@ mod tests {
                     64,
                 );
             let got = r(mu, alpha, Scattering::Multiple);
-            assert!((got - direct).abs() < REFLECTANCE_BOUND, "({mu}, {alpha}): {got} vs {direct}");
+            assert!(
+                (got - direct).abs() < REFLECTANCE_BOUND,
+                "({mu}, {alpha}): {got} vs {direct}"
+            );
             assert!(
                 (multiple_scattering_cos(mu, 0.4, alpha)
                     - (b - m * (0.16 + mu * mu).sqrt()).exp()
@@ -596,11 +615,17 @@ mod tests {
         for &(mu, alpha) in &[(0.1f64, 0.01f64), (0.5, 0.05), (1.0, 0.1), (0.01, 0.003)] {
             let sigma = alpha * alpha;
             let ss = r(mu, alpha, Scattering::Single);
-            assert!(ss >= 0.0 && ss <= 8.0 * sigma.powi(3) / mu.powi(5), "({mu}, {alpha}): {ss}");
+            assert!(
+                ss >= 0.0 && ss <= 8.0 * sigma.powi(3) / mu.powi(5),
+                "({mu}, {alpha}): {ss}"
+            );
         }
         // α = 0 exactly is the floor σ = SIGMA_MIN, and below the floor nothing changes.
         for mu in [0.0, 1e-3, 0.1, 0.5, 1.0] {
-            assert_eq!(r(mu, 0.0, Scattering::Total), r(mu, 1e-7, Scattering::Total));
+            assert_eq!(
+                r(mu, 0.0, Scattering::Total),
+                r(mu, 1e-7, Scattering::Total)
+            );
         }
         // At the floor R is the multiple-scattering fit alone once μ ≥ 1e-3 …
         for mu in [1e-3, 0.1, 0.5, 1.0] {
@@ -629,21 +654,38 @@ mod tests {
             assert!((got - want).abs() <= 1e-14 * want, "c={c}: {got} vs {want}");
             // μ just above 0 approaches it.
             let near = single_scattering_cos(1e-12, c, phi, alpha);
-            assert!((near - want).abs() <= 1e-6 * want, "c={c}: {near} vs {want}");
+            assert!(
+                (near - want).abs() <= 1e-6 * want,
+                "c={c}: {near} vs {want}"
+            );
         }
         // L → 0 (σ → 0 at normal view): −expm1 keeps the digits, no 0/0.
         let v = single_scattering_cos(1.0, 1.0, 0.0, 0.0);
         assert!(v.is_finite() && v >= 0.0);
         // Both on the horizon, facing each other: ωi + ωo = 0, N = 0.
         assert_eq!(single_scattering_cos(0.0, 0.0, PI, alpha), 0.0);
-        let grid = [0.0, 1e-300, 1e-12, 1e-6, 0.01, 0.3, 0.5, 0.99, 1.0 - 1e-15, 1.0];
+        let grid = [
+            0.0,
+            1e-300,
+            1e-12,
+            1e-6,
+            0.01,
+            0.3,
+            0.5,
+            0.99,
+            1.0 - 1e-15,
+            1.0,
+        ];
         for &mu in &grid {
             for &c in &grid {
                 for &a in &grid {
                     for phi in [0.0, 1.0, PI] {
                         let ss = single_scattering_cos(mu, c, phi, a);
                         let ms = multiple_scattering_cos(mu, c, a);
-                        assert!(ss.is_finite() && ss >= 0.0, "ss({mu}, {c}, {phi}, {a}) = {ss}");
+                        assert!(
+                            ss.is_finite() && ss >= 0.0,
+                            "ss({mu}, {c}, {phi}, {a}) = {ss}"
+                        );
                         assert!(ms.is_finite() && ms >= 0.0, "ms({mu}, {c}, {a}) = {ms}");
                     }
                 }
@@ -680,7 +722,16 @@ mod tests {
     #[test]
     fn reflectance_is_finite_bounded_and_converged_on_a_grid_with_extremes() {
         let mut values: Vec<f64> = (0..=8).map(|i| i as f64 / 8.0).collect();
-        values.extend([1e-300, 1e-12, 1e-4, 0.5 - 1e-15, 1.0 - 1e-15, f64::NAN, -1.0, 2.0]);
+        values.extend([
+            1e-300,
+            1e-12,
+            1e-4,
+            0.5 - 1e-15,
+            1.0 - 1e-15,
+            f64::NAN,
+            -1.0,
+            2.0,
+        ]);
         for &mu in &values {
             for &alpha in &values {
                 let est = reflectance_quadrature(mu, alpha, Scattering::Total, REFLECTANCE_TOL);
@@ -700,7 +751,8 @@ mod tests {
     fn committed_table_is_what_the_quadrature_gives() {
         let fresh = generate_table();
         if std::env::var_os("VELVET_UPDATE_GOLDEN").is_some() {
-            let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src/shading/fuzz_table.rs");
+            let path =
+                std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src/shading/fuzz_table.rs");
             std::fs::write(&path, table_source(&fresh)).unwrap();
             return;
         }
@@ -719,7 +771,10 @@ mod tests {
         for (i, j) in [(0, 0), (5, 9), (32, 32), (32, 0), (0, 32)] {
             let u = table_node(i);
             let want = fuzz_table::VALUES[j * n + i];
-            assert_eq!(fuzz_reflectance(u * u, table_node(j), ReflectanceMethod::Table), want);
+            assert_eq!(
+                fuzz_reflectance(u * u, table_node(j), ReflectanceMethod::Table),
+                want
+            );
         }
         let t = |mu, a| fuzz_reflectance(mu, a, ReflectanceMethod::Table);
         assert_eq!(t(-1.0, f64::NAN), t(0.0, 0.0));
@@ -727,7 +782,7 @@ mod tests {
         for i in 0..=200 {
             for j in 0..=200 {
                 let v = t(i as f64 / 200.0, j as f64 / 200.0);
-                assert!(v.is_finite() && v >= 0.0 && v < 0.8, "({i}, {j}): {v}");
+                assert!(v.is_finite() && (0.0..0.8).contains(&v), "({i}, {j}): {v}");
             }
         }
     }
@@ -736,7 +791,10 @@ mod tests {
     fn catmull_rom_reproduces_lines_and_nodes() {
         let line = |k: usize| 0.25 + 3.0 * k as f64 / 8.0;
         for x in [0.0, 0.01, 0.3, 0.5, 0.99, 1.0] {
-            assert!((catmull_rom(9, line, x) - (0.25 + 3.0 * x)).abs() < 1e-14, "{x}");
+            assert!(
+                (catmull_rom(9, line, x) - (0.25 + 3.0 * x)).abs() < 1e-14,
+                "{x}"
+            );
         }
         let bumpy = |k: usize| ((k * 7919) % 13) as f64;
         for k in 0..=8 {
@@ -750,8 +808,10 @@ mod tests {
         // A grid that is not the table's: μ and α in steps of 1/40 (0 and 1 included) and the
         // corner's own points.
         let axis: Vec<f64> = (0..=40).map(|i| i as f64 / 40.0).collect();
-        let mut points: Vec<(f64, f64)> =
-            axis.iter().flat_map(|&a| axis.iter().map(move |&mu| (mu, a))).collect();
+        let mut points: Vec<(f64, f64)> = axis
+            .iter()
+            .flat_map(|&a| axis.iter().map(move |&mu| (mu, a)))
+            .collect();
         for mu in [1e-6, 1e-4, 4e-4, 2e-3, 6e-3] {
             for a in [0.0, 0.01, 0.03, 0.1, 0.3, 1.0] {
                 points.push((mu, a));

@@ -413,7 +413,9 @@ mod tests {
         assert_eq!(last.mu, 1.0);
         assert!((last.fuzz_reflectance - 0.3324).abs() < 1e-3, "{last:?}");
         assert!((last.sheen_reflectance - 0.164).abs() < 1e-3, "{last:?}");
-        assert!((last.difference() - (last.fuzz_reflectance - last.sheen_reflectance)).abs() < 1e-15);
+        assert!(
+            (last.difference() - (last.fuzz_reflectance - last.sheen_reflectance)).abs() < 1e-15
+        );
         assert!(cmp.max_difference >= last.difference());
         assert_eq!(cmp.fuzz_reflectance, "fuzz R (quadrature)");
     }

@@ -160,7 +160,10 @@ fn scan_then_minimise(f: &mut impl FnMut(f64) -> f64, n: usize, tol: f64) -> (f6
     let step = 1.0 / (n - 1) as f64;
     let best = (0..n)
         .map(|i| (i, f(i as f64 * step)))
-        .fold((0, f64::INFINITY), |b, (i, v)| if v < b.1 { (i, v) } else { b });
+        .fold(
+            (0, f64::INFINITY),
+            |b, (i, v)| if v < b.1 { (i, v) } else { b },
+        );
     let lo = best.0.saturating_sub(1) as f64 * step;
     let hi = ((best.0 + 1).min(n - 1)) as f64 * step;
     let (x, fx) = bounded_minimum(f, lo, hi, tol);
@@ -343,14 +346,18 @@ pub fn generate_tables(samples: &ObjectiveSamples) -> MappingTables {
         .into_par_iter()
         .map(|j| {
             let e = samples.sheen_at(node(j));
-            optimum(Box::new(move |a| mean_square(&rule, &e, &samples.fuzz_at(a))))
+            optimum(Box::new(move |a| {
+                mean_square(&rule, &e, &samples.fuzz_at(a))
+            }))
         })
         .collect();
     let sheen_for_fuzz = (0..NODES)
         .into_par_iter()
         .map(|j| {
             let f = samples.fuzz_at(node(j));
-            let best = optimum(Box::new(move |t| mean_square(&rule, &samples.sheen_at(t * t), &f)));
+            let best = optimum(Box::new(move |t| {
+                mean_square(&rule, &samples.sheen_at(t * t), &f)
+            }));
             Optimum {
                 roughness: best.roughness * best.roughness,
                 rms: best.rms,
@@ -515,10 +522,11 @@ pub fn layer_match_with(
             (c * e - w * r).abs()
         })
         .collect();
-    let (at, max) = diffs
-        .iter()
-        .enumerate()
-        .fold((0, f64::NEG_INFINITY), |b, (i, &d)| if d > b.1 { (i, d) } else { b });
+    let (at, max) =
+        diffs.iter().enumerate().fold(
+            (0, f64::NEG_INFINITY),
+            |b, (i, &d)| if d > b.1 { (i, d) } else { b },
+        );
     let max_ordinary = mus
         .iter()
         .zip(&diffs)
@@ -572,7 +580,10 @@ mod tests {
         assert!(calls < 30, "{calls} evaluations for a parabola");
         // A minimum on an end is found exactly.
         assert_eq!(bounded_minimum(&mut |x: f64| x, 0.0, 1.0, 1e-9), (0.0, 0.0));
-        assert_eq!(bounded_minimum(&mut |x: f64| -x, 0.2, 0.7, 1e-9), (0.7, -0.7));
+        assert_eq!(
+            bounded_minimum(&mut |x: f64| -x, 0.2, 0.7, 1e-9),
+            (0.7, -0.7)
+        );
         // A kinked function: |x − 0.6|.
         let (x, _) = bounded_minimum(&mut |x: f64| (x - 0.6).abs(), 0.0, 1.0, 1e-9);
         assert!((x - 0.6).abs() < 2e-8, "{x}");
@@ -602,8 +613,16 @@ mod tests {
             return;
         }
         let pairs = [
-            (&tables.fuzz_for_sheen, &mapping_table::FUZZ_FOR_SHEEN, &mapping_table::FUZZ_FOR_SHEEN_RMS),
-            (&tables.sheen_for_fuzz, &mapping_table::SHEEN_FOR_FUZZ, &mapping_table::SHEEN_FOR_FUZZ_RMS),
+            (
+                &tables.fuzz_for_sheen,
+                &mapping_table::FUZZ_FOR_SHEEN,
+                &mapping_table::FUZZ_FOR_SHEEN_RMS,
+            ),
+            (
+                &tables.sheen_for_fuzz,
+                &mapping_table::SHEEN_FOR_FUZZ,
+                &mapping_table::SHEEN_FOR_FUZZ_RMS,
+            ),
         ];
         for (fresh, roughness, rms) in pairs {
             for j in 0..NODES {
@@ -633,7 +652,10 @@ mod tests {
                 (table - best.roughness).abs() <= FUZZ_FOR_SHEEN_DEVIATION,
                 "α({r}): table {table}, optimum {best:?}"
             );
-            assert!(mapping_rms(r, table) <= best.rms + MAPPING_RMS_LOSS, "α({r})");
+            assert!(
+                mapping_rms(r, table) <= best.rms + MAPPING_RMS_LOSS,
+                "α({r})"
+            );
         }
         // The reverse, where the best sheen is a real lobe (above the jump).
         for alpha in [0.3, 0.6, 0.77] {
@@ -643,7 +665,10 @@ mod tests {
                 (table - best.roughness).abs() <= SHEEN_FOR_FUZZ_DEVIATION,
                 "r({alpha}): table {table}, optimum {best:?}"
             );
-            assert!(mapping_rms(table, alpha) <= best.rms + MAPPING_RMS_LOSS, "r({alpha})");
+            assert!(
+                mapping_rms(table, alpha) <= best.rms + MAPPING_RMS_LOSS,
+                "r({alpha})"
+            );
         }
     }
 
@@ -725,7 +750,10 @@ mod tests {
         assert_eq!(scaled.at_mu, full.at_mu);
         // r below 0.1: flagged, and E's rise at grazing views dominates the maximum.
         let small = at(1.0, 0.05, 1.0, fuzz_roughness_for_sheen(0.05));
-        assert!(small.poor_match && small.max > 1.0 && small.at_mu < 0.01, "{small:?}");
+        assert!(
+            small.poor_match && small.max > 1.0 && small.at_mu < 0.01,
+            "{small:?}"
+        );
         assert!(!at(1.0, POOR_MATCH_BELOW, 1.0, 0.3).poor_match);
     }
 

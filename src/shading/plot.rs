@@ -344,7 +344,12 @@ pub fn mapping_svg(curves: &MappingCurves) -> Result<String, String> {
             .label("r(α): fuzz α → fallback sheen r")
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], reverse));
         right
-            .draw_series(DashedLineSeries::new([(0.0, 0.0), (1.0, 1.0)], 2, 4, identity))
+            .draw_series(DashedLineSeries::new(
+                [(0.0, 0.0), (1.0, 1.0)],
+                2,
+                4,
+                identity,
+            ))
             .map_err(|e| err(&e))?
             .label("identity (copy the number)")
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], identity));

@@ -288,7 +288,10 @@ mod tests {
         for (a, b, p) in [(0.0, 1.0, 22), (0.1, 1.0, 7), (-2.0, 3.0, 0)] {
             let sum: f64 = kronrod_15(a, b).iter().map(|(x, w)| w * x.powi(p)).sum();
             let exact = (b.powi(p + 1) - a.powi(p + 1)) / f64::from(p + 1);
-            assert!((sum - exact).abs() < 1e-13 * exact.abs().max(1.0), "{a} {b} {p}");
+            assert!(
+                (sum - exact).abs() < 1e-13 * exact.abs().max(1.0),
+                "{a} {b} {p}"
+            );
         }
         let r = kronrod_15(0.0, 0.1);
         assert!(r.windows(2).all(|w| w[0].0 < w[1].0));
