@@ -353,9 +353,13 @@ struct MigrateArgs {
     /// Decode sheen colour textures to measure what the fast conversion changes.
     #[arg(long)]
     report: bool,
-    /// Bake textures so that the fuzz matches the sheen texel by texel (needs the bake engine).
+    /// Bake a fuzzTexture and a normalised fuzzColorTexture from each sheen colour texture so
+    /// that the fuzz matches the sheen texel by texel (lobe and base attenuation).
     #[arg(long)]
     exact: bool,
+    /// .gltf: store baked textures as data: URIs instead of files next to the output.
+    #[arg(long)]
+    embed: bool,
     /// Regenerate the sheen fallback of materials that already have fuzz and sheen.
     #[arg(long)]
     refresh_fallback: bool,
@@ -385,6 +389,7 @@ fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
             refresh_fallback: args.refresh_fallback,
             report: args.report,
             exact: args.exact,
+            embed: args.embed,
             copy_resources: args.copy_resources,
         },
         dry_run: args.dry_run || args.check,

@@ -109,8 +109,21 @@ pub enum Note {
     ClearcoatOrder { fallback: bool },
     /// fuzzRoughnessFactor absent: the table default was used for the fallback.
     FuzzRoughnessDefault { assumed: f64 },
-    /// A fuzz texture needs a bake to become part of the sheen colour texture.
-    FuzzTextureNeedsBake { texture: String },
+    /// A fuzz texture could not be baked into the sheen colour texture.
+    FuzzTextureNotBaked { texture: String, reason: String },
+    /// The fallback's sheen colour texture is baked from the fuzz textures.
+    FallbackTextureBaked { sources: String },
+    /// --exact: fuzzTexture and fuzzColorTexture are baked from the sheen colour texture.
+    ExactBaked,
+    /// --exact could not bake: the fast mode was used for this material.
+    ExactNotBaked { reason: String },
+    /// A baked texture's largest difference from the exact f64 value, in codes.
+    BakeError {
+        pointer: String,
+        image: String,
+        max_codes: f64,
+        clamped: u64,
+    },
     /// fuzzTexture and fuzzColorTexture cannot be combined into one texture.
     FuzzTexturesIncompatible { reason: String },
     /// Black fuzz on an active layer: a fallback sheen would be switched off.
@@ -126,8 +139,12 @@ pub enum Note {
         product: [f64; 3],
         clamped: [f64; 3],
     },
-    /// Legacy sheen roughness followed a metallicRoughnessTexture (green): needs a bake.
-    LegacyRoughnessTexture { texture: Value },
+    /// Legacy sheen roughness followed a metallicRoughnessTexture (green), which could not be
+    /// baked into the alpha channel a sheen roughness texture reads.
+    LegacyRoughnessTexture { texture: Value, reason: String },
+    /// Legacy sheen roughness followed a metallicRoughnessTexture: its green channel (times
+    /// roughnessFactor) is baked into the alpha of a new sheenRoughnessTexture.
+    LegacyRoughnessBaked { roughness_factor: f64 },
     /// Legacy sheenTexture's intensity (alpha) is not applied by sheenColorTexture.
     LegacyTextureIntensity,
     /// Legacy properties next to ratified ones: the ratified ones stand.
@@ -157,7 +174,11 @@ impl Note {
             | Note::AttenuationMeasured { .. }
             | Note::ClearcoatOrder { .. }
             | Note::FuzzRoughnessDefault { .. }
-            | Note::ResourcesCopied { .. } => Level::Info,
+            | Note::ResourcesCopied { .. }
+            | Note::FallbackTextureBaked { .. }
+            | Note::ExactBaked
+            | Note::BakeError { .. }
+            | Note::LegacyRoughnessBaked { .. } => Level::Info,
             Note::UrisRewritten { leaves_folder, .. } => {
                 if *leaves_folder {
                     Level::Warning
@@ -168,7 +189,8 @@ impl Note {
             Note::Excluded { .. }
             | Note::Malformed { .. }
             | Note::MeasureFailed { .. }
-            | Note::FuzzTextureNeedsBake { .. }
+            | Note::FuzzTextureNotBaked { .. }
+            | Note::ExactNotBaked { .. }
             | Note::FuzzTexturesIncompatible { .. }
             | Note::DarkFuzz { .. }
             | Note::BlackFuzz
@@ -210,9 +232,25 @@ impl Note {
                 "fuzzRoughnessFactor is absent: the fallback uses the draft's table default {assumed:?} (its schema says {:?}); the fuzz is left as it is",
                 crate::layers::FUZZ_ROUGHNESS_DEFAULT_SCHEMA
             ),
-            Note::FuzzTextureNeedsBake { texture } => format!(
-                "{texture} needs a bake into the sheen colour texture (fuzzColor × fuzzIntensity), which this build does not include: the fallback sheen uses the factors instead"
+            Note::FuzzTextureNotBaked { texture, reason } => format!(
+                "{texture} cannot be baked into the sheen colour texture (fuzzColor × fuzzIntensity): {reason}; the fallback sheen uses the factors instead"
             ),
+            Note::FallbackTextureBaked { sources } => format!(
+                "the fallback's sheenColorTexture is baked from {sources} (fuzzColor × fuzzIntensity, per texel) and sheenColorFactor is [1.0, 1.0, 1.0]"
+            ),
+            Note::ExactBaked => {
+                "--exact: fuzzTexture (per-texel max3 of the linear sheen colour) and a normalised fuzzColorTexture are baked from sheenColorTexture, so lobe and base attenuation match texel by texel up to quantisation; fuzzFactor and fuzzColorFactor are the identity".into()
+            }
+            Note::ExactNotBaked { reason } => format!(
+                "--exact cannot bake this material's textures ({reason}): sheenColorTexture became fuzzColorTexture as it is (the fast mode)"
+            ),
+            Note::BakeError { pointer, image, max_codes, clamped } => {
+                let mut m = format!("{pointer}: {image} differs from the exact f64 result by at most {max_codes:.3} codes (quantisation)");
+                if *clamped > 0 {
+                    m += &format!("; {clamped} values clamped to the channel's range");
+                }
+                m
+            }
             Note::FuzzTexturesIncompatible { reason } => format!(
                 "fuzzTexture and fuzzColorTexture cannot be combined into one sheen colour texture ({reason}): the fallback sheen uses the factors instead"
             ),
@@ -227,8 +265,11 @@ impl Note {
                 rgb(*product),
                 rgb(*clamped)
             ),
-            Note::LegacyRoughnessTexture { texture } => format!(
-                "the draft sheen's roughness followed the material's roughness, which reads the green channel of metallicRoughnessTexture {texture}; sheenRoughnessTexture reads alpha, so carrying the texture needs a bake that this build does not include: sheenRoughnessFactor is the roughnessFactor alone"
+            Note::LegacyRoughnessTexture { texture, reason } => format!(
+                "the draft sheen's roughness followed the material's roughness, which reads the green channel of metallicRoughnessTexture {texture}; sheenRoughnessTexture reads alpha, and the texture cannot be baked ({reason}): sheenRoughnessFactor is the roughnessFactor alone"
+            ),
+            Note::LegacyRoughnessBaked { roughness_factor } => format!(
+                "the draft sheen's roughness followed the material's roughness: the green channel of its metallicRoughnessTexture × roughnessFactor {roughness_factor:?} is baked into the alpha of a new sheenRoughnessTexture (sheenRoughnessFactor 1.0)"
             ),
             Note::LegacyTextureIntensity => {
                 "sheenTexture became sheenColorTexture: its colour (RGB) is carried, but the draft's intensity in its alpha channel is not applied (that needs a bake)".into()
