@@ -171,7 +171,7 @@ fn unchanged_files_are_the_cases_with_nothing_to_migrate() {
 #[test]
 fn migrating_an_output_again_changes_nothing() {
     for case in cases() {
-        let (dir, output, _) = migrate_case(&case);
+        let (_dir, output, _) = migrate_case(&case);
         for refresh_fallback in [false, true] {
             // Inputs whose own fallback is stale (both), or that keep draft properties beside
             // ratified ones (legacy), are what a refresh changes; a fallback whose colour
@@ -867,4 +867,367 @@ fn the_command_exits_0_when_done_1_when_a_file_failed_2_on_usage_errors() {
         std::fs::read(&good).unwrap(),
         std::fs::read(fixtures().join("fuzz-only.gltf")).unwrap()
     );
+}
+
+// ---- Textures baked by migrate (decoded and compared pixel by pixel) ----
+
+/// The exact sRGB decode and encode (IEC 61966-2-1), written out here so that the tests do not
+/// check velvet's functions against themselves.
+fn srgb_decode(code: u8) -> f64 {
+    let v = code as f64 / 255.0;
+    if v <= 0.04045 {
+        v / 12.92
+    } else {
+        ((v + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+fn srgb_encode_code(linear: f64) -> u8 {
+    let l = linear.clamp(0.0, 1.0);
+    let v = if l <= 0.0031308 {
+        12.92 * l
+    } else {
+        1.055 * l.powf(1.0 / 2.4) - 0.055
+    };
+    (v * 255.0).round() as u8
+}
+
+fn linear_code(linear: f64) -> u8 {
+    (linear.clamp(0.0, 1.0) * 255.0).round() as u8
+}
+
+fn png_file(path: &Path, width: u32, height: u32, layout: image::ColorType, data: &[u8]) {
+    image::save_buffer(path, data, width, height, layout).unwrap();
+}
+
+/// The decoded RGBA8 pixels of the image that textureInfo `pointer` of the document at `gltf`
+/// reads (a file next to it).
+fn texture_pixels(gltf: &Path, pointer: &str) -> (image::ColorType, Vec<[u8; 4]>) {
+    let doc: Value = serde_json::from_slice(&std::fs::read(gltf).unwrap()).unwrap();
+    let texture = doc
+        .pointer(&format!("{pointer}/index"))
+        .unwrap()
+        .as_u64()
+        .unwrap();
+    let image = doc["textures"][texture as usize]["source"]
+        .as_u64()
+        .unwrap();
+    let uri = doc["images"][image as usize]["uri"].as_str().unwrap();
+    let decoded = image::open(gltf.parent().unwrap().join(uri)).unwrap();
+    let colour = decoded.color();
+    let pixels = decoded.to_rgba8().pixels().map(|p| p.0).collect();
+    (colour, pixels)
+}
+
+/// Sheen colour texels that cover black, the sRGB segment boundary (code 10 decodes below
+/// 0.04045, 11 above), mid values, one channel dominant per texel, and white.
+const SHEEN_TEXELS: [[u8; 3]; 8] = [
+    [0, 0, 0],
+    [10, 11, 0],
+    [255, 128, 64],
+    [64, 255, 128],
+    [1, 2, 200],
+    [200, 200, 200],
+    [255, 255, 255],
+    [37, 0, 90],
+];
+
+#[test]
+fn exact_mode_bakes_the_sheen_strength_and_normalised_colour_texel_by_texel() {
+    let dir = tempfile::tempdir().unwrap();
+    let data: Vec<u8> = SHEEN_TEXELS.iter().flatten().copied().collect();
+    png_file(
+        &dir.path().join("sheen.png"),
+        4,
+        2,
+        image::ColorType::Rgb8,
+        &data,
+    );
+    let factor = [0.8, 0.6, 0.3];
+    let input = dir.path().join("exact.gltf");
+    std::fs::write(
+        &input,
+        serde_json::to_vec_pretty(&serde_json::json!({
+            "asset": {"version": "2.0"},
+            "extensionsUsed": ["KHR_materials_sheen"],
+            "materials": [{"extensions": {"KHR_materials_sheen": {
+                "sheenColorFactor": factor,
+                "sheenColorTexture": {"index": 0},
+                "sheenRoughnessFactor": 0.4
+            }}}],
+            "textures": [{"source": 0, "sampler": 0}],
+            "samplers": [{"magFilter": 9729}],
+            "images": [{"uri": "sheen.png"}]
+        }))
+        .unwrap(),
+    )
+    .unwrap();
+    let output = dir.path().join("out/exact.gltf");
+    let report = migrate::run(&request(
+        vec![input.clone()],
+        Destination::File(output.clone()),
+        Options {
+            exact: true,
+            ..Options::default()
+        },
+    ))
+    .unwrap();
+    assert_eq!(report.files[0].outcome, FileOutcome::Changed);
+    assert!(report.files[0].materials[0]
+        .notes
+        .contains(&Note::ExactBaked));
+    let doc: Value = serde_json::from_slice(&std::fs::read(&output).unwrap()).unwrap();
+    let fuzz = &doc["materials"][0]["extensions"]["KHR_materials_fuzz"];
+    assert_eq!(fuzz["fuzzFactor"], serde_json::json!(1.0));
+    assert_eq!(fuzz["fuzzColorFactor"], serde_json::json!([1.0, 1.0, 1.0]));
+    assert_eq!(fuzz["fuzzRoughnessFactor"], serde_json::json!(0.4));
+    // The sheen fallback still reads the original texture, and the new textures keep its sampler.
+    let sheen = &doc["materials"][0]["extensions"]["KHR_materials_sheen"];
+    assert_eq!(sheen["sheenColorTexture"]["index"], 0);
+    assert_eq!(doc["images"][0]["uri"], "../sheen.png");
+    for pointer in ["fuzzTexture", "fuzzColorTexture"] {
+        let t = fuzz[pointer]["index"].as_u64().unwrap() as usize;
+        assert_eq!(doc["textures"][t]["sampler"], 0, "{pointer}");
+    }
+
+    let base = "/materials/0/extensions/KHR_materials_fuzz";
+    let (strength_type, strength) = texture_pixels(&output, &format!("{base}/fuzzTexture"));
+    let (_, colour) = texture_pixels(&output, &format!("{base}/fuzzColorTexture"));
+    assert_eq!(
+        strength_type,
+        image::ColorType::L8,
+        "the strength is one grey channel"
+    );
+    let mut worst_lobe: f64 = 0.0;
+    let mut worst_attenuation: f64 = 0.0;
+    for (k, texel) in SHEEN_TEXELS.iter().enumerate() {
+        let linear: [f64; 3] = std::array::from_fn(|i| factor[i] * srgb_decode(texel[i]));
+        let w = linear.iter().cloned().fold(0.0, f64::max);
+        assert_eq!(
+            strength[k][0],
+            linear_code(w),
+            "strength of texel {k} {texel:?}"
+        );
+        for i in 0..3 {
+            let expected = if w == 0.0 {
+                255
+            } else {
+                srgb_encode_code(linear[i] / w)
+            };
+            assert_eq!(
+                colour[k][i], expected,
+                "colour channel {i} of texel {k} {texel:?}"
+            );
+            // The lobe the fuzz shows, from the stored codes, against the sheen's.
+            let lobe = srgb_decode(colour[k][i]) * strength[k][0] as f64 / 255.0;
+            worst_lobe = worst_lobe.max((lobe - linear[i]).abs());
+        }
+        worst_attenuation = worst_attenuation.max((strength[k][0] as f64 / 255.0 - w).abs());
+    }
+    // Quantisation alone: half a linear code for the strength; the lobe adds the colour's code.
+    assert!(
+        worst_attenuation <= 0.5 / 255.0 + 1e-12,
+        "{worst_attenuation}"
+    );
+    assert!(worst_lobe < 0.01, "{worst_lobe}");
+    assert!(errors(&output).is_empty(), "{:?}", errors(&output));
+}
+
+#[test]
+fn a_draft_sheen_roughness_moves_from_metallic_roughness_green_to_alpha() {
+    let dir = tempfile::tempdir().unwrap();
+    // Metallic in blue, roughness in green; red (occlusion) must stay bit-exact.
+    let texels: [[u8; 3]; 4] = [[1, 0, 255], [2, 128, 0], [3, 255, 77], [4, 31, 9]];
+    let data: Vec<u8> = texels.iter().flatten().copied().collect();
+    png_file(
+        &dir.path().join("mr.png"),
+        2,
+        2,
+        image::ColorType::Rgb8,
+        &data,
+    );
+    let input = dir.path().join("legacy.gltf");
+    std::fs::write(
+        &input,
+        serde_json::to_vec_pretty(&serde_json::json!({
+            "asset": {"version": "2.0"},
+            "extensionsUsed": ["KHR_materials_sheen"],
+            "materials": [{
+                "pbrMetallicRoughness": {"roughnessFactor": 0.6, "metallicRoughnessTexture": {"index": 0}},
+                "extensions": {"KHR_materials_sheen": {"sheenFactor": 0.5}}
+            }],
+            "textures": [{"source": 0}],
+            "images": [{"uri": "mr.png"}]
+        }))
+        .unwrap(),
+    )
+    .unwrap();
+    let output = dir.path().join("legacy.out.gltf");
+    let report = migrate::run(&request(
+        vec![input],
+        Destination::File(output.clone()),
+        Options::default(),
+    ))
+    .unwrap();
+    assert_eq!(report.files[0].outcome, FileOutcome::Changed);
+    let doc: Value = serde_json::from_slice(&std::fs::read(&output).unwrap()).unwrap();
+    let layers = &doc["materials"][0]["extensions"];
+    assert_eq!(
+        layers["KHR_materials_sheen"]["sheenRoughnessFactor"],
+        serde_json::json!(1.0)
+    );
+    assert_eq!(
+        layers["KHR_materials_fuzz"]["fuzzRoughnessFactor"],
+        serde_json::json!(1.0)
+    );
+    assert_eq!(
+        layers["KHR_materials_sheen"]["sheenRoughnessTexture"],
+        layers["KHR_materials_fuzz"]["fuzzRoughnessTexture"],
+        "sheen and fuzz share the one baked texture"
+    );
+    // The material's own metallicRoughness still reads the original.
+    assert_eq!(
+        doc["materials"][0]["pbrMetallicRoughness"]["metallicRoughnessTexture"]["index"],
+        0
+    );
+    let (kind, pixels) = texture_pixels(
+        &output,
+        "/materials/0/extensions/KHR_materials_sheen/sheenRoughnessTexture",
+    );
+    assert_eq!(kind, image::ColorType::Rgba8);
+    for (k, t) in texels.iter().enumerate() {
+        assert_eq!(&pixels[k][..3], t, "RGB of texel {k} is bit-exact");
+        // 0.6 × code never lands on a half code here, where rounding order would decide.
+        assert_eq!(
+            pixels[k][3],
+            linear_code(0.6 * t[1] as f64 / 255.0),
+            "alpha of texel {k}"
+        );
+    }
+    assert!(errors(&output).is_empty(), "{:?}", errors(&output));
+}
+
+#[test]
+fn a_fallback_sheen_colour_is_baked_from_fuzz_colour_times_intensity() {
+    let dir = tempfile::tempdir().unwrap();
+    let colours: [[u8; 3]; 4] = [[255, 0, 0], [10, 11, 12], [128, 200, 255], [0, 0, 0]];
+    let data: Vec<u8> = colours.iter().flatten().copied().collect();
+    png_file(
+        &dir.path().join("colour.png"),
+        2,
+        2,
+        image::ColorType::Rgb8,
+        &data,
+    );
+    let intensity = [255u8, 128, 0, 77];
+    png_file(
+        &dir.path().join("intensity.png"),
+        2,
+        2,
+        image::ColorType::L8,
+        &intensity,
+    );
+    let input = dir.path().join("fuzz.gltf");
+    std::fs::write(
+        &input,
+        serde_json::to_vec_pretty(&serde_json::json!({
+            "asset": {"version": "2.0"},
+            "extensionsUsed": ["KHR_materials_fuzz"],
+            "materials": [{"extensions": {"KHR_materials_fuzz": {
+                "fuzzFactor": 0.9,
+                "fuzzTexture": {"index": 1},
+                "fuzzColorFactor": [1.0, 0.5, 0.25],
+                "fuzzColorTexture": {"index": 0},
+                "fuzzRoughnessFactor": 0.3
+            }}}],
+            "textures": [{"source": 0}, {"source": 1}],
+            "images": [{"uri": "colour.png"}, {"uri": "intensity.png"}]
+        }))
+        .unwrap(),
+    )
+    .unwrap();
+    let output = dir.path().join("fuzz.out.gltf");
+    migrate::run(&request(
+        vec![input],
+        Destination::File(output.clone()),
+        Options::default(),
+    ))
+    .unwrap();
+    let doc: Value = serde_json::from_slice(&std::fs::read(&output).unwrap()).unwrap();
+    let sheen = &doc["materials"][0]["extensions"]["KHR_materials_sheen"];
+    assert_eq!(
+        sheen["sheenColorFactor"],
+        serde_json::json!([1.0, 1.0, 1.0])
+    );
+    let (_, pixels) = texture_pixels(
+        &output,
+        "/materials/0/extensions/KHR_materials_sheen/sheenColorTexture",
+    );
+    let factor = [0.9, 0.45, 0.225];
+    for k in 0..4 {
+        for i in 0..3 {
+            let linear = factor[i] * srgb_decode(colours[k][i]) * intensity[k] as f64 / 255.0;
+            assert_eq!(
+                pixels[k][i],
+                srgb_encode_code(linear),
+                "channel {i} of texel {k}"
+            );
+        }
+    }
+    assert!(errors(&output).is_empty(), "{:?}", errors(&output));
+}
+
+#[test]
+fn a_glb_keeps_baked_textures_in_its_bin_chunk() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut png = std::io::Cursor::new(Vec::new());
+    image::write_buffer_with_format(
+        &mut png,
+        &[255, 0, 0, 128, 0, 0],
+        2,
+        1,
+        image::ColorType::Rgb8,
+        image::ImageFormat::Png,
+    )
+    .unwrap();
+    let png = png.into_inner();
+    let json = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_materials_sheen"],
+        "materials": [{"extensions": {"KHR_materials_sheen": {
+            "sheenColorFactor": [0.5, 0.25, 0.0], "sheenColorTexture": {"index": 0}
+        }}}],
+        "textures": [{"source": 0}],
+        "images": [{"bufferView": 0, "mimeType": "image/png"}],
+        "bufferViews": [{"buffer": 0, "byteLength": png.len()}],
+        "buffers": [{"byteLength": png.len()}]
+    });
+    let input = dir.path().join("in.glb");
+    std::fs::write(
+        &input,
+        glb::join(&serde_json::to_vec(&json).unwrap(), Some(&png)),
+    )
+    .unwrap();
+    let output = dir.path().join("out.glb");
+    let report = migrate::run(&request(
+        vec![input],
+        Destination::File(output.clone()),
+        Options {
+            exact: true,
+            ..Options::default()
+        },
+    ))
+    .unwrap();
+    assert_eq!(report.files[0].outcome, FileOutcome::Changed);
+    let bytes = std::fs::read(&output).unwrap();
+    let loaded = velvet::asset::load_bytes(&output, &bytes);
+    let asset = loaded.asset.unwrap();
+    let views = asset.json["bufferViews"].as_array().unwrap();
+    assert_eq!(views.len(), 3, "the source and the two baked images");
+    for view in views {
+        assert_eq!(view["byteOffset"].as_u64().unwrap_or(0) % 4, 0);
+    }
+    let images = asset.json["images"].as_array().unwrap();
+    assert!(images.iter().all(|i| i.get("uri").is_none()));
+    assert!(errors(&output).is_empty(), "{:?}", errors(&output));
 }
