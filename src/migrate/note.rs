@@ -103,6 +103,16 @@ pub enum Note {
         max: f64,
         mean: f64,
     },
+    /// --report: how far the fuzz layer's base attenuation is from the sheen layer's, over
+    /// view angles, at the material's factors (1 − max3·E against 1 − w·R).
+    LayerDifference {
+        sheen_roughness: f64,
+        fuzz_roughness: f64,
+        max_difference: f64,
+        at_mu: f64,
+        fuzz_model: String,
+        clamped: u64,
+    },
     /// --report: the measurement could not be made.
     MeasureFailed { reason: String },
     /// Fuzz lies over a clear coat where sheen lay under it.
@@ -172,6 +182,7 @@ impl Note {
             | Note::FallbackUpToDate
             | Note::ColorTextureAsIs { .. }
             | Note::AttenuationMeasured { .. }
+            | Note::LayerDifference { .. }
             | Note::ClearcoatOrder { .. }
             | Note::FuzzRoughnessDefault { .. }
             | Note::ResourcesCopied { .. }
@@ -221,6 +232,15 @@ impl Note {
             Note::AttenuationMeasured { image, texels, w, max, mean } => format!(
                 "attenuation difference |{w:?} − max3(sheenColor)| over the {texels} texels of image {image}: max {max:.4}, mean {mean:.4}"
             ),
+            Note::LayerDifference { sheen_roughness, fuzz_roughness, max_difference, at_mu, fuzz_model, clamped } => {
+                let mut m = format!(
+                    "layer difference: the base attenuation under the fuzz (roughness {fuzz_roughness:?}, {fuzz_model}) differs from that under the sheen (roughness {sheen_roughness:?}) by at most {max_difference:.4}, at view cosine {at_mu:.3}"
+                );
+                if *clamped > 0 {
+                    m += &format!(" ({clamped} attenuations clamped at 0 where the albedo exceeds 1)");
+                }
+                m
+            }
             Note::MeasureFailed { reason } => format!("the attenuation difference could not be measured: {reason}"),
             Note::ClearcoatOrder { fallback: false } => {
                 "the material has KHR_materials_clearcoat: the fuzz lies over the coat, while the sheen lay under it; the look changes where the coat is strong".into()

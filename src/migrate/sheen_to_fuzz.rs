@@ -21,6 +21,7 @@ use super::plan::{number_like, MaterialCx, MaterialPlan};
 use super::roughness::{self, Direction};
 use super::textures::{Contents, TextureBake};
 use crate::bake::Channel;
+use crate::shading::layering;
 use crate::edit::Edit;
 use crate::layers::{self, max3};
 use serde_json::{Map, Value};
@@ -192,6 +193,27 @@ pub fn convert(cx: &MaterialCx, sheen: &Sheen, plan: &mut MaterialPlan) {
     }
     if let Some(bake) = roughness_bake {
         plan.bakes.push(bake);
+    }
+    if cx.options.report {
+        let fuzz_roughness = roughness::map(sheen.roughness, Direction::SheenToFuzz);
+        let comparison = layering::sheen_to_fuzz_attenuation_difference(
+            layering::SheenParams {
+                color_max3: w,
+                roughness: sheen.roughness,
+            },
+            layering::FuzzParams {
+                weight: w,
+                roughness: fuzz_roughness,
+            },
+        );
+        plan.notes.push(Note::LayerDifference {
+            sheen_roughness: sheen.roughness,
+            fuzz_roughness,
+            max_difference: comparison.max_difference,
+            at_mu: comparison.at_mu,
+            fuzz_model: comparison.fuzz_reflectance,
+            clamped: comparison.clamps.clamped,
+        });
     }
     if let Some(bakes) = exact {
         plan.bakes.extend(bakes);
