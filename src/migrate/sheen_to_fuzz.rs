@@ -194,6 +194,26 @@ pub fn convert(cx: &MaterialCx, sheen: &Sheen, plan: &mut MaterialPlan) {
     if let Some(bake) = roughness_bake {
         plan.bakes.push(bake);
     }
+    if let Some(bakes) = exact {
+        plan.bakes.extend(bakes);
+        plan.notes.push(Note::ExactBaked);
+    } else if let Some(texture) = &sheen.color_texture {
+        plan.notes.push(Note::ColorTextureAsIs { w });
+        if cx.options.report {
+            plan.notes.push(
+                match measure::attenuation(cx.asset, texture, sheen.color, w) {
+                    Ok(m) => Note::AttenuationMeasured {
+                        image: m.image,
+                        texels: m.texels,
+                        w,
+                        max: m.max,
+                        mean: m.mean,
+                    },
+                    Err(reason) => Note::MeasureFailed { reason },
+                },
+            );
+        }
+    }
     if cx.options.report {
         let fuzz_roughness = roughness::map(sheen.roughness, Direction::SheenToFuzz);
         let comparison = layering::sheen_to_fuzz_attenuation_difference(
@@ -214,26 +234,6 @@ pub fn convert(cx: &MaterialCx, sheen: &Sheen, plan: &mut MaterialPlan) {
             fuzz_model: comparison.fuzz_reflectance,
             clamped: comparison.clamps.clamped,
         });
-    }
-    if let Some(bakes) = exact {
-        plan.bakes.extend(bakes);
-        plan.notes.push(Note::ExactBaked);
-    } else if let Some(texture) = &sheen.color_texture {
-        plan.notes.push(Note::ColorTextureAsIs { w });
-        if cx.options.report {
-            plan.notes.push(
-                match measure::attenuation(cx.asset, texture, sheen.color, w) {
-                    Ok(m) => Note::AttenuationMeasured {
-                        image: m.image,
-                        texels: m.texels,
-                        w,
-                        max: m.max,
-                        mean: m.mean,
-                    },
-                    Err(reason) => Note::MeasureFailed { reason },
-                },
-            );
-        }
     }
 }
 
