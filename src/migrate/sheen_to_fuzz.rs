@@ -21,9 +21,9 @@ use super::plan::{number_like, MaterialCx, MaterialPlan};
 use super::roughness::{self, Direction};
 use super::textures::{Contents, TextureBake};
 use crate::bake::Channel;
-use crate::shading::layering;
 use crate::edit::Edit;
 use crate::layers::{self, max3};
+use crate::shading::layering;
 use serde_json::{Map, Value};
 
 /// A ratified sheen as the conversion needs it: values with the JSON text they came in (so
