@@ -900,6 +900,30 @@ fn png_file(path: &Path, width: u32, height: u32, layout: image::ColorType, data
     image::save_buffer(path, data, width, height, layout).unwrap();
 }
 
+/// Writes `json` as `<dir>/<name>.gltf`, migrates it to `output` (relative to `dir`) and
+/// returns the output's path, its document and the file's result.
+fn migrate_document(
+    dir: &Path,
+    name: &str,
+    json: Value,
+    output: &str,
+    options: Options,
+) -> (PathBuf, Value, migrate::FileResult) {
+    let input = dir.join(format!("{name}.gltf"));
+    std::fs::write(&input, serde_json::to_vec_pretty(&json).unwrap()).unwrap();
+    let output = dir.join(output);
+    let report = migrate::run(&request(
+        vec![input],
+        Destination::File(output.clone()),
+        options,
+    ))
+    .unwrap();
+    let result = report.files.into_iter().next().unwrap();
+    assert_eq!(result.outcome, FileOutcome::Changed, "{name}");
+    let doc: Value = serde_json::from_slice(&std::fs::read(&output).unwrap()).unwrap();
+    (output, doc, result)
+}
+
 /// The decoded RGBA8 pixels of the image that textureInfo `pointer` of the document at `gltf`
 /// reads (a file next to it).
 fn texture_pixels(gltf: &Path, pointer: &str) -> (image::ColorType, Vec<[u8; 4]>) {
@@ -944,10 +968,10 @@ fn exact_mode_bakes_the_sheen_strength_and_normalised_colour_texel_by_texel() {
         &data,
     );
     let factor = [0.8, 0.6, 0.3];
-    let input = dir.path().join("exact.gltf");
-    std::fs::write(
-        &input,
-        serde_json::to_vec_pretty(&serde_json::json!({
+    let (output, doc, result) = migrate_document(
+        dir.path(),
+        "exact",
+        serde_json::json!({
             "asset": {"version": "2.0"},
             "extensionsUsed": ["KHR_materials_sheen"],
             "materials": [{"extensions": {"KHR_materials_sheen": {
@@ -958,25 +982,13 @@ fn exact_mode_bakes_the_sheen_strength_and_normalised_colour_texel_by_texel() {
             "textures": [{"source": 0, "sampler": 0}],
             "samplers": [{"magFilter": 9729}],
             "images": [{"uri": "sheen.png"}]
-        }))
-        .unwrap(),
-    )
-    .unwrap();
-    let output = dir.path().join("out/exact.gltf");
-    let report = migrate::run(&request(
-        vec![input.clone()],
-        Destination::File(output.clone()),
+        }),
+        "out/exact.gltf",
         Options {
             exact: true,
             ..Options::default()
         },
-    ))
-    .unwrap();
-    assert_eq!(report.files[0].outcome, FileOutcome::Changed);
-    assert!(report.files[0].materials[0]
-        .notes
-        .contains(&Note::ExactBaked));
-    let doc: Value = serde_json::from_slice(&std::fs::read(&output).unwrap()).unwrap();
+    );
     let fuzz = &doc["materials"][0]["extensions"]["KHR_materials_fuzz"];
     assert_eq!(fuzz["fuzzFactor"], serde_json::json!(1.0));
     assert_eq!(fuzz["fuzzColorFactor"], serde_json::json!([1.0, 1.0, 1.0]));
@@ -1046,10 +1058,10 @@ fn a_draft_sheen_roughness_moves_from_metallic_roughness_green_to_alpha() {
         image::ColorType::Rgb8,
         &data,
     );
-    let input = dir.path().join("legacy.gltf");
-    std::fs::write(
-        &input,
-        serde_json::to_vec_pretty(&serde_json::json!({
+    let (output, doc, _) = migrate_document(
+        dir.path(),
+        "legacy",
+        serde_json::json!({
             "asset": {"version": "2.0"},
             "extensionsUsed": ["KHR_materials_sheen"],
             "materials": [{
@@ -1058,19 +1070,10 @@ fn a_draft_sheen_roughness_moves_from_metallic_roughness_green_to_alpha() {
             }],
             "textures": [{"source": 0}],
             "images": [{"uri": "mr.png"}]
-        }))
-        .unwrap(),
-    )
-    .unwrap();
-    let output = dir.path().join("legacy.out.gltf");
-    let report = migrate::run(&request(
-        vec![input],
-        Destination::File(output.clone()),
+        }),
+        "legacy.out.gltf",
         Options::default(),
-    ))
-    .unwrap();
-    assert_eq!(report.files[0].outcome, FileOutcome::Changed);
-    let doc: Value = serde_json::from_slice(&std::fs::read(&output).unwrap()).unwrap();
+    );
     let layers = &doc["materials"][0]["extensions"];
     assert_eq!(
         layers["KHR_materials_sheen"]["sheenRoughnessFactor"],
@@ -1127,10 +1130,10 @@ fn a_fallback_sheen_colour_is_baked_from_fuzz_colour_times_intensity() {
         image::ColorType::L8,
         &intensity,
     );
-    let input = dir.path().join("fuzz.gltf");
-    std::fs::write(
-        &input,
-        serde_json::to_vec_pretty(&serde_json::json!({
+    let (output, doc, _) = migrate_document(
+        dir.path(),
+        "fuzz",
+        serde_json::json!({
             "asset": {"version": "2.0"},
             "extensionsUsed": ["KHR_materials_fuzz"],
             "materials": [{"extensions": {"KHR_materials_fuzz": {
@@ -1142,18 +1145,10 @@ fn a_fallback_sheen_colour_is_baked_from_fuzz_colour_times_intensity() {
             }}}],
             "textures": [{"source": 0}, {"source": 1}],
             "images": [{"uri": "colour.png"}, {"uri": "intensity.png"}]
-        }))
-        .unwrap(),
-    )
-    .unwrap();
-    let output = dir.path().join("fuzz.out.gltf");
-    migrate::run(&request(
-        vec![input],
-        Destination::File(output.clone()),
+        }),
+        "fuzz.out.gltf",
         Options::default(),
-    ))
-    .unwrap();
-    let doc: Value = serde_json::from_slice(&std::fs::read(&output).unwrap()).unwrap();
+    );
     let sheen = &doc["materials"][0]["extensions"]["KHR_materials_sheen"];
     assert_eq!(
         sheen["sheenColorFactor"],
