@@ -989,6 +989,29 @@ fn exact_mode_bakes_the_sheen_strength_and_normalised_colour_texel_by_texel() {
             ..Options::default()
         },
     );
+    assert!(result.materials[0].notes.contains(&Note::ExactBaked));
+    // Each baked image states its quantisation error: at most half a code.
+    let errors_in_codes: Vec<(String, f64)> = result
+        .notes
+        .iter()
+        .filter_map(|n| match n {
+            Note::BakeError {
+                image, max_codes, ..
+            } => Some((image.clone(), *max_codes)),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(
+        errors_in_codes
+            .iter()
+            .map(|e| e.0.as_str())
+            .collect::<Vec<_>>(),
+        ["sheen.fuzz", "sheen.fuzzColor"]
+    );
+    assert!(
+        errors_in_codes.iter().all(|e| e.1 <= 0.5),
+        "{errors_in_codes:?}"
+    );
     let fuzz = &doc["materials"][0]["extensions"]["KHR_materials_fuzz"];
     assert_eq!(fuzz["fuzzFactor"], serde_json::json!(1.0));
     assert_eq!(fuzz["fuzzColorFactor"], serde_json::json!([1.0, 1.0, 1.0]));
