@@ -360,12 +360,26 @@ struct MigrateArgs {
     /// .gltf: store baked textures as data: URIs instead of files next to the output.
     #[arg(long)]
     embed: bool,
+    /// How roughness is carried between sheen and fuzz: fitted (by appearance: α(r) for the
+    /// fuzz, r(α) for a fallback sheen) or identity (the same number).
+    #[arg(long, value_enum, default_value_t = RoughnessArg::Fitted, value_name = "MAPPING")]
+    roughness: RoughnessArg,
+    /// With a roughness texture, copy the roughness (identity) instead of baking a mapped
+    /// texture, and say so.
+    #[arg(long)]
+    fast: bool,
     /// Regenerate the sheen fallback of materials that already have fuzz and sheen.
     #[arg(long)]
     refresh_fallback: bool,
     /// Copy relative resources next to outputs in another folder instead of rewriting URIs.
     #[arg(long)]
     copy_resources: bool,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum RoughnessArg {
+    Fitted,
+    Identity,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -390,6 +404,11 @@ fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
             report: args.report,
             exact: args.exact,
             embed: args.embed,
+            roughness: match args.roughness {
+                RoughnessArg::Fitted => migrate::roughness::RoughnessMapping::Fitted,
+                RoughnessArg::Identity => migrate::roughness::RoughnessMapping::Identity,
+            },
+            fast: args.fast,
             copy_resources: args.copy_resources,
         },
         dry_run: args.dry_run || args.check,

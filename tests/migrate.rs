@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use velvet::asset::glb;
 use velvet::diagnostics::Severity;
+use velvet::migrate::roughness::{self, Direction, RoughnessMapping};
 use velvet::migrate::{
     self, render, Conversion, Destination, FileOutcome, Note, Options, Request, Skip, UsageError,
 };
@@ -49,6 +50,7 @@ fn options_for(case: &Path) -> Options {
                 "--report" => options.report = true,
                 "--refresh-fallback" => options.refresh_fallback = true,
                 "--copy-resources" => options.copy_resources = true,
+                "--roughness identity" => options.roughness = RoughnessMapping::Identity,
                 other => panic!("{}: unknown flag {other}", case.display()),
             }
         }
@@ -106,6 +108,13 @@ fn golden(path: &Path, actual: &[u8]) {
 
 /// Migrates one fixture into a temporary folder; returns (folder, output path, result).
 fn migrate_case(case: &Path) -> (tempfile::TempDir, PathBuf, migrate::FileResult) {
+    migrate_case_with(case, options_for(case))
+}
+
+fn migrate_case_with(
+    case: &Path,
+    options: Options,
+) -> (tempfile::TempDir, PathBuf, migrate::FileResult) {
     let dir = tempfile::tempdir().unwrap();
     let input = dir.path().join("in").join(case.file_name().unwrap());
     std::fs::create_dir_all(input.parent().unwrap()).unwrap();
@@ -114,7 +123,7 @@ fn migrate_case(case: &Path) -> (tempfile::TempDir, PathBuf, migrate::FileResult
     let report = migrate::run(&request(
         vec![input.parent().unwrap().to_path_buf()],
         Destination::Dir(out_dir.clone()),
-        options_for(case),
+        options,
     ))
     .unwrap();
     assert_eq!(report.files.len(), 1);
@@ -170,19 +179,37 @@ fn unchanged_files_are_the_cases_with_nothing_to_migrate() {
 
 #[test]
 fn migrating_an_output_again_changes_nothing() {
-    for case in cases() {
-        let (_dir, output, _) = migrate_case(&case);
-        for refresh_fallback in [false, true] {
+    // The fitted mappings α(r) and r(α) are each optimal, not each other's inverse, so only the
+    // identity promises that a refreshed fallback gives back the sheen it came from.
+    for (mapping, refreshes) in [
+        (RoughnessMapping::Fitted, &[false][..]),
+        (RoughnessMapping::Identity, &[false, true][..]),
+    ] {
+        for case in cases() {
+            let options = Options {
+                roughness: mapping,
+                ..options_for(&case)
+            };
+            again_changes_nothing(&case, options, refreshes);
+        }
+    }
+}
+
+fn again_changes_nothing(case: &Path, first: Options, refreshes: &[bool]) {
+    {
+        let (_dir, output, _) = migrate_case_with(case, first.clone());
+        for &refresh_fallback in refreshes {
             // Inputs whose own fallback is stale (both), or that keep draft properties beside
             // ratified ones (legacy), are what a refresh changes; a fallback whose colour
             // texture is baked from fuzz textures is baked anew by every refresh.
             if refresh_fallback
-                && ["both", "legacy", "fuzz-textures"].contains(&stem(&case).as_str())
+                && ["both", "legacy", "fuzz-textures"].contains(&stem(case).as_str())
             {
                 continue;
             }
             let options = Options {
                 refresh_fallback,
+                roughness: first.roughness,
                 ..Options::default()
             };
             // Beside the first output, whose baked images it shares.
@@ -196,8 +223,9 @@ fn migrating_an_output_again_changes_nothing() {
             assert_eq!(
                 report.files[0].outcome,
                 FileOutcome::Copied,
-                "{} (refresh {refresh_fallback})",
-                case.display()
+                "{} (refresh {refresh_fallback}, {:?})",
+                case.display(),
+                first.roughness
             );
             assert_file(&again, &std::fs::read(&output).unwrap());
         }
@@ -791,7 +819,7 @@ fn dry_run_prints_the_plan_and_writes_nothing() {
         "{text}"
     );
     assert!(text.contains(
-        "    set /materials/0/extensions/KHR_materials_fuzz = {\"fuzzFactor\":0.9,\"fuzzColorFactor\":[1.0,0.7777777777777777,0.6666666666666666],\"fuzzRoughnessFactor\":0.6}\n"
+        "    set /materials/0/extensions/KHR_materials_fuzz = {\"fuzzFactor\":0.9,\"fuzzColorFactor\":[1.0,0.7777777777777777,0.6666666666666666],\"fuzzRoughnessFactor\":0.623624274420407}\n"
     ), "{text}");
     assert!(
         text.contains("  declare KHR_materials_fuzz in /extensionsUsed\n"),
@@ -1015,7 +1043,15 @@ fn exact_mode_bakes_the_sheen_strength_and_normalised_colour_texel_by_texel() {
     let fuzz = &doc["materials"][0]["extensions"]["KHR_materials_fuzz"];
     assert_eq!(fuzz["fuzzFactor"], serde_json::json!(1.0));
     assert_eq!(fuzz["fuzzColorFactor"], serde_json::json!([1.0, 1.0, 1.0]));
-    assert_eq!(fuzz["fuzzRoughnessFactor"], serde_json::json!(0.4));
+    // The fitted mapping, the default, writes α(0.4) for the fuzz.
+    assert_eq!(
+        fuzz["fuzzRoughnessFactor"].as_f64(),
+        Some(roughness::map(
+            0.4,
+            Direction::SheenToFuzz,
+            RoughnessMapping::Fitted
+        ))
+    );
     // The sheen fallback still reads the original texture, and the new textures keep its sampler.
     let sheen = &doc["materials"][0]["extensions"]["KHR_materials_sheen"];
     assert_eq!(sheen["sheenColorTexture"]["index"], 0);
@@ -1081,21 +1117,45 @@ fn a_draft_sheen_roughness_moves_from_metallic_roughness_green_to_alpha() {
         image::ColorType::Rgb8,
         &data,
     );
+    let legacy = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_materials_sheen"],
+        "materials": [{
+            "pbrMetallicRoughness": {"roughnessFactor": 0.6, "metallicRoughnessTexture": {"index": 0}},
+            "extensions": {"KHR_materials_sheen": {"sheenFactor": 0.5}}
+        }],
+        "textures": [{"source": 0}],
+        "images": [{"uri": "mr.png"}]
+    });
+    let alpha_of = |output: &Path, layer: &str, slot: &str| -> Vec<u8> {
+        let (kind, pixels) =
+            texture_pixels(output, &format!("/materials/0/extensions/{layer}/{slot}"));
+        assert_eq!(kind, image::ColorType::Rgba8);
+        for (k, t) in texels.iter().enumerate() {
+            assert_eq!(
+                &pixels[k][..3],
+                t,
+                "RGB of texel {k} of {slot} is bit-exact"
+            );
+        }
+        pixels.iter().map(|p| p[3]).collect()
+    };
+    // 0.6 × code never lands on a half code here, where rounding order would decide.
+    let sheen_alpha: Vec<u8> = texels
+        .iter()
+        .map(|t| linear_code(0.6 * t[1] as f64 / 255.0))
+        .collect();
+
+    // Identity: sheen and fuzz read one texture holding 0.6 × green in alpha.
     let (output, doc, _) = migrate_document(
         dir.path(),
         "legacy",
-        serde_json::json!({
-            "asset": {"version": "2.0"},
-            "extensionsUsed": ["KHR_materials_sheen"],
-            "materials": [{
-                "pbrMetallicRoughness": {"roughnessFactor": 0.6, "metallicRoughnessTexture": {"index": 0}},
-                "extensions": {"KHR_materials_sheen": {"sheenFactor": 0.5}}
-            }],
-            "textures": [{"source": 0}],
-            "images": [{"uri": "mr.png"}]
-        }),
-        "legacy.out.gltf",
-        Options::default(),
+        legacy.clone(),
+        "identity.gltf",
+        Options {
+            roughness: RoughnessMapping::Identity,
+            ..Options::default()
+        },
     );
     let layers = &doc["materials"][0]["extensions"];
     assert_eq!(
@@ -1116,20 +1176,44 @@ fn a_draft_sheen_roughness_moves_from_metallic_roughness_green_to_alpha() {
         doc["materials"][0]["pbrMetallicRoughness"]["metallicRoughnessTexture"]["index"],
         0
     );
-    let (kind, pixels) = texture_pixels(
-        &output,
-        "/materials/0/extensions/KHR_materials_sheen/sheenRoughnessTexture",
+    assert_eq!(
+        alpha_of(&output, "KHR_materials_sheen", "sheenRoughnessTexture"),
+        sheen_alpha
     );
-    assert_eq!(kind, image::ColorType::Rgba8);
-    for (k, t) in texels.iter().enumerate() {
-        assert_eq!(&pixels[k][..3], t, "RGB of texel {k} is bit-exact");
-        // 0.6 × code never lands on a half code here, where rounding order would decide.
-        assert_eq!(
-            pixels[k][3],
-            linear_code(0.6 * t[1] as f64 / 255.0),
-            "alpha of texel {k}"
-        );
-    }
+    assert!(errors(&output).is_empty(), "{:?}", errors(&output));
+
+    // Fitted (the default): the sheen keeps 0.6 × green; the fuzz gets α(0.6 × green), each
+    // texel the nearest code to the mapping of its exact value.
+    let (output, doc, _) = migrate_document(
+        dir.path(),
+        "legacy",
+        legacy,
+        "fitted.gltf",
+        Options::default(),
+    );
+    let layers = &doc["materials"][0]["extensions"];
+    assert_ne!(
+        layers["KHR_materials_sheen"]["sheenRoughnessTexture"],
+        layers["KHR_materials_fuzz"]["fuzzRoughnessTexture"]
+    );
+    assert_eq!(
+        alpha_of(&output, "KHR_materials_sheen", "sheenRoughnessTexture"),
+        sheen_alpha
+    );
+    let fuzz_alpha: Vec<u8> = texels
+        .iter()
+        .map(|t| {
+            linear_code(roughness::map(
+                0.6 * t[1] as f64 / 255.0,
+                Direction::SheenToFuzz,
+                RoughnessMapping::Fitted,
+            ))
+        })
+        .collect();
+    assert_eq!(
+        alpha_of(&output, "KHR_materials_fuzz", "fuzzRoughnessTexture"),
+        fuzz_alpha
+    );
     assert!(errors(&output).is_empty(), "{:?}", errors(&output));
 }
 

@@ -19,9 +19,10 @@
 
 use super::note::{Conversion, Note, Skip};
 use super::plan::{number_like, MaterialCx, MaterialPlan};
-use super::roughness::{self, Direction};
+use super::roughness::{self, Direction, RoughnessMapping};
 use super::textures::{self, texture_index, Contents, TextureBake};
 use crate::asset::pointer;
+use crate::bake::Channel;
 use crate::edit::Edit;
 use crate::layers::{self, max3, FuzzView};
 use crate::rules::effective_tex_coord;
@@ -119,13 +120,46 @@ pub fn sheen_for(
             assumed: layers::FUZZ_ROUGHNESS_DEFAULT_TABLE,
         });
     }
-    let roughness = roughness::map(view.roughness_or_table_default(), Direction::FuzzToSheen);
+    // A fuzz roughness texture can be carried as it is only with the identity; with the
+    // fitted mapping the fallback gets a baked one holding r(factor × texel) (factor 1).
+    let fuzz_roughness = view.roughness_or_table_default();
+    let roughness_texture = fuzz.get("fuzzRoughnessTexture").filter(|v| v.is_object());
+    let mut mapping = cx.options.roughness;
+    let mut roughness_bakes = Vec::new();
+    if let (Some(texture), false) = (roughness_texture, mapping == RoughnessMapping::Identity) {
+        if cx.options.fast {
+            notes.push(Note::RoughnessTextureFast {
+                mapping: mapping.name(),
+            });
+            mapping = RoughnessMapping::Identity;
+        } else {
+            match cx.texture_bake(
+                layers::SHEEN,
+                "sheenRoughnessTexture",
+                "sheenRoughnessFactor",
+                vec![fuzz_roughness],
+                texture,
+                Contents::Roughness {
+                    channel: Channel::A,
+                    factor: fuzz_roughness,
+                    curve: Some(roughness::curve(Direction::FuzzToSheen, mapping)),
+                },
+            ) {
+                Ok(bake) => roughness_bakes.push(bake),
+                Err(reason) => {
+                    notes.push(Note::RoughnessNotMapped { reason });
+                    mapping = RoughnessMapping::Identity;
+                }
+            }
+        }
+    }
+    let roughness = roughness::map(fuzz_roughness, Direction::FuzzToSheen, mapping);
 
     let mut sheen = Map::new();
     sheen.insert("sheenColorFactor".into(), Value::Array(color));
     let intensity_texture = fuzz.get("fuzzTexture").filter(|v| v.is_object());
     let color_texture = fuzz.get("fuzzColorTexture").filter(|v| v.is_object());
-    let mut bakes = Vec::new();
+    let mut bakes = roughness_bakes;
     // The colour the lobe shows, which a baked texture holds in place of the factor.
     let lobe: [f64; 3] = std::array::from_fn(|i| view.color_factor[i] * view.factor);
     let mut bake_colour = |template: &Value, contents, what: &str, notes: &mut Vec<Note>| match cx

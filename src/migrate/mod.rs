@@ -40,6 +40,11 @@ pub struct Options {
     pub exact: bool,
     /// .gltf: store baked textures as `data:` URIs instead of files next to the output.
     pub embed: bool,
+    /// How roughness is carried between the layers (fitted by appearance, or copied).
+    pub roughness: roughness::RoughnessMapping,
+    /// Never bake a texture only to map roughness: copy it (identity) where a texture would
+    /// need the bake, and say so.
+    pub fast: bool,
     /// Copy relative resources next to an output in another folder instead of rewriting URIs.
     pub copy_resources: bool,
 }

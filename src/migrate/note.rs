@@ -106,13 +106,24 @@ pub enum Note {
     /// --report: how far the fuzz layer's base attenuation is from the sheen layer's, over
     /// view angles, at the material's factors (1 − max3·E against 1 − w·R).
     LayerDifference {
+        mapping: &'static str,
         sheen_roughness: f64,
         fuzz_roughness: f64,
         max_difference: f64,
         at_mu: f64,
+        /// max over μ of |max3(sheenColor)·E(μ, r) − w·R(μ, α)|.
+        reflectance_max: f64,
+        /// Its cosine-weighted rms over μ.
+        reflectance_rms: f64,
+        /// r < 0.1, where no fuzz roughness matches the sheen well.
+        poor_match: bool,
         fuzz_model: String,
         clamped: u64,
     },
+    /// --fast: a roughness texture keeps the identity mapping instead of a baked mapped one.
+    RoughnessTextureFast { mapping: &'static str },
+    /// The roughness texture could not be baked through the mapping: the identity is used.
+    RoughnessNotMapped { reason: String },
     /// --report: the measurement could not be made.
     MeasureFailed { reason: String },
     /// Fuzz lies over a clear coat where sheen lay under it.
@@ -183,6 +194,7 @@ impl Note {
             | Note::ColorTextureAsIs { .. }
             | Note::AttenuationMeasured { .. }
             | Note::LayerDifference { .. }
+            | Note::RoughnessTextureFast { .. }
             | Note::ClearcoatOrder { .. }
             | Note::FuzzRoughnessDefault { .. }
             | Note::ResourcesCopied { .. }
@@ -202,6 +214,7 @@ impl Note {
             | Note::MeasureFailed { .. }
             | Note::FuzzTextureNotBaked { .. }
             | Note::ExactNotBaked { .. }
+            | Note::RoughnessNotMapped { .. }
             | Note::FuzzTexturesIncompatible { .. }
             | Note::DarkFuzz { .. }
             | Note::BlackFuzz
@@ -232,15 +245,24 @@ impl Note {
             Note::AttenuationMeasured { image, texels, w, max, mean } => format!(
                 "attenuation difference |{w:?} − max3(sheenColor)| over the {texels} texels of image {image}: max {max:.4}, mean {mean:.4}"
             ),
-            Note::LayerDifference { sheen_roughness, fuzz_roughness, max_difference, at_mu, fuzz_model, clamped } => {
+            Note::LayerDifference { mapping, sheen_roughness, fuzz_roughness, max_difference, at_mu, reflectance_max, reflectance_rms, poor_match, fuzz_model, clamped } => {
                 let mut m = format!(
-                    "layer difference: the base attenuation under the fuzz (roughness {fuzz_roughness:?}, {fuzz_model}) differs from that under the sheen (roughness {sheen_roughness:?}) by at most {max_difference:.4}, at view cosine {at_mu:.3}"
+                    "layer difference ({mapping} roughness mapping, sheen {sheen_roughness:.4} → fuzz {fuzz_roughness:.4}, {fuzz_model}): |max3·E − w·R| over view angles max {reflectance_max:.4}, cosine-weighted rms {reflectance_rms:.4}; base attenuation differs by at most {max_difference:.4}, at view cosine {at_mu:.3}"
                 );
+                if *poor_match {
+                    m += &format!(" (sheen roughness below {}: no fuzz roughness matches it well)", crate::shading::mapping::POOR_MATCH_BELOW);
+                }
                 if *clamped > 0 {
                     m += &format!(" ({clamped} attenuations clamped at 0 where the albedo exceeds 1)");
                 }
                 m
             }
+            Note::RoughnessTextureFast { mapping } => format!(
+                "--fast: the roughness texture is carried as it is, so this material's roughness is copied (identity) instead of mapped ({mapping}), which would bake a new texture"
+            ),
+            Note::RoughnessNotMapped { reason } => format!(
+                "the roughness texture cannot be baked through the roughness mapping ({reason}): it is carried as it is and the roughness copied (identity)"
+            ),
             Note::MeasureFailed { reason } => format!("the attenuation difference could not be measured: {reason}"),
             Note::ClearcoatOrder { fallback: false } => {
                 "the material has KHR_materials_clearcoat: the fuzz lies over the coat, while the sheen lay under it; the look changes where the coat is strong".into()

@@ -18,7 +18,7 @@
 use super::measure;
 use super::note::{Conversion, Note, Skip};
 use super::plan::{number_like, MaterialCx, MaterialPlan};
-use super::roughness::{self, Direction};
+use super::roughness::{self, Direction, RoughnessMapping};
 use super::textures::{Contents, TextureBake};
 use crate::bake::Channel;
 use crate::edit::Edit;
@@ -76,7 +76,11 @@ impl Sheen {
 /// The KHR_materials_fuzz object that stands for `sheen`, or `None` when the sheen is off.
 /// Keys follow the draft's parameter table. With `strength_texture`, the fuzzTexture slot
 /// reads it (the exact mode, whose bake fills it).
-pub fn fuzz_for(sheen: &Sheen, strength_texture: Option<&Value>) -> Option<Map<String, Value>> {
+pub fn fuzz_for(
+    sheen: &Sheen,
+    strength_texture: Option<&Value>,
+    mapping: RoughnessMapping,
+) -> Option<Map<String, Value>> {
     let w = max3(sheen.color);
     if !w.is_finite() || w <= 0.0 {
         return None;
@@ -96,7 +100,7 @@ pub fn fuzz_for(sheen: &Sheen, strength_texture: Option<&Value>) -> Option<Map<S
     if let Some(texture) = &sheen.color_texture {
         fuzz.insert("fuzzColorTexture".into(), texture.clone());
     }
-    let r = roughness::map(sheen.roughness, Direction::SheenToFuzz);
+    let r = roughness::map(sheen.roughness, Direction::SheenToFuzz, mapping);
     fuzz.insert(
         "fuzzRoughnessFactor".into(),
         number_like(Some(&sheen.roughness_value), r),
@@ -148,38 +152,53 @@ pub fn convert(cx: &MaterialCx, sheen: &Sheen, plan: &mut MaterialPlan) {
             Err(reason) => plan.notes.push(Note::ExactNotBaked { reason }),
         }
     }
-    // A draft sheen's roughness texture (green of metallicRoughness) is baked into alpha: the
-    // fuzz reads the same baked alpha as the upgraded sheen.
+    // A roughness texture is carried as it is only when the mapping is the identity and it
+    // holds roughness in alpha; otherwise the fuzz gets a baked one holding
+    // mapping(factor × texel) in alpha (a draft sheen's green channel moves there too).
+    let mut mapping = cx.options.roughness;
     let mut carried = std::borrow::Cow::Borrowed(sheen);
     let mut roughness_bake = None;
-    if let (Some(texture), false) = (
-        &sheen.roughness_texture,
-        sheen.roughness_channel == Channel::A,
-    ) {
-        match cx.texture_bake(
-            layers::FUZZ,
-            "fuzzRoughnessTexture",
-            "fuzzRoughnessFactor",
-            vec![sheen.roughness],
-            texture,
-            Contents::Roughness {
-                channel: sheen.roughness_channel,
-                factor: sheen.roughness,
-                curve: None,
-            },
-        ) {
-            Ok(bake) => roughness_bake = Some(bake),
-            Err(reason) => {
-                plan.notes.push(Note::TextureDropped {
-                    property: "fuzzRoughnessTexture".into(),
-                    reason,
-                });
-                carried.to_mut().roughness_texture = None;
+    if let Some(texture) = &sheen.roughness_texture {
+        if mapping != RoughnessMapping::Identity && cx.options.fast {
+            plan.notes.push(Note::RoughnessTextureFast {
+                mapping: mapping.name(),
+            });
+            mapping = RoughnessMapping::Identity;
+        }
+        let alpha = sheen.roughness_channel == Channel::A;
+        if !alpha || mapping != RoughnessMapping::Identity {
+            let curve = (mapping != RoughnessMapping::Identity)
+                .then(|| roughness::curve(Direction::SheenToFuzz, mapping));
+            match cx.texture_bake(
+                layers::FUZZ,
+                "fuzzRoughnessTexture",
+                "fuzzRoughnessFactor",
+                vec![sheen.roughness],
+                texture,
+                Contents::Roughness {
+                    channel: sheen.roughness_channel,
+                    factor: sheen.roughness,
+                    curve,
+                },
+            ) {
+                Ok(bake) => roughness_bake = Some(bake),
+                Err(reason) if alpha => {
+                    // The texture can still be carried as it is, with the identity.
+                    plan.notes.push(Note::RoughnessNotMapped { reason });
+                    mapping = RoughnessMapping::Identity;
+                }
+                Err(reason) => {
+                    plan.notes.push(Note::TextureDropped {
+                        property: "fuzzRoughnessTexture".into(),
+                        reason,
+                    });
+                    carried.to_mut().roughness_texture = None;
+                }
             }
         }
     }
     let strength_texture = exact.as_ref().and(sheen.color_texture.as_ref());
-    let Some(fuzz) = fuzz_for(&carried, strength_texture) else {
+    let Some(fuzz) = fuzz_for(&carried, strength_texture, mapping) else {
         plan.skip(Skip::SheenOff, Note::SheenOff);
         return;
     };
@@ -215,22 +234,26 @@ pub fn convert(cx: &MaterialCx, sheen: &Sheen, plan: &mut MaterialPlan) {
         }
     }
     if cx.options.report {
-        let fuzz_roughness = roughness::map(sheen.roughness, Direction::SheenToFuzz);
-        let comparison = layering::sheen_to_fuzz_attenuation_difference(
-            layering::SheenParams {
-                color_max3: w,
-                roughness: sheen.roughness,
-            },
-            layering::FuzzParams {
-                weight: w,
-                roughness: fuzz_roughness,
-            },
-        );
+        let fuzz_roughness = roughness::map(sheen.roughness, Direction::SheenToFuzz, mapping);
+        let sheen_params = layering::SheenParams {
+            color_max3: w,
+            roughness: sheen.roughness,
+        };
+        let fuzz_params = layering::FuzzParams {
+            weight: w,
+            roughness: fuzz_roughness,
+        };
+        let comparison = layering::sheen_to_fuzz_attenuation_difference(sheen_params, fuzz_params);
+        let matched = crate::shading::mapping::layer_match(sheen_params, fuzz_params);
         plan.notes.push(Note::LayerDifference {
+            mapping: mapping.name(),
             sheen_roughness: sheen.roughness,
             fuzz_roughness,
             max_difference: comparison.max_difference,
             at_mu: comparison.at_mu,
+            reflectance_max: matched.max,
+            reflectance_rms: matched.rms,
+            poor_match: matched.poor_match,
             fuzz_model: comparison.fuzz_reflectance,
             clamped: comparison.clamps.clamped,
         });
@@ -243,7 +266,7 @@ mod tests {
     use serde_json::json;
 
     fn fuzz_text(sheen: Value) -> Option<String> {
-        fuzz_for(&Sheen::read(&sheen), None)
+        fuzz_for(&Sheen::read(&sheen), None, RoughnessMapping::Identity)
             .map(|m| serde_json::to_string(&Value::Object(m)).unwrap())
     }
 
@@ -285,7 +308,7 @@ mod tests {
     fn textures_are_carried_with_their_extensions() {
         let tex = json!({"index": 2, "texCoord": 1, "extensions": {"KHR_texture_transform": {"scale": [30.0, -30.0]}}});
         let sheen = json!({"sheenColorFactor": [0.5, 0.5, 0.5], "sheenColorTexture": tex, "sheenRoughnessTexture": tex});
-        let fuzz = fuzz_for(&Sheen::read(&sheen), None).unwrap();
+        let fuzz = fuzz_for(&Sheen::read(&sheen), None, RoughnessMapping::Identity).unwrap();
         assert_eq!(fuzz["fuzzColorTexture"], tex);
         assert_eq!(fuzz["fuzzRoughnessTexture"], tex);
         assert_eq!(
@@ -308,7 +331,12 @@ mod tests {
             [1e-6, 0.0, 3e-7],
             [0.12, 0.12, 0.13],
         ] {
-            let fuzz = fuzz_for(&Sheen::read(&json!({ "sheenColorFactor": c })), None).unwrap();
+            let fuzz = fuzz_for(
+                &Sheen::read(&json!({ "sheenColorFactor": c })),
+                None,
+                RoughnessMapping::Identity,
+            )
+            .unwrap();
             let w = fuzz["fuzzFactor"].as_f64().unwrap();
             for i in 0..3 {
                 let colour = fuzz["fuzzColorFactor"][i].as_f64().unwrap();

@@ -12,6 +12,7 @@ pub mod disabled_layer;
 pub mod exclusions;
 pub mod fallback;
 pub mod fuzz_roughness_default;
+pub mod fuzz_roughness_mapping;
 pub mod legacy_sheen;
 pub mod placement;
 pub mod references;
@@ -56,6 +57,7 @@ pub static REGISTRY: &[&dyn Rule] = &[
     &disabled_layer::DisabledLayer,
     &roughness_alpha::RoughnessAlpha,
     &fallback::Fallback,
+    &fuzz_roughness_mapping::FuzzRoughnessMapping,
     &fuzz_roughness_default::FuzzRoughnessDefault,
     &legacy_sheen::LegacySheen,
     &clearcoat::Clearcoat,
