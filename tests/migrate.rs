@@ -1333,3 +1333,79 @@ fn a_glb_keeps_baked_textures_in_its_bin_chunk() {
     assert!(images.iter().all(|i| i.get("uri").is_none()));
     assert!(errors(&output).is_empty(), "{:?}", errors(&output));
 }
+
+#[test]
+fn a_fallback_sheen_roughness_texture_holds_the_mapped_roughness_unless_fast() {
+    let dir = tempfile::tempdir().unwrap();
+    let alphas = [0u8, 26, 128, 255];
+    let data: Vec<u8> = alphas.iter().flat_map(|&a| [200, 100, 50, a]).collect();
+    png_file(
+        &dir.path().join("rough.png"),
+        2,
+        2,
+        image::ColorType::Rgba8,
+        &data,
+    );
+    let fuzz = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_materials_fuzz"],
+        "materials": [{"extensions": {"KHR_materials_fuzz": {
+            "fuzzFactor": 1.0,
+            "fuzzColorFactor": [0.5, 0.5, 0.5],
+            "fuzzRoughnessFactor": 0.8,
+            "fuzzRoughnessTexture": {"index": 0}
+        }}}],
+        "textures": [{"source": 0}],
+        "images": [{"uri": "rough.png"}]
+    });
+    let (output, doc, _) = migrate_document(
+        dir.path(),
+        "fuzz",
+        fuzz.clone(),
+        "fitted.gltf",
+        Options::default(),
+    );
+    let sheen = &doc["materials"][0]["extensions"]["KHR_materials_sheen"];
+    assert_eq!(sheen["sheenRoughnessFactor"], serde_json::json!(1.0));
+    assert_ne!(sheen["sheenRoughnessTexture"]["index"], 0);
+    let (_, pixels) = texture_pixels(
+        &output,
+        "/materials/0/extensions/KHR_materials_sheen/sheenRoughnessTexture",
+    );
+    for (k, &a) in alphas.iter().enumerate() {
+        assert_eq!(
+            &pixels[k][..3],
+            &[200, 100, 50],
+            "RGB of texel {k} is bit-exact"
+        );
+        let expected = roughness::map(
+            0.8 * a as f64 / 255.0,
+            Direction::FuzzToSheen,
+            RoughnessMapping::Fitted,
+        );
+        assert_eq!(pixels[k][3], linear_code(expected), "alpha of texel {k}");
+    }
+    assert!(errors(&output).is_empty(), "{:?}", errors(&output));
+
+    // --fast: the texture is carried as it is and the roughness copied, said so.
+    let (_, doc, result) = migrate_document(
+        dir.path(),
+        "fuzz",
+        fuzz,
+        "fast.gltf",
+        Options {
+            fast: true,
+            ..Options::default()
+        },
+    );
+    let sheen = &doc["materials"][0]["extensions"]["KHR_materials_sheen"];
+    assert_eq!(sheen["sheenRoughnessFactor"], serde_json::json!(0.8));
+    assert_eq!(
+        sheen["sheenRoughnessTexture"],
+        serde_json::json!({"index": 0})
+    );
+    assert!(result.materials[0]
+        .notes
+        .contains(&Note::RoughnessTextureFast { mapping: "fitted" }));
+    assert_eq!(doc["images"].as_array().unwrap().len(), 1, "nothing baked");
+}
