@@ -11,9 +11,11 @@
 //! the size of the error of copying the roughness number across at r = 0.25 (0.073); a test pins
 //! these figures.
 //!
-//! Checked on factors only (a roughness texture multiplies both the same way), when both layers
-//! are on (a switched-off layer is the fallback rule's business) and fuzzRoughnessFactor is
-//! written (its default is ambiguous, which another rule reports).
+//! Checked on factors, so only when neither layer has a roughness texture: with one, the
+//! roughness is factor × texel, and the fitted mapping is not linear, so a mapped texture (as
+//! `velvet migrate` bakes it, with factor 1) cannot be judged by its factor. Also only when both
+//! layers are on (a switched-off layer is the fallback rule's business) and fuzzRoughnessFactor
+//! is written (its default is ambiguous, which another rule reports).
 //!
 //! Example: sheen r = 0.25 with fuzz α = 0.25 triggers (α(0.25) = 0.391); with α = 0.39 it does
 //! not.
@@ -56,7 +58,10 @@ impl Rule for FuzzRoughnessMapping {
             let Some(alpha) = fuzz.roughness_factor else {
                 continue;
             };
-            if !(fuzz.is_on() && sheen.is_on()) {
+            if !(fuzz.is_on() && sheen.is_on())
+                || fuzz.roughness_texture.is_some()
+                || sheen.roughness_texture.is_some()
+            {
                 continue;
             }
             let r = sheen.roughness_factor;
@@ -86,6 +91,48 @@ impl Rule for FuzzRoughnessMapping {
 mod tests {
     use super::*;
     use crate::shading::mapping::mapping_rms;
+
+    fn findings(doc: serde_json::Value) -> Vec<String> {
+        let text = serde_json::to_string(&doc).unwrap();
+        let loaded =
+            crate::asset::load_bytes(std::path::Path::new("memory/rule.gltf"), text.as_bytes());
+        let asset = loaded.asset.unwrap();
+        let schemas = crate::rules::schema::Schemas::builtin();
+        let cx = Context {
+            asset: &asset,
+            schemas: &schemas,
+        };
+        let mut out = Vec::new();
+        FuzzRoughnessMapping.check(&cx, &mut out);
+        out.into_iter().map(|d| d.pointer).collect()
+    }
+
+    #[test]
+    fn a_roughness_texture_on_either_layer_leaves_the_factors_unjudged() {
+        let material = |fuzz_texture: bool, sheen_texture: bool| {
+            let mut fuzz = serde_json::json!({"fuzzFactor": 1.0, "fuzzRoughnessFactor": 1.0});
+            let mut sheen = serde_json::json!({"sheenColorFactor": [1.0, 1.0, 1.0], "sheenRoughnessFactor": 0.25});
+            if fuzz_texture {
+                fuzz["fuzzRoughnessTexture"] = serde_json::json!({"index": 0});
+            }
+            if sheen_texture {
+                sheen["sheenRoughnessTexture"] = serde_json::json!({"index": 0});
+            }
+            serde_json::json!({
+                "asset": {"version": "2.0"},
+                "materials": [{"extensions": {"KHR_materials_fuzz": fuzz, "KHR_materials_sheen": sheen}}],
+                "textures": [{"source": 0}],
+                "images": [{"uri": "missing.png"}]
+            })
+        };
+        assert_eq!(
+            findings(material(false, false)),
+            ["/materials/0/extensions/KHR_materials_fuzz/fuzzRoughnessFactor"]
+        );
+        for (f, s) in [(true, false), (false, true), (true, true)] {
+            assert!(findings(material(f, s)).is_empty(), "{f} {s}");
+        }
+    }
 
     #[test]
     fn the_threshold_marks_a_several_fold_loss_of_match() {
