@@ -93,6 +93,36 @@ struct SettingsArgs {
     fail_on: Option<FailOnArg>,
 }
 
+/// Limits for reading assets nobody checked; each refusal names the flag that raises it.
+#[derive(clap::Args)]
+struct LoadArgs {
+    /// Refuse a JSON document (a .gltf, or a .glb's JSON chunk) larger than this.
+    #[arg(long, value_name = "BYTES", default_value_t = velvet::asset::limits::DEFAULT_MAX_DOCUMENT_BYTES)]
+    max_document_bytes: u64,
+    /// Refuse JSON that nests arrays and objects deeper than this (at most 127).
+    #[arg(long, value_name = "N", default_value_t = velvet::asset::limits::DEFAULT_MAX_JSON_DEPTH as u16,
+          value_parser = clap::value_parser!(u16).range(1..=velvet::asset::limits::JSON_DEPTH_CEILING as i64))]
+    max_json_depth: u16,
+    /// Refuse to decode an image whose header declares more pixels (width × height) than this.
+    #[arg(long, value_name = "PIXELS", default_value_t = velvet::asset::limits::DEFAULT_MAX_IMAGE_PIXELS)]
+    max_image_pixels: u64,
+    /// Read resources whose URI leaves the asset's folder (../, absolute paths, file:).
+    /// Outputs never follow such URIs.
+    #[arg(long)]
+    allow_outside_uris: bool,
+}
+
+impl LoadArgs {
+    fn options(&self) -> velvet::asset::LoadOptions {
+        velvet::asset::LoadOptions {
+            max_document_bytes: self.max_document_bytes,
+            max_json_depth: usize::from(self.max_json_depth),
+            max_image_pixels: self.max_image_pixels,
+            allow_outside_uris: self.allow_outside_uris,
+        }
+    }
+}
+
 #[derive(clap::Args)]
 struct ValidateArgs {
     /// Files and folders to check (folders are searched for *.gltf and *.glb).
@@ -106,6 +136,8 @@ struct ValidateArgs {
     /// Read schema files from DIR instead of the built-in ones (files absent there stay built-in).
     #[arg(long, value_name = "DIR")]
     schema_dir: Option<PathBuf>,
+    #[command(flatten)]
+    load: LoadArgs,
 }
 
 #[derive(clap::Args)]
@@ -151,6 +183,8 @@ struct BakeArgs {
     copy_resources: bool,
     #[arg(long, value_enum, default_value_t = BakeFormat::Text)]
     format: BakeFormat,
+    #[command(flatten)]
+    load: LoadArgs,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -306,18 +340,34 @@ fn validate(args: ValidateArgs, color: ColorChoice, quiet: bool) -> ExitCode {
         },
         None => Schemas::builtin(),
     };
-    let validator = Validator::new(schemas, Settings::default());
+    let validator =
+        Validator::new(schemas, Settings::default()).with_load_options(args.load.options());
     let progress = report::progress_bar(quiet);
-    let outcome =
-        match velvet::run::validate(&validator, &args.paths, &mut resolver, progress.as_ref()) {
-            Ok(o) => o,
-            Err(e) => return usage_error(e),
-        };
     let options = report::Options {
         color: args.format == Format::Text && color.for_stdout(),
         quiet,
     };
-    emit(report::render(args.format, &outcome.reports, &options).as_bytes());
+    // Each file's report is written as soon as it is done (see report::Stream).
+    let stdout = std::io::BufWriter::new(std::io::stdout().lock());
+    let mut stream = report::Stream::new(args.format, options, stdout);
+    let outcome = match velvet::run::validate_each(
+        &validator,
+        &args.paths,
+        &mut resolver,
+        progress.as_ref(),
+        &mut |r| match &progress {
+            // The bar is cleared while the report is written, so the two do not mix.
+            Some(bar) => bar.suspend(|| {
+                stream.push(r);
+                stream.flush();
+            }),
+            None => stream.push(r),
+        },
+    ) {
+        Ok(o) => o,
+        Err(e) => return usage_error(e),
+    };
+    stream.finish();
     if outcome.failed {
         ExitCode::from(1)
     } else {
@@ -374,6 +424,8 @@ struct MigrateArgs {
     /// Copy relative resources next to outputs in another folder instead of rewriting URIs.
     #[arg(long)]
     copy_resources: bool,
+    #[command(flatten)]
+    load: LoadArgs,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -410,6 +462,7 @@ fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
             },
             fast: args.fast,
             copy_resources: args.copy_resources,
+            load: args.load.options(),
         },
         dry_run: args.dry_run || args.check,
         progress: !quiet,
@@ -458,6 +511,7 @@ fn bake(args: BakeArgs, quiet: bool) -> ExitCode {
                 Compression::Best => velvet::bake::PngCompression::Best,
             },
             copy_resources: args.copy_resources,
+            load: args.load.options(),
         },
         progress: !quiet,
     };

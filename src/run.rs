@@ -2,6 +2,10 @@
 //! found for it (see [`crate::config`]), leave out excluded files, validate the rest in
 //! parallel, and decide whether the run failed. A configuration error stops the run before any
 //! file is read: a broken velvet.toml is a usage error, not a finding.
+//!
+//! Files are validated in parallel a batch at a time and each report is handed on in input
+//! order as soon as its batch is done, so that a run over ten thousand files holds one batch of
+//! reports, not ten thousand (see [`validate_each`]).
 
 use crate::asset::discover;
 use crate::config::{ConfigError, Resolver};
@@ -28,6 +32,39 @@ pub fn validate(
     resolver: &mut Resolver,
     progress: Option<&indicatif::ProgressBar>,
 ) -> Result<Outcome, ConfigError> {
+    let mut reports = Vec::new();
+    let each = validate_each(validator, inputs, resolver, progress, &mut |r| {
+        reports.push(r)
+    })?;
+    Ok(Outcome {
+        reports,
+        excluded: each.excluded,
+        failed: each.failed,
+    })
+}
+
+/// What a run produced besides its reports.
+#[derive(Debug)]
+pub struct Totals {
+    /// Files left out by an exclude pattern.
+    pub excluded: Vec<PathBuf>,
+    /// True when a report has a finding at or above its configuration's fail-on severity.
+    pub failed: bool,
+}
+
+/// Files validated in parallel before their reports are handed on: enough to keep every core
+/// busy, few enough that the reports in hand stay small.
+const BATCH: usize = 256;
+
+/// Validates like [`validate`], handing each report to `sink` in input order as soon as its
+/// batch is done instead of keeping them.
+pub fn validate_each(
+    validator: &Validator,
+    inputs: &[PathBuf],
+    resolver: &mut Resolver,
+    progress: Option<&indicatif::ProgressBar>,
+    sink: &mut dyn FnMut(FileReport),
+) -> Result<Totals, ConfigError> {
     let (files, walk_errors) = discover::collect(inputs);
     let mut planned = Vec::with_capacity(files.len());
     let mut excluded = Vec::new();
@@ -39,38 +76,41 @@ pub fn validate(
             planned.push((file, config));
         }
     }
-    let mut reports = Vec::with_capacity(planned.len() + walk_errors.len());
-    let mut failed = false;
+    // Every configuration is resolved before the first report goes out: a configuration error
+    // stops the run with nothing written.
+    let mut unreadable = Vec::with_capacity(walk_errors.len());
     for (folder, error) in walk_errors {
         let config = resolver.for_path(&folder)?;
+        unreadable.push((folder, error, config));
+    }
+    let mut failed = false;
+    for (folder, error, config) in unreadable {
         let report = validator.unreadable_folder(folder, &error, config.settings());
         failed |= report.fails(config.settings());
-        reports.push(report);
+        sink(report);
     }
     if let Some(bar) = progress {
         bar.set_length(planned.len() as u64);
     }
-    let checked: Vec<(FileReport, bool)> = planned
-        .par_iter()
-        .map(|(file, config)| {
-            let report = validator.validate_file_with(file, config.settings());
-            let fails = report.fails(config.settings());
-            if let Some(bar) = progress {
-                bar.inc(1);
-            }
-            (report, fails)
-        })
-        .collect();
+    for batch in planned.chunks(BATCH) {
+        let checked: Vec<(FileReport, bool)> = batch
+            .par_iter()
+            .map(|(file, config)| {
+                let report = validator.validate_file_with(file, config.settings());
+                let fails = report.fails(config.settings());
+                if let Some(bar) = progress {
+                    bar.inc(1);
+                }
+                (report, fails)
+            })
+            .collect();
+        for (report, fails) in checked {
+            failed |= fails;
+            sink(report);
+        }
+    }
     if let Some(bar) = progress {
         bar.finish_and_clear();
     }
-    for (report, fails) in checked {
-        failed |= fails;
-        reports.push(report);
-    }
-    Ok(Outcome {
-        reports,
-        excluded,
-        failed,
-    })
+    Ok(Totals { excluded, failed })
 }

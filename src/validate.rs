@@ -73,15 +73,26 @@ impl FileReport {
     }
 }
 
-/// A validator for one run: schemas compiled once, settings applied to every file.
+/// A validator for one run: schemas compiled once, settings applied to every file, every file
+/// loaded under the same limits.
 pub struct Validator {
     pub schemas: Schemas,
     pub settings: Settings,
+    pub load: asset::LoadOptions,
 }
 
 impl Validator {
     pub fn new(schemas: Schemas, settings: Settings) -> Validator {
-        Validator { schemas, settings }
+        Validator {
+            schemas,
+            settings,
+            load: asset::LoadOptions::default(),
+        }
+    }
+
+    /// The same validator loading files under `load`.
+    pub fn with_load_options(self, load: asset::LoadOptions) -> Validator {
+        Validator { load, ..self }
     }
 
     /// Validates every asset found under `inputs`, in parallel, in input order.
@@ -108,7 +119,7 @@ impl Validator {
     /// Validates one file under `settings` instead of the validator's own (a run whose
     /// configuration differs from folder to folder).
     pub fn validate_file_with(&self, path: &Path, settings: &Settings) -> FileReport {
-        let loaded = asset::load(path);
+        let loaded = asset::load_with(path, &self.load);
         self.validate_loaded_with(path, loaded, settings)
     }
 

@@ -1,6 +1,8 @@
 //! Finding the assets to work on: files named on the command line are taken as they are;
 //! folders are walked recursively for `*.gltf` and `*.glb` (case-insensitive), in sorted order,
-//! without following links to folders (so a link loop cannot hang a run).
+//! without following links to folders (so a link loop cannot hang a run). A link named like an
+//! asset whose target is missing is kept, so that the loader reports it rather than the run
+//! skipping it in silence; so is a file that vanishes between the walk and its loading.
 
 use std::io;
 use std::path::{Path, PathBuf};
@@ -43,7 +45,10 @@ fn walk(dir: &Path, files: &mut Vec<PathBuf>, errors: &mut Vec<(PathBuf, io::Err
         };
         if meta.is_dir() {
             walk(&path, files, errors);
-        } else if is_asset_path(&path) && (meta.is_file() || path.is_file()) {
+        } else if is_asset_path(&path)
+            && (meta.is_file()
+                || (meta.is_symlink() && std::fs::metadata(&path).map_or(true, |m| m.is_file())))
+        {
             files.push(path);
         }
     }

@@ -7,12 +7,14 @@
 
 pub mod discover;
 pub mod glb;
+pub mod limits;
 pub mod pointer;
 pub mod position;
 pub mod resource;
 pub mod write;
 
 use crate::diagnostics::{codes, Diagnostic};
+pub use limits::LoadOptions;
 use resource::{ImageHeader, Location};
 use serde_json::Value;
 use std::borrow::Cow;
@@ -49,6 +51,8 @@ pub struct Asset {
     pub json_offset: usize,
     /// The GLB BIN chunk, if any.
     pub bin: Option<Vec<u8>>,
+    /// The limits and URI policy it was loaded with; resources are read under them too.
+    pub options: LoadOptions,
     image_headers: Mutex<HashMap<usize, Result<ImageHeader, Diagnostic>>>,
 }
 
@@ -60,24 +64,62 @@ pub struct Loaded {
     pub diagnostics: Vec<Diagnostic>,
 }
 
-/// Reads and parses one file. Never fails: faults become diagnostics.
+/// Reads and parses one file under the default limits. Never fails: faults become
+/// diagnostics.
 pub fn load(path: &Path) -> Loaded {
-    match std::fs::read(path) {
-        Ok(bytes) => load_bytes(path, &bytes),
-        Err(e) => Loaded {
+    load_with(path, &LoadOptions::default())
+}
+
+/// Reads and parses one file under `options`. Never fails: faults become diagnostics.
+pub fn load_with(path: &Path, options: &LoadOptions) -> Loaded {
+    match read(path, options) {
+        Ok(bytes) => load_bytes_with(path, &bytes, options),
+        Err(d) => Loaded {
             asset: None,
-            diagnostics: vec![Diagnostic::new(
-                &codes::IO_ERROR,
-                "",
-                format!("cannot read {}: {e}", path.display()),
-            )],
+            diagnostics: vec![d],
         },
     }
 }
 
+/// Reads the bytes of an asset file (see [`limits::read_asset_file`]). A .gltf larger than
+/// the document limit is refused from its size alone, without being read.
+pub fn read(path: &Path, options: &LoadOptions) -> Result<Vec<u8>, Diagnostic> {
+    let io_error = |e: std::io::Error| {
+        Diagnostic::new(
+            &codes::IO_ERROR,
+            "",
+            format!("cannot read {}: {e}", path.display()),
+        )
+    };
+    if let Ok(meta) = std::fs::metadata(path) {
+        // The document limit applies to the JSON, which is the whole file unless it is a GLB
+        // (whose BIN chunk may be large) or starts with a byte-order mark.
+        if meta.is_file() && meta.len() > options.max_document_bytes.saturating_add(3) {
+            let mut magic = [0u8; 4];
+            let is_glb = std::fs::File::open(path)
+                .and_then(|mut f| std::io::Read::read_exact(&mut f, &mut magic))
+                .is_ok()
+                && &magic == b"glTF";
+            if !is_glb {
+                return Err(Diagnostic::new(
+                    &codes::DOCUMENT_TOO_LARGE,
+                    "",
+                    options.document_too_large(meta.len()),
+                ));
+            }
+        }
+    }
+    limits::read_asset_file(path, options).map_err(io_error)
+}
+
+/// Parses the bytes of a file that lives (or would live) at `path` under the default limits.
+pub fn load_bytes(path: &Path, bytes: &[u8]) -> Loaded {
+    load_bytes_with(path, bytes, &LoadOptions::default())
+}
+
 /// Parses the bytes of a file that lives (or would live) at `path`; `path` is used for the
 /// container kind (when the bytes do not tell) and to resolve relative URIs.
-pub fn load_bytes(path: &Path, bytes: &[u8]) -> Loaded {
+pub fn load_bytes_with(path: &Path, bytes: &[u8], options: &LoadOptions) -> Loaded {
     let mut diagnostics = Vec::new();
     let is_glb = bytes.starts_with(b"glTF")
         || path
@@ -101,6 +143,21 @@ pub fn load_bytes(path: &Path, bytes: &[u8]) -> Loaded {
     } else {
         (Container::Gltf, bytes, 0, None)
     };
+    let json_len = json_bytes
+        .strip_prefix(b"\xEF\xBB\xBF")
+        .unwrap_or(json_bytes)
+        .len() as u64;
+    if json_len > options.max_document_bytes {
+        diagnostics.push(Diagnostic::new(
+            &codes::DOCUMENT_TOO_LARGE,
+            "",
+            options.document_too_large(json_len),
+        ));
+        return Loaded {
+            asset: None,
+            diagnostics,
+        };
+    }
     let (json_bytes, json_offset) = match json_bytes.strip_prefix(b"\xEF\xBB\xBF") {
         Some(rest) => {
             diagnostics.push(Diagnostic::new(
@@ -141,6 +198,24 @@ pub fn load_bytes(path: &Path, bytes: &[u8]) -> Loaded {
     };
     // A GLB's JSON chunk may carry NUL padding (reported by glb::split); parse past it.
     let parse_text = json_text.trim_end_matches(['\0', ' ']);
+    let max_depth = options.max_json_depth.min(limits::JSON_DEPTH_CEILING);
+    if let Some(at) = limits::find_too_deep(parse_text, max_depth) {
+        diagnostics.push(Diagnostic::new(
+            &codes::JSON_TOO_DEEP,
+            "",
+            format!(
+                "line {}, column {}: the JSON nests deeper than {max_depth} arrays and objects \
+                 (raise the limit with --max-json-depth, at most {})",
+                at.line,
+                at.column,
+                limits::JSON_DEPTH_CEILING
+            ),
+        ));
+        return Loaded {
+            asset: None,
+            diagnostics,
+        };
+    }
     let json: Value = match serde_json::from_str(parse_text) {
         Ok(v) => v,
         Err(e) => {
@@ -171,6 +246,9 @@ pub fn load_bytes(path: &Path, bytes: &[u8]) -> Loaded {
             diagnostics,
         };
     }
+    if container == Container::Glb {
+        check_bin_length(&json, bin.as_deref(), &mut diagnostics);
+    }
     Loaded {
         asset: Some(Asset {
             path: path.to_path_buf(),
@@ -179,9 +257,54 @@ pub fn load_bytes(path: &Path, bytes: &[u8]) -> Loaded {
             json_text,
             json_offset,
             bin,
+            options: *options,
             image_headers: Mutex::new(HashMap::new()),
         }),
         diagnostics,
+    }
+}
+
+/// A GLB's buffer 0 without a URI is its BIN chunk: the chunk must hold the declared
+/// byteLength (it may be up to 3 bytes longer, for padding).
+fn check_bin_length(json: &Value, bin: Option<&[u8]>, out: &mut Vec<Diagnostic>) {
+    let Some(buffer) = json.pointer("/buffers/0") else {
+        return;
+    };
+    if buffer.get("uri").is_some() {
+        return;
+    }
+    let Some(declared) = buffer.get("byteLength").and_then(Value::as_u64) else {
+        return;
+    };
+    let actual = bin.map_or(0, <[u8]>::len) as u64;
+    if actual < declared {
+        out.push(Diagnostic::new(
+            &codes::BUFFER_BYTE_LENGTH_MISMATCH,
+            "/buffers/0/byteLength",
+            match bin {
+                Some(_) => format!(
+                    "buffer 0 declares {declared} bytes but the GLB's BIN chunk holds {actual}"
+                ),
+                None => format!("buffer 0 declares {declared} bytes but the GLB has no BIN chunk"),
+            },
+        ));
+    }
+}
+
+/// Checks that a buffer's data holds its declared byteLength.
+fn check_buffer_length(
+    buffer: &Value,
+    index: usize,
+    actual: usize,
+    pointer: &str,
+) -> Result<(), Diagnostic> {
+    match buffer.get("byteLength").and_then(Value::as_u64) {
+        Some(declared) if (actual as u64) < declared => Err(Diagnostic::new(
+            &codes::BUFFER_BYTE_LENGTH_MISMATCH,
+            format!("{pointer}/byteLength"),
+            format!("buffer {index} declares {declared} bytes but its data holds {actual}"),
+        )),
+        _ => Ok(()),
     }
 }
 
@@ -207,11 +330,16 @@ impl Asset {
             )
         })?;
         match buffer.get("uri").and_then(Value::as_str) {
-            Some(uri) => self
-                .read_uri(uri, &format!("{pointer}/uri"))
-                .map(Cow::Owned),
+            Some(uri) => {
+                let bytes = self.read_uri(uri, &format!("{pointer}/uri"))?;
+                check_buffer_length(buffer, index, bytes.len(), &pointer)?;
+                Ok(Cow::Owned(bytes))
+            }
             None => match (&self.bin, index) {
-                (Some(bin), 0) => Ok(Cow::Borrowed(bin.as_slice())),
+                (Some(bin), 0) => {
+                    check_buffer_length(buffer, index, bin.len(), &pointer)?;
+                    Ok(Cow::Borrowed(bin.as_slice()))
+                }
                 _ => Err(Diagnostic::new(
                     &codes::IO_ERROR,
                     &pointer,
@@ -288,16 +416,20 @@ impl Asset {
         })
     }
 
+    /// Where a resource URI leads under this asset's URI policy.
+    pub fn resolve(&self, uri: &str, pointer: &str) -> Result<Location, Diagnostic> {
+        resource::resolve_with(
+            uri,
+            self.base_dir(),
+            pointer,
+            self.options.allow_outside_uris,
+        )
+    }
+
     fn read_uri(&self, uri: &str, pointer: &str) -> Result<Vec<u8>, Diagnostic> {
-        match resource::resolve(uri, self.base_dir(), pointer)? {
+        match self.resolve(uri, pointer)? {
             Location::Data { bytes, .. } => Ok(bytes),
-            Location::File(path) => std::fs::read(&path).map_err(|e| {
-                Diagnostic::new(
-                    &codes::IO_ERROR,
-                    pointer,
-                    format!("cannot read '{uri}' ({}): {e}", path.display()),
-                )
-            }),
+            Location::File(path) => resource::read_file(&path, uri, pointer),
         }
     }
 
@@ -313,6 +445,18 @@ impl Asset {
                 format!("image {index}: {detail}"),
             )
         };
+        let header = resource::read_header(
+            Cursor::new(bytes.as_ref()),
+            &pointer,
+            &format!("image {index}"),
+        )?;
+        if let Some(message) = self.options.image_too_large(header.width, header.height) {
+            return Err(Diagnostic::new(
+                &codes::IMAGE_TOO_LARGE,
+                &pointer,
+                format!("image {index}: {message}"),
+            ));
+        }
         let format = match resource::ImageFormat::sniff(&bytes) {
             Some(resource::ImageFormat::Png) => image::ImageFormat::Png,
             Some(resource::ImageFormat::Jpeg) => image::ImageFormat::Jpeg,
@@ -326,7 +470,11 @@ impl Asset {
                 ))
             }
         };
-        image::load_from_memory_with_format(&bytes, format).map_err(|e| unreadable(e.to_string()))
+        let mut reader = image::ImageReader::with_format(Cursor::new(bytes.as_ref()), format);
+        let mut limits = image::Limits::default();
+        limits.max_alloc = Some(self.options.max_decode_bytes());
+        reader.limits(limits);
+        reader.decode().map_err(|e| unreadable(e.to_string()))
     }
 
     /// The header of image `index`, read once per asset. A file is opened and only its header
@@ -348,14 +496,8 @@ impl Asset {
             .and_then(Value::as_str);
         if let Some(uri) = uri {
             let uri_pointer = format!("{pointer}/uri");
-            if let Location::File(path) = resource::resolve(uri, self.base_dir(), &uri_pointer)? {
-                let file = std::fs::File::open(&path).map_err(|e| {
-                    Diagnostic::new(
-                        &codes::IO_ERROR,
-                        &uri_pointer,
-                        format!("cannot read '{uri}' ({}): {e}", path.display()),
-                    )
-                })?;
+            if let Location::File(path) = self.resolve(uri, &uri_pointer)? {
+                let file = resource::open_file(&path, uri, &uri_pointer)?;
                 return resource::read_header(BufReader::new(file), &pointer, &what);
             }
         }

@@ -3,7 +3,10 @@
 //!
 //! URIs are refused unless they are `data:` or a relative path that stays inside the asset's
 //! folder: velvet runs unattended over assets nobody checked, and must not read `/etc/passwd`
-//! because a glTF names it.
+//! because a glTF names it. `--allow-outside-uris` lifts this for reading (paths that climb
+//! out, absolute paths, `file:` URIs); writing always resolves with [`resolve`], which never
+//! leaves the folder. Only regular files are read: a URI naming a device or a pipe (through a
+//! link) could otherwise stream without end.
 
 use crate::diagnostics::{codes, Diagnostic};
 use base64::Engine;
@@ -18,8 +21,20 @@ pub enum Location {
     File(PathBuf),
 }
 
-/// Resolves `uri` against `base_dir`. `pointer` names the URI in the document, for diagnostics.
+/// Resolves `uri` against `base_dir`, inside the folder only. `pointer` names the URI in the
+/// document, for diagnostics.
 pub fn resolve(uri: &str, base_dir: &Path, pointer: &str) -> Result<Location, Diagnostic> {
+    resolve_with(uri, base_dir, pointer, false)
+}
+
+/// Resolves `uri` against `base_dir`; with `allow_outside`, paths that climb out of the
+/// folder, absolute paths and `file:` URIs are followed too.
+pub fn resolve_with(
+    uri: &str,
+    base_dir: &Path,
+    pointer: &str,
+    allow_outside: bool,
+) -> Result<Location, Diagnostic> {
     if let Some(rest) = uri.strip_prefix("data:") {
         let (header, payload) = rest.split_once(',').ok_or_else(|| {
             Diagnostic::new(
@@ -49,14 +64,27 @@ pub fn resolve(uri: &str, base_dir: &Path, pointer: &str) -> Result<Location, Di
             bytes,
         });
     }
+    let mut path_part = uri;
     if has_scheme(uri) {
-        return Err(Diagnostic::new(
-            &codes::URI_NOT_FOLLOWED,
-            pointer,
-            format!("'{uri}' has a URL scheme; only data: URIs and relative paths are read"),
-        ));
+        match file_uri_path(uri) {
+            Some(path) if allow_outside => path_part = path,
+            Some(_) => {
+                return Err(Diagnostic::new(
+                    &codes::URI_NOT_FOLLOWED,
+                    pointer,
+                    format!("'{uri}' is a file: URI; only relative paths inside the asset's folder are read (--allow-outside-uris reads it)"),
+                ))
+            }
+            None => {
+                return Err(Diagnostic::new(
+                    &codes::URI_NOT_FOLLOWED,
+                    pointer,
+                    format!("'{uri}' has a URL scheme; only data: URIs and file paths are read"),
+                ))
+            }
+        }
     }
-    let decoded = percent_encoding::percent_decode_str(uri)
+    let decoded = percent_encoding::percent_decode_str(path_part)
         .decode_utf8()
         .map_err(|_| {
             Diagnostic::new(
@@ -66,6 +94,10 @@ pub fn resolve(uri: &str, base_dir: &Path, pointer: &str) -> Result<Location, Di
             )
         })?;
     let relative = Path::new(decoded.as_ref());
+    if allow_outside {
+        // Absolute paths replace the base in `join`; relative ones climb as they say.
+        return Ok(Location::File(base_dir.join(relative)));
+    }
     let mut depth: i64 = 0;
     for component in relative.components() {
         match component {
@@ -77,7 +109,7 @@ pub fn resolve(uri: &str, base_dir: &Path, pointer: &str) -> Result<Location, Di
                     return Err(Diagnostic::new(
                         &codes::URI_NOT_FOLLOWED,
                         pointer,
-                        format!("'{uri}' climbs out of the asset's folder"),
+                        format!("'{uri}' climbs out of the asset's folder (--allow-outside-uris reads it)"),
                     ));
                 }
             }
@@ -85,12 +117,61 @@ pub fn resolve(uri: &str, base_dir: &Path, pointer: &str) -> Result<Location, Di
                 return Err(Diagnostic::new(
                     &codes::URI_NOT_FOLLOWED,
                     pointer,
-                    format!("'{uri}' is an absolute path; only relative paths are read"),
+                    format!("'{uri}' is an absolute path; only relative paths are read (--allow-outside-uris reads it)"),
                 ))
             }
         }
     }
     Ok(Location::File(base_dir.join(relative)))
+}
+
+/// The path of a local `file:` URI (`file:///p`, `file://localhost/p` or `file:/p`), still
+/// percent-encoded; `None` for any other URI.
+fn file_uri_path(uri: &str) -> Option<&str> {
+    let rest = uri
+        .get(..5)
+        .filter(|s| s.eq_ignore_ascii_case("file:"))
+        .map(|_| &uri[5..])?;
+    match rest.strip_prefix("//") {
+        Some(authority_and_path) => {
+            let slash = authority_and_path.find('/')?;
+            let host = &authority_and_path[..slash];
+            (host.is_empty() || host.eq_ignore_ascii_case("localhost"))
+                .then_some(&authority_and_path[slash..])
+        }
+        None => rest.starts_with('/').then_some(rest),
+    }
+}
+
+/// Opens a resource file that a URI led to, refusing anything but a regular file.
+pub fn open_file(path: &Path, uri: &str, pointer: &str) -> Result<std::fs::File, Diagnostic> {
+    let fail = |detail: String| {
+        Diagnostic::new(
+            &codes::IO_ERROR,
+            pointer,
+            format!("cannot read '{uri}' ({}): {detail}", path.display()),
+        )
+    };
+    // Checked before opening: opening a pipe waits for a writer.
+    let meta = std::fs::metadata(path).map_err(|e| fail(e.to_string()))?;
+    if !meta.is_file() {
+        return Err(fail("not a regular file".to_string()));
+    }
+    std::fs::File::open(path).map_err(|e| fail(e.to_string()))
+}
+
+/// Reads a resource file that a URI led to (see [`open_file`]).
+pub fn read_file(path: &Path, uri: &str, pointer: &str) -> Result<Vec<u8>, Diagnostic> {
+    let mut file = open_file(path, uri, pointer)?;
+    let mut bytes = Vec::new();
+    std::io::Read::read_to_end(&mut file, &mut bytes).map_err(|e| {
+        Diagnostic::new(
+            &codes::IO_ERROR,
+            pointer,
+            format!("cannot read '{uri}' ({}): {e}", path.display()),
+        )
+    })?;
+    Ok(bytes)
 }
 
 /// RFC 3986 scheme: a letter, then letters, digits, '+', '-' or '.', then ':'. A Windows drive
@@ -259,6 +340,54 @@ mod tests {
                 "{uri}"
             );
         }
+    }
+
+    #[test]
+    fn outside_uris_are_followed_only_when_allowed() {
+        for (uri, expected) in [
+            ("../x.png", "/assets/chair/../x.png"),
+            ("a/../../x%20y.png", "/assets/chair/a/../../x y.png"),
+            ("/etc/hostname", "/etc/hostname"),
+            ("file:///srv/tex/a%20b.png", "/srv/tex/a b.png"),
+            ("file://localhost/srv/a.png", "/srv/a.png"),
+            ("FILE:/srv/a.png", "/srv/a.png"),
+        ] {
+            assert_eq!(
+                resolve_with(uri, base(), "", true).unwrap(),
+                Location::File(PathBuf::from(expected)),
+                "{uri}"
+            );
+            let refused = resolve_with(uri, base(), "", false).unwrap_err();
+            assert_eq!(refused.code, "URI_NOT_FOLLOWED", "{uri}");
+            assert!(
+                refused.message.contains("--allow-outside-uris"),
+                "{}",
+                refused.message
+            );
+        }
+        // Remote schemes and other hosts are never fetched.
+        for uri in [
+            "https://example.com/x.png",
+            "file://server/share/x.png",
+            "C:/x.png",
+        ] {
+            let refused = resolve_with(uri, base(), "", true).unwrap_err();
+            assert_eq!(refused.code, "URI_NOT_FOLLOWED", "{uri}");
+        }
+    }
+
+    #[test]
+    fn only_regular_files_are_read() {
+        let err = read_file(Path::new("/dev/zero"), "zero.bin", "/buffers/0/uri").unwrap_err();
+        assert_eq!(
+            (err.code, err.pointer.as_str()),
+            ("IO_ERROR", "/buffers/0/uri")
+        );
+        assert!(
+            err.message.contains("not a regular file"),
+            "{}",
+            err.message
+        );
     }
 
     #[test]

@@ -1,12 +1,62 @@
 //! Writing assets: serialising an edited document in the input's own JSON style, packing GLBs,
 //! and the atomic write (a temporary file in the target folder, renamed into place) that every
 //! output of velvet goes through.
+//!
+//! The atomic write carries a fault-injection seam for the tests of the "nothing lost"
+//! guarantee, set by the environment variable `VELVET_TEST_WRITE_FAULT` (read once per
+//! process): `error:N` makes every write after the first N fail halfway through its temporary
+//! file with an I/O error, `abort:N` aborts the process there instead, as a kill or a power cut
+//! would. Unset (always, outside those tests), it costs one cached lookup per write.
 
 use super::{glb, Asset, Container};
 use serde::Serialize;
 use serde_json::Value;
 use std::io::{self, Write};
 use std::path::Path;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::OnceLock;
+
+/// A fault the test seam injects into writes after the first `after`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Fault {
+    Error { after: usize },
+    Abort { after: usize },
+}
+
+fn injected_fault() -> Option<Fault> {
+    static FAULT: OnceLock<Option<Fault>> = OnceLock::new();
+    *FAULT.get_or_init(|| {
+        let value = std::env::var("VELVET_TEST_WRITE_FAULT").ok()?;
+        let (kind, after) = value.split_once(':')?;
+        let after = after.parse().ok()?;
+        match kind {
+            "error" => Some(Fault::Error { after }),
+            "abort" => Some(Fault::Abort { after }),
+            _ => None,
+        }
+    })
+}
+
+/// Writes `bytes` into a temporary file, or half of them and then the injected fault.
+fn write_temporary(file: &mut impl Write, bytes: &[u8]) -> io::Result<()> {
+    static WRITES: AtomicUsize = AtomicUsize::new(0);
+    let Some(fault) = injected_fault() else {
+        return file.write_all(bytes);
+    };
+    let n = WRITES.fetch_add(1, Ordering::SeqCst);
+    let after = match fault {
+        Fault::Error { after } | Fault::Abort { after } => after,
+    };
+    if n < after {
+        return file.write_all(bytes);
+    }
+    file.write_all(&bytes[..bytes.len() / 2])?;
+    file.flush()?;
+    match fault {
+        Fault::Abort { .. } => std::process::abort(),
+        Fault::Error { .. } => Err(io::Error::other("injected write fault")),
+    }
+}
 
 /// How the input's JSON was laid out, so that an edited file keeps its look.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -86,7 +136,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
         builder.permissions(std::fs::Permissions::from_mode(0o666));
     }
     let mut tmp = builder.tempfile_in(dir)?;
-    tmp.write_all(bytes)?;
+    write_temporary(&mut tmp, bytes)?;
     tmp.as_file().sync_all()?;
     if let Ok(meta) = std::fs::metadata(path) {
         // Keep the permissions of a file being replaced.

@@ -115,6 +115,14 @@ pub enum CodecError {
         /// The decoder's message.
         message: String,
     },
+    /// The header declares more pixels than the limit; nothing was decoded.
+    #[error("{format}: {message}")]
+    TooLarge {
+        /// The format.
+        format: &'static str,
+        /// What the header declares and the limit, with the flag that raises it.
+        message: String,
+    },
     /// The encoder failed.
     #[error("cannot encode a {format} image: {message}")]
     Encode {
@@ -129,8 +137,16 @@ pub enum CodecError {
 pub const KTX2_REASON: &str = "KTX2 / Basis Universal data is GPU block-compressed; baking it \
      would need transcoding and lossy re-encoding, so the slot is left as it is";
 
-/// Decodes an image (PNG, JPEG or WebP) to pixels; KTX2 and unknown data are refused.
+/// Decodes an image (PNG, JPEG or WebP) to pixels under the default pixel limit; KTX2 and
+/// unknown data are refused.
 pub fn decode(bytes: &[u8]) -> Result<(Pixels, ImageFormat), CodecError> {
+    decode_limited(bytes, crate::asset::limits::DEFAULT_MAX_IMAGE_PIXELS)
+}
+
+/// Decodes an image whose header declares at most `max_pixels` pixels. The header is read
+/// first and a larger image refused before any pixel buffer exists: a 100000 × 100000 PNG of
+/// a few hundred bytes would otherwise ask for 40 GB.
+pub fn decode_limited(bytes: &[u8], max_pixels: u64) -> Result<(Pixels, ImageFormat), CodecError> {
     let format = ImageFormat::sniff(bytes).ok_or_else(|| {
         let head: Vec<String> = bytes.iter().take(8).map(|b| format!("{b:02x}")).collect();
         CodecError::Unrecognised(if head.is_empty() {
@@ -154,9 +170,21 @@ pub fn decode(bytes: &[u8]) -> Result<(Pixels, ImageFormat), CodecError> {
         format: format_name(format),
         message: e.to_string(),
     };
+    let (width, height) = ImageReader::with_format(Cursor::new(bytes), image_format)
+        .into_dimensions()
+        .map_err(decode_error)?;
+    if let Some(message) = crate::asset::limits::image_too_large(width, height, max_pixels) {
+        return Err(CodecError::TooLarge {
+            format: format_name(format),
+            message,
+        });
+    }
     let mut reader = ImageReader::with_format(Cursor::new(bytes), image_format);
-    // The default limits (512 MiB of allocation) stop a forged header from exhausting memory.
-    reader.limits(Limits::default());
+    // Within the pixel limit, the allocation limit stops what the header did not tell (a
+    // decoder's own buffers) from growing past what such an image needs.
+    let mut limits = Limits::default();
+    limits.max_alloc = Some(crate::asset::limits::max_decode_bytes(max_pixels));
+    reader.limits(limits);
     let image = reader.decode().map_err(decode_error)?;
     let (w, h) = (image.width(), image.height());
     let (layout, samples) = match image {

@@ -18,7 +18,7 @@ use serde_json::Value;
 
 use super::apply::{apply, ApplyOptions, Names, OutputReport};
 use super::codec::{EncodeOptions, PngCompression};
-use super::engine::{bake, BakeOptions};
+use super::engine::{bake, BakeOptions, MaxImagePixels};
 use super::kernel::KernelOptions;
 use super::plan::{plan, BakePlan, Note, PlanOptions};
 use super::prune::Dropped;
@@ -46,6 +46,8 @@ pub struct Options {
     pub png: PngCompression,
     /// Copy relative resources next to an output in another folder instead of rewriting URIs.
     pub copy_resources: bool,
+    /// Limits and URI policy for reading inputs and their images.
+    pub load: asset::LoadOptions,
 }
 
 /// One `velvet bake` invocation.
@@ -279,8 +281,10 @@ pub(crate) fn write_new_files(dir: &Path, files: &[super::apply::NewFile]) -> Re
 /// Bakes one file; errors name what is wrong (the caller adds the file).
 fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult, String> {
     let input = job.input.as_path();
-    let bytes = std::fs::read(input).map_err(|e| format!("cannot read: {e}"))?;
-    let loaded = asset::load_bytes(input, &bytes);
+    let options = request.options;
+    let bytes = asset::read(input, &options.load)
+        .map_err(|d| format!("cannot be baked: {} ({})", d.message, d.code))?;
+    let loaded = asset::load_bytes_with(input, &bytes, &options.load);
     let errors: Vec<String> = loaded
         .diagnostics
         .iter()
@@ -291,7 +295,6 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
         Some(asset) if errors.is_empty() => asset,
         _ => return Err(format!("cannot be baked: {}", errors.join("; "))),
     };
-    let options = request.options;
     let plan = plan(&asset, options.plan);
     let planned_names: Vec<String> = plan
         .outputs
@@ -348,6 +351,7 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
             png: options.png,
             ..EncodeOptions::default()
         },
+        max_image_pixels: MaxImagePixels(options.load.max_image_pixels),
     };
     let mut baked = Vec::with_capacity(plan.recipes.len());
     let results = bake(&plan.recipes, &asset, &bake_options);

@@ -120,6 +120,18 @@ pub struct BakeOptions {
     pub kernel: KernelOptions,
     /// Encoder settings.
     pub encode: EncodeOptions,
+    /// Images whose header declares more pixels are refused before decoding.
+    pub max_image_pixels: MaxImagePixels,
+}
+
+/// The pixel limit for decoding (see [`crate::asset::limits`]); defaults to the loader's.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MaxImagePixels(pub u64);
+
+impl Default for MaxImagePixels {
+    fn default() -> Self {
+        MaxImagePixels(crate::asset::limits::DEFAULT_MAX_IMAGE_PIXELS)
+    }
 }
 
 /// One output of a run.
@@ -241,11 +253,11 @@ pub fn bake(
 
 type Decoded = Result<(Pixels, ImageFormat), BakeError>;
 
-fn decode_image(source: &dyn ImageSource, image: ImageId) -> Decoded {
+fn decode_image(source: &dyn ImageSource, image: ImageId, max_pixels: u64) -> Decoded {
     let bytes = source
         .image_bytes(image)
         .map_err(|message| BakeError::Source { image, message })?;
-    codec::decode(&bytes).map_err(|error| BakeError::Decode { image, error })
+    codec::decode_limited(&bytes, max_pixels).map_err(|error| BakeError::Decode { image, error })
 }
 
 fn bake_component(
@@ -262,7 +274,12 @@ fn bake_component(
     images.dedup();
     let decoded: Vec<(ImageId, Decoded)> = images
         .par_iter()
-        .map(|&image| (image, decode_image(source, image)))
+        .map(|&image| {
+            (
+                image,
+                decode_image(source, image, options.max_image_pixels.0),
+            )
+        })
         .collect();
     let mut pixels = HashMap::new();
     let mut formats = HashMap::new();

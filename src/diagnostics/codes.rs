@@ -90,8 +90,32 @@ pub const IMAGE_UNRECOGNIZED_FORMAT: Code = Code::new(
     "An image's header is not PNG, JPEG, WebP or KTX2, or is damaged.",
 );
 
+pub const DOCUMENT_TOO_LARGE: Code = Code::new(
+    "DOCUMENT_TOO_LARGE",
+    Error,
+    "The JSON document is larger than --max-document-bytes allows; it was not parsed.",
+);
+pub const JSON_TOO_DEEP: Code = Code::new(
+    "JSON_TOO_DEEP",
+    Error,
+    "The JSON nests arrays and objects deeper than --max-json-depth allows; it was not parsed.",
+);
+pub const BUFFER_BYTE_LENGTH_MISMATCH: Code = Code::new(
+    "BUFFER_BYTE_LENGTH_MISMATCH",
+    Error,
+    "A buffer's data (GLB BIN chunk, data: URI or file) is shorter than its byteLength.",
+);
+/// Reported by the image-size rule from headers, and by the decoders that refuse such images.
+pub const IMAGE_TOO_LARGE: Code = Code::new(
+    "IMAGE_TOO_LARGE",
+    Error,
+    "An image's header declares more pixels than --max-image-pixels allows; it was not decoded.",
+);
+
 pub const LOADER: &[&Code] = &[
     &IO_ERROR,
+    &DOCUMENT_TOO_LARGE,
+    &JSON_TOO_DEEP,
     &INVALID_JSON,
     &INVALID_JSON_ROOT_OBJECT,
     &BOM_PRESENT,
@@ -107,6 +131,7 @@ pub const LOADER: &[&Code] = &[
     &URI_NOT_FOLLOWED,
     &INVALID_URI,
     &BUFFER_VIEW_OUT_OF_RANGE,
+    &BUFFER_BYTE_LENGTH_MISMATCH,
     &IMAGE_UNRECOGNIZED_FORMAT,
 ];
 

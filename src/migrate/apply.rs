@@ -58,9 +58,15 @@ pub enum Written {
 
 /// Loads and plans one file. Errors name the file and what is wrong.
 pub fn plan_file(job: &Job, options: &Options) -> Result<FilePlan, String> {
-    let bytes = std::fs::read(&job.input)
-        .map_err(|e| format!("cannot read {}: {e}", job.input.display()))?;
-    let loaded = asset::load_bytes(&job.input, &bytes);
+    let bytes = asset::read(&job.input, &options.load).map_err(|d| {
+        format!(
+            "{} cannot be migrated: {} ({})",
+            job.input.display(),
+            d.message,
+            d.code
+        )
+    })?;
+    let loaded = asset::load_bytes_with(&job.input, &bytes, &options.load);
     let errors: Vec<String> = loaded
         .diagnostics
         .iter()

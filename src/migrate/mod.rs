@@ -47,6 +47,8 @@ pub struct Options {
     pub fast: bool,
     /// Copy relative resources next to an output in another folder instead of rewriting URIs.
     pub copy_resources: bool,
+    /// Limits and URI policy for reading inputs and their resources.
+    pub load: crate::asset::LoadOptions,
 }
 
 /// A request velvet cannot carry out as given (exit status 2): nothing is read or written.

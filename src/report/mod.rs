@@ -84,6 +84,107 @@ pub fn render(format: Format, reports: &[FileReport], options: &Options) -> Stri
     }
 }
 
+/// Writes a run's reports as they come, one file at a time, keeping only the totals: a run over
+/// many files holds one file's report, not all of them. The JSON report is an object for one
+/// file and an array for several, so the first report waits for the second to tell which;
+/// each element is written as the array would print it. SARIF is one log for the whole run
+/// and is written at the end. Write errors (a closed pipe) are ignored: the run's outcome is
+/// its exit status.
+pub struct Stream<W: std::io::Write> {
+    format: Format,
+    options: Options,
+    out: W,
+    kept: Vec<FileReport>,
+    files: usize,
+    totals: [usize; 4],
+}
+
+/// A JSON report as an element of the pretty-printed array of several: every line indented.
+fn json_element(report: &FileReport) -> String {
+    let text =
+        serde_json::to_string_pretty(&json::report_value(report)).expect("a report serialises");
+    let mut out = String::with_capacity(text.len() + 64);
+    for (i, line) in text.lines().enumerate() {
+        if i > 0 {
+            out.push('\n');
+        }
+        out.push_str("  ");
+        out.push_str(line);
+    }
+    out
+}
+
+impl<W: std::io::Write> Stream<W> {
+    pub fn new(format: Format, options: Options, out: W) -> Stream<W> {
+        Stream {
+            format,
+            options,
+            out,
+            kept: Vec::new(),
+            files: 0,
+            totals: [0; 4],
+        }
+    }
+
+    /// Takes the next file's report (in input order).
+    pub fn push(&mut self, report: FileReport) {
+        self.files += 1;
+        let c = report.counts;
+        for (t, n) in self
+            .totals
+            .iter_mut()
+            .zip([c.errors, c.warnings, c.infos, c.hints])
+        {
+            *t += n;
+        }
+        let one = std::slice::from_ref(&report);
+        let text = match self.format {
+            Format::Text => text::render_with(
+                one,
+                &Options {
+                    quiet: true,
+                    ..self.options
+                },
+            ),
+            Format::Jsonl => json::render_lines(one),
+            Format::Github => github::render(one),
+            Format::Json => match self.files {
+                1 => {
+                    self.kept.push(report);
+                    return;
+                }
+                2 => {
+                    let first = self.kept.pop().expect("the first report waits");
+                    format!("[\n{},\n{}", json_element(&first), json_element(&report))
+                }
+                _ => format!(",\n{}", json_element(&report)),
+            },
+            Format::Sarif => {
+                self.kept.push(report);
+                return;
+            }
+        };
+        let _ = self.out.write_all(text.as_bytes());
+    }
+
+    /// Writes out what is buffered.
+    pub fn flush(&mut self) {
+        let _ = self.out.flush();
+    }
+
+    /// Writes what ends the output: the summary line, or the whole-run document.
+    pub fn finish(mut self) {
+        let text = match self.format {
+            Format::Text if !self.options.quiet => text::summary(self.files, self.totals),
+            Format::Json if self.files >= 2 => "\n]\n".to_string(),
+            Format::Json | Format::Sarif => render(self.format, &self.kept, &self.options),
+            _ => String::new(),
+        };
+        let _ = self.out.write_all(text.as_bytes());
+        let _ = self.out.flush();
+    }
+}
+
 /// A progress bar on standard error, or `None` when standard error is not a terminal or the
 /// run is quiet (so logs and pipes never see one). Built only when asked for.
 pub fn progress_bar(quiet: bool) -> Option<indicatif::ProgressBar> {
@@ -98,4 +199,58 @@ pub fn progress_bar(quiet: bool) -> Option<indicatif::ProgressBar> {
         bar.set_style(style);
     }
     Some(bar)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::diagnostics::Settings;
+    use crate::rules::schema::Schemas;
+    use crate::validate::Validator;
+
+    fn reports(n: usize) -> Vec<FileReport> {
+        let validator = Validator::new(Schemas::builtin(), Settings::default());
+        (0..n)
+            .map(|i| {
+                let path = std::path::PathBuf::from(format!("memory/{i}.gltf"));
+                let text = format!(
+                    r#"{{"asset":{{"version":"2.0"}},"extensionsUsed":["KHR_materials_fuzz"],"extras":{{"n":{i},"s":"a\nb"}}}}"#
+                );
+                let loaded = crate::asset::load_bytes(&path, text.as_bytes());
+                validator.validate_loaded(&path, loaded)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn streamed_output_is_the_rendered_output_in_every_format() {
+        for format in [
+            Format::Text,
+            Format::Json,
+            Format::Jsonl,
+            Format::Sarif,
+            Format::Github,
+        ] {
+            for quiet in [false, true] {
+                let options = Options {
+                    color: false,
+                    quiet,
+                };
+                for n in 0..4 {
+                    let all = reports(n);
+                    let mut out = Vec::new();
+                    let mut stream = Stream::new(format, options, &mut out);
+                    for r in all.clone() {
+                        stream.push(r);
+                    }
+                    stream.finish();
+                    assert_eq!(
+                        String::from_utf8(out).unwrap(),
+                        render(format, &all, &options),
+                        "{format:?}, {n} reports, quiet {quiet}"
+                    );
+                }
+            }
+        }
+    }
 }

@@ -75,10 +75,15 @@ pub fn render_with(reports: &[FileReport], options: &Options) -> String {
     if options.quiet {
         return out;
     }
-    let files = reports.len();
-    let _ = writeln!(
-        out,
-        "{files} file{} checked: {} error{}, {} warning{}, {} info, {} hint{}",
+    out += &summary(reports.len(), totals);
+    out
+}
+
+/// The closing line: files checked and findings per severity (`totals`: errors, warnings,
+/// infos, hints).
+pub fn summary(files: usize, totals: [usize; 4]) -> String {
+    format!(
+        "{files} file{} checked: {} error{}, {} warning{}, {} info, {} hint{}\n",
         if files == 1 { "" } else { "s" },
         totals[0],
         if totals[0] == 1 { "" } else { "s" },
@@ -87,6 +92,5 @@ pub fn render_with(reports: &[FileReport], options: &Options) -> String {
         totals[2],
         totals[3],
         if totals[3] == 1 { "" } else { "s" },
-    );
-    out
+    )
 }

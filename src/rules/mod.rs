@@ -13,6 +13,7 @@ pub mod exclusions;
 pub mod fallback;
 pub mod fuzz_roughness_default;
 pub mod fuzz_roughness_mapping;
+pub mod image_size;
 pub mod legacy_sheen;
 pub mod placement;
 pub mod references;
@@ -56,6 +57,7 @@ pub static REGISTRY: &[&dyn Rule] = &[
     &texcoord::TexCoords,
     &disabled_layer::DisabledLayer,
     &roughness_alpha::RoughnessAlpha,
+    &image_size::ImageSize,
     &fallback::Fallback,
     &fuzz_roughness_mapping::FuzzRoughnessMapping,
     &fuzz_roughness_default::FuzzRoughnessDefault,

@@ -1,0 +1,37 @@
+//! Arbitrary documents through `velvet migrate`, in memory: plan every material, apply the
+//! edits, serialise in the input's style, and load the result again, which must parse (velvet
+//! never writes a document it cannot read back). A second migration must change nothing.
+#![no_main]
+
+use libfuzzer_sys::fuzz_target;
+use std::path::Path;
+use velvet::asset::write;
+use velvet::migrate::{plan_document, Options};
+
+fuzz_target!(|data: &[u8]| {
+    let options = Options {
+        report: data.first().is_some_and(|b| b & 1 == 1),
+        refresh_fallback: data.first().is_some_and(|b| b & 2 == 2),
+        load: velvet_fuzz::options(),
+        ..Options::default()
+    };
+    let path = "/nonexistent/fuzz.gltf";
+    let loaded = velvet_fuzz::load(path, data);
+    let Some(mut asset) = loaded.asset else {
+        return;
+    };
+    let plan = plan_document(&asset, &options);
+    let edits: Vec<_> = plan.edits().cloned().collect();
+    let Ok(true) = velvet::edit::apply(&mut asset.json, &edits) else {
+        return;
+    };
+    let bytes = write::to_bytes(&asset, &asset.json, asset.bin.as_deref());
+    let again = velvet::asset::load_bytes_with(Path::new(path), &bytes, &options.load);
+    let migrated = again.asset.unwrap_or_else(|| {
+        panic!(
+            "the migrated document does not load again: {:?}",
+            again.diagnostics
+        )
+    });
+    let _ = plan_document(&migrated, &options);
+});

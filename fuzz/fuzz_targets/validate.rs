@@ -1,0 +1,33 @@
+//! Arbitrary bytes through `velvet validate`: load (as .glb when the bytes say so), every rule,
+//! source positions, and every report format.
+#![no_main]
+
+use libfuzzer_sys::fuzz_target;
+use std::path::Path;
+use std::sync::OnceLock;
+use velvet::diagnostics::Settings;
+use velvet::report::{self, Format};
+use velvet::rules::schema::Schemas;
+use velvet::validate::Validator;
+
+fn validator() -> &'static Validator {
+    static VALIDATOR: OnceLock<Validator> = OnceLock::new();
+    VALIDATOR.get_or_init(|| {
+        Validator::new(Schemas::builtin(), Settings::default())
+            .with_load_options(velvet_fuzz::options())
+    })
+}
+
+fuzz_target!(|data: &[u8]| {
+    let path = Path::new("/nonexistent/fuzz.gltf");
+    let loaded = velvet_fuzz::load("/nonexistent/fuzz.gltf", data);
+    let report = validator().validate_loaded(path, loaded);
+    let options = report::Options {
+        color: false,
+        quiet: false,
+    };
+    let reports = [report];
+    for format in [Format::Text, Format::Json, Format::Sarif, Format::Github] {
+        let _ = report::render(format, &reports, &options);
+    }
+});

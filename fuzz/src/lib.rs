@@ -1,0 +1,38 @@
+//! What the fuzz targets share: loading arbitrary bytes as an asset and touching every lazy
+//! accessor the loader offers, under limits small enough that one input stays fast.
+
+use std::path::Path;
+use velvet::asset::{self, Asset, LoadOptions};
+
+/// Limits for fuzzing: the defaults, but images of at most 64 × 64 pixels are decoded so that
+/// a forged header costs microseconds, not the decoder's time on a real texture.
+pub fn options() -> LoadOptions {
+    LoadOptions {
+        max_image_pixels: 64 * 64,
+        ..LoadOptions::default()
+    }
+}
+
+/// Loads `data` as a file at `path` (in a folder that does not exist: external URIs fail to
+/// open, which is itself a path worth taking).
+pub fn load(path: &str, data: &[u8]) -> asset::Loaded {
+    asset::load_bytes_with(Path::new(path), data, &options())
+}
+
+/// Reads every buffer, image header and image through the asset's lazy accessors.
+pub fn touch_resources(asset: &Asset) {
+    let count = |key: &str| {
+        asset
+            .json
+            .get(key)
+            .and_then(serde_json::Value::as_array)
+            .map_or(0, Vec::len)
+    };
+    for i in 0..count("buffers").min(8) {
+        let _ = asset.buffer_bytes(i);
+    }
+    for i in 0..count("images").min(8) {
+        let _ = asset.image_header(i);
+        let _ = asset.decode_image(i);
+    }
+}

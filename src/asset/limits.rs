@@ -1,0 +1,213 @@
+//! What velvet is willing to read from an asset nobody checked: the size of the JSON document,
+//! how deep its values nest, how many pixels an image may declare before it is decoded, and
+//! whether resource URIs may lead out of the asset's folder. Each limit has a default that
+//! real assets stay far below and a command-line flag to raise it; every refusal names the
+//! limit and its flag, so that a user who meets one knows what to change.
+//!
+//! The limits exist so that a hostile or broken file costs a clear error, not a crash, a stack
+//! overflow or an out-of-memory kill: a parsed JSON value takes about ten times its text in
+//! memory, nesting is walked recursively (parsing, schema checks, source positions, dropping),
+//! and a decoded image takes up to eight bytes per pixel however small its file is.
+
+use std::io::Read;
+use std::path::Path;
+
+/// The deepest nesting serde_json parses (its recursion limit of 128 counts the root);
+/// `--max-json-depth` cannot go beyond it.
+pub const JSON_DEPTH_CEILING: usize = 127;
+
+/// Limits and URI policy for loading one asset. [`Default`] is what the command line uses
+/// when no flag is given.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct LoadOptions {
+    /// Largest JSON document, in bytes: a .gltf file, or a .glb's JSON chunk.
+    pub max_document_bytes: u64,
+    /// Deepest nesting of arrays and objects (the root object is depth 1).
+    pub max_json_depth: usize,
+    /// Most pixels (width × height) an image may declare and still be decoded.
+    pub max_image_pixels: u64,
+    /// Read resources whose URI leads out of the asset's folder: `../` past its root, absolute
+    /// paths and `file:` URIs. Writing never follows such URIs, whatever this says.
+    pub allow_outside_uris: bool,
+}
+
+/// 64 MiB: a 20,000-material document is about 11 MB; the parsed value takes ~14× its text.
+pub const DEFAULT_MAX_DOCUMENT_BYTES: u64 = 64 << 20;
+/// glTF documents nest about 8 deep; `extras` may go further.
+pub const DEFAULT_MAX_JSON_DEPTH: usize = 64;
+/// 16384 × 16384: the largest textures in use; decoded as 16-bit RGBA, 2 GiB.
+pub const DEFAULT_MAX_IMAGE_PIXELS: u64 = 16384 * 16384;
+
+impl Default for LoadOptions {
+    fn default() -> Self {
+        LoadOptions {
+            max_document_bytes: DEFAULT_MAX_DOCUMENT_BYTES,
+            max_json_depth: DEFAULT_MAX_JSON_DEPTH,
+            max_image_pixels: DEFAULT_MAX_IMAGE_PIXELS,
+            allow_outside_uris: false,
+        }
+    }
+}
+
+impl LoadOptions {
+    /// The message for a document over the size limit.
+    pub fn document_too_large(&self, size: u64) -> String {
+        format!(
+            "the JSON document is {size} bytes, over the limit of {} (raise it with --max-document-bytes)",
+            self.max_document_bytes
+        )
+    }
+
+    /// The message for an image over the pixel limit, or `None` when it is within it.
+    pub fn image_too_large(&self, width: u32, height: u32) -> Option<String> {
+        image_too_large(width, height, self.max_image_pixels)
+    }
+
+    /// The most bytes a decoder may allocate for an image within the pixel limit.
+    pub fn max_decode_bytes(&self) -> u64 {
+        max_decode_bytes(self.max_image_pixels)
+    }
+}
+
+/// The message for an image of `width` × `height` over `max_pixels`, or `None` when within.
+pub fn image_too_large(width: u32, height: u32, max_pixels: u64) -> Option<String> {
+    let pixels = u64::from(width) * u64::from(height);
+    (pixels > max_pixels).then(|| {
+        format!(
+            "the image declares {width} × {height} = {pixels} pixels, over the limit of \
+             {max_pixels} (raise it with --max-image-pixels); it was not decoded"
+        )
+    })
+}
+
+/// The most bytes a decoder may allocate for an image of at most `max_pixels`: 16-bit RGBA
+/// (8 bytes a pixel) plus room for the decoder's own buffers.
+pub fn max_decode_bytes(max_pixels: u64) -> u64 {
+    max_pixels.saturating_mul(8).saturating_add(64 << 20)
+}
+
+/// Where a JSON text first nests deeper than a limit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct TooDeep {
+    /// Byte offset of the bracket that goes one level too deep.
+    pub offset: usize,
+    pub line: usize,
+    /// 1-based, in characters.
+    pub column: usize,
+}
+
+/// Finds the first `[` or `{` in `text` that opens a container deeper than `max_depth`. A scan
+/// of our own because serde_json's only depth limit is a fixed 128 whose error does not say
+/// how deep the text went; this one runs in one pass over the bytes, skipping strings, and
+/// stops at the first excess. Malformed JSON is left for the parser to report.
+pub fn find_too_deep(text: &str, max_depth: usize) -> Option<TooDeep> {
+    let bytes = text.as_bytes();
+    let mut depth = 0usize;
+    let mut in_string = false;
+    let mut escaped = false;
+    for (i, &b) in bytes.iter().enumerate() {
+        if in_string {
+            if escaped {
+                escaped = false;
+            } else if b == b'\\' {
+                escaped = true;
+            } else if b == b'"' {
+                in_string = false;
+            }
+            continue;
+        }
+        match b {
+            b'"' => in_string = true,
+            b'[' | b'{' => {
+                depth += 1;
+                if depth > max_depth {
+                    let before = &text[..i];
+                    let line = before.matches('\n').count() + 1;
+                    let column = before.rsplit('\n').next().unwrap_or("").chars().count() + 1;
+                    return Some(TooDeep {
+                        offset: i,
+                        line,
+                        column,
+                    });
+                }
+            }
+            b']' | b'}' => depth = depth.saturating_sub(1),
+            _ => {}
+        }
+    }
+    None
+}
+
+/// Reads a file that is to be parsed as an asset. A regular file is read whole (its size is
+/// what the user stored); anything else — a pipe, a device — is read up to what the limits
+/// allow, so that `/dev/zero` named as an input costs an error, not all memory. A GLB stream
+/// is read up to the length its header declares (at most 4 GiB), anything else up to the
+/// document limit; one byte more is read so that a longer stream is seen to be longer.
+pub fn read_asset_file(path: &Path, options: &LoadOptions) -> std::io::Result<Vec<u8>> {
+    let mut file = std::fs::File::open(path)?;
+    if file.metadata()?.is_file() {
+        let mut bytes = Vec::new();
+        file.read_to_end(&mut bytes)?;
+        return Ok(bytes);
+    }
+    let mut head = Vec::with_capacity(12);
+    (&mut file).take(12).read_to_end(&mut head)?;
+    let cap = if head.len() == 12 && head.starts_with(b"glTF") {
+        u64::from(u32::from_le_bytes([head[8], head[9], head[10], head[11]]))
+    } else {
+        // A byte-order mark may precede the document.
+        options.max_document_bytes.saturating_add(3)
+    };
+    let mut bytes = head;
+    file.take(cap.saturating_sub(bytes.len() as u64).saturating_add(1))
+        .read_to_end(&mut bytes)?;
+    Ok(bytes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn depth_counts_containers_and_skips_strings() {
+        assert_eq!(find_too_deep(r#"{"a":[1,{"b":2}]}"#, 3), None);
+        let deep = find_too_deep(r#"{"a":[1,{"b":[2]}]}"#, 3).unwrap();
+        assert_eq!((deep.offset, deep.line, deep.column), (13, 1, 14));
+        // Brackets inside strings, escaped quotes included, do not count.
+        assert_eq!(find_too_deep(r#"{"a":"[[[{{\"[[["}"#, 1), None);
+        let text = "{\n  \"é\": [\n    [[]]\n  ]\n}";
+        let deep = find_too_deep(text, 3).unwrap();
+        assert_eq!((deep.line, deep.column), (3, 6));
+    }
+
+    #[test]
+    fn the_ceiling_is_what_serde_json_parses() {
+        let nested = |depth: usize| "[".repeat(depth) + &"]".repeat(depth);
+        assert!(serde_json::from_str::<serde_json::Value>(&nested(JSON_DEPTH_CEILING)).is_ok());
+        assert!(
+            serde_json::from_str::<serde_json::Value>(&nested(JSON_DEPTH_CEILING + 1)).is_err()
+        );
+    }
+
+    #[test]
+    fn pixel_limit_is_inclusive_and_named_with_its_flag() {
+        let options = LoadOptions {
+            max_image_pixels: 100,
+            ..LoadOptions::default()
+        };
+        assert_eq!(options.image_too_large(10, 10), None);
+        let message = options.image_too_large(100_000, 100_000).unwrap();
+        assert!(message.contains("10000000000 pixels"), "{message}");
+        assert!(message.contains("--max-image-pixels"), "{message}");
+    }
+
+    #[test]
+    fn streams_are_read_up_to_the_limit() {
+        let options = LoadOptions {
+            max_document_bytes: 1000,
+            ..LoadOptions::default()
+        };
+        let bytes = read_asset_file(Path::new("/dev/zero"), &options).unwrap();
+        assert_eq!(bytes.len(), 1000 + 3 + 1);
+    }
+}

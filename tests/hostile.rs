@@ -1,0 +1,969 @@
+//! Hostile and broken input: every loader limit and path rule with a crafted input, write
+//! failures that must leave no partial output and the input untouched, a batch interrupted
+//! in the middle of a write, files that vanish or dangle mid-run, and the inputs that fuzzing
+//! found (fixtures/hostile, see docs/fuzzing.md).
+
+use serde_json::{json, Value};
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use velvet::asset::{self, glb, limits, LoadOptions};
+use velvet::bake::codec::{self, CodecError};
+use velvet::diagnostics::Settings;
+use velvet::rules::schema::Schemas;
+use velvet::validate::Validator;
+
+// ---------------------------------------------------------------------------------------------
+// Helpers
+
+/// Counts the largest single allocation made on the current thread, so that a test can show
+/// that a refusal came before any pixel buffer was allocated.
+struct LargestAllocation;
+
+thread_local! {
+    static LARGEST: Cell<usize> = const { Cell::new(0) };
+}
+
+unsafe impl GlobalAlloc for LargestAllocation {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        let _ = LARGEST.try_with(|l| l.set(l.get().max(layout.size())));
+        System.alloc(layout)
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        System.dealloc(ptr, layout)
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        let _ = LARGEST.try_with(|l| l.set(l.get().max(new_size)));
+        System.realloc(ptr, layout, new_size)
+    }
+}
+
+#[global_allocator]
+static ALLOCATOR: LargestAllocation = LargestAllocation;
+
+/// Runs `f` and returns its result with the largest allocation it made on this thread.
+fn largest_allocation<T>(f: impl FnOnce() -> T) -> (T, usize) {
+    LARGEST.with(|l| l.set(0));
+    let out = f();
+    (out, LARGEST.with(Cell::get))
+}
+
+fn fixture(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("fixtures/hostile")
+        .join(name)
+}
+
+fn velvet_env(args: &[&str], env: &[(&str, &str)]) -> (Option<i32>, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_velvet"))
+        .args(args)
+        .env_remove("VELVET_TEST_WRITE_FAULT")
+        .envs(env.iter().copied())
+        .output()
+        .unwrap();
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn velvet(args: &[&str]) -> (i32, String, String) {
+    let (code, out, err) = velvet_env(args, &[]);
+    (code.expect("velvet exited normally"), out, err)
+}
+
+fn s(path: &Path) -> &str {
+    path.to_str().unwrap()
+}
+
+fn write(path: &Path, bytes: impl AsRef<[u8]>) {
+    std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+    std::fs::write(path, bytes).unwrap();
+}
+
+fn png(width: u32, height: u32, color: image::ExtendedColorType) -> Vec<u8> {
+    let channels = color.channel_count() as usize;
+    let data: Vec<u8> = (0..width as usize * height as usize * channels)
+        .map(|i| (i * 37 % 251) as u8)
+        .collect();
+    let mut out = Vec::new();
+    image::ImageEncoder::write_image(
+        image::codecs::png::PngEncoder::new(&mut out),
+        &data,
+        width,
+        height,
+        color,
+    )
+    .unwrap();
+    out
+}
+
+/// A document with one sheen material whose colour and roughness textures read image 0.
+fn sheen_document(image_uri: &str) -> Value {
+    json!({
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_materials_sheen"],
+        "materials": [{"extensions": {"KHR_materials_sheen": {
+            "sheenColorFactor": [0.5, 0.5, 0.5],
+            "sheenColorTexture": {"index": 0},
+            "sheenRoughnessFactor": 0.5,
+            "sheenRoughnessTexture": {"index": 0}
+        }}}],
+        "textures": [{"source": 0}],
+        "images": [{"uri": image_uri}]
+    })
+}
+
+fn codes(diagnostics: &[velvet::diagnostics::Diagnostic]) -> Vec<&str> {
+    diagnostics.iter().map(|d| d.code).collect()
+}
+
+/// Every file under `root` with its bytes.
+fn tree(root: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
+    let mut out = BTreeMap::new();
+    let mut stack = vec![root.to_path_buf()];
+    while let Some(dir) = stack.pop() {
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let path = entry.unwrap().path();
+            let meta = std::fs::symlink_metadata(&path).unwrap();
+            if meta.is_dir() {
+                stack.push(path);
+            } else if meta.is_file() {
+                out.insert(
+                    path.strip_prefix(root).unwrap().to_path_buf(),
+                    std::fs::read(&path).unwrap(),
+                );
+            }
+        }
+    }
+    out
+}
+
+// ---------------------------------------------------------------------------------------------
+// Limits
+
+#[test]
+fn a_document_over_the_size_limit_is_refused_naming_the_limit_and_its_flag() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut doc = sheen_document("tex.png");
+    doc["extras"] = json!({"padding": "x".repeat(5000)});
+    let text = doc.to_string();
+    let path = dir.path().join("big.gltf");
+    write(&path, &text);
+    let options = LoadOptions {
+        max_document_bytes: 4096,
+        ..LoadOptions::default()
+    };
+    let loaded = asset::load_with(&path, &options);
+    assert!(loaded.asset.is_none());
+    assert_eq!(codes(&loaded.diagnostics), ["DOCUMENT_TOO_LARGE"]);
+    assert_eq!(
+        loaded.diagnostics[0].message,
+        format!(
+            "the JSON document is {} bytes, over the limit of 4096 (raise it with --max-document-bytes)",
+            text.len()
+        )
+    );
+    // At the limit it loads.
+    let at_limit = LoadOptions {
+        max_document_bytes: text.len() as u64,
+        ..LoadOptions::default()
+    };
+    assert!(asset::load_with(&path, &at_limit).asset.is_some());
+    // In a GLB the JSON chunk counts (padded to 4 bytes), not the BIN chunk.
+    let glb_bytes = glb::join(text.as_bytes(), Some(&vec![0u8; 10_000]));
+    let loaded = asset::load_bytes_with(&dir.path().join("big.glb"), &glb_bytes, &options);
+    assert_eq!(codes(&loaded.diagnostics), ["DOCUMENT_TOO_LARGE"]);
+    let json_chunk = text.len().div_ceil(4) * 4;
+    assert!(loaded.diagnostics[0]
+        .message
+        .starts_with(&format!("the JSON document is {json_chunk} bytes")));
+
+    // On the command line: validate reports it for the file; migrate refuses it and writes
+    // nothing; the flag raises the limit.
+    let (status, out, _) = velvet(&["validate", "--max-document-bytes", "4096", s(&path)]);
+    assert_eq!(status, 1, "{out}");
+    assert!(out.contains("DOCUMENT_TOO_LARGE"), "{out}");
+    assert!(out.contains("big.gltf"), "{out}");
+    let output = dir.path().join("out.gltf");
+    let (status, out, _) = velvet(&[
+        "migrate",
+        s(&path),
+        "-o",
+        s(&output),
+        "--max-document-bytes",
+        "4096",
+    ]);
+    assert_eq!(status, 1, "{out}");
+    assert!(
+        out.contains(&format!(
+            "{} cannot be migrated: the JSON document is {} bytes, over the limit of 4096 (raise it with --max-document-bytes) (DOCUMENT_TOO_LARGE)",
+            path.display(),
+            text.len()
+        )),
+        "{out}"
+    );
+    assert!(!output.exists());
+    let (status, out, _) = velvet(&["validate", "--max-document-bytes", "6000", s(&path)]);
+    assert!(!out.contains("DOCUMENT_TOO_LARGE"), "{status} {out}");
+}
+
+#[test]
+fn an_endless_stream_named_as_input_stops_at_the_document_limit() {
+    let (status, out, _) = velvet(&["validate", "--max-document-bytes", "100000", "/dev/zero"]);
+    assert_eq!(status, 1, "{out}");
+    assert!(
+        out.contains("the JSON document is 100004 bytes, over the limit of 100000"),
+        "{out}"
+    );
+}
+
+#[test]
+fn deep_nesting_is_refused_at_the_limit_without_exhausting_the_stack() {
+    let prefix = r#"{"asset":{"version":"2.0"},"extras":"#;
+    let nested = |depth: usize| format!("{prefix}{}{}}}", "[".repeat(depth), "]".repeat(depth));
+    let path = Path::new("memory/deep.gltf");
+    // A hundred thousand levels: refused by the scan, before a recursive parser sees it.
+    let loaded = asset::load_bytes(path, nested(100_000).as_bytes());
+    assert!(loaded.asset.is_none());
+    assert_eq!(codes(&loaded.diagnostics), ["JSON_TOO_DEEP"]);
+    // The root object is level 1 and `extras` opens level 2, so the 64th '[' is level 65.
+    let column = prefix.len() + 64;
+    assert_eq!(
+        loaded.diagnostics[0].message,
+        format!("line 1, column {column}: the JSON nests deeper than 64 arrays and objects (raise the limit with --max-json-depth, at most 127)")
+    );
+    // 64 levels in all load under the default; 127 under the highest limit.
+    assert!(asset::load_bytes(path, nested(63).as_bytes())
+        .asset
+        .is_some());
+    assert_eq!(
+        codes(&asset::load_bytes(path, nested(64).as_bytes()).diagnostics),
+        ["JSON_TOO_DEEP"]
+    );
+    let highest = LoadOptions {
+        max_json_depth: limits::JSON_DEPTH_CEILING,
+        ..LoadOptions::default()
+    };
+    assert!(
+        asset::load_bytes_with(path, nested(126).as_bytes(), &highest)
+            .asset
+            .is_some()
+    );
+
+    // Every rule, on a worker thread, over the deepest document the flag allows.
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("deep.gltf");
+    write(&file, nested(126));
+    let (status, out, _) = velvet(&["validate", "--max-json-depth", "127", s(&file)]);
+    assert!(!out.contains("JSON_TOO_DEEP"), "{status} {out}");
+    let (status, out, _) = velvet(&["validate", s(&file)]);
+    assert_eq!(status, 1);
+    assert!(out.contains("JSON_TOO_DEEP"), "{out}");
+    let (status, _, err) = velvet(&["validate", "--max-json-depth", "128", s(&file)]);
+    assert_eq!(status, 2, "{err}");
+    assert!(err.contains("128 is not in 1..=127"), "{err}");
+}
+
+#[test]
+fn glb_chunk_lengths_beyond_the_file_are_reported_not_followed() {
+    let json = br#"{"asset":{"version":"2.0"}} "#;
+    let mut bytes = b"glTF\x02\0\0\0\0\0\0\0".to_vec();
+    bytes.extend_from_slice(&(json.len() as u32).to_le_bytes());
+    bytes.extend_from_slice(b"JSON");
+    bytes.extend_from_slice(json);
+    bytes.extend_from_slice(&0xFFFF_FFF0u32.to_le_bytes());
+    bytes.extend_from_slice(b"BIN\0");
+    bytes.extend_from_slice(&[1, 2, 3, 4]);
+    let len = bytes.len() as u32;
+    bytes[8..12].copy_from_slice(&len.to_le_bytes());
+    let loaded = asset::load_bytes(Path::new("memory/x.glb"), &bytes);
+    assert_eq!(codes(&loaded.diagnostics), ["GLB_UNEXPECTED_END"]);
+    assert_eq!(
+        loaded.diagnostics[0].message,
+        "chunk 1 at byte 48 declares 4294967280 bytes but only 4 remain in the file"
+    );
+    // A JSON chunk that claims the whole address space.
+    let mut bytes = b"glTF\x02\0\0\0\x18\0\0\0".to_vec();
+    bytes.extend_from_slice(&u32::MAX.to_le_bytes());
+    bytes.extend_from_slice(b"JSON{}  ");
+    let loaded = asset::load_bytes(Path::new("memory/x.glb"), &bytes);
+    assert_eq!(
+        codes(&loaded.diagnostics),
+        ["GLB_CHUNK_LENGTH_UNALIGNED", "GLB_UNEXPECTED_END"]
+    );
+}
+
+#[test]
+fn buffers_shorter_than_their_byte_length_are_reported() {
+    let dir = tempfile::tempdir().unwrap();
+    // GLB: checked on load, from the BIN chunk in hand.
+    let doc = json!({"asset": {"version": "2.0"}, "buffers": [{"byteLength": 64}]});
+    let bytes = glb::join(doc.to_string().as_bytes(), Some(&[0u8; 8]));
+    let loaded = asset::load_bytes(&dir.path().join("short.glb"), &bytes);
+    assert_eq!(codes(&loaded.diagnostics), ["BUFFER_BYTE_LENGTH_MISMATCH"]);
+    assert_eq!(loaded.diagnostics[0].pointer, "/buffers/0/byteLength");
+    assert_eq!(
+        loaded.diagnostics[0].message,
+        "buffer 0 declares 64 bytes but the GLB's BIN chunk holds 8"
+    );
+    let without_bin = glb::join(doc.to_string().as_bytes(), None);
+    let loaded = asset::load_bytes(&dir.path().join("short.glb"), &without_bin);
+    assert_eq!(
+        loaded.diagnostics[0].message,
+        "buffer 0 declares 64 bytes but the GLB has no BIN chunk"
+    );
+    // A data: URI and a file: checked when read.
+    write(&dir.path().join("short.bin"), [1u8, 2, 3]);
+    let doc = json!({"asset": {"version": "2.0"}, "buffers": [
+        {"byteLength": 10, "uri": "data:application/octet-stream;base64,AQID"},
+        {"byteLength": 10, "uri": "short.bin"},
+        {"byteLength": 3, "uri": "short.bin"}
+    ]});
+    let loaded = asset::load_bytes(&dir.path().join("a.gltf"), doc.to_string().as_bytes());
+    let a = loaded.asset.unwrap();
+    for i in [0, 1] {
+        let err = a.buffer_bytes(i).unwrap_err();
+        assert_eq!(
+            (err.code, err.pointer.as_str(), err.message.as_str()),
+            (
+                "BUFFER_BYTE_LENGTH_MISMATCH",
+                format!("/buffers/{i}/byteLength").as_str(),
+                format!("buffer {i} declares 10 bytes but its data holds 3").as_str()
+            )
+        );
+    }
+    assert_eq!(a.buffer_bytes(2).unwrap().as_ref(), [1, 2, 3]);
+
+    // migrate does not rewrite a GLB whose buffer is short, and writes nothing.
+    let input = dir.path().join("short.glb");
+    write(&input, &bytes);
+    let output = dir.path().join("out.glb");
+    let (status, out, _) = velvet(&["migrate", s(&input), "-o", s(&output)]);
+    assert_eq!(status, 1, "{out}");
+    assert!(out.contains("(BUFFER_BYTE_LENGTH_MISMATCH)"), "{out}");
+    assert!(!output.exists());
+    assert_eq!(std::fs::read(&input).unwrap(), bytes);
+}
+
+#[test]
+fn a_forged_100000_square_png_is_refused_before_any_pixel_buffer_is_allocated() {
+    let bytes = std::fs::read(fixture("huge-100000x100000.png")).unwrap();
+    let (result, largest) = largest_allocation(|| codec::decode(&bytes));
+    match result {
+        Err(CodecError::TooLarge { format, message }) => {
+            assert_eq!(format, "PNG");
+            assert_eq!(
+                message,
+                "the image declares 100000 × 100000 = 10000000000 pixels, over the limit of \
+                 268435456 (raise it with --max-image-pixels); it was not decoded"
+            );
+        }
+        other => panic!("expected TooLarge, got {other:?}"),
+    }
+    assert!(
+        largest < 1 << 20,
+        "{largest} bytes allocated at once while refusing"
+    );
+
+    // The asset's decoder (used by `migrate --report`) refuses it the same way.
+    let dir = tempfile::tempdir().unwrap();
+    write(&dir.path().join("huge.png"), &bytes);
+    let path = dir.path().join("chair.gltf");
+    write(&path, sheen_document("huge.png").to_string());
+    let a = asset::load(&path).asset.unwrap();
+    let (result, largest) = largest_allocation(|| a.decode_image(0));
+    let err = result.unwrap_err();
+    assert_eq!(
+        (err.code, err.pointer.as_str()),
+        ("IMAGE_TOO_LARGE", "/images/0")
+    );
+    assert!(
+        err.message.contains("--max-image-pixels"),
+        "{}",
+        err.message
+    );
+    assert!(largest < 1 << 20, "{largest}");
+
+    // `velvet bake` fails that file, names the image, the limit and the flag, and writes
+    // nothing.
+    let before = tree(dir.path());
+    let output = dir.path().join("out/chair.gltf");
+    let (status, out, _) = velvet(&["bake", s(&path), "-o", s(&output)]);
+    assert_eq!(status, 1, "{out}");
+    assert!(
+        out.contains("failed: cannot bake image 0: sheenColor + sheenRoughness: image 0: PNG: the image declares 100000 × 100000 = 10000000000 pixels, over the limit of 268435456 (raise it with --max-image-pixels)"),
+        "{out}"
+    );
+    assert_eq!(tree(dir.path()), before);
+}
+
+#[test]
+fn the_pixel_limit_is_inclusive_and_raised_by_its_flag() {
+    let dir = tempfile::tempdir().unwrap();
+    write(
+        &dir.path().join("tex.png"),
+        png(4, 4, image::ExtendedColorType::Rgba8),
+    );
+    let path = dir.path().join("chair.gltf");
+    write(&path, sheen_document("tex.png").to_string());
+    let output = dir.path().join("out/chair.gltf");
+    let (status, out, _) = velvet(&[
+        "bake",
+        s(&path),
+        "-o",
+        s(&output),
+        "--max-image-pixels",
+        "15",
+    ]);
+    assert_eq!(status, 1, "{out}");
+    assert!(
+        out.contains("4 × 4 = 16 pixels, over the limit of 15 (raise it with --max-image-pixels)"),
+        "{out}"
+    );
+    assert!(!output.exists());
+    let (status, out, _) = velvet(&[
+        "bake",
+        s(&path),
+        "-o",
+        s(&output),
+        "--max-image-pixels",
+        "16",
+    ]);
+    assert_eq!(status, 0, "{out}");
+    assert!(output.exists());
+}
+
+#[test]
+fn data_uris_that_are_not_base64_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("chair.gltf");
+    write(
+        &path,
+        sheen_document("data:image/png,%89PNG%0D%0A").to_string(),
+    );
+    let validator = Validator::new(Schemas::builtin(), Settings::default());
+    let report = validator.validate_file(&path);
+    let found: Vec<_> = report
+        .findings
+        .iter()
+        .filter(|f| f.diagnostic.code == "INVALID_URI")
+        .map(|f| (f.diagnostic.pointer.as_str(), f.diagnostic.message.as_str()))
+        .collect();
+    assert_eq!(
+        found,
+        [(
+            "/images/0/uri",
+            "the data: URI is not base64-encoded (glTF requires ';base64')"
+        )]
+    );
+    let output = dir.path().join("out.gltf");
+    let (status, out, _) = velvet(&["bake", s(&path), "-o", s(&output)]);
+    assert_eq!(status, 1, "{out}");
+    assert!(
+        out.contains("the data: URI is not base64-encoded (glTF requires ';base64')"),
+        "{out}"
+    );
+    assert!(!output.exists());
+}
+
+// ---------------------------------------------------------------------------------------------
+// Paths
+
+/// root/assets/chair.gltf whose roughness texture is `uri`, and root/shared/rgb.png (no alpha).
+fn chair_reading(root: &Path, uri: &str) -> PathBuf {
+    write(
+        &root.join("shared/rgb.png"),
+        png(2, 2, image::ExtendedColorType::Rgb8),
+    );
+    let path = root.join("assets/chair.gltf");
+    write(&path, sheen_document(uri).to_string());
+    path
+}
+
+#[test]
+fn uris_leaving_the_folder_are_read_only_with_the_flag() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = dir.path().canonicalize().unwrap();
+    let absolute = root.join("shared/rgb.png");
+    let file_uri = format!("file://{}", absolute.display());
+    for uri in [
+        "../shared/rgb.png",
+        absolute.to_str().unwrap(),
+        file_uri.as_str(),
+    ] {
+        let path = chair_reading(&root, uri);
+        let (status, out, _) = velvet(&["validate", "--format", "json", s(&path)]);
+        assert_eq!(status, 1, "{uri}: {out}");
+        let report: Value = serde_json::from_str(&out).unwrap();
+        let messages: Vec<(&str, &str)> = report["issues"]["messages"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|m| (m["code"].as_str().unwrap(), m["pointer"].as_str().unwrap()))
+            .collect();
+        assert_eq!(messages, [("URI_NOT_FOLLOWED", "/images/0/uri")], "{uri}");
+        assert!(out.contains("--allow-outside-uris reads it"), "{out}");
+        // With the flag the image is read: its header has no alpha.
+        let (_, out, _) = velvet(&[
+            "validate",
+            "--format",
+            "json",
+            "--allow-outside-uris",
+            s(&path),
+        ]);
+        let report: Value = serde_json::from_str(&out).unwrap();
+        let found: Vec<&str> = report["issues"]["messages"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|m| m["code"].as_str().unwrap())
+            .collect();
+        assert_eq!(
+            found,
+            ["KHR_MATERIALS_SHEEN_ROUGHNESS_TEXTURE_WITHOUT_ALPHA"],
+            "{uri}"
+        );
+    }
+    // Remote URLs are never fetched, flag or not.
+    let path = chair_reading(&root, "https://example.com/rgb.png");
+    let (_, out, _) = velvet(&["validate", "--allow-outside-uris", s(&path)]);
+    assert!(out.contains("URI_NOT_FOLLOWED"), "{out}");
+}
+
+#[test]
+fn writing_never_follows_outside_uris_and_outputs_stay_in_the_out_dir() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = dir.path();
+    write(
+        &root.join("shared/tex.png"),
+        png(2, 2, image::ExtendedColorType::Rgba8),
+    );
+    write(&root.join("shared/mesh.bin"), [0u8; 12]);
+    let mut doc = sheen_document("../shared/tex.png");
+    // A name that would climb out of the output folder if it became a path.
+    doc["images"][0]["name"] = json!("../../../escaped");
+    doc["buffers"] = json!([{"byteLength": 12, "uri": "../shared/mesh.bin"}]);
+    let input = root.join("assets/chair.gltf");
+    write(&input, doc.to_string());
+    let before = tree(root);
+    let out_dir = root.join("out");
+
+    let (status, out, _) = velvet(&[
+        "bake",
+        s(&root.join("assets")),
+        "--out-dir",
+        s(&out_dir),
+        "--allow-outside-uris",
+        "--copy-resources",
+    ]);
+    assert_eq!(status, 0, "{out}");
+    let (status, out, _) = velvet(&[
+        "migrate",
+        s(&root.join("assets")),
+        "--out-dir",
+        s(&out_dir.join("migrated")),
+        "--allow-outside-uris",
+        "--copy-resources",
+    ]);
+    assert_eq!(status, 0, "{out}");
+
+    // Nothing outside out/ changed or appeared; inside, only the outputs and baked images.
+    let after = tree(root);
+    for (path, bytes) in &before {
+        assert_eq!(after.get(path), Some(bytes), "{} changed", path.display());
+    }
+    let new: Vec<&PathBuf> = after.keys().filter(|p| !before.contains_key(*p)).collect();
+    assert_eq!(
+        new,
+        [
+            // The name's separators became '_': the file stays in the output folder.
+            Path::new("out/.._.._.._escaped.sheenColor.sheenRoughness.png"),
+            Path::new("out/chair.gltf"),
+            // migrate's fitted roughness bakes the mapped roughness texture beside its output.
+            Path::new("out/migrated/.._.._.._escaped.fuzzRoughness.png"),
+            Path::new("out/migrated/chair.gltf"),
+        ]
+    );
+    // The outside resources are referenced where they are, not copied next to the outputs.
+    let baked: Value =
+        serde_json::from_slice(&std::fs::read(out_dir.join("chair.gltf")).unwrap()).unwrap();
+    assert_eq!(baked["buffers"][0]["uri"], "../assets/../shared/mesh.bin");
+    let migrated: Value =
+        serde_json::from_slice(&std::fs::read(out_dir.join("migrated/chair.gltf")).unwrap())
+            .unwrap();
+    assert_eq!(
+        migrated["images"][0]["uri"],
+        "../../assets/../shared/tex.png"
+    );
+    // Both outputs load with the flag.
+    for output in [
+        out_dir.join("chair.gltf"),
+        out_dir.join("migrated/chair.gltf"),
+    ] {
+        let (status, out, _) = velvet(&["validate", "--allow-outside-uris", s(&output)]);
+        assert_eq!(status, 0, "{out}");
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Nothing lost
+
+/// `count` sheen documents under `root/in`, and what an uninterrupted migration makes of them.
+fn batch(root: &Path, count: usize) -> (PathBuf, BTreeMap<PathBuf, Vec<u8>>) {
+    let input = root.join("in");
+    for i in 0..count {
+        let mut doc = sheen_document("tex.png");
+        doc["materials"][0]["name"] = json!(format!("cloth {i}"));
+        doc["extras"] = json!({"padding": "x".repeat(4000)});
+        write(
+            &input.join(format!("{i:03}.gltf")),
+            serde_json::to_string_pretty(&doc).unwrap(),
+        );
+    }
+    let reference = root.join("reference");
+    let (status, out, _) = velvet(&["migrate", s(&input), "--out-dir", s(&reference)]);
+    assert_eq!(status, 0, "{out}");
+    let expected = tree(&reference);
+    assert_eq!(expected.len(), count);
+    std::fs::remove_dir_all(&reference).unwrap();
+    (input, expected)
+}
+
+/// Splits a folder's files into complete outputs (checked against `expected`) and leftover
+/// temporary files; anything else fails the test.
+fn complete_outputs(
+    dir: &Path,
+    expected: &BTreeMap<PathBuf, Vec<u8>>,
+) -> (Vec<PathBuf>, Vec<PathBuf>) {
+    let (mut outputs, mut temporaries) = (Vec::new(), Vec::new());
+    if !dir.exists() {
+        return (outputs, temporaries);
+    }
+    for (path, bytes) in tree(dir) {
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        if name.starts_with(".velvet-") && name.ends_with(".tmp") {
+            temporaries.push(path);
+        } else {
+            assert!(
+                expected.get(&path) == Some(&bytes),
+                "{} is not a complete output",
+                path.display()
+            );
+            outputs.push(path);
+        }
+    }
+    (outputs, temporaries)
+}
+
+#[test]
+fn an_injected_write_error_leaves_no_partial_output_and_the_inputs_untouched() {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, expected) = batch(dir.path(), 6);
+    let inputs_before = tree(&input);
+    let out_dir = dir.path().join("out");
+    let (status, out, _) = velvet_env(
+        &["migrate", s(&input), "--out-dir", s(&out_dir)],
+        &[("VELVET_TEST_WRITE_FAULT", "error:2")],
+    );
+    assert_eq!(status, Some(1), "{out}");
+    let (outputs, temporaries) = complete_outputs(&out_dir, &expected);
+    assert_eq!(outputs.len(), 2, "{out}");
+    assert_eq!(
+        temporaries,
+        Vec::<PathBuf>::new(),
+        "a failed write cleans up"
+    );
+    assert_eq!(out.matches(": injected write fault").count(), 4, "{out}");
+    assert!(out.contains(", 4 failed"), "{out}");
+    assert_eq!(tree(&input), inputs_before);
+
+    // In place: every write fails, every input keeps its bytes.
+    let (status, out, _) = velvet_env(
+        &["migrate", s(&input), "--in-place"],
+        &[("VELVET_TEST_WRITE_FAULT", "error:0")],
+    );
+    assert_eq!(status, Some(1), "{out}");
+    assert_eq!(tree(&input), inputs_before);
+}
+
+#[test]
+fn an_interrupted_batch_leaves_only_complete_outputs() {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, expected) = batch(dir.path(), 12);
+    let inputs_before = tree(&input);
+    let out_dir = dir.path().join("out");
+    // The process aborts halfway through its fourth write, as a kill would.
+    let (status, out, _) = velvet_env(
+        &["migrate", s(&input), "--out-dir", s(&out_dir)],
+        &[("VELVET_TEST_WRITE_FAULT", "abort:3")],
+    );
+    assert_eq!(status, None, "killed by a signal: {out}");
+    let (outputs, temporaries) = complete_outputs(&out_dir, &expected);
+    assert!(outputs.len() <= 3, "{outputs:?}");
+    assert!(
+        !temporaries.is_empty(),
+        "the interrupted write was mid-file"
+    );
+    assert_eq!(tree(&input), inputs_before);
+    // A rerun completes the batch; the leftover temporaries are hidden and never taken for
+    // assets.
+    let (status, out, _) = velvet(&["migrate", s(&input), "--out-dir", s(&out_dir)]);
+    assert_eq!(status, 0, "{out}");
+    let (outputs, _) = complete_outputs(&out_dir, &expected);
+    assert_eq!(outputs.len(), 12);
+
+    // In place: every input is its old bytes or its complete migration.
+    let in_place = dir.path().join("in-place");
+    std::fs::create_dir(&in_place).unwrap();
+    for (path, bytes) in &inputs_before {
+        write(&in_place.join(path), bytes);
+    }
+    let (status, _, _) = velvet(&["migrate", s(&in_place), "--in-place"]);
+    assert_eq!(status, 0);
+    let expected = tree(&in_place);
+    let (status, _, _) = velvet_env(
+        &["migrate", s(&input), "--in-place"],
+        &[("VELVET_TEST_WRITE_FAULT", "abort:5")],
+    );
+    assert_eq!(status, None);
+    let mut migrated = 0;
+    for (path, bytes) in tree(&input) {
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        if name.starts_with(".velvet-") {
+            continue;
+        }
+        if bytes != inputs_before[&path] {
+            assert!(expected.get(&path) == Some(&bytes), "{}", path.display());
+            migrated += 1;
+        }
+    }
+    assert!(migrated <= 5, "{migrated}");
+}
+
+/// Runs `script` (sh) in a new user and mount namespace, where a tmpfs can be mounted without
+/// privileges; `None` when this system does not allow that.
+fn in_mount_namespace(script: &str, args: &[&str]) -> Option<std::process::Output> {
+    let probe = Command::new("unshare")
+        .args(["--user", "--map-root-user", "--mount", "true"])
+        .output()
+        .ok()?;
+    if !probe.status.success() {
+        return None;
+    }
+    Some(
+        Command::new("unshare")
+            .args([
+                "--user",
+                "--map-root-user",
+                "--mount",
+                "sh",
+                "-c",
+                script,
+                "sh",
+            ])
+            .args(args)
+            .env_remove("VELVET_TEST_WRITE_FAULT")
+            .output()
+            .unwrap(),
+    )
+}
+
+#[test]
+fn a_read_only_output_folder_fails_without_output() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = tempfile::tempdir().unwrap();
+    let (input, _) = batch(dir.path(), 2);
+    let inputs_before = tree(&input);
+    let out_dir = dir.path().join("out");
+    std::fs::create_dir(&out_dir).unwrap();
+    std::fs::set_permissions(&out_dir, std::fs::Permissions::from_mode(0o555)).unwrap();
+    // Permission bits do not stop a privileged user: then a read-only mount does.
+    let privileged = std::fs::write(out_dir.join("probe"), b"").is_ok();
+    let (status, out) = if !privileged {
+        let (status, out, _) = velvet(&["migrate", s(&input), "--out-dir", s(&out_dir)]);
+        (status, out)
+    } else {
+        std::fs::remove_file(out_dir.join("probe")).unwrap();
+        let Some(output) = in_mount_namespace(
+            r#"mount -t tmpfs -o ro tmpfs "$2" && "$1" migrate "$3" --out-dir "$2"; s=$?; ls -A "$2"; exit $s"#,
+            &[env!("CARGO_BIN_EXE_velvet"), s(&out_dir), s(&input)],
+        ) else {
+            panic!("running privileged without user namespaces: no way to make a read-only folder");
+        };
+        (
+            output.status.code().unwrap(),
+            String::from_utf8_lossy(&output.stdout).into_owned(),
+        )
+    };
+    std::fs::set_permissions(&out_dir, std::fs::Permissions::from_mode(0o755)).unwrap();
+    assert_eq!(status, 1, "{out}");
+    assert_eq!(out.matches("FAILED: cannot write").count(), 2, "{out}");
+    assert!(
+        out.contains("Permission denied") || out.contains("Read-only file system"),
+        "{out}"
+    );
+    assert_eq!(tree(&out_dir).len(), 0);
+    assert_eq!(tree(&input), inputs_before);
+}
+
+#[test]
+fn a_full_disk_fails_without_partial_output_when_a_tiny_tmpfs_can_be_made() {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, _) = batch(dir.path(), 1);
+    let file = input.join("000.gltf");
+    let mut doc: Value = serde_json::from_slice(&std::fs::read(&file).unwrap()).unwrap();
+    doc["extras"]["padding"] = json!("x".repeat(64 * 1024));
+    write(&file, serde_json::to_string_pretty(&doc).unwrap());
+    let inputs_before = tree(&input);
+    std::fs::create_dir(dir.path().join("out")).unwrap();
+    let Some(output) = in_mount_namespace(
+        r#"mount -t tmpfs -o size=16k tmpfs "$2" || exit 99; "$1" migrate "$3" --out-dir "$2"; s=$?; echo "files:"; ls -A "$2"; exit $s"#,
+        &[
+            env!("CARGO_BIN_EXE_velvet"),
+            s(&dir.path().join("out")),
+            s(&file),
+        ],
+    ) else {
+        eprintln!("skipped: this system does not let an unprivileged user mount a tmpfs");
+        return;
+    };
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    if output.status.code() == Some(99) {
+        eprintln!("skipped: mounting a tmpfs failed: {stdout}");
+        return;
+    }
+    assert_eq!(output.status.code(), Some(1), "{stdout}");
+    assert!(stdout.contains("No space left on device"), "{stdout}");
+    let listing = stdout.rsplit("files:\n").next().unwrap();
+    assert_eq!(listing, "", "the full folder is left empty");
+    assert_eq!(tree(&input), inputs_before);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Under load
+
+#[test]
+fn files_that_vanish_or_dangle_get_a_clear_error_and_the_run_goes_on() {
+    let dir = tempfile::tempdir().unwrap();
+    let folder = dir.path().join("assets");
+    for name in ["a.gltf", "b.gltf", "c.gltf"] {
+        write(&folder.join(name), sheen_document("tex.png").to_string());
+    }
+    write(
+        &folder.join("tex.png"),
+        png(2, 2, image::ExtendedColorType::Rgba8),
+    );
+    std::os::unix::fs::symlink(folder.join("gone.gltf"), folder.join("dangling.gltf")).unwrap();
+    // A link named like an asset is reported, not skipped.
+    let (status, out, _) = velvet(&["validate", "--format", "json", s(&folder)]);
+    assert_eq!(status, 1, "{out}");
+    let reports: Value = serde_json::from_str(&out).unwrap();
+    let summary: Vec<(String, Vec<String>)> = reports
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| {
+            (
+                Path::new(r["uri"].as_str().unwrap())
+                    .file_name()
+                    .unwrap()
+                    .to_string_lossy()
+                    .into_owned(),
+                r["issues"]["messages"]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .filter(|m| m["severity"] == 0)
+                    .map(|m| m["code"].as_str().unwrap().to_owned())
+                    .collect(),
+            )
+        })
+        .collect();
+    assert_eq!(
+        summary,
+        [
+            ("a.gltf".to_owned(), vec![]),
+            ("b.gltf".to_owned(), vec![]),
+            ("c.gltf".to_owned(), vec![]),
+            ("dangling.gltf".to_owned(), vec!["IO_ERROR".to_owned()]),
+        ]
+    );
+    assert!(
+        out.contains("dangling.gltf: No such file or directory"),
+        "{out}"
+    );
+
+    // Files deleted or cut short between discovery and loading.
+    let (files, errors) = velvet::asset::discover::collect(&[folder.clone()]);
+    assert!(errors.is_empty());
+    assert_eq!(files.len(), 4);
+    std::fs::remove_file(folder.join("a.gltf")).unwrap();
+    write(&folder.join("b.gltf"), br#"{"asset": {"vers"#);
+    let validator = Validator::new(Schemas::builtin(), Settings::default());
+    let found: Vec<(&str, String)> = files[..2]
+        .iter()
+        .map(|f| validator.validate_file(f))
+        .map(|r| {
+            let d = &r.findings[0].diagnostic;
+            (d.code, d.message.clone())
+        })
+        .collect();
+    assert_eq!(found[0].0, "IO_ERROR");
+    assert_eq!(
+        found[0].1,
+        format!(
+            "cannot read {}: No such file or directory (os error 2)",
+            folder.join("a.gltf").display()
+        )
+    );
+    assert_eq!(
+        found[1],
+        (
+            "INVALID_JSON",
+            "line 1, column 16: EOF while parsing a string".to_owned()
+        )
+    );
+
+    // migrate: the dangling link fails, the others are migrated.
+    let out_dir = dir.path().join("out");
+    let (status, out, _) = velvet(&["migrate", s(&folder), "--out-dir", s(&out_dir)]);
+    assert_eq!(status, 1, "{out}");
+    assert!(
+        out.contains("dangling.gltf cannot be migrated: cannot read"),
+        "{out}"
+    );
+    assert!(
+        out.contains("b.gltf cannot be migrated: line 1, column 16"),
+        "{out}"
+    );
+    assert_eq!(
+        tree(&out_dir).into_keys().collect::<Vec<_>>(),
+        // c.gltf and the fuzz roughness texture its fitted mapping bakes.
+        [
+            PathBuf::from("c.gltf"),
+            PathBuf::from("tex.fuzzRoughness.png")
+        ]
+    );
+}
+
+#[test]
+fn a_resource_that_is_not_a_regular_file_is_not_read() {
+    let dir = tempfile::tempdir().unwrap();
+    std::os::unix::fs::symlink("/dev/zero", dir.path().join("zero.bin")).unwrap();
+    let doc =
+        json!({"asset": {"version": "2.0"}, "buffers": [{"byteLength": 4, "uri": "zero.bin"}]});
+    let path = dir.path().join("a.gltf");
+    write(&path, doc.to_string());
+    let a = asset::load(&path).asset.unwrap();
+    let err = a.buffer_bytes(0).unwrap_err();
+    assert_eq!(err.code, "IO_ERROR");
+    assert!(
+        err.message.ends_with("not a regular file"),
+        "{}",
+        err.message
+    );
+}

@@ -1,0 +1,447 @@
+//! Properties over random valid documents (proptest, 64 cases each so the suite stays fast):
+//! sheen, fuzz, both, and legacy draft sheen materials, with and without textures, with and
+//! without a clear coat, among unrelated JSON (unknown extensions, extras, numbers written in
+//! every way JSON allows). Each property states what must hold for every such document:
+//!
+//! - migrate, then validate: no error (the input had none);
+//! - migrate twice = migrate once (the second run writes the first's bytes);
+//! - bake twice = bake once;
+//! - migrate leaves every byte of the JSON it does not own as it was: with the sheen and fuzz
+//!   objects and `extensionsUsed` set aside, the output's text equals the input's.
+
+use base64::Engine;
+use proptest::prelude::*;
+use serde_json::{json, Map, Value};
+use std::path::{Path, PathBuf};
+use velvet::bake::command as bake;
+use velvet::diagnostics::{Settings, Severity};
+use velvet::migrate::{self, Destination, FileOutcome, Options};
+use velvet::rules::schema::Schemas;
+use velvet::validate::Validator;
+
+const CASES: u32 = 64;
+
+/// A 2×2 PNG as a data: URI; with `alpha`, RGBA (a roughness texture reads alpha).
+fn png_uri(alpha: bool, seed: u8) -> String {
+    let channels = if alpha { 4 } else { 3 };
+    let data: Vec<u8> = (0..4 * channels)
+        .map(|i| (i as u8).wrapping_mul(53).wrapping_add(seed))
+        .collect();
+    let mut bytes = Vec::new();
+    image::ImageEncoder::write_image(
+        image::codecs::png::PngEncoder::new(&mut bytes),
+        &data,
+        2,
+        2,
+        if alpha {
+            image::ExtendedColorType::Rgba8
+        } else {
+            image::ExtendedColorType::Rgb8
+        },
+    )
+    .unwrap();
+    format!(
+        "data:image/png;base64,{}",
+        base64::engine::general_purpose::STANDARD.encode(bytes)
+    )
+}
+
+/// A number in [0, 1]: the bounds exactly, or anything between.
+fn unit() -> impl Strategy<Value = f64> {
+    prop_oneof![Just(0.0), Just(1.0), Just(0.5), 0.0..=1.0f64]
+}
+
+fn colour() -> impl Strategy<Value = [f64; 3]> {
+    [unit(), unit(), unit()]
+}
+
+/// A textureInfo for texture 0 (RGBA) or 1 (RGB); roughness slots need alpha, so take 0.
+fn texture_info(alpha_needed: bool) -> impl Strategy<Value = Value> {
+    let index = if alpha_needed {
+        Just(0u64).boxed()
+    } else {
+        (0u64..=1).boxed()
+    };
+    (index, any::<bool>()).prop_map(|(index, transform)| {
+        let mut info = json!({"index": index});
+        if transform {
+            info["extensions"] =
+                json!({"KHR_texture_transform": {"scale": [2.0, 2.0], "offset": [0.5, 0.0]}});
+        }
+        info
+    })
+}
+
+fn maybe(strategy: impl Strategy<Value = Value>) -> impl Strategy<Value = Option<Value>> {
+    prop::option::of(strategy)
+}
+
+/// JSON that velvet does not own: numbers in odd spellings, strings, nested objects.
+fn unrelated() -> impl Strategy<Value = Value> {
+    let number = prop_oneof![
+        Just("1e-7"),
+        Just("0.30000000000000004"),
+        Just("12345678901234567890123"),
+        Just("-0.0"),
+        Just("1E+2"),
+        Just("0.50"),
+        Just("7"),
+    ]
+    .prop_map(|text| serde_json::from_str::<Value>(text).unwrap());
+    let leaf = prop_oneof![
+        number,
+        "[a-z ]{0,8}".prop_map(Value::String),
+        any::<bool>().prop_map(Value::Bool),
+        Just(Value::Null),
+    ];
+    leaf.prop_recursive(3, 12, 3, |inner| {
+        prop_oneof![
+            prop::collection::vec(inner.clone(), 0..3).prop_map(Value::Array),
+            prop::collection::vec(("[a-z]{1,6}", inner), 0..3)
+                .prop_map(|entries| Value::Object(entries.into_iter().collect::<Map<_, _>>())),
+        ]
+    })
+}
+
+#[derive(Debug, Clone)]
+enum Layers {
+    Sheen,
+    Fuzz,
+    Both,
+    Legacy,
+}
+
+fn sheen_object() -> impl Strategy<Value = Value> {
+    (
+        colour(),
+        unit(),
+        maybe(texture_info(false)),
+        maybe(texture_info(true)),
+    )
+        .prop_map(|(c, r, color_tex, rough_tex)| {
+            let mut sheen = json!({"sheenColorFactor": c, "sheenRoughnessFactor": r});
+            if let Some(t) = color_tex {
+                sheen["sheenColorTexture"] = t;
+            }
+            if let Some(t) = rough_tex {
+                sheen["sheenRoughnessTexture"] = t;
+            }
+            sheen
+        })
+}
+
+fn fuzz_object() -> impl Strategy<Value = Value> {
+    (
+        unit(),
+        colour(),
+        prop::option::of(unit()),
+        maybe(texture_info(false)),
+        maybe(texture_info(false)),
+        maybe(texture_info(true)),
+    )
+        .prop_map(|(f, c, r, color_tex, fuzz_tex, rough_tex)| {
+            let mut fuzz = json!({"fuzzFactor": f, "fuzzColorFactor": c});
+            if let Some(r) = r {
+                fuzz["fuzzRoughnessFactor"] = json!(r);
+            }
+            for (key, t) in [
+                ("fuzzColorTexture", color_tex),
+                ("fuzzTexture", fuzz_tex),
+                ("fuzzRoughnessTexture", rough_tex),
+            ] {
+                if let Some(t) = t {
+                    fuzz[key] = t;
+                }
+            }
+            fuzz
+        })
+}
+
+/// The pre-ratification draft: sheenFactor, sheenColor, sheenTexture; roughness from the
+/// material's own.
+fn legacy_object() -> impl Strategy<Value = Value> {
+    (unit(), colour(), maybe(texture_info(false))).prop_map(|(f, c, t)| {
+        let mut sheen = json!({"sheenFactor": f, "sheenColor": c});
+        if let Some(t) = t {
+            sheen["sheenTexture"] = t;
+        }
+        sheen
+    })
+}
+
+fn material() -> impl Strategy<Value = Value> {
+    let layers = prop_oneof![
+        Just(Layers::Sheen),
+        Just(Layers::Fuzz),
+        Just(Layers::Both),
+        Just(Layers::Legacy),
+    ];
+    (
+        layers,
+        sheen_object(),
+        fuzz_object(),
+        legacy_object(),
+        prop::option::of(unit()),
+        unit(),
+        any::<bool>(),
+        maybe(unrelated()),
+        maybe(unrelated()),
+    )
+        .prop_map(
+            |(layers, sheen, fuzz, legacy, clearcoat, roughness, mr_texture, extras, unknown)| {
+                let mut extensions = Map::new();
+                match layers {
+                    Layers::Sheen => {
+                        extensions.insert("KHR_materials_sheen".into(), sheen);
+                    }
+                    Layers::Fuzz => {
+                        extensions.insert("KHR_materials_fuzz".into(), fuzz);
+                    }
+                    Layers::Both => {
+                        extensions.insert("KHR_materials_fuzz".into(), fuzz);
+                        extensions.insert("KHR_materials_sheen".into(), sheen);
+                    }
+                    Layers::Legacy => {
+                        extensions.insert("KHR_materials_sheen".into(), legacy);
+                    }
+                }
+                if let Some(c) = clearcoat {
+                    extensions.insert(
+                        "KHR_materials_clearcoat".into(),
+                        json!({"clearcoatFactor": c}),
+                    );
+                }
+                if let Some(u) = unknown {
+                    extensions.insert("EXT_unknown_to_velvet".into(), json!({ "data": u }));
+                }
+                let mut pbr = json!({"roughnessFactor": roughness});
+                if mr_texture {
+                    pbr["metallicRoughnessTexture"] = json!({"index": 1});
+                }
+                let mut m = json!({"pbrMetallicRoughness": pbr, "extensions": extensions});
+                if let Some(e) = extras {
+                    m["extras"] = e;
+                }
+                m
+            },
+        )
+}
+
+fn document() -> impl Strategy<Value = Value> {
+    (
+        prop::collection::vec(material(), 1..4),
+        maybe(unrelated()),
+        any::<bool>(),
+    )
+        .prop_map(|(materials, extras, minified)| {
+            let mut used = vec![
+                "KHR_materials_sheen",
+                "KHR_materials_fuzz",
+                "KHR_texture_transform",
+            ];
+            if materials
+                .iter()
+                .any(|m| m["extensions"].get("KHR_materials_clearcoat").is_some())
+            {
+                used.push("KHR_materials_clearcoat");
+            }
+            if materials
+                .iter()
+                .any(|m| m["extensions"].get("EXT_unknown_to_velvet").is_some())
+            {
+                used.push("EXT_unknown_to_velvet");
+            }
+            let mut doc = json!({
+                "asset": {"version": "2.0", "generator": "velvet properties"},
+                "extensionsUsed": used,
+                "materials": materials,
+                "textures": [{"source": 0}, {"source": 1}],
+                "images": [{"uri": png_uri(true, 7)}, {"uri": png_uri(false, 91)}],
+                "scene": 0,
+                "scenes": [{"nodes": []}],
+            });
+            if let Some(e) = extras {
+                doc["extras"] = e;
+            }
+            // The style flag travels in the document's text; see `text`.
+            doc["asset"]["minified"] = Value::Bool(minified);
+            doc
+        })
+}
+
+/// The document's text, minified or pretty as the generator chose.
+fn text(doc: &Value) -> String {
+    let mut doc = doc.clone();
+    let minified = doc["asset"]
+        .as_object_mut()
+        .unwrap()
+        .shift_remove("minified")
+        .is_some_and(|m| m == true);
+    if minified {
+        doc.to_string()
+    } else {
+        serde_json::to_string_pretty(&doc).unwrap() + "\n"
+    }
+}
+
+fn validation_errors(path: &Path) -> Vec<String> {
+    let report = Validator::new(Schemas::builtin(), Settings::default()).validate_file(path);
+    report
+        .findings
+        .iter()
+        .filter(|f| f.diagnostic.severity == Severity::Error)
+        .map(|f| {
+            format!(
+                "{} {}: {}",
+                f.diagnostic.code, f.diagnostic.pointer, f.diagnostic.message
+            )
+        })
+        .collect()
+}
+
+fn migrate_file(input: &Path, output: &Path) -> FileOutcome {
+    let report = migrate::run(&migrate::Request {
+        inputs: vec![input.to_path_buf()],
+        destination: Destination::File(output.to_path_buf()),
+        options: Options::default(),
+        dry_run: false,
+        progress: false,
+    })
+    .unwrap();
+    report.files.into_iter().next().unwrap().outcome
+}
+
+fn bake_file(input: &Path, output: &Path) -> bake::Outcome {
+    let results = bake::run(&bake::Request {
+        inputs: vec![input.to_path_buf()],
+        destination: bake::Destination::File(output.to_path_buf()),
+        dry_run: false,
+        options: bake::Options::default(),
+        progress: false,
+    })
+    .unwrap();
+    results.into_iter().next().unwrap().outcome
+}
+
+/// A folder holding the document as `in.gltf`.
+fn written(doc: &Value) -> (tempfile::TempDir, PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in.gltf");
+    std::fs::write(&input, text(doc)).unwrap();
+    (dir, input)
+}
+
+/// The document's text with what migrate owns set aside: the sheen and fuzz objects of every
+/// material, and `extensionsUsed`.
+fn unrelated_text(bytes: &[u8]) -> String {
+    let mut doc: Value = serde_json::from_slice(bytes).unwrap();
+    let root = doc.as_object_mut().unwrap();
+    root.shift_remove("extensionsUsed");
+    for m in root
+        .get_mut("materials")
+        .and_then(Value::as_array_mut)
+        .into_iter()
+        .flatten()
+    {
+        if let Some(ext) = m.get_mut("extensions").and_then(Value::as_object_mut) {
+            ext.shift_remove("KHR_materials_sheen");
+            ext.shift_remove("KHR_materials_fuzz");
+        }
+    }
+    // Serialised, not compared as values: key order is part of what must be kept.
+    doc.to_string()
+}
+
+/// `after` without the textures and images migrate appended for the textures it baked (the
+/// mapped roughness, the fallback's colour × intensity): those are migrate's, like the layers.
+fn baked_entries_removed(before: &[u8], after: &[u8]) -> Vec<u8> {
+    let before: Value = serde_json::from_slice(before).unwrap();
+    let mut after: Value = serde_json::from_slice(after).unwrap();
+    let root = after.as_object_mut().unwrap();
+    for key in ["textures", "images"] {
+        match before.get(key).and_then(Value::as_array).map(Vec::len) {
+            Some(n) => {
+                if let Some(list) = root.get_mut(key).and_then(Value::as_array_mut) {
+                    list.truncate(n);
+                }
+            }
+            None => {
+                root.shift_remove(key);
+            }
+        }
+    }
+    serde_json::to_vec(&after).unwrap()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(CASES))]
+
+    #[test]
+    fn migrated_documents_validate_without_error(doc in document()) {
+        let (dir, input) = written(&doc);
+        prop_assert_eq!(validation_errors(&input), Vec::<String>::new(), "the generated input is valid");
+        let output = dir.path().join("out.gltf");
+        let outcome = migrate_file(&input, &output);
+        prop_assert!(
+            matches!(outcome, FileOutcome::Changed | FileOutcome::Copied),
+            "{:?}", outcome
+        );
+        prop_assert_eq!(validation_errors(&output), Vec::<String>::new());
+    }
+
+    #[test]
+    fn migrating_twice_is_migrating_once(doc in document()) {
+        let (dir, input) = written(&doc);
+        let once = dir.path().join("once.gltf");
+        let twice = dir.path().join("twice.gltf");
+        migrate_file(&input, &once);
+        let outcome = migrate_file(&once, &twice);
+        prop_assert_eq!(outcome, FileOutcome::Copied);
+        prop_assert!(std::fs::read(&once).unwrap() == std::fs::read(&twice).unwrap());
+    }
+
+    #[test]
+    fn baking_twice_is_baking_once(doc in document()) {
+        let (dir, input) = written(&doc);
+        let once = dir.path().join("once.gltf");
+        let twice = dir.path().join("twice.gltf");
+        let first = bake_file(&input, &once);
+        prop_assert!(matches!(first, bake::Outcome::Changed | bake::Outcome::Copied), "{:?}", first);
+        prop_assert_eq!(bake_file(&once, &twice), bake::Outcome::Copied);
+        prop_assert!(std::fs::read(&once).unwrap() == std::fs::read(&twice).unwrap());
+        prop_assert_eq!(validation_errors(&twice), Vec::<String>::new());
+    }
+
+    #[test]
+    fn migrate_keeps_the_json_it_does_not_own(doc in document()) {
+        let (dir, input) = written(&doc);
+        let output = dir.path().join("out.gltf");
+        migrate_file(&input, &output);
+        let before = std::fs::read(&input).unwrap();
+        let after = baked_entries_removed(&before, &std::fs::read(&output).unwrap());
+        prop_assert_eq!(unrelated_text(&before), unrelated_text(&after));
+        // What migrate owns loads again too: the output is a document velvet reads.
+        prop_assert!(velvet::asset::load(&output).asset.is_some());
+    }
+}
+
+/// Found by the properties above: glTF allows `extras` of any JSON type (an object is only
+/// recommended), and the core structure check refused arrays and scalars.
+#[test]
+fn extras_of_every_json_type_are_valid() {
+    for extras in [
+        json!([1, "a"]),
+        json!(7),
+        json!("text"),
+        json!(null),
+        json!({"a": []}),
+    ] {
+        let doc = json!({
+            "asset": {"version": "2.0", "extras": extras},
+            "materials": [{"extras": extras}],
+            "extras": extras,
+        });
+        let (_dir, input) = written(&doc);
+        assert_eq!(validation_errors(&input), Vec::<String>::new(), "{extras}");
+    }
+}
