@@ -58,7 +58,7 @@ impl Rule for CoreStructure {
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
         let text = cx.asset.json_text.trim_end_matches(['\0', ' ']);
-        let root: gltf::json::Root = match gltf::json::deserialize::from_str(text) {
+        let mut root: gltf::json::Root = match gltf::json::deserialize::from_str(text) {
             Ok(root) => root,
             Err(e) => {
                 out.push(Diagnostic::new(
@@ -76,8 +76,16 @@ impl Rule for CoreStructure {
                 return;
             }
         };
+        let dangling = take_dangling_positions(&mut root);
         root.validate(&root, gltf::json::Path::new, &mut |path, error| {
             let path = path();
+            // A POSITION taken out above is reported missing by the crate: it names no object.
+            let error = match error {
+                CoreError::Missing if dangling.iter().any(|d| d == path.as_str()) => {
+                    CoreError::IndexOutOfBounds
+                }
+                other => other,
+            };
             // The crate rejects required extensions it does not implement; that is a loader's
             // capability, not a fault of the asset.
             if path.as_str().starts_with("extensionsRequired") {
@@ -107,6 +115,32 @@ impl Rule for CoreStructure {
             out.push(Diagnostic::new(code, pointer, message));
         });
     }
+}
+
+/// gltf-json 1.4 looks up a primitive's POSITION accessor without checking the index, and
+/// panics when it names no accessor. Such attributes are taken out of the (local) document
+/// before the crate's check; their paths are returned so that the check reports them as the
+/// dangling references they are.
+fn take_dangling_positions(root: &mut gltf::json::Root) -> Vec<String> {
+    use gltf::json::{mesh::Semantic, validation::Checked};
+    let accessors = root.accessors.len();
+    let mut dangling = Vec::new();
+    for (m, mesh) in root.meshes.iter_mut().enumerate() {
+        for (p, primitive) in mesh.primitives.iter_mut().enumerate() {
+            let key = Checked::Valid(Semantic::Positions);
+            if primitive
+                .attributes
+                .get(&key)
+                .is_some_and(|i| i.value() >= accessors)
+            {
+                primitive.attributes.remove(&key);
+                dangling.push(format!(
+                    "meshes[{m}].primitives[{p}].attributes[\"POSITION\"]"
+                ));
+            }
+        }
+    }
+    dangling
 }
 
 #[cfg(test)]
