@@ -403,9 +403,21 @@ struct MigrateArgs {
     /// Decode sheen colour textures to measure what the fast conversion changes.
     #[arg(long)]
     report: bool,
-    /// Bake textures so that the fuzz matches the sheen texel by texel (needs the bake engine).
+    /// Bake a fuzzTexture and a normalised fuzzColorTexture from each sheen colour texture so
+    /// that the fuzz matches the sheen texel by texel (lobe and base attenuation).
     #[arg(long)]
     exact: bool,
+    /// .gltf: store baked textures as data: URIs instead of files next to the output.
+    #[arg(long)]
+    embed: bool,
+    /// How roughness is carried between sheen and fuzz: fitted (by appearance: α(r) for the
+    /// fuzz, r(α) for a fallback sheen) or identity (the same number).
+    #[arg(long, value_enum, default_value_t = RoughnessArg::Fitted, value_name = "MAPPING")]
+    roughness: RoughnessArg,
+    /// With a roughness texture, copy the roughness (identity) instead of baking a mapped
+    /// texture, and say so.
+    #[arg(long)]
+    fast: bool,
     /// Regenerate the sheen fallback of materials that already have fuzz and sheen.
     #[arg(long)]
     refresh_fallback: bool,
@@ -414,6 +426,12 @@ struct MigrateArgs {
     copy_resources: bool,
     #[command(flatten)]
     load: LoadArgs,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum RoughnessArg {
+    Fitted,
+    Identity,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -437,6 +455,12 @@ fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
             refresh_fallback: args.refresh_fallback,
             report: args.report,
             exact: args.exact,
+            embed: args.embed,
+            roughness: match args.roughness {
+                RoughnessArg::Fitted => migrate::roughness::RoughnessMapping::Fitted,
+                RoughnessArg::Identity => migrate::roughness::RoughnessMapping::Identity,
+            },
+            fast: args.fast,
             copy_resources: args.copy_resources,
             load: args.load.options(),
         },

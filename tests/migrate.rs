@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use velvet::asset::glb;
 use velvet::diagnostics::Severity;
+use velvet::migrate::roughness::{self, Direction, RoughnessMapping};
 use velvet::migrate::{
     self, render, Conversion, Destination, FileOutcome, Note, Options, Request, Skip, UsageError,
 };
@@ -49,6 +50,7 @@ fn options_for(case: &Path) -> Options {
                 "--report" => options.report = true,
                 "--refresh-fallback" => options.refresh_fallback = true,
                 "--copy-resources" => options.copy_resources = true,
+                "--roughness identity" => options.roughness = RoughnessMapping::Identity,
                 other => panic!("{}: unknown flag {other}", case.display()),
             }
         }
@@ -106,6 +108,13 @@ fn golden(path: &Path, actual: &[u8]) {
 
 /// Migrates one fixture into a temporary folder; returns (folder, output path, result).
 fn migrate_case(case: &Path) -> (tempfile::TempDir, PathBuf, migrate::FileResult) {
+    migrate_case_with(case, options_for(case))
+}
+
+fn migrate_case_with(
+    case: &Path,
+    options: Options,
+) -> (tempfile::TempDir, PathBuf, migrate::FileResult) {
     let dir = tempfile::tempdir().unwrap();
     let input = dir.path().join("in").join(case.file_name().unwrap());
     std::fs::create_dir_all(input.parent().unwrap()).unwrap();
@@ -114,7 +123,7 @@ fn migrate_case(case: &Path) -> (tempfile::TempDir, PathBuf, migrate::FileResult
     let report = migrate::run(&request(
         vec![input.parent().unwrap().to_path_buf()],
         Destination::Dir(out_dir.clone()),
-        options_for(case),
+        options,
     ))
     .unwrap();
     assert_eq!(report.files.len(), 1);
@@ -170,19 +179,41 @@ fn unchanged_files_are_the_cases_with_nothing_to_migrate() {
 
 #[test]
 fn migrating_an_output_again_changes_nothing() {
-    for case in cases() {
-        let (dir, output, _) = migrate_case(&case);
-        for refresh_fallback in [false, true] {
+    // The fitted mappings α(r) and r(α) are each optimal, not each other's inverse, so only the
+    // identity promises that a refreshed fallback gives back the sheen it came from.
+    for (mapping, refreshes) in [
+        (RoughnessMapping::Fitted, &[false][..]),
+        (RoughnessMapping::Identity, &[false, true][..]),
+    ] {
+        for case in cases() {
+            let options = Options {
+                roughness: mapping,
+                ..options_for(&case)
+            };
+            again_changes_nothing(&case, options, refreshes);
+        }
+    }
+}
+
+fn again_changes_nothing(case: &Path, first: Options, refreshes: &[bool]) {
+    {
+        let (_dir, output, _) = migrate_case_with(case, first.clone());
+        for &refresh_fallback in refreshes {
             // Inputs whose own fallback is stale (both), or that keep draft properties beside
-            // ratified ones (legacy), are what a refresh changes.
-            if refresh_fallback && ["both", "legacy"].contains(&stem(&case).as_str()) {
+            // ratified ones (legacy), are what a refresh changes; a fallback whose colour
+            // texture is baked from fuzz textures is baked anew by every refresh.
+            if refresh_fallback
+                && ["both", "legacy", "fuzz-textures"].contains(&stem(case).as_str())
+            {
                 continue;
             }
             let options = Options {
                 refresh_fallback,
+                roughness: first.roughness,
                 ..Options::default()
             };
-            let again = dir.path().join(format!("again-{refresh_fallback}.gltf"));
+            // Beside the first output, whose baked images it shares.
+            let again = output.with_file_name(format!("again-{refresh_fallback}.gltf"));
             let report = migrate::run(&request(
                 vec![output.clone()],
                 Destination::File(again.clone()),
@@ -192,8 +223,9 @@ fn migrating_an_output_again_changes_nothing() {
             assert_eq!(
                 report.files[0].outcome,
                 FileOutcome::Copied,
-                "{} (refresh {refresh_fallback})",
-                case.display()
+                "{} (refresh {refresh_fallback}, {:?})",
+                case.display(),
+                first.roughness
             );
             assert_file(&again, &std::fs::read(&output).unwrap());
         }
@@ -491,17 +523,6 @@ fn refused_requests_write_nothing() {
             request(vec![], Destination::InPlace, Options::default()),
             UsageError::NoInputs,
         ),
-        (
-            request(
-                vec![a.clone()],
-                Destination::Dir(dir.path().join("out")),
-                Options {
-                    exact: true,
-                    ..Options::default()
-                },
-            ),
-            UsageError::ExactUnavailable,
-        ),
     ];
     for (req, expected) in cases {
         assert_eq!(migrate::run(&req).unwrap_err(), expected);
@@ -798,7 +819,7 @@ fn dry_run_prints_the_plan_and_writes_nothing() {
         "{text}"
     );
     assert!(text.contains(
-        "    set /materials/0/extensions/KHR_materials_fuzz = {\"fuzzFactor\":0.9,\"fuzzColorFactor\":[1.0,0.7777777777777777,0.6666666666666666],\"fuzzRoughnessFactor\":0.6}\n"
+        "    set /materials/0/extensions/KHR_materials_fuzz = {\"fuzzFactor\":0.9,\"fuzzColorFactor\":[1.0,0.7777777777777777,0.6666666666666666],\"fuzzRoughnessFactor\":0.623624274420407}\n"
     ), "{text}");
     assert!(
         text.contains("  declare KHR_materials_fuzz in /extensionsUsed\n"),
@@ -854,9 +875,6 @@ fn the_command_exits_0_when_done_1_when_a_file_failed_2_on_usage_errors() {
     assert_eq!(code, 1, "{stdout}");
     assert!(stdout.contains("bad.gltf: FAILED: "), "{stdout}");
 
-    let (code, _, stderr) = velvet(&["migrate", good.to_str().unwrap(), "--exact", "--in-place"]);
-    assert_eq!(code, 2);
-    assert!(stderr.contains("--exact bakes textures with the bake engine, which this build of velvet does not include"), "{stderr}");
     let (code, _, stderr) = velvet(&[
         "migrate",
         good.to_str().unwrap(),
@@ -877,4 +895,517 @@ fn the_command_exits_0_when_done_1_when_a_file_failed_2_on_usage_errors() {
         std::fs::read(&good).unwrap(),
         std::fs::read(fixtures().join("fuzz-only.gltf")).unwrap()
     );
+}
+
+// ---- Textures baked by migrate (decoded and compared pixel by pixel) ----
+
+/// The exact sRGB decode and encode (IEC 61966-2-1), written out here so that the tests do not
+/// check velvet's functions against themselves.
+fn srgb_decode(code: u8) -> f64 {
+    let v = code as f64 / 255.0;
+    if v <= 0.04045 {
+        v / 12.92
+    } else {
+        ((v + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+fn srgb_encode_code(linear: f64) -> u8 {
+    let l = linear.clamp(0.0, 1.0);
+    let v = if l <= 0.0031308 {
+        12.92 * l
+    } else {
+        1.055 * l.powf(1.0 / 2.4) - 0.055
+    };
+    (v * 255.0).round() as u8
+}
+
+fn linear_code(linear: f64) -> u8 {
+    (linear.clamp(0.0, 1.0) * 255.0).round() as u8
+}
+
+fn png_file(path: &Path, width: u32, height: u32, layout: image::ColorType, data: &[u8]) {
+    image::save_buffer(path, data, width, height, layout).unwrap();
+}
+
+/// Writes `json` as `<dir>/<name>.gltf`, migrates it to `output` (relative to `dir`) and
+/// returns the output's path, its document and the file's result.
+fn migrate_document(
+    dir: &Path,
+    name: &str,
+    json: Value,
+    output: &str,
+    options: Options,
+) -> (PathBuf, Value, migrate::FileResult) {
+    let input = dir.join(format!("{name}.gltf"));
+    std::fs::write(&input, serde_json::to_vec_pretty(&json).unwrap()).unwrap();
+    let output = dir.join(output);
+    let report = migrate::run(&request(
+        vec![input],
+        Destination::File(output.clone()),
+        options,
+    ))
+    .unwrap();
+    let result = report.files.into_iter().next().unwrap();
+    assert_eq!(result.outcome, FileOutcome::Changed, "{name}");
+    let doc: Value = serde_json::from_slice(&std::fs::read(&output).unwrap()).unwrap();
+    (output, doc, result)
+}
+
+/// The decoded RGBA8 pixels of the image that textureInfo `pointer` of the document at `gltf`
+/// reads (a file next to it).
+fn texture_pixels(gltf: &Path, pointer: &str) -> (image::ColorType, Vec<[u8; 4]>) {
+    let doc: Value = serde_json::from_slice(&std::fs::read(gltf).unwrap()).unwrap();
+    let texture = doc
+        .pointer(&format!("{pointer}/index"))
+        .unwrap()
+        .as_u64()
+        .unwrap();
+    let image = doc["textures"][texture as usize]["source"]
+        .as_u64()
+        .unwrap();
+    let uri = doc["images"][image as usize]["uri"].as_str().unwrap();
+    let decoded = image::open(gltf.parent().unwrap().join(uri)).unwrap();
+    let colour = decoded.color();
+    let pixels = decoded.to_rgba8().pixels().map(|p| p.0).collect();
+    (colour, pixels)
+}
+
+/// Sheen colour texels that cover black, the sRGB segment boundary (code 10 decodes below
+/// 0.04045, 11 above), mid values, one channel dominant per texel, and white.
+const SHEEN_TEXELS: [[u8; 3]; 8] = [
+    [0, 0, 0],
+    [10, 11, 0],
+    [255, 128, 64],
+    [64, 255, 128],
+    [1, 2, 200],
+    [200, 200, 200],
+    [255, 255, 255],
+    [37, 0, 90],
+];
+
+#[test]
+fn exact_mode_bakes_the_sheen_strength_and_normalised_colour_texel_by_texel() {
+    let dir = tempfile::tempdir().unwrap();
+    let data: Vec<u8> = SHEEN_TEXELS.iter().flatten().copied().collect();
+    png_file(
+        &dir.path().join("sheen.png"),
+        4,
+        2,
+        image::ColorType::Rgb8,
+        &data,
+    );
+    let factor = [0.8, 0.6, 0.3];
+    let (output, doc, result) = migrate_document(
+        dir.path(),
+        "exact",
+        serde_json::json!({
+            "asset": {"version": "2.0"},
+            "extensionsUsed": ["KHR_materials_sheen"],
+            "materials": [{"extensions": {"KHR_materials_sheen": {
+                "sheenColorFactor": factor,
+                "sheenColorTexture": {"index": 0},
+                "sheenRoughnessFactor": 0.4
+            }}}],
+            "textures": [{"source": 0, "sampler": 0}],
+            "samplers": [{"magFilter": 9729}],
+            "images": [{"uri": "sheen.png"}]
+        }),
+        "out/exact.gltf",
+        Options {
+            exact: true,
+            ..Options::default()
+        },
+    );
+    assert!(result.materials[0].notes.contains(&Note::ExactBaked));
+    // Each baked image states its quantisation error: at most half a code.
+    let errors_in_codes: Vec<(String, f64)> = result
+        .notes
+        .iter()
+        .filter_map(|n| match n {
+            Note::BakeError {
+                image, max_codes, ..
+            } => Some((image.clone(), *max_codes)),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(
+        errors_in_codes
+            .iter()
+            .map(|e| e.0.as_str())
+            .collect::<Vec<_>>(),
+        ["sheen.fuzz", "sheen.fuzzColor"]
+    );
+    assert!(
+        errors_in_codes.iter().all(|e| e.1 <= 0.5),
+        "{errors_in_codes:?}"
+    );
+    let fuzz = &doc["materials"][0]["extensions"]["KHR_materials_fuzz"];
+    assert_eq!(fuzz["fuzzFactor"], serde_json::json!(1.0));
+    assert_eq!(fuzz["fuzzColorFactor"], serde_json::json!([1.0, 1.0, 1.0]));
+    // The fitted mapping, the default, writes α(0.4) for the fuzz.
+    assert_eq!(
+        fuzz["fuzzRoughnessFactor"].as_f64(),
+        Some(roughness::map(
+            0.4,
+            Direction::SheenToFuzz,
+            RoughnessMapping::Fitted
+        ))
+    );
+    // The sheen fallback still reads the original texture, and the new textures keep its sampler.
+    let sheen = &doc["materials"][0]["extensions"]["KHR_materials_sheen"];
+    assert_eq!(sheen["sheenColorTexture"]["index"], 0);
+    assert_eq!(doc["images"][0]["uri"], "../sheen.png");
+    for pointer in ["fuzzTexture", "fuzzColorTexture"] {
+        let t = fuzz[pointer]["index"].as_u64().unwrap() as usize;
+        assert_eq!(doc["textures"][t]["sampler"], 0, "{pointer}");
+    }
+
+    let base = "/materials/0/extensions/KHR_materials_fuzz";
+    let (strength_type, strength) = texture_pixels(&output, &format!("{base}/fuzzTexture"));
+    let (_, colour) = texture_pixels(&output, &format!("{base}/fuzzColorTexture"));
+    assert_eq!(
+        strength_type,
+        image::ColorType::L8,
+        "the strength is one grey channel"
+    );
+    let mut worst_lobe: f64 = 0.0;
+    let mut worst_attenuation: f64 = 0.0;
+    for (k, texel) in SHEEN_TEXELS.iter().enumerate() {
+        let linear: [f64; 3] = std::array::from_fn(|i| factor[i] * srgb_decode(texel[i]));
+        let w = linear.iter().cloned().fold(0.0, f64::max);
+        assert_eq!(
+            strength[k][0],
+            linear_code(w),
+            "strength of texel {k} {texel:?}"
+        );
+        for i in 0..3 {
+            let expected = if w == 0.0 {
+                255
+            } else {
+                srgb_encode_code(linear[i] / w)
+            };
+            assert_eq!(
+                colour[k][i], expected,
+                "colour channel {i} of texel {k} {texel:?}"
+            );
+            // The lobe the fuzz shows, from the stored codes, against the sheen's.
+            let lobe = srgb_decode(colour[k][i]) * strength[k][0] as f64 / 255.0;
+            worst_lobe = worst_lobe.max((lobe - linear[i]).abs());
+        }
+        worst_attenuation = worst_attenuation.max((strength[k][0] as f64 / 255.0 - w).abs());
+    }
+    // Quantisation alone: half a linear code for the strength; the lobe adds the colour's code.
+    assert!(
+        worst_attenuation <= 0.5 / 255.0 + 1e-12,
+        "{worst_attenuation}"
+    );
+    assert!(worst_lobe < 0.01, "{worst_lobe}");
+    assert!(errors(&output).is_empty(), "{:?}", errors(&output));
+}
+
+#[test]
+fn a_draft_sheen_roughness_moves_from_metallic_roughness_green_to_alpha() {
+    let dir = tempfile::tempdir().unwrap();
+    // Metallic in blue, roughness in green; red (occlusion) must stay bit-exact.
+    let texels: [[u8; 3]; 4] = [[1, 0, 255], [2, 128, 0], [3, 255, 77], [4, 31, 9]];
+    let data: Vec<u8> = texels.iter().flatten().copied().collect();
+    png_file(
+        &dir.path().join("mr.png"),
+        2,
+        2,
+        image::ColorType::Rgb8,
+        &data,
+    );
+    let legacy = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_materials_sheen"],
+        "materials": [{
+            "pbrMetallicRoughness": {"roughnessFactor": 0.6, "metallicRoughnessTexture": {"index": 0}},
+            "extensions": {"KHR_materials_sheen": {"sheenFactor": 0.5}}
+        }],
+        "textures": [{"source": 0}],
+        "images": [{"uri": "mr.png"}]
+    });
+    let alpha_of = |output: &Path, layer: &str, slot: &str| -> Vec<u8> {
+        let (kind, pixels) =
+            texture_pixels(output, &format!("/materials/0/extensions/{layer}/{slot}"));
+        assert_eq!(kind, image::ColorType::Rgba8);
+        for (k, t) in texels.iter().enumerate() {
+            assert_eq!(
+                &pixels[k][..3],
+                t,
+                "RGB of texel {k} of {slot} is bit-exact"
+            );
+        }
+        pixels.iter().map(|p| p[3]).collect()
+    };
+    // 0.6 × code never lands on a half code here, where rounding order would decide.
+    let sheen_alpha: Vec<u8> = texels
+        .iter()
+        .map(|t| linear_code(0.6 * t[1] as f64 / 255.0))
+        .collect();
+
+    // Identity: sheen and fuzz read one texture holding 0.6 × green in alpha.
+    let (output, doc, _) = migrate_document(
+        dir.path(),
+        "legacy",
+        legacy.clone(),
+        "identity.gltf",
+        Options {
+            roughness: RoughnessMapping::Identity,
+            ..Options::default()
+        },
+    );
+    let layers = &doc["materials"][0]["extensions"];
+    assert_eq!(
+        layers["KHR_materials_sheen"]["sheenRoughnessFactor"],
+        serde_json::json!(1.0)
+    );
+    assert_eq!(
+        layers["KHR_materials_fuzz"]["fuzzRoughnessFactor"],
+        serde_json::json!(1.0)
+    );
+    assert_eq!(
+        layers["KHR_materials_sheen"]["sheenRoughnessTexture"],
+        layers["KHR_materials_fuzz"]["fuzzRoughnessTexture"],
+        "sheen and fuzz share the one baked texture"
+    );
+    // The material's own metallicRoughness still reads the original.
+    assert_eq!(
+        doc["materials"][0]["pbrMetallicRoughness"]["metallicRoughnessTexture"]["index"],
+        0
+    );
+    assert_eq!(
+        alpha_of(&output, "KHR_materials_sheen", "sheenRoughnessTexture"),
+        sheen_alpha
+    );
+    assert!(errors(&output).is_empty(), "{:?}", errors(&output));
+
+    // Fitted (the default): the sheen keeps 0.6 × green; the fuzz gets α(0.6 × green), each
+    // texel the nearest code to the mapping of its exact value.
+    let (output, doc, _) = migrate_document(
+        dir.path(),
+        "legacy",
+        legacy,
+        "fitted.gltf",
+        Options::default(),
+    );
+    let layers = &doc["materials"][0]["extensions"];
+    assert_ne!(
+        layers["KHR_materials_sheen"]["sheenRoughnessTexture"],
+        layers["KHR_materials_fuzz"]["fuzzRoughnessTexture"]
+    );
+    assert_eq!(
+        alpha_of(&output, "KHR_materials_sheen", "sheenRoughnessTexture"),
+        sheen_alpha
+    );
+    let fuzz_alpha: Vec<u8> = texels
+        .iter()
+        .map(|t| {
+            linear_code(roughness::map(
+                0.6 * t[1] as f64 / 255.0,
+                Direction::SheenToFuzz,
+                RoughnessMapping::Fitted,
+            ))
+        })
+        .collect();
+    assert_eq!(
+        alpha_of(&output, "KHR_materials_fuzz", "fuzzRoughnessTexture"),
+        fuzz_alpha
+    );
+    assert!(errors(&output).is_empty(), "{:?}", errors(&output));
+}
+
+#[test]
+fn a_fallback_sheen_colour_is_baked_from_fuzz_colour_times_intensity() {
+    let dir = tempfile::tempdir().unwrap();
+    let colours: [[u8; 3]; 4] = [[255, 0, 0], [10, 11, 12], [128, 200, 255], [0, 0, 0]];
+    let data: Vec<u8> = colours.iter().flatten().copied().collect();
+    png_file(
+        &dir.path().join("colour.png"),
+        2,
+        2,
+        image::ColorType::Rgb8,
+        &data,
+    );
+    let intensity = [255u8, 128, 0, 77];
+    png_file(
+        &dir.path().join("intensity.png"),
+        2,
+        2,
+        image::ColorType::L8,
+        &intensity,
+    );
+    let (output, doc, _) = migrate_document(
+        dir.path(),
+        "fuzz",
+        serde_json::json!({
+            "asset": {"version": "2.0"},
+            "extensionsUsed": ["KHR_materials_fuzz"],
+            "materials": [{"extensions": {"KHR_materials_fuzz": {
+                "fuzzFactor": 0.9,
+                "fuzzTexture": {"index": 1},
+                "fuzzColorFactor": [1.0, 0.5, 0.25],
+                "fuzzColorTexture": {"index": 0},
+                "fuzzRoughnessFactor": 0.3
+            }}}],
+            "textures": [{"source": 0}, {"source": 1}],
+            "images": [{"uri": "colour.png"}, {"uri": "intensity.png"}]
+        }),
+        "fuzz.out.gltf",
+        Options::default(),
+    );
+    let sheen = &doc["materials"][0]["extensions"]["KHR_materials_sheen"];
+    assert_eq!(
+        sheen["sheenColorFactor"],
+        serde_json::json!([1.0, 1.0, 1.0])
+    );
+    let (_, pixels) = texture_pixels(
+        &output,
+        "/materials/0/extensions/KHR_materials_sheen/sheenColorTexture",
+    );
+    let factor = [0.9, 0.45, 0.225];
+    for k in 0..4 {
+        for i in 0..3 {
+            let linear = factor[i] * srgb_decode(colours[k][i]) * intensity[k] as f64 / 255.0;
+            assert_eq!(
+                pixels[k][i],
+                srgb_encode_code(linear),
+                "channel {i} of texel {k}"
+            );
+        }
+    }
+    assert!(errors(&output).is_empty(), "{:?}", errors(&output));
+}
+
+#[test]
+fn a_glb_keeps_baked_textures_in_its_bin_chunk() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut png = std::io::Cursor::new(Vec::new());
+    image::write_buffer_with_format(
+        &mut png,
+        &[255, 0, 0, 128, 0, 0],
+        2,
+        1,
+        image::ColorType::Rgb8,
+        image::ImageFormat::Png,
+    )
+    .unwrap();
+    let png = png.into_inner();
+    let json = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_materials_sheen"],
+        "materials": [{"extensions": {"KHR_materials_sheen": {
+            "sheenColorFactor": [0.5, 0.25, 0.0], "sheenColorTexture": {"index": 0}
+        }}}],
+        "textures": [{"source": 0}],
+        "images": [{"bufferView": 0, "mimeType": "image/png"}],
+        "bufferViews": [{"buffer": 0, "byteLength": png.len()}],
+        "buffers": [{"byteLength": png.len()}]
+    });
+    let input = dir.path().join("in.glb");
+    std::fs::write(
+        &input,
+        glb::join(&serde_json::to_vec(&json).unwrap(), Some(&png)),
+    )
+    .unwrap();
+    let output = dir.path().join("out.glb");
+    let report = migrate::run(&request(
+        vec![input],
+        Destination::File(output.clone()),
+        Options {
+            exact: true,
+            ..Options::default()
+        },
+    ))
+    .unwrap();
+    assert_eq!(report.files[0].outcome, FileOutcome::Changed);
+    let bytes = std::fs::read(&output).unwrap();
+    let loaded = velvet::asset::load_bytes(&output, &bytes);
+    let asset = loaded.asset.unwrap();
+    let views = asset.json["bufferViews"].as_array().unwrap();
+    assert_eq!(views.len(), 3, "the source and the two baked images");
+    for view in views {
+        assert_eq!(view["byteOffset"].as_u64().unwrap_or(0) % 4, 0);
+    }
+    let images = asset.json["images"].as_array().unwrap();
+    assert!(images.iter().all(|i| i.get("uri").is_none()));
+    assert!(errors(&output).is_empty(), "{:?}", errors(&output));
+}
+
+#[test]
+fn a_fallback_sheen_roughness_texture_holds_the_mapped_roughness_unless_fast() {
+    let dir = tempfile::tempdir().unwrap();
+    let alphas = [0u8, 26, 128, 255];
+    let data: Vec<u8> = alphas.iter().flat_map(|&a| [200, 100, 50, a]).collect();
+    png_file(
+        &dir.path().join("rough.png"),
+        2,
+        2,
+        image::ColorType::Rgba8,
+        &data,
+    );
+    let fuzz = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_materials_fuzz"],
+        "materials": [{"extensions": {"KHR_materials_fuzz": {
+            "fuzzFactor": 1.0,
+            "fuzzColorFactor": [0.5, 0.5, 0.5],
+            "fuzzRoughnessFactor": 0.8,
+            "fuzzRoughnessTexture": {"index": 0}
+        }}}],
+        "textures": [{"source": 0}],
+        "images": [{"uri": "rough.png"}]
+    });
+    let (output, doc, _) = migrate_document(
+        dir.path(),
+        "fuzz",
+        fuzz.clone(),
+        "fitted.gltf",
+        Options::default(),
+    );
+    let sheen = &doc["materials"][0]["extensions"]["KHR_materials_sheen"];
+    assert_eq!(sheen["sheenRoughnessFactor"], serde_json::json!(1.0));
+    assert_ne!(sheen["sheenRoughnessTexture"]["index"], 0);
+    let (_, pixels) = texture_pixels(
+        &output,
+        "/materials/0/extensions/KHR_materials_sheen/sheenRoughnessTexture",
+    );
+    for (k, &a) in alphas.iter().enumerate() {
+        assert_eq!(
+            &pixels[k][..3],
+            &[200, 100, 50],
+            "RGB of texel {k} is bit-exact"
+        );
+        let expected = roughness::map(
+            0.8 * a as f64 / 255.0,
+            Direction::FuzzToSheen,
+            RoughnessMapping::Fitted,
+        );
+        assert_eq!(pixels[k][3], linear_code(expected), "alpha of texel {k}");
+    }
+    assert!(errors(&output).is_empty(), "{:?}", errors(&output));
+
+    // --fast: the texture is carried as it is and the roughness copied, said so.
+    let (_, doc, result) = migrate_document(
+        dir.path(),
+        "fuzz",
+        fuzz,
+        "fast.gltf",
+        Options {
+            fast: true,
+            ..Options::default()
+        },
+    );
+    let sheen = &doc["materials"][0]["extensions"]["KHR_materials_sheen"];
+    assert_eq!(sheen["sheenRoughnessFactor"], serde_json::json!(0.8));
+    assert_eq!(
+        sheen["sheenRoughnessTexture"],
+        serde_json::json!({"index": 0})
+    );
+    assert!(result.materials[0]
+        .notes
+        .contains(&Note::RoughnessTextureFast { mapping: "fitted" }));
+    assert_eq!(doc["images"].as_array().unwrap().len(), 1, "nothing baked");
 }

@@ -352,6 +352,27 @@ fn unrelated_text(bytes: &[u8]) -> String {
     doc.to_string()
 }
 
+/// `after` without the textures and images migrate appended for the textures it baked (the
+/// mapped roughness, the fallback's colour × intensity): those are migrate's, like the layers.
+fn baked_entries_removed(before: &[u8], after: &[u8]) -> Vec<u8> {
+    let before: Value = serde_json::from_slice(before).unwrap();
+    let mut after: Value = serde_json::from_slice(after).unwrap();
+    let root = after.as_object_mut().unwrap();
+    for key in ["textures", "images"] {
+        match before.get(key).and_then(Value::as_array).map(Vec::len) {
+            Some(n) => {
+                if let Some(list) = root.get_mut(key).and_then(Value::as_array_mut) {
+                    list.truncate(n);
+                }
+            }
+            None => {
+                root.shift_remove(key);
+            }
+        }
+    }
+    serde_json::to_vec(&after).unwrap()
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(CASES))]
 
@@ -397,7 +418,7 @@ proptest! {
         let output = dir.path().join("out.gltf");
         migrate_file(&input, &output);
         let before = std::fs::read(&input).unwrap();
-        let after = std::fs::read(&output).unwrap();
+        let after = baked_entries_removed(&before, &std::fs::read(&output).unwrap());
         prop_assert_eq!(unrelated_text(&before), unrelated_text(&after));
         // What migrate owns loads again too: the output is a document velvet reads.
         prop_assert!(velvet::asset::load(&output).asset.is_some());

@@ -1,7 +1,9 @@
 //! The shading API as other modules call it, and `velvet bench accuracy` as users run it.
 
 use std::process::Command;
+use velvet::migrate::roughness::{self, Direction, RoughnessMapping};
 use velvet::shading::layering::{sheen_to_fuzz_attenuation_difference, FuzzParams, SheenParams};
+use velvet::shading::mapping::layer_match;
 use velvet::shading::{sheen_albedo, AlbedoMethod};
 
 fn velvet(args: &[&str]) -> std::process::Output {
@@ -25,19 +27,41 @@ fn every_method_answers_through_one_signature() {
 }
 
 #[test]
-fn sheen_to_fuzz_difference_is_zero_for_the_stand_in_at_equal_settings() {
-    let cmp = sheen_to_fuzz_attenuation_difference(
-        SheenParams {
-            color_max3: 0.6,
-            roughness: 0.4,
-        },
+fn sheen_to_fuzz_difference_uses_the_fuzz_model_and_the_mapping_narrows_it() {
+    let sheen = SheenParams {
+        color_max3: 0.6,
+        roughness: 0.4,
+    };
+    let copied = sheen_to_fuzz_attenuation_difference(
+        sheen,
         FuzzParams {
             weight: 0.6,
             roughness: 0.4,
         },
     );
-    assert_eq!(cmp.max_difference, 0.0);
-    assert_eq!(cmp.curve.len(), 65);
+    assert_eq!(copied.curve.len(), 65);
+    assert_eq!(copied.fuzz_reflectance, "fuzz R (quadrature)");
+    // Same roughness number, different lobes: the attenuations differ.
+    assert!(copied.max_difference > 0.02, "{}", copied.max_difference);
+    let fitted = layer_match(
+        sheen,
+        FuzzParams {
+            weight: 0.6,
+            roughness: roughness::map(0.4, Direction::SheenToFuzz, RoughnessMapping::Fitted),
+        },
+    );
+    let identity = layer_match(
+        sheen,
+        FuzzParams {
+            weight: 0.6,
+            roughness: 0.4,
+        },
+    );
+    assert!(
+        fitted.rms < 0.5 * identity.rms,
+        "{fitted:?} vs {identity:?}"
+    );
+    assert!(fitted.max_ordinary < identity.max_ordinary);
 }
 
 #[test]

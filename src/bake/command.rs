@@ -144,16 +144,57 @@ impl FileResult {
 
 /// File names claimed in one run, across files (several assets may write into one folder).
 #[derive(Default)]
-struct Claims {
+pub struct Claims {
     claimed: Mutex<HashMap<PathBuf, Vec<u8>>>,
 }
 
 /// The names one output may use: not a file the document references, not the document
 /// itself, and either new or already holding exactly the bytes to be written.
-struct FileNames<'a> {
+pub(crate) struct FileNames<'a> {
     claims: &'a Claims,
     dir: PathBuf,
     taken: HashSet<PathBuf>,
+}
+
+impl<'a> FileNames<'a> {
+    /// The names free next to `output` for new images of `asset` (read from `input`, its
+    /// resources relocated by `relocation`).
+    pub(crate) fn next_to(
+        claims: &'a Claims,
+        asset: &asset::Asset,
+        input: &Path,
+        output: &Path,
+        relocation: &Relocation,
+    ) -> FileNames<'a> {
+        let taken: HashSet<PathBuf> = ["buffers", "images"]
+            .iter()
+            .flat_map(|kind| {
+                asset
+                    .json
+                    .get(*kind)
+                    .and_then(Value::as_array)
+                    .into_iter()
+                    .flatten()
+            })
+            .filter_map(|item| item.get("uri").and_then(Value::as_str))
+            .filter_map(|uri| match resource::resolve(uri, asset.base_dir(), "") {
+                Ok(resource::Location::File(p)) => Some(identity(&p)),
+                _ => None,
+            })
+            .chain(relocation.copies.iter().map(|c| identity(&c.to)))
+            .chain([identity(output), identity(input)])
+            .collect();
+        FileNames {
+            claims,
+            dir: folder_of(output),
+            taken,
+        }
+    }
+
+    /// The folder new files go to.
+    pub(crate) fn dir(&self) -> &Path {
+        &self.dir
+    }
 }
 
 impl Names for FileNames<'_> {
@@ -218,6 +259,21 @@ fn copy_resources(relocation: &Relocation) -> Result<(), String> {
         create_parent(&copy.to)?;
         write::write_atomic(&copy.to, &data)
             .map_err(|e| format!("cannot write resource {}: {e}", copy.to.display()))?;
+    }
+    Ok(())
+}
+
+/// Writes new image files into `dir` (each atomically; one already holding the bytes is left).
+pub(crate) fn write_new_files(dir: &Path, files: &[super::apply::NewFile]) -> Result<(), String> {
+    std::fs::create_dir_all(dir)
+        .map_err(|e| format!("cannot create folder {}: {e}", dir.display()))?;
+    for file in files {
+        let path = dir.join(&file.name);
+        if std::fs::read(&path).is_ok_and(|b| b == file.bytes) {
+            continue;
+        }
+        write::write_atomic(&path, &file.bytes)
+            .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
     }
     Ok(())
 }
@@ -302,31 +358,9 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
     for (name, result) in planned_names.iter().zip(results) {
         baked.push(result.map_err(|e| format!("cannot bake {name}: {e}"))?);
     }
-    // File names next to the output that the document already uses.
-    let out_dir = folder_of(output);
-    let taken: HashSet<PathBuf> = ["buffers", "images"]
-        .iter()
-        .flat_map(|kind| {
-            asset
-                .json
-                .get(*kind)
-                .and_then(Value::as_array)
-                .into_iter()
-                .flatten()
-        })
-        .filter_map(|item| item.get("uri").and_then(Value::as_str))
-        .filter_map(|uri| match resource::resolve(uri, asset.base_dir(), "") {
-            Ok(resource::Location::File(p)) => Some(identity(&p)),
-            _ => None,
-        })
-        .chain(relocation.copies.iter().map(|c| identity(&c.to)))
-        .chain([identity(output), identity(input)])
-        .collect();
-    let mut names = FileNames {
-        claims,
-        dir: out_dir.clone(),
-        taken,
-    };
+    // File names next to the output that the document already uses are not free.
+    let mut names = FileNames::next_to(claims, &asset, input, output, &relocation);
+    let out_dir = names.dir().to_path_buf();
     let bin = asset.bin.take();
     let applied = apply(
         json,
@@ -340,16 +374,7 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
         &mut names,
     );
     copy_resources(&relocation)?;
-    std::fs::create_dir_all(&out_dir)
-        .map_err(|e| format!("cannot create folder {}: {e}", out_dir.display()))?;
-    for file in &applied.files {
-        let path = out_dir.join(&file.name);
-        if std::fs::read(&path).is_ok_and(|b| b == file.bytes) {
-            continue;
-        }
-        write::write_atomic(&path, &file.bytes)
-            .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-    }
+    write_new_files(&out_dir, &applied.files)?;
     let out_bytes = write::to_bytes(&asset, &applied.json, applied.bin.as_deref());
     write::write_atomic(output, &out_bytes)
         .map_err(|e| format!("cannot write {}: {e}", output.display()))?;

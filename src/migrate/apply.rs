@@ -8,8 +8,12 @@
 
 use super::paths::{relocate, Job, Relocation};
 use super::plan::{plan_document, DocumentPlan};
+use super::textures;
 use super::Options;
 use crate::asset::{self, write, Asset};
+use crate::bake::apply::{apply as bake_apply, ApplyOptions, OutputReport};
+use crate::bake::command::{write_new_files, Claims, FileNames};
+use crate::bake::{bake, BakeOptions, KernelOptions};
 use crate::diagnostics::Severity;
 use crate::edit;
 use std::path::{Path, PathBuf};
@@ -24,6 +28,10 @@ pub struct FilePlan {
     pub asset: Asset,
     pub document: DocumentPlan,
     pub relocation: Relocation,
+    /// .gltf: store baked textures as `data:` URIs.
+    pub embed: bool,
+    /// After writing: the textures baked, with their quantisation error.
+    pub baked: Vec<OutputReport>,
 }
 
 impl FilePlan {
@@ -88,6 +96,8 @@ pub fn plan_file(job: &Job, options: &Options) -> Result<FilePlan, String> {
         asset,
         document,
         relocation,
+        embed: options.embed,
+        baked: Vec::new(),
     })
 }
 
@@ -103,10 +113,45 @@ fn create_parent(path: &Path) -> Result<(), String> {
 /// is as it was: every write goes through a temporary file renamed into place. The document is
 /// edited where it lies (a large one is not copied), so the plan's asset holds the edited
 /// document afterwards.
-pub fn execute(plan: &mut FilePlan) -> Result<Written, String> {
+pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> {
     let Some(output) = plan.output.clone() else {
         return Err(format!("{}: no output path", plan.input.display()));
     };
+    // Textures are baked first, from the document as loaded (its URIs not yet relocated).
+    let bake_plan = textures::bake_plan(plan.document.materials.iter().flat_map(|m| &m.bakes))
+        .map_err(|e| format!("{}: {e}", plan.input.display()))?;
+    let mut baked = Vec::with_capacity(bake_plan.recipes.len());
+    if !bake_plan.is_empty() {
+        let options = BakeOptions {
+            kernel: KernelOptions {
+                exact: false,
+                measure: true,
+            },
+            ..BakeOptions::default()
+        };
+        for (info, result) in
+            bake_plan
+                .outputs
+                .iter()
+                .zip(bake(&bake_plan.recipes, &plan.asset, &options))
+        {
+            baked.push(result.map_err(|e| {
+                format!(
+                    "{}: cannot bake {} of image {}: {e}",
+                    plan.input.display(),
+                    info.labels.join(" + "),
+                    info.image
+                )
+            })?);
+        }
+    }
+    // Names for new image files, from the document's URIs before they are relocated.
+    let mut names = (!bake_plan.is_empty())
+        .then(|| FileNames::next_to(claims, &plan.asset, &plan.input, &output, &plan.relocation));
+    let names_dir = names
+        .as_ref()
+        .map(|n| n.dir().to_path_buf())
+        .unwrap_or_default();
     let edits: Vec<_> = plan
         .document
         .edits()
@@ -126,10 +171,29 @@ pub fn execute(plan: &mut FilePlan) -> Result<Written, String> {
             .map_err(|e| format!("cannot write resource {}: {e}", copy.to.display()))?;
     }
     create_parent(&output)?;
-    let bytes = if changed {
-        write::to_bytes(&plan.asset, &plan.asset.json, plan.asset.bin.as_deref())
+    let bytes = if bake_plan.is_empty() {
+        if changed {
+            write::to_bytes(&plan.asset, &plan.asset.json, plan.asset.bin.as_deref())
+        } else {
+            std::mem::take(&mut plan.bytes)
+        }
     } else {
-        std::mem::take(&mut plan.bytes)
+        let json = std::mem::take(&mut plan.asset.json);
+        let applied = bake_apply(
+            json,
+            plan.asset.bin.take(),
+            plan.asset.container,
+            &bake_plan,
+            &mut baked,
+            ApplyOptions { embed: plan.embed },
+            names.as_mut().expect("made with the bake plan"),
+        );
+        write_new_files(&names_dir, &applied.files)?;
+        let bytes = write::to_bytes(&plan.asset, &applied.json, applied.bin.as_deref());
+        plan.asset.json = applied.json;
+        plan.asset.bin = applied.bin;
+        plan.baked = applied.outputs;
+        bytes
     };
     write::write_atomic(&output, &bytes)
         .map_err(|e| format!("cannot write {}: {e}", output.display()))?;

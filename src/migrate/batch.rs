@@ -6,7 +6,8 @@ use super::apply::{execute, plan_file, Written};
 use super::note::{Conversion, Level, Note, Skip};
 use super::paths::{jobs, Destination, Job, ResourceCopy};
 use super::plan::MaterialPlan;
-use super::{Options, UsageError, BAKE_ENGINE_AVAILABLE};
+use super::{Options, UsageError};
+use crate::bake::command::Claims;
 use crate::edit::Edit;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -101,7 +102,7 @@ impl RunReport {
     }
 }
 
-fn migrate_one(job: &Job, options: &Options, dry_run: bool) -> FileResult {
+fn migrate_one(job: &Job, options: &Options, dry_run: bool, claims: &Claims) -> FileResult {
     let mut plan = match plan_file(job, options) {
         Ok(plan) => plan,
         Err(error) => return FileResult::failed(job, error),
@@ -111,7 +112,7 @@ fn migrate_one(job: &Job, options: &Options, dry_run: bool) -> FileResult {
             changes: plan.changes(),
         }
     } else {
-        match execute(&mut plan) {
+        match execute(&mut plan, claims) {
             Ok(Written::Changed) => FileOutcome::Changed,
             Ok(Written::Copied) => FileOutcome::Copied,
             Ok(Written::Untouched) => FileOutcome::Untouched,
@@ -119,6 +120,16 @@ fn migrate_one(job: &Job, options: &Options, dry_run: bool) -> FileResult {
         }
     };
     let mut notes = plan.relocation.notes.clone();
+    for output in &plan.baked {
+        notes.push(Note::BakeError {
+            pointer: output
+                .image
+                .map_or_else(String::new, |i| format!("/images/{i}")),
+            image: output.name.clone(),
+            max_codes: output.max_error.unwrap_or(0.0),
+            clamped: output.clamped,
+        });
+    }
     if !plan.changes() {
         // Relocation notes matter only when the document is rewritten.
         notes.retain(|n| {
@@ -147,10 +158,8 @@ fn migrate_one(job: &Job, options: &Options, dry_run: bool) -> FileResult {
 
 /// Runs a request. `Err` is a usage error: nothing was read or written.
 pub fn run(request: &Request) -> Result<RunReport, UsageError> {
-    if request.options.exact && !BAKE_ENGINE_AVAILABLE {
-        return Err(UsageError::ExactUnavailable);
-    }
     let (jobs, walk_errors) = jobs(&request.inputs, &request.destination, request.dry_run)?;
+    let claims = Claims::default();
     let bar = (request.progress && std::io::stderr().is_terminal() && jobs.len() > 1).then(|| {
         let bar = indicatif::ProgressBar::new(jobs.len() as u64);
         if let Ok(style) =
@@ -173,7 +182,7 @@ pub fn run(request: &Request) -> Result<RunReport, UsageError> {
         })
         .collect();
     files.par_extend(jobs.par_iter().map(|job| {
-        let result = migrate_one(job, &request.options, request.dry_run);
+        let result = migrate_one(job, &request.options, request.dry_run, &claims);
         if let Some(bar) = &bar {
             bar.inc(1);
         }

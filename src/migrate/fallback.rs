@@ -5,10 +5,11 @@
 //! sheenRoughnessFactor comes from fuzzRoughnessFactor through [`roughness::map`], or from the
 //! draft table's default 0.5 when the fuzz leaves it out (said so). A fuzz colour texture alone
 //! is carried as the sheen colour texture (both sRGB, both scaled by the factor: exact); a fuzz
-//! roughness texture likewise (both alpha). A fuzz intensity texture would have to be baked
-//! into the colour (fuzzColor × fuzzIntensity); without the bake engine, or when the two
-//! textures use different texCoord sets or transforms and cannot be combined, the colour falls
-//! back to the factors, reported.
+//! roughness texture likewise (both alpha). A fuzz intensity texture is baked into the colour:
+//! the new sheenColorTexture holds fuzzColorFactor × fuzzFactor × fuzzColorTexture ×
+//! fuzzTexture.r per texel (sheenColorFactor the identity). When the two textures use different
+//! texCoord sets or transforms they cannot be combined, and when an image cannot be baked
+//! (unreadable, KTX2): the colour falls back to the factors, reported.
 //!
 //! Sheen only adds light, while fuzz blends towards its colour: dark fuzz over a bright base
 //! darkens it, which no sheen can show. Per unit of layer reflectance the fallback is brighter
@@ -18,8 +19,10 @@
 
 use super::note::{Conversion, Note, Skip};
 use super::plan::{number_like, MaterialCx, MaterialPlan};
-use super::roughness::{self, Direction};
+use super::roughness::{self, Direction, RoughnessMapping};
+use super::textures::{self, texture_index, Contents, TextureBake};
 use crate::asset::pointer;
+use crate::bake::Channel;
 use crate::edit::Edit;
 use crate::layers::{self, max3, FuzzView};
 use crate::rules::effective_tex_coord;
@@ -93,8 +96,12 @@ pub fn same_json(a: &Value, b: &Value) -> bool {
     }
 }
 
-/// The sheen that stands for `fuzz` on `cx`'s material, and what the user should know.
-pub fn sheen_for(cx: &MaterialCx, fuzz: &Value) -> (Map<String, Value>, Vec<Note>) {
+/// The sheen that stands for `fuzz` on `cx`'s material, what the user should know, and the
+/// textures to bake for it.
+pub fn sheen_for(
+    cx: &MaterialCx,
+    fuzz: &Value,
+) -> (Map<String, Value>, Vec<Note>, Vec<TextureBake>) {
     let view = FuzzView::read(fuzz).expect("the planner passes objects only");
     let mut notes = Vec::new();
     let factor_raw = fuzz.get("fuzzFactor");
@@ -113,25 +120,118 @@ pub fn sheen_for(cx: &MaterialCx, fuzz: &Value) -> (Map<String, Value>, Vec<Note
             assumed: layers::FUZZ_ROUGHNESS_DEFAULT_TABLE,
         });
     }
-    let roughness = roughness::map(view.roughness_or_table_default(), Direction::FuzzToSheen);
+    // A fuzz roughness texture can be carried as it is only with the identity; with the
+    // fitted mapping the fallback gets a baked one holding r(factor × texel) (factor 1).
+    let fuzz_roughness = view.roughness_or_table_default();
+    let roughness_texture = fuzz.get("fuzzRoughnessTexture").filter(|v| v.is_object());
+    let mut mapping = cx.options.roughness;
+    let mut roughness_bakes = Vec::new();
+    if let (Some(texture), false) = (roughness_texture, mapping == RoughnessMapping::Identity) {
+        if cx.options.fast {
+            notes.push(Note::RoughnessTextureFast {
+                mapping: mapping.name(),
+            });
+            mapping = RoughnessMapping::Identity;
+        } else {
+            match cx.texture_bake(
+                layers::SHEEN,
+                "sheenRoughnessTexture",
+                "sheenRoughnessFactor",
+                vec![fuzz_roughness],
+                texture,
+                Contents::Roughness {
+                    channel: Channel::A,
+                    factor: fuzz_roughness,
+                    curve: Some(roughness::curve(Direction::FuzzToSheen, mapping)),
+                },
+            ) {
+                Ok(bake) => roughness_bakes.push(bake),
+                Err(reason) => {
+                    notes.push(Note::RoughnessNotMapped { reason });
+                    mapping = RoughnessMapping::Identity;
+                }
+            }
+        }
+    }
+    let roughness = roughness::map(fuzz_roughness, Direction::FuzzToSheen, mapping);
 
     let mut sheen = Map::new();
     sheen.insert("sheenColorFactor".into(), Value::Array(color));
     let intensity_texture = fuzz.get("fuzzTexture").filter(|v| v.is_object());
     let color_texture = fuzz.get("fuzzColorTexture").filter(|v| v.is_object());
+    let mut bakes = roughness_bakes;
+    // The colour the lobe shows, which a baked texture holds in place of the factor.
+    let lobe: [f64; 3] = std::array::from_fn(|i| view.color_factor[i] * view.factor);
+    let mut bake_colour = |template: &Value, contents, what: &str, notes: &mut Vec<Note>| match cx
+        .texture_bake(
+            layers::SHEEN,
+            "sheenColorTexture",
+            "sheenColorFactor",
+            lobe.to_vec(),
+            template,
+            contents,
+        ) {
+        Ok(bake) => {
+            bakes.push(bake);
+            notes.push(Note::FallbackTextureBaked {
+                sources: what.into(),
+            });
+            true
+        }
+        Err(reason) => {
+            notes.push(Note::FuzzTextureNotBaked {
+                texture: what.into(),
+                reason,
+            });
+            false
+        }
+    };
     match (intensity_texture, color_texture) {
         (None, Some(texture)) => {
             sheen.insert("sheenColorTexture".into(), texture.clone());
         }
-        (Some(_), None) => notes.push(Note::FuzzTextureNeedsBake {
-            texture: "fuzzTexture".into(),
-        }),
-        (Some(intensity), Some(colour)) => notes.push(match incompatible(intensity, colour) {
-            Some(reason) => Note::FuzzTexturesIncompatible { reason },
-            None => Note::FuzzTextureNeedsBake {
-                texture: "fuzzTexture with fuzzColorTexture".into(),
-            },
-        }),
+        (Some(intensity), None) => {
+            if bake_colour(
+                intensity,
+                Contents::IntensityAsColor { color: lobe },
+                "fuzzTexture",
+                &mut notes,
+            ) {
+                sheen.insert("sheenColorTexture".into(), intensity.clone());
+            }
+        }
+        (Some(intensity), Some(colour)) => match incompatible(intensity, colour) {
+            Some(reason) => notes.push(Note::FuzzTexturesIncompatible { reason }),
+            None => {
+                let intensity_image = texture_index(intensity)
+                    .ok_or_else(|| "fuzzTexture has no valid index".to_string())
+                    .and_then(|t| textures::sources(cx.asset, t))
+                    .and_then(|sources| match sources.as_slice() {
+                        [(_, image)] => Ok(*image),
+                        _ => Err("fuzzTexture has more than one source image".to_string()),
+                    });
+                let what = "fuzzColorTexture × fuzzTexture";
+                match intensity_image {
+                    Ok(intensity_image) => {
+                        if bake_colour(
+                            colour,
+                            Contents::ColorTimesIntensity {
+                                color: lobe,
+                                intensity_image,
+                            },
+                            what,
+                            &mut notes,
+                        ) {
+                            sheen.insert("sheenColorTexture".into(), colour.clone());
+                        }
+                    }
+                    Err(reason) => notes.push(Note::FuzzTextureNotBaked {
+                        texture: what.into(),
+                        reason,
+                    }),
+                }
+            }
+        },
         (None, None) => {}
     }
     sheen.insert(
@@ -163,7 +263,7 @@ pub fn sheen_for(cx: &MaterialCx, fuzz: &Value) -> (Map<String, Value>, Vec<Note
             });
         }
     }
-    (sheen, notes)
+    (sheen, notes, bakes)
 }
 
 /// True when a sheen with these properties is switched off (sheenColorFactor all zero).
@@ -179,8 +279,9 @@ pub fn add(cx: &MaterialCx, fuzz: &Value, plan: &mut MaterialPlan) {
         plan.skip(Skip::FuzzOff, Note::FuzzOff);
         return;
     }
-    let (sheen, notes) = sheen_for(cx, fuzz);
+    let (sheen, notes, bakes) = sheen_for(cx, fuzz);
     plan.notes.extend(notes);
+    plan.bakes.extend(bakes);
     if switched_off(&sheen) {
         // A switched-off sheen next to an active fuzz is no fallback, and contradicts it.
         plan.skip(Skip::BlackFuzz, Note::BlackFuzz);
@@ -196,7 +297,7 @@ pub fn add(cx: &MaterialCx, fuzz: &Value, plan: &mut MaterialPlan) {
 /// Regenerates the sheen of a material that has both: each property is set when it differs
 /// and removed when the fuzz gives none; the sheen's other members (extras, extensions) stay.
 pub fn refresh(cx: &MaterialCx, sheen: &Value, fuzz: &Value, plan: &mut MaterialPlan) {
-    let (target, notes) = sheen_for(cx, fuzz);
+    let (target, notes, bakes) = sheen_for(cx, fuzz);
     plan.notes.extend(notes);
     if switched_off(&target) && FuzzView::read(fuzz).is_some_and(|f| f.is_on()) {
         plan.skip(Skip::BlackFuzz, Note::BlackFuzz);
@@ -230,6 +331,7 @@ pub fn refresh(cx: &MaterialCx, sheen: &Value, fuzz: &Value, plan: &mut Material
         plan.skip(Skip::FallbackUpToDate, Note::FallbackUpToDate);
     } else {
         plan.edits.extend(edits);
+        plan.bakes.extend(bakes);
         plan.conversions.push(Conversion::RefreshedFallback);
     }
 }

@@ -6,7 +6,9 @@
 //! sheenRoughnessFactor = pbrMetallicRoughness.roughnessFactor (default 1); sheenTexture →
 //! sheenColorTexture (its RGB; the alpha intensity would need a bake, reported). A material
 //! roughness that comes from a metallicRoughnessTexture lives in its green channel, where the
-//! ratified sheen reads alpha: that needs a bake too, reported, and the factor stands alone.
+//! ratified sheen reads alpha: green × roughnessFactor is baked into the alpha of a new
+//! sheenRoughnessTexture (the other channels kept), or, where the image cannot be baked, the
+//! factor stands alone (reported).
 //!
 //! A draft object that also holds ratified properties is not rewritten: ratified loaders read
 //! the ratified ones, and those are what gets migrated.
@@ -14,7 +16,9 @@
 use super::note::{Conversion, Note};
 use super::plan::{number_like, texture_unusable, MaterialCx, MaterialPlan};
 use super::sheen_to_fuzz::Sheen;
+use super::textures::Contents;
 use crate::asset::pointer;
+use crate::bake::Channel;
 use crate::edit::Edit;
 use crate::layers;
 use crate::rules::legacy_sheen::LEGACY_PROPERTIES;
@@ -81,10 +85,33 @@ pub fn upgrade(cx: &MaterialCx, sheen: &Value, plan: &mut MaterialPlan) -> Optio
         .and_then(|p| p.get("roughnessFactor"))
         .filter(|v| v.as_f64().is_some());
     let roughness = roughness_raw.and_then(Value::as_f64).unwrap_or(1.0);
+    let mut roughness_texture = None;
     if let Some(texture) = pbr.and_then(|p| p.get("metallicRoughnessTexture")) {
-        plan.notes.push(Note::LegacyRoughnessTexture {
-            texture: texture.clone(),
-        });
+        let bake = cx.texture_bake(
+            layers::SHEEN,
+            "sheenRoughnessTexture",
+            "sheenRoughnessFactor",
+            vec![roughness],
+            texture,
+            Contents::Roughness {
+                channel: Channel::G,
+                factor: roughness,
+                curve: None,
+            },
+        );
+        match bake {
+            Ok(bake) => {
+                plan.bakes.push(bake);
+                plan.notes.push(Note::LegacyRoughnessBaked {
+                    roughness_factor: roughness,
+                });
+                roughness_texture = Some(texture.clone());
+            }
+            Err(reason) => plan.notes.push(Note::LegacyRoughnessTexture {
+                texture: texture.clone(),
+                reason,
+            }),
+        }
     }
 
     let mut color_texture = None;
@@ -116,7 +143,8 @@ pub fn upgrade(cx: &MaterialCx, sheen: &Value, plan: &mut MaterialPlan) -> Optio
         roughness,
         roughness_value: number_like(roughness_raw, roughness),
         color_texture,
-        roughness_texture: None,
+        roughness_texture,
+        roughness_channel: Channel::G,
     };
     plan.edits.push(Edit::set(
         pointer::join(&base, "sheenColorFactor"),
@@ -132,6 +160,12 @@ pub fn upgrade(cx: &MaterialCx, sheen: &Value, plan: &mut MaterialPlan) -> Optio
         pointer::join(&base, "sheenRoughnessFactor"),
         upgraded.roughness_value.clone(),
     ));
+    if let Some(texture) = &upgraded.roughness_texture {
+        plan.edits.push(Edit::set(
+            pointer::join(&base, "sheenRoughnessTexture"),
+            texture.clone(),
+        ));
+    }
     plan.conversions.push(Conversion::LegacyUpgrade);
     Some(upgraded)
 }

@@ -6,7 +6,8 @@
 //! [`paths`] decides where each output goes and which relative URIs or resources must follow
 //! it; [`apply`] executes a file's plan and writes it atomically; [`batch`] runs many files in
 //! parallel and sums up. Each conversion rule is one file: [`sheen_to_fuzz`], [`fallback`],
-//! [`legacy`]. The roughness choice between the layers lives in [`roughness`] alone.
+//! [`legacy`]. The roughness choice between the layers lives in [`roughness`] alone. Textures
+//! that a conversion must bake are planned in [`textures`] and made by the bake engine.
 
 pub mod apply;
 pub mod batch;
@@ -19,6 +20,7 @@ pub mod plan;
 pub mod render;
 pub mod roughness;
 pub mod sheen_to_fuzz;
+pub mod textures;
 
 pub use batch::{run, FileOutcome, FileResult, Request, RunReport, Summary};
 pub use note::{Conversion, Level, Note, Skip};
@@ -34,23 +36,24 @@ pub struct Options {
     pub refresh_fallback: bool,
     /// Decode sheen colour textures to measure what fast mode changes (and only then).
     pub report: bool,
-    /// Bake textures so that lobe and attenuation match texel by texel (needs the bake engine).
+    /// Bake textures so that lobe and attenuation match texel by texel.
     pub exact: bool,
+    /// .gltf: store baked textures as `data:` URIs instead of files next to the output.
+    pub embed: bool,
+    /// How roughness is carried between the layers (fitted by appearance, or copied).
+    pub roughness: roughness::RoughnessMapping,
+    /// Never bake a texture only to map roughness: copy it (identity) where a texture would
+    /// need the bake, and say so.
+    pub fast: bool,
     /// Copy relative resources next to an output in another folder instead of rewriting URIs.
     pub copy_resources: bool,
     /// Limits and URI policy for reading inputs and their resources.
     pub load: crate::asset::LoadOptions,
 }
 
-/// Whether this build carries the texture bake engine that `--exact` and texture fallbacks
-/// need. Until it does, `--exact` is refused and fuzz textures fall back to factors (reported).
-pub const BAKE_ENGINE_AVAILABLE: bool = false;
-
 /// A request velvet cannot carry out as given (exit status 2): nothing is read or written.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum UsageError {
-    #[error("--exact bakes textures with the bake engine, which this build of velvet does not include; run without --exact (the fast mode reports what it changes, --report measures it)")]
-    ExactUnavailable,
     #[error("say where the output goes: -o FILE (one input), --out-dir DIR or --in-place (or use --dry-run)")]
     NoDestination,
     #[error("-o names one output file, but {0} inputs were given; use --out-dir DIR for several")]

@@ -103,14 +103,48 @@ pub enum Note {
         max: f64,
         mean: f64,
     },
+    /// --report: how far the fuzz layer's base attenuation is from the sheen layer's, over
+    /// view angles, at the material's factors (1 − max3·E against 1 − w·R).
+    LayerDifference {
+        mapping: &'static str,
+        sheen_roughness: f64,
+        fuzz_roughness: f64,
+        max_difference: f64,
+        at_mu: f64,
+        /// max over μ of |max3(sheenColor)·E(μ, r) − w·R(μ, α)|.
+        reflectance_max: f64,
+        /// Its cosine-weighted rms over μ.
+        reflectance_rms: f64,
+        /// r < 0.1, where no fuzz roughness matches the sheen well.
+        poor_match: bool,
+        fuzz_model: String,
+        clamped: u64,
+    },
+    /// --fast: a roughness texture keeps the identity mapping instead of a baked mapped one.
+    RoughnessTextureFast { mapping: &'static str },
+    /// The roughness texture could not be baked through the mapping: the identity is used.
+    RoughnessNotMapped { reason: String },
     /// --report: the measurement could not be made.
     MeasureFailed { reason: String },
     /// Fuzz lies over a clear coat where sheen lay under it.
     ClearcoatOrder { fallback: bool },
     /// fuzzRoughnessFactor absent: the table default was used for the fallback.
     FuzzRoughnessDefault { assumed: f64 },
-    /// A fuzz texture needs a bake to become part of the sheen colour texture.
-    FuzzTextureNeedsBake { texture: String },
+    /// A fuzz texture could not be baked into the sheen colour texture.
+    FuzzTextureNotBaked { texture: String, reason: String },
+    /// The fallback's sheen colour texture is baked from the fuzz textures.
+    FallbackTextureBaked { sources: String },
+    /// --exact: fuzzTexture and fuzzColorTexture are baked from the sheen colour texture.
+    ExactBaked,
+    /// --exact could not bake: the fast mode was used for this material.
+    ExactNotBaked { reason: String },
+    /// A baked texture's largest difference from the exact f64 value, in codes.
+    BakeError {
+        pointer: String,
+        image: String,
+        max_codes: f64,
+        clamped: u64,
+    },
     /// fuzzTexture and fuzzColorTexture cannot be combined into one texture.
     FuzzTexturesIncompatible { reason: String },
     /// Black fuzz on an active layer: a fallback sheen would be switched off.
@@ -126,8 +160,12 @@ pub enum Note {
         product: [f64; 3],
         clamped: [f64; 3],
     },
-    /// Legacy sheen roughness followed a metallicRoughnessTexture (green): needs a bake.
-    LegacyRoughnessTexture { texture: Value },
+    /// Legacy sheen roughness followed a metallicRoughnessTexture (green), which could not be
+    /// baked into the alpha channel a sheen roughness texture reads.
+    LegacyRoughnessTexture { texture: Value, reason: String },
+    /// Legacy sheen roughness followed a metallicRoughnessTexture: its green channel (times
+    /// roughnessFactor) is baked into the alpha of a new sheenRoughnessTexture.
+    LegacyRoughnessBaked { roughness_factor: f64 },
     /// Legacy sheenTexture's intensity (alpha) is not applied by sheenColorTexture.
     LegacyTextureIntensity,
     /// Legacy properties next to ratified ones: the ratified ones stand.
@@ -155,9 +193,15 @@ impl Note {
             | Note::FallbackUpToDate
             | Note::ColorTextureAsIs { .. }
             | Note::AttenuationMeasured { .. }
+            | Note::LayerDifference { .. }
+            | Note::RoughnessTextureFast { .. }
             | Note::ClearcoatOrder { .. }
             | Note::FuzzRoughnessDefault { .. }
-            | Note::ResourcesCopied { .. } => Level::Info,
+            | Note::ResourcesCopied { .. }
+            | Note::FallbackTextureBaked { .. }
+            | Note::ExactBaked
+            | Note::BakeError { .. }
+            | Note::LegacyRoughnessBaked { .. } => Level::Info,
             Note::UrisRewritten { leaves_folder, .. } => {
                 if *leaves_folder {
                     Level::Warning
@@ -168,7 +212,9 @@ impl Note {
             Note::Excluded { .. }
             | Note::Malformed { .. }
             | Note::MeasureFailed { .. }
-            | Note::FuzzTextureNeedsBake { .. }
+            | Note::FuzzTextureNotBaked { .. }
+            | Note::ExactNotBaked { .. }
+            | Note::RoughnessNotMapped { .. }
             | Note::FuzzTexturesIncompatible { .. }
             | Note::DarkFuzz { .. }
             | Note::BlackFuzz
@@ -199,6 +245,24 @@ impl Note {
             Note::AttenuationMeasured { image, texels, w, max, mean } => format!(
                 "attenuation difference |{w:?} − max3(sheenColor)| over the {texels} texels of image {image}: max {max:.4}, mean {mean:.4}"
             ),
+            Note::LayerDifference { mapping, sheen_roughness, fuzz_roughness, max_difference, at_mu, reflectance_max, reflectance_rms, poor_match, fuzz_model, clamped } => {
+                let mut m = format!(
+                    "layer difference ({mapping} roughness mapping, sheen {sheen_roughness:.4} → fuzz {fuzz_roughness:.4}, {fuzz_model}): |max3·E − w·R| over view angles max {reflectance_max:.4}, cosine-weighted rms {reflectance_rms:.4}; base attenuation differs by at most {max_difference:.4}, at view cosine {at_mu:.3}"
+                );
+                if *poor_match {
+                    m += &format!(" (sheen roughness below {}: no fuzz roughness matches it well)", crate::shading::mapping::POOR_MATCH_BELOW);
+                }
+                if *clamped > 0 {
+                    m += &format!(" ({clamped} attenuations clamped at 0 where the albedo exceeds 1)");
+                }
+                m
+            }
+            Note::RoughnessTextureFast { mapping } => format!(
+                "--fast: the roughness texture is carried as it is, so this material's roughness is copied (identity) instead of mapped ({mapping}), which would bake a new texture"
+            ),
+            Note::RoughnessNotMapped { reason } => format!(
+                "the roughness texture cannot be baked through the roughness mapping ({reason}): it is carried as it is and the roughness copied (identity)"
+            ),
             Note::MeasureFailed { reason } => format!("the attenuation difference could not be measured: {reason}"),
             Note::ClearcoatOrder { fallback: false } => {
                 "the material has KHR_materials_clearcoat: the fuzz lies over the coat, while the sheen lay under it; the look changes where the coat is strong".into()
@@ -210,9 +274,25 @@ impl Note {
                 "fuzzRoughnessFactor is absent: the fallback uses the draft's table default {assumed:?} (its schema says {:?}); the fuzz is left as it is",
                 crate::layers::FUZZ_ROUGHNESS_DEFAULT_SCHEMA
             ),
-            Note::FuzzTextureNeedsBake { texture } => format!(
-                "{texture} needs a bake into the sheen colour texture (fuzzColor × fuzzIntensity), which this build does not include: the fallback sheen uses the factors instead"
+            Note::FuzzTextureNotBaked { texture, reason } => format!(
+                "{texture} cannot be baked into the sheen colour texture (fuzzColor × fuzzIntensity): {reason}; the fallback sheen uses the factors instead"
             ),
+            Note::FallbackTextureBaked { sources } => format!(
+                "the fallback's sheenColorTexture is baked from {sources} (fuzzColor × fuzzIntensity, per texel) and sheenColorFactor is [1.0, 1.0, 1.0]"
+            ),
+            Note::ExactBaked => {
+                "--exact: fuzzTexture (per-texel max3 of the linear sheen colour) and a normalised fuzzColorTexture are baked from sheenColorTexture, so lobe and base attenuation match texel by texel up to quantisation; fuzzFactor and fuzzColorFactor are the identity".into()
+            }
+            Note::ExactNotBaked { reason } => format!(
+                "--exact cannot bake this material's textures ({reason}): sheenColorTexture became fuzzColorTexture as it is (the fast mode)"
+            ),
+            Note::BakeError { pointer, image, max_codes, clamped } => {
+                let mut m = format!("{pointer}: {image} differs from the exact f64 result by at most {max_codes:.3} codes (quantisation)");
+                if *clamped > 0 {
+                    m += &format!("; {clamped} values clamped to the channel's range");
+                }
+                m
+            }
             Note::FuzzTexturesIncompatible { reason } => format!(
                 "fuzzTexture and fuzzColorTexture cannot be combined into one sheen colour texture ({reason}): the fallback sheen uses the factors instead"
             ),
@@ -227,8 +307,11 @@ impl Note {
                 rgb(*product),
                 rgb(*clamped)
             ),
-            Note::LegacyRoughnessTexture { texture } => format!(
-                "the draft sheen's roughness followed the material's roughness, which reads the green channel of metallicRoughnessTexture {texture}; sheenRoughnessTexture reads alpha, so carrying the texture needs a bake that this build does not include: sheenRoughnessFactor is the roughnessFactor alone"
+            Note::LegacyRoughnessTexture { texture, reason } => format!(
+                "the draft sheen's roughness followed the material's roughness, which reads the green channel of metallicRoughnessTexture {texture}; sheenRoughnessTexture reads alpha, and the texture cannot be baked ({reason}): sheenRoughnessFactor is the roughnessFactor alone"
+            ),
+            Note::LegacyRoughnessBaked { roughness_factor } => format!(
+                "the draft sheen's roughness followed the material's roughness: the green channel of its metallicRoughnessTexture × roughnessFactor {roughness_factor:?} is baked into the alpha of a new sheenRoughnessTexture (sheenRoughnessFactor 1.0)"
             ),
             Note::LegacyTextureIntensity => {
                 "sheenTexture became sheenColorTexture: its colour (RGB) is carried, but the draft's intensity in its alpha channel is not applied (that needs a bake)".into()

@@ -3,6 +3,7 @@
 //! is a value that `apply` executes and `render` prints.
 
 use super::note::{Conversion, Note, Skip};
+use super::textures::{self, TextureBake};
 use super::{fallback, legacy, sheen_to_fuzz, Options};
 use crate::asset::Asset;
 use crate::edit::Edit;
@@ -20,6 +21,9 @@ pub struct MaterialPlan {
     /// Why nothing was done, when nothing was.
     pub skipped: Option<Skip>,
     pub edits: Vec<Edit>,
+    /// Textures baked for this material (their textureInfos are among the edits).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub bakes: Vec<TextureBake>,
     #[serde(serialize_with = "notes_json")]
     pub notes: Vec<Note>,
 }
@@ -44,6 +48,7 @@ impl MaterialPlan {
             conversions: Vec::new(),
             skipped: None,
             edits: Vec::new(),
+            bakes: Vec::new(),
             notes: Vec::new(),
         }
     }
@@ -81,6 +86,35 @@ impl MaterialCx<'_> {
 
     pub fn has_extension(&self, extension: &str) -> bool {
         layers::extensions(self.material).is_some_and(|e| e.contains_key(extension))
+    }
+
+    /// A bake of the texture `texture_info` names into slot `texture_key` of `extension` on
+    /// this material, or why it cannot be made (no such texture, an image that cannot be read
+    /// or is KTX2).
+    #[allow(clippy::too_many_arguments)]
+    pub fn texture_bake(
+        &self,
+        extension: &'static str,
+        texture_key: &'static str,
+        factor_key: &'static str,
+        factor: Vec<f64>,
+        texture_info: &Value,
+        contents: textures::Contents,
+    ) -> Result<TextureBake, String> {
+        let texture = textures::texture_index(texture_info)
+            .ok_or_else(|| "its textureInfo has no valid index".to_string())?;
+        let sources = textures::sources(self.asset, texture)?;
+        Ok(TextureBake {
+            material: self.index,
+            extension,
+            layer_pointer: self.extension_pointer(extension),
+            texture_key,
+            factor_key,
+            factor,
+            texture,
+            sources,
+            contents,
+        })
     }
 }
 

@@ -69,6 +69,9 @@ pub fn file_text(f: &FileResult, plan: bool) -> String {
             for edit in &m.edits {
                 let _ = writeln!(out, "    {edit}");
             }
+            for bake in &m.bakes {
+                let _ = writeln!(out, "    {bake}");
+            }
         }
     }
     for note in &f.notes {

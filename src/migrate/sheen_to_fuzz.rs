@@ -5,19 +5,25 @@
 //! fuzzFactor = w and fuzzColorFactor = sheenColorFactor / w give the same lobe colour
 //! (fuzzColor · w = sheenColor) and the same attenuation. w = 0 is a switched-off sheen: nothing
 //! is added. fuzzRoughnessFactor is always written (the draft's default is ambiguous) and comes
-//! from [`roughness::map`]. The roughness texture is carried as it is (both read alpha).
+//! from [`roughness::map`]. The roughness texture is carried as it is (both read alpha); a
+//! draft sheen's, which lived in the green channel of metallicRoughness, is baked into alpha.
 //!
 //! A sheen colour texture becomes the fuzz colour texture as it is (fast mode): the lobe stays
 //! exact texel by texel, but the attenuation now follows w, not the per-texel maximum of the
-//! sheen colour. `--report` measures that difference by decoding the texture; `--exact` would
-//! bake a fuzz texture and a normalised colour texture instead.
+//! sheen colour. `--report` measures that difference by decoding the texture. `--exact` bakes
+//! instead a fuzzTexture holding the per-texel max3 of the linear sheen colour and a
+//! fuzzColorTexture holding the colour normalised by it (factors become the identity), so lobe
+//! and attenuation both match texel by texel up to quantisation, which is reported.
 
 use super::measure;
 use super::note::{Conversion, Note, Skip};
 use super::plan::{number_like, MaterialCx, MaterialPlan};
-use super::roughness::{self, Direction};
+use super::roughness::{self, Direction, RoughnessMapping};
+use super::textures::{Contents, TextureBake};
+use crate::bake::Channel;
 use crate::edit::Edit;
 use crate::layers::{self, max3};
+use crate::shading::layering;
 use serde_json::{Map, Value};
 
 /// A ratified sheen as the conversion needs it: values with the JSON text they came in (so
@@ -30,6 +36,10 @@ pub struct Sheen {
     pub roughness_value: Value,
     pub color_texture: Option<Value>,
     pub roughness_texture: Option<Value>,
+    /// The channel the roughness texture holds roughness in: alpha for a ratified sheen, green
+    /// for a draft sheen that followed the material's metallicRoughnessTexture (baked into
+    /// alpha on the way).
+    pub roughness_channel: Channel,
 }
 
 impl Sheen {
@@ -58,13 +68,19 @@ impl Sheen {
                 .get("sheenRoughnessTexture")
                 .filter(|v| v.is_object())
                 .cloned(),
+            roughness_channel: Channel::A,
         }
     }
 }
 
 /// The KHR_materials_fuzz object that stands for `sheen`, or `None` when the sheen is off.
-/// Keys follow the draft's parameter table.
-pub fn fuzz_for(sheen: &Sheen) -> Option<Map<String, Value>> {
+/// Keys follow the draft's parameter table. With `strength_texture`, the fuzzTexture slot
+/// reads it (the exact mode, whose bake fills it).
+pub fn fuzz_for(
+    sheen: &Sheen,
+    strength_texture: Option<&Value>,
+    mapping: RoughnessMapping,
+) -> Option<Map<String, Value>> {
     let w = max3(sheen.color);
     if !w.is_finite() || w <= 0.0 {
         return None;
@@ -74,6 +90,9 @@ pub fn fuzz_for(sheen: &Sheen) -> Option<Map<String, Value>> {
         .expect("w is one of the components");
     let mut fuzz = Map::new();
     fuzz.insert("fuzzFactor".into(), sheen.color_values[strongest].clone());
+    if let Some(texture) = strength_texture {
+        fuzz.insert("fuzzTexture".into(), texture.clone());
+    }
     let color: Vec<Value> = (0..3)
         .map(|i| number_like(Some(&sheen.color_values[i]), sheen.color[i] / w))
         .collect();
@@ -81,7 +100,7 @@ pub fn fuzz_for(sheen: &Sheen) -> Option<Map<String, Value>> {
     if let Some(texture) = &sheen.color_texture {
         fuzz.insert("fuzzColorTexture".into(), texture.clone());
     }
-    let r = roughness::map(sheen.roughness, Direction::SheenToFuzz);
+    let r = roughness::map(sheen.roughness, Direction::SheenToFuzz, mapping);
     fuzz.insert(
         "fuzzRoughnessFactor".into(),
         number_like(Some(&sheen.roughness_value), r),
@@ -92,13 +111,97 @@ pub fn fuzz_for(sheen: &Sheen) -> Option<Map<String, Value>> {
     Some(fuzz)
 }
 
+/// The bakes of the exact mode: fuzzTexture = max3 of the linear sheen colour, fuzzColorTexture
+/// = the sheen colour normalised by it, both from the sheen colour texture.
+fn exact_bakes(
+    cx: &MaterialCx,
+    sheen: &Sheen,
+    texture: &Value,
+) -> Result<Vec<TextureBake>, String> {
+    let w = max3(sheen.color);
+    let strength = cx.texture_bake(
+        layers::FUZZ,
+        "fuzzTexture",
+        "fuzzFactor",
+        vec![w],
+        texture,
+        Contents::SheenStrength { color: sheen.color },
+    )?;
+    let colour = cx.texture_bake(
+        layers::FUZZ,
+        "fuzzColorTexture",
+        "fuzzColorFactor",
+        sheen.color.iter().map(|c| c / w).collect(),
+        texture,
+        Contents::SheenNormalised { color: sheen.color },
+    )?;
+    Ok(vec![strength, colour])
+}
+
 /// Adds the fuzz that stands for `sheen` to the material, with its notes.
 pub fn convert(cx: &MaterialCx, sheen: &Sheen, plan: &mut MaterialPlan) {
-    let Some(fuzz) = fuzz_for(sheen) else {
+    let w = max3(sheen.color);
+    if !w.is_finite() || w <= 0.0 {
+        plan.skip(Skip::SheenOff, Note::SheenOff);
+        return;
+    }
+    let mut exact = None;
+    if let (true, Some(texture)) = (cx.options.exact, &sheen.color_texture) {
+        match exact_bakes(cx, sheen, texture) {
+            Ok(bakes) => exact = Some(bakes),
+            Err(reason) => plan.notes.push(Note::ExactNotBaked { reason }),
+        }
+    }
+    // A roughness texture is carried as it is only when the mapping is the identity and it
+    // holds roughness in alpha; otherwise the fuzz gets a baked one holding
+    // mapping(factor × texel) in alpha (a draft sheen's green channel moves there too).
+    let mut mapping = cx.options.roughness;
+    let mut carried = std::borrow::Cow::Borrowed(sheen);
+    let mut roughness_bake = None;
+    if let Some(texture) = &sheen.roughness_texture {
+        if mapping != RoughnessMapping::Identity && cx.options.fast {
+            plan.notes.push(Note::RoughnessTextureFast {
+                mapping: mapping.name(),
+            });
+            mapping = RoughnessMapping::Identity;
+        }
+        let alpha = sheen.roughness_channel == Channel::A;
+        if !alpha || mapping != RoughnessMapping::Identity {
+            let curve = (mapping != RoughnessMapping::Identity)
+                .then(|| roughness::curve(Direction::SheenToFuzz, mapping));
+            match cx.texture_bake(
+                layers::FUZZ,
+                "fuzzRoughnessTexture",
+                "fuzzRoughnessFactor",
+                vec![sheen.roughness],
+                texture,
+                Contents::Roughness {
+                    channel: sheen.roughness_channel,
+                    factor: sheen.roughness,
+                    curve,
+                },
+            ) {
+                Ok(bake) => roughness_bake = Some(bake),
+                Err(reason) if alpha => {
+                    // The texture can still be carried as it is, with the identity.
+                    plan.notes.push(Note::RoughnessNotMapped { reason });
+                    mapping = RoughnessMapping::Identity;
+                }
+                Err(reason) => {
+                    plan.notes.push(Note::TextureDropped {
+                        property: "fuzzRoughnessTexture".into(),
+                        reason,
+                    });
+                    carried.to_mut().roughness_texture = None;
+                }
+            }
+        }
+    }
+    let strength_texture = exact.as_ref().and(sheen.color_texture.as_ref());
+    let Some(fuzz) = fuzz_for(&carried, strength_texture, mapping) else {
         plan.skip(Skip::SheenOff, Note::SheenOff);
         return;
     };
-    let w = max3(sheen.color);
     plan.edits.push(Edit::set(
         cx.extension_pointer(layers::FUZZ),
         Value::Object(fuzz),
@@ -107,7 +210,13 @@ pub fn convert(cx: &MaterialCx, sheen: &Sheen, plan: &mut MaterialPlan) {
     if cx.has_extension(layers::CLEARCOAT) {
         plan.notes.push(Note::ClearcoatOrder { fallback: false });
     }
-    if let Some(texture) = &sheen.color_texture {
+    if let Some(bake) = roughness_bake {
+        plan.bakes.push(bake);
+    }
+    if let Some(bakes) = exact {
+        plan.bakes.extend(bakes);
+        plan.notes.push(Note::ExactBaked);
+    } else if let Some(texture) = &sheen.color_texture {
         plan.notes.push(Note::ColorTextureAsIs { w });
         if cx.options.report {
             plan.notes.push(
@@ -124,6 +233,31 @@ pub fn convert(cx: &MaterialCx, sheen: &Sheen, plan: &mut MaterialPlan) {
             );
         }
     }
+    if cx.options.report {
+        let fuzz_roughness = roughness::map(sheen.roughness, Direction::SheenToFuzz, mapping);
+        let sheen_params = layering::SheenParams {
+            color_max3: w,
+            roughness: sheen.roughness,
+        };
+        let fuzz_params = layering::FuzzParams {
+            weight: w,
+            roughness: fuzz_roughness,
+        };
+        let comparison = layering::sheen_to_fuzz_attenuation_difference(sheen_params, fuzz_params);
+        let matched = crate::shading::mapping::layer_match(sheen_params, fuzz_params);
+        plan.notes.push(Note::LayerDifference {
+            mapping: mapping.name(),
+            sheen_roughness: sheen.roughness,
+            fuzz_roughness,
+            max_difference: comparison.max_difference,
+            at_mu: comparison.at_mu,
+            reflectance_max: matched.max,
+            reflectance_rms: matched.rms,
+            poor_match: matched.poor_match,
+            fuzz_model: comparison.fuzz_reflectance,
+            clamped: comparison.clamps.clamped,
+        });
+    }
 }
 
 #[cfg(test)]
@@ -132,7 +266,8 @@ mod tests {
     use serde_json::json;
 
     fn fuzz_text(sheen: Value) -> Option<String> {
-        fuzz_for(&Sheen::read(&sheen)).map(|m| serde_json::to_string(&Value::Object(m)).unwrap())
+        fuzz_for(&Sheen::read(&sheen), None, RoughnessMapping::Identity)
+            .map(|m| serde_json::to_string(&Value::Object(m)).unwrap())
     }
 
     #[test]
@@ -173,7 +308,7 @@ mod tests {
     fn textures_are_carried_with_their_extensions() {
         let tex = json!({"index": 2, "texCoord": 1, "extensions": {"KHR_texture_transform": {"scale": [30.0, -30.0]}}});
         let sheen = json!({"sheenColorFactor": [0.5, 0.5, 0.5], "sheenColorTexture": tex, "sheenRoughnessTexture": tex});
-        let fuzz = fuzz_for(&Sheen::read(&sheen)).unwrap();
+        let fuzz = fuzz_for(&Sheen::read(&sheen), None, RoughnessMapping::Identity).unwrap();
         assert_eq!(fuzz["fuzzColorTexture"], tex);
         assert_eq!(fuzz["fuzzRoughnessTexture"], tex);
         assert_eq!(
@@ -196,7 +331,12 @@ mod tests {
             [1e-6, 0.0, 3e-7],
             [0.12, 0.12, 0.13],
         ] {
-            let fuzz = fuzz_for(&Sheen::read(&json!({ "sheenColorFactor": c }))).unwrap();
+            let fuzz = fuzz_for(
+                &Sheen::read(&json!({ "sheenColorFactor": c })),
+                None,
+                RoughnessMapping::Identity,
+            )
+            .unwrap();
             let w = fuzz["fuzzFactor"].as_f64().unwrap();
             for i in 0..3 {
                 let colour = fuzz["fuzzColorFactor"][i].as_f64().unwrap();

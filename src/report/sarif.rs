@@ -6,7 +6,8 @@
 //! directory (the repository root, in CI) when the file lies below it, else an absolute
 //! `file:` URI. A .gltf finding whose pointer names a value gets `region.startLine` and
 //! `startColumn` (columns count Unicode code points, declared by `columnKind`); a .glb is
-//! binary, so its region is the `byteOffset` of the value in the file instead. The JSON pointer
+//! binary, so its region is the `byteOffset` of the value in the file instead, with
+//! `startLine` 1 because GitHub code scanning requires a line on every result. The JSON pointer
 //! goes in each result's `properties.pointer`.
 
 use crate::asset::Container;
@@ -98,7 +99,6 @@ struct Driver {
     name: &'static str,
     version: &'static str,
     semantic_version: &'static str,
-    information_uri: &'static str,
     rules: Vec<Rule>,
 }
 
@@ -176,8 +176,13 @@ enum Region {
         start_line: usize,
         start_column: usize,
     },
-    /// A value in a .glb: its byte offset in the file.
-    Binary { byte_offset: usize },
+    /// A value in a .glb: its byte offset in the file, and line 1 (GitHub code scanning
+    /// requires `startLine` on every result; a GLB has no lines of its own, and its JSON chunk
+    /// sits on the first "line" of the file as a text viewer splits it).
+    Binary {
+        start_line: usize,
+        byte_offset: usize,
+    },
 }
 
 #[derive(Serialize)]
@@ -213,6 +218,7 @@ fn log<'a>(reports: &'a [FileReport], artifacts: &'a [ArtifactLocation]) -> Log<
             let d = &f.diagnostic;
             let region = f.position.map(|p| match report.container {
                 Some(Container::Glb) => Region::Binary {
+                    start_line: 1,
                     byte_offset: report.json_offset + p.offset,
                 },
                 _ => Region::Text {
@@ -261,7 +267,6 @@ fn log<'a>(reports: &'a [FileReport], artifacts: &'a [ArtifactLocation]) -> Log<
                     name: "velvet",
                     version: env!("CARGO_PKG_VERSION"),
                     semantic_version: env!("CARGO_PKG_VERSION"),
-                    information_uri: env!("CARGO_PKG_REPOSITORY"),
                     rules,
                 },
             },

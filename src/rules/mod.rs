@@ -12,6 +12,7 @@ pub mod disabled_layer;
 pub mod exclusions;
 pub mod fallback;
 pub mod fuzz_roughness_default;
+pub mod fuzz_roughness_mapping;
 pub mod image_size;
 pub mod legacy_sheen;
 pub mod placement;
@@ -58,6 +59,7 @@ pub static REGISTRY: &[&dyn Rule] = &[
     &roughness_alpha::RoughnessAlpha,
     &image_size::ImageSize,
     &fallback::Fallback,
+    &fuzz_roughness_mapping::FuzzRoughnessMapping,
     &fuzz_roughness_default::FuzzRoughnessDefault,
     &legacy_sheen::LegacySheen,
     &clearcoat::Clearcoat,

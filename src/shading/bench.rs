@@ -1,17 +1,44 @@
 //! The `velvet bench` command: its arguments and what it runs. The binary only parses and maps
 //! the outcome to an exit code; everything here is callable from tests.
 
-use super::accuracy::{accuracy_report, parse_points, points_csv, PointsError, REPORT_GRID};
-use super::plot::accuracy_svg;
+use super::accuracy::{
+    accuracy_report, fuzz_accuracy, mapping_accuracy, mapping_comparison, parse_points, points_csv,
+    MappingReport, PointsError, REPORT_GRID,
+};
+use super::plot::{accuracy_svg, mapping_svg, MappingCurves};
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 
 /// `velvet bench …`: numeric reports.
 #[derive(Debug, Clone, PartialEq, Eq, clap::Subcommand)]
 pub enum BenchCommand {
-    /// Speed against error of the sheen albedo methods (quadrature, lut16, lut32, fit).
+    /// Speed against error of the sheen albedo methods (quadrature, lut16, lut32, fit), of the
+    /// fuzz reflectance table, and of the fitted roughness mapping.
     Accuracy(AccuracyArgs),
+    /// The fitted sheen ↔ fuzz roughness mapping against copying the roughness.
+    Mapping(MappingArgs),
 }
+
+/// Arguments of `velvet bench mapping`.
+#[derive(Debug, Clone, PartialEq, Eq, clap::Args)]
+pub struct MappingArgs {
+    /// Also write an SVG plot of E(μ, r) against R(μ, α(r)) for r = 0.2, 0.4, …, 1, and of the
+    /// mapping itself, to this file.
+    #[arg(long, value_name = "FILE.svg")]
+    pub plot: Option<PathBuf>,
+}
+
+/// Roughness values of the mapping command's table.
+const COMPARISON_VALUES: [f64; 11] = [0.05, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0];
+
+/// Sheen roughness values of the mapping plot.
+const PLOT_VALUES: [f64; 5] = [0.2, 0.4, 0.6, 0.8, 1.0];
+
+/// View cosines per curve in the mapping plot.
+const PLOT_SAMPLES: usize = 101;
+
+/// Roughness values at which `bench accuracy` measures the mapping against its optimum.
+const MAPPING_POINTS: usize = 65;
 
 /// Arguments of `velvet bench accuracy`.
 #[derive(Debug, Clone, PartialEq, Eq, clap::Args)]
@@ -61,7 +88,27 @@ pub enum BenchError {
 pub fn run(command: &BenchCommand, out: &mut dyn Write) -> Result<(), BenchError> {
     match command {
         BenchCommand::Accuracy(args) => run_accuracy(args, out),
+        BenchCommand::Mapping(args) => run_mapping(args, out),
     }
+}
+
+fn run_mapping(args: &MappingArgs, out: &mut dyn Write) -> Result<(), BenchError> {
+    write!(out, "{}", mapping_comparison(&COMPARISON_VALUES)).map_err(BenchError::Output)?;
+    if let Some(path) = &args.plot {
+        let svg = mapping_svg(&MappingCurves::compute(&PLOT_VALUES, PLOT_SAMPLES));
+        write_plot(path, svg)?;
+    }
+    Ok(())
+}
+
+/// Writes a drawn plot (or the reason it could not be drawn) to `path`, atomically.
+fn write_plot(path: &Path, svg: Result<String, String>) -> Result<(), BenchError> {
+    let plot_error = |message: String| BenchError::Plot {
+        path: path.to_path_buf(),
+        message,
+    };
+    let svg = svg.map_err(plot_error)?;
+    write_atomically(path, svg.as_bytes()).map_err(|e| plot_error(e.to_string()))
 }
 
 fn run_accuracy(args: &AccuracyArgs, out: &mut dyn Write) -> Result<(), BenchError> {
@@ -80,13 +127,13 @@ fn run_accuracy(args: &AccuracyArgs, out: &mut dyn Write) -> Result<(), BenchErr
     }
     let report = accuracy_report(REPORT_GRID);
     write!(out, "{report}").map_err(BenchError::Output)?;
+    writeln!(out).map_err(BenchError::Output)?;
+    write!(out, "{}", fuzz_accuracy(REPORT_GRID)).map_err(BenchError::Output)?;
+    writeln!(out).map_err(BenchError::Output)?;
+    let mapping = mapping_accuracy(MAPPING_POINTS);
+    write!(out, "{}", MappingReport(&mapping)).map_err(BenchError::Output)?;
     if let Some(path) = &args.plot {
-        let plot_error = |message: String| BenchError::Plot {
-            path: path.clone(),
-            message,
-        };
-        let svg = accuracy_svg(&report).map_err(plot_error)?;
-        write_atomically(path, svg.as_bytes()).map_err(|e| plot_error(e.to_string()))?;
+        write_plot(path, accuracy_svg(&report))?;
     }
     Ok(())
 }
@@ -149,6 +196,23 @@ mod tests {
             err.to_string()
                 .starts_with(&format!("{}: cannot read: ", missing.display())),
             "{err}"
+        );
+    }
+
+    #[test]
+    fn mapping_plot_into_a_missing_folder_names_the_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("no/such/dir/mapping.svg");
+        let err = write_plot(&path, Ok("<svg/>".into())).unwrap_err();
+        assert!(
+            err.to_string()
+                .starts_with(&format!("{}: cannot write the plot: ", path.display())),
+            "{err}"
+        );
+        let err = write_plot(&path, Err("nothing to plot".into())).unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            format!("{}: cannot write the plot: nothing to plot", path.display())
         );
     }
 

@@ -11,13 +11,14 @@
 //! Every attenuation here is clamped into [0, 1] and says whether the clamp acted; [`ClampCount`]
 //! adds them up so reports can say how often it happened.
 //!
-//! The fuzz layer's own reflectance R(μ, α) is not modelled yet: [`FuzzReflectance::SheenStandIn`]
-//! uses the sheen albedo E at the same roughness in its place. The comparison functions take the
-//! reflectances as [`LayerReflectance`] trait objects, so the real R slots in as another
-//! implementation without changing them.
+//! The fuzz layer's reflectance R(μ, α) is velvet's model of the fuzz draft's fibre layer
+//! ([`FuzzReflectance`], see `fuzz.rs`). The comparison functions take the reflectances as
+//! [`LayerReflectance`] trait objects, so either layer's reflectance can be swapped for another
+//! method (a table, a stand-in in tests) without changing them.
 
 use super::albedo::AlbedoMethod;
 use super::charlie::clamp01;
+use super::fuzz::{fuzz_reflectance, ReflectanceMethod};
 use super::sheen_albedo;
 
 /// A base attenuation factor, clamped into [0, 1], with the value before the clamp.
@@ -129,24 +130,17 @@ impl LayerReflectance for SheenAlbedo {
     }
 }
 
-/// The fuzz layer's reflectance R(μ, α).
+/// The fuzz layer's reflectance R(μ, α) (velvet's model of the fibre layer the fuzz draft
+/// recommends) by one of velvet's methods.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum FuzzReflectance {
-    /// Stand-in until velvet models the fuzz layer's own reflectance: the sheen albedo E at the
-    /// same roughness, by the given method.
-    SheenStandIn(AlbedoMethod),
-}
+pub struct FuzzReflectance(pub ReflectanceMethod);
 
 impl LayerReflectance for FuzzReflectance {
     fn name(&self) -> String {
-        match self {
-            FuzzReflectance::SheenStandIn(m) => format!("fuzz R = sheen E stand-in ({})", m.name()),
-        }
+        format!("fuzz R ({})", self.0.name())
     }
     fn reflectance(&self, mu: f64, roughness: f64) -> f64 {
-        match self {
-            FuzzReflectance::SheenStandIn(m) => sheen_albedo(mu, roughness, *m),
-        }
+        fuzz_reflectance(mu, roughness, self.0)
     }
 }
 
@@ -257,8 +251,7 @@ pub fn compare_base_attenuation(
     }
 }
 
-/// [`compare_base_attenuation`] with the sheen E by quadrature and the fuzz R by its current
-/// model (the sheen-E stand-in, by quadrature).
+/// [`compare_base_attenuation`] with the sheen E and the fuzz R both by quadrature.
 pub fn sheen_to_fuzz_attenuation_difference(
     sheen: SheenParams,
     fuzz: FuzzParams,
@@ -267,7 +260,7 @@ pub fn sheen_to_fuzz_attenuation_difference(
         sheen,
         fuzz,
         &SheenAlbedo(AlbedoMethod::Quadrature),
-        &FuzzReflectance::SheenStandIn(AlbedoMethod::Quadrature),
+        &FuzzReflectance(ReflectanceMethod::Quadrature),
     )
 }
 
@@ -382,8 +375,8 @@ mod tests {
     }
 
     #[test]
-    fn identical_layers_differ_by_nothing() {
-        // Sheen max3 = w and the stand-in R = E at the same roughness: the layers agree exactly.
+    fn identical_reflectances_differ_by_nothing() {
+        // The same reflectance on both sides with max3 = w: the layers agree exactly.
         let cmp = compare_base_attenuation(
             SheenParams {
                 color_max3: 0.8,
@@ -394,17 +387,44 @@ mod tests {
                 roughness: 0.5,
             },
             &SheenAlbedo(AlbedoMethod::Fit),
-            &FuzzReflectance::SheenStandIn(AlbedoMethod::Fit),
+            &SheenAlbedo(AlbedoMethod::Fit),
         );
         assert_eq!(cmp.max_difference, 0.0);
         assert_eq!(cmp.curve.len(), COMPARISON_SAMPLES);
-        assert_eq!(cmp.fuzz_reflectance, "fuzz R = sheen E stand-in (fit)");
+        assert_eq!(cmp.fuzz_reflectance, "sheen E (fit)");
     }
 
     #[test]
-    fn a_weaker_fuzz_layer_shows_the_gap_where_e_is_largest() {
-        // Same roughness, w = 0.5·max3: the difference is 0.5·max3·E, largest where E is.
+    fn sheen_and_fuzz_at_one_roughness_differ_most_at_normal_view_for_r_one() {
+        // r = α = 1, full colour and weight: E(1, 1) ≈ 0.164 and R(1, 1) ≈ 0.332 (velvet's
+        // quadrature), so the base attenuations differ by R − E ≈ 0.168 at μ = 1, and the
+        // comparison's curve carries both reflectances.
         let cmp = sheen_to_fuzz_attenuation_difference(
+            SheenParams {
+                color_max3: 1.0,
+                roughness: 1.0,
+            },
+            FuzzParams {
+                weight: 1.0,
+                roughness: 1.0,
+            },
+        );
+        let last = cmp.curve.last().unwrap();
+        assert_eq!(last.mu, 1.0);
+        assert!((last.fuzz_reflectance - 0.3324).abs() < 1e-3, "{last:?}");
+        assert!((last.sheen_reflectance - 0.164).abs() < 1e-3, "{last:?}");
+        assert!(
+            (last.difference() - (last.fuzz_reflectance - last.sheen_reflectance)).abs() < 1e-15
+        );
+        assert!(cmp.max_difference >= last.difference());
+        assert_eq!(cmp.fuzz_reflectance, "fuzz R (quadrature)");
+    }
+
+    #[test]
+    fn a_weaker_layer_shows_the_gap_where_the_reflectance_is_largest() {
+        // Same reflectance on both sides, w = 0.5·max3: the difference is 0.5·max3·E, largest
+        // where E is.
+        let cmp = compare_base_attenuation(
             SheenParams {
                 color_max3: 1.0,
                 roughness: 0.5,
@@ -413,6 +433,8 @@ mod tests {
                 weight: 0.5,
                 roughness: 0.5,
             },
+            &SheenAlbedo(AlbedoMethod::Quadrature),
+            &SheenAlbedo(AlbedoMethod::Quadrature),
         );
         let e_max = cmp
             .curve

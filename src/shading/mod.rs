@@ -9,12 +9,17 @@ pub mod albedo;
 pub mod bench;
 pub mod charlie;
 pub mod fit;
+pub mod fuzz;
+mod fuzz_table;
 pub mod layering;
+pub mod mapping;
+mod mapping_table;
 pub mod plot;
 pub mod quadrature;
 pub mod table;
 
 pub use albedo::AlbedoMethod;
+pub use fuzz::{fuzz_reflectance, ReflectanceMethod};
 
 /// E(μ, r) of the Charlie sheen BRDF: the fraction of light at view cosine μ that the sheen layer
 /// reflects, for sheen roughness r. μ and r are clamped into [0, 1] and μ is floored at

@@ -1,10 +1,16 @@
-//! The accuracy report drawn as an SVG: max absolute error against time per evaluation, both on
-//! log axes, one point per method and region. Drawn with plotters' SVG backend only (no system
-//! fonts: the SVG names a font family and the viewer renders the text).
+//! The reports drawn as SVG: the accuracy report (max absolute error against time per
+//! evaluation, both on log axes, one point per method and region) and the roughness mapping
+//! (the sheen albedo E(μ, r) against the fuzz reflectance R(μ, α(r)) for a few r, and the
+//! mapping α(r) and its reverse r(α)). Drawn with plotters' SVG backend only (no system fonts:
+//! the SVG names a font family and the viewer renders the text).
 
 use super::accuracy::AccuracyReport;
 use super::albedo::{AlbedoMethod, QUADRATURE_BOUND};
+use super::fuzz::{fuzz_reflectance, ReflectanceMethod};
+use super::mapping;
+use super::{sheen_albedo, AlbedoMethod as Method};
 use plotters::prelude::*;
+use rayon::prelude::*;
 
 /// Width and height of the plot in pixels.
 const SIZE: (u32, u32) = (900, 560);
@@ -154,6 +160,212 @@ pub fn accuracy_svg(report: &AccuracyReport) -> Result<String, String> {
     Ok(svg)
 }
 
+/// E(μ, r) and R(μ, α(r)) for one sheen roughness.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LobePair {
+    /// The sheen roughness r.
+    pub r: f64,
+    /// α(r), the fitted fuzz roughness.
+    pub alpha: f64,
+    /// E(μ_i, r).
+    pub sheen: Vec<f64>,
+    /// R(μ_i, α(r)).
+    pub fuzz: Vec<f64>,
+}
+
+/// What the mapping plot draws: E against R(α(r)) on a μ grid for a few r, and both mappings
+/// at their table nodes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MappingCurves {
+    /// The view cosines μ_i = i/(n − 1).
+    pub mu: Vec<f64>,
+    /// One pair of curves per sheen roughness.
+    pub lobes: Vec<LobePair>,
+    /// The table nodes j/256.
+    pub roughness: Vec<f64>,
+    /// α(r) at the nodes.
+    pub fuzz_for_sheen: Vec<f64>,
+    /// r(α) at the nodes.
+    pub sheen_for_fuzz: Vec<f64>,
+}
+
+impl MappingCurves {
+    /// E and R by quadrature at `samples` view cosines (0 and 1 included) for each r in `rs`.
+    pub fn compute(rs: &[f64], samples: usize) -> Self {
+        assert!(samples >= 2);
+        let mu: Vec<f64> = (0..samples)
+            .map(|i| i as f64 / (samples - 1) as f64)
+            .collect();
+        let lobes = rs
+            .iter()
+            .map(|&r| {
+                let alpha = mapping::fuzz_roughness_for_sheen(r);
+                let pairs: Vec<(f64, f64)> = mu
+                    .par_iter()
+                    .map(|&m| {
+                        (
+                            sheen_albedo(m, r, Method::Quadrature),
+                            fuzz_reflectance(m, alpha, ReflectanceMethod::Quadrature),
+                        )
+                    })
+                    .collect();
+                LobePair {
+                    r,
+                    alpha,
+                    sheen: pairs.iter().map(|p| p.0).collect(),
+                    fuzz: pairs.iter().map(|p| p.1).collect(),
+                }
+            })
+            .collect();
+        MappingCurves {
+            mu,
+            lobes,
+            roughness: (0..mapping::NODES).map(mapping::node).collect(),
+            fuzz_for_sheen: mapping::fuzz_for_sheen_nodes().to_vec(),
+            sheen_for_fuzz: mapping::sheen_for_fuzz_nodes().to_vec(),
+        }
+    }
+}
+
+/// Colours of the lobe pairs, in order.
+const PALETTE: [RGBColor; 6] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+];
+
+/// The mapping plot as SVG text, two panels side by side. Left: for each r, E(μ, r) as a solid
+/// line and R(μ, α(r)) dashed in the same colour (the y axis reaches the largest value, so
+/// nothing is clipped). Right: α(r) solid, r(α) dashed, and the identity dotted.
+pub fn mapping_svg(curves: &MappingCurves) -> Result<String, String> {
+    if curves.lobes.is_empty() || curves.mu.len() < 2 || curves.roughness.len() < 2 {
+        return Err("nothing to plot".into());
+    }
+    let err = |e: &dyn std::fmt::Display| e.to_string();
+    let top = curves
+        .lobes
+        .iter()
+        .flat_map(|l| l.sheen.iter().chain(&l.fuzz))
+        .fold(0.0f64, |a, &b| a.max(b));
+    let top = (top * 10.0).ceil() / 10.0;
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (1200, 560)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| err(&e))?;
+        let panels = root.split_evenly((1, 2));
+
+        let mut left = ChartBuilder::on(&panels[0])
+            .caption(
+                "Sheen E(μ, r) solid, fuzz R(μ, α(r)) dashed",
+                ("sans-serif", 18),
+            )
+            .margin(16)
+            .x_label_area_size(45)
+            .y_label_area_size(55)
+            .build_cartesian_2d(0.0..1.0, 0.0..top)
+            .map_err(|e| err(&e))?;
+        left.configure_mesh()
+            .x_desc("μ = cos θ (view)")
+            .y_desc("directional reflectance")
+            .draw()
+            .map_err(|e| err(&e))?;
+        for (k, lobe) in curves.lobes.iter().enumerate() {
+            let colour = PALETTE[k % PALETTE.len()];
+            let style = colour.stroke_width(2);
+            left.draw_series(LineSeries::new(
+                curves.mu.iter().copied().zip(lobe.sheen.iter().copied()),
+                style,
+            ))
+            .map_err(|e| err(&e))?
+            .label(format!("r = {}, α(r) = {:.3}", lobe.r, lobe.alpha))
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+            left.draw_series(DashedLineSeries::new(
+                curves.mu.iter().copied().zip(lobe.fuzz.iter().copied()),
+                6,
+                4,
+                style,
+            ))
+            .map_err(|e| err(&e))?;
+        }
+        left.configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .background_style(WHITE.mix(0.9))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 13))
+            .draw()
+            .map_err(|e| err(&e))?;
+
+        let mut right = ChartBuilder::on(&panels[1])
+            .caption(
+                "The fitted mapping: α(r) solid, r(α) dashed",
+                ("sans-serif", 18),
+            )
+            .margin(16)
+            .x_label_area_size(45)
+            .y_label_area_size(55)
+            .build_cartesian_2d(0.0..1.0, 0.0..1.0)
+            .map_err(|e| err(&e))?;
+        right
+            .configure_mesh()
+            .x_desc("roughness of the layer mapped from")
+            .y_desc("roughness of the layer mapped to")
+            .draw()
+            .map_err(|e| err(&e))?;
+        let forward = PALETTE[0].stroke_width(2);
+        let reverse = PALETTE[3].stroke_width(2);
+        let identity = RGBColor(150, 150, 150).stroke_width(1);
+        right
+            .draw_series(LineSeries::new(
+                curves
+                    .roughness
+                    .iter()
+                    .copied()
+                    .zip(curves.fuzz_for_sheen.iter().copied()),
+                forward,
+            ))
+            .map_err(|e| err(&e))?
+            .label("α(r): sheen r → fuzz α")
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], forward));
+        right
+            .draw_series(DashedLineSeries::new(
+                curves
+                    .roughness
+                    .iter()
+                    .copied()
+                    .zip(curves.sheen_for_fuzz.iter().copied()),
+                6,
+                4,
+                reverse,
+            ))
+            .map_err(|e| err(&e))?
+            .label("r(α): fuzz α → fallback sheen r")
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], reverse));
+        right
+            .draw_series(DashedLineSeries::new(
+                [(0.0, 0.0), (1.0, 1.0)],
+                2,
+                4,
+                identity,
+            ))
+            .map_err(|e| err(&e))?
+            .label("identity (copy the number)")
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], identity));
+        right
+            .configure_series_labels()
+            .position(SeriesLabelPosition::LowerRight)
+            .background_style(WHITE.mix(0.9))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 13))
+            .draw()
+            .map_err(|e| err(&e))?;
+        root.present().map_err(|e| err(&e))?;
+    }
+    Ok(svg)
+}
+
 #[cfg(test)]
 mod tests {
     use super::super::accuracy::{ErrorStats, MethodResult};
@@ -166,6 +378,47 @@ mod tests {
             worst_at: (0.0, 0.0),
             points: 1,
         })
+    }
+
+    #[test]
+    fn mapping_svg_draws_both_panels_and_names_every_r() {
+        let curves = MappingCurves {
+            mu: vec![0.0, 0.5, 1.0],
+            lobes: vec![
+                LobePair {
+                    r: 0.2,
+                    alpha: 0.36,
+                    sheen: vec![1.3, 0.2, 0.01],
+                    fuzz: vec![0.7, 0.1, 0.0],
+                },
+                LobePair {
+                    r: 1.0,
+                    alpha: 0.79,
+                    sheen: vec![0.8, 0.35, 0.16],
+                    fuzz: vec![0.78, 0.3, 0.2],
+                },
+            ],
+            roughness: vec![0.0, 0.5, 1.0],
+            fuzz_for_sheen: vec![0.0, 0.56, 0.79],
+            sheen_for_fuzz: vec![0.0, 0.42, 1.0],
+        };
+        let svg = mapping_svg(&curves).unwrap();
+        assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
+        for text in [
+            "r = 0.2, α(r) = 0.360",
+            "r = 1, α(r) = 0.790",
+            "α(r): sheen r → fuzz α",
+            "r(α): fuzz α → fallback sheen r",
+            "identity (copy the number)",
+        ] {
+            assert!(svg.contains(text), "missing {text}");
+        }
+        assert!(!svg.contains("NaN"));
+        let empty = MappingCurves {
+            lobes: vec![],
+            ..curves
+        };
+        assert!(mapping_svg(&empty).is_err());
     }
 
     #[test]
