@@ -435,6 +435,25 @@ fn the_pixel_limit_is_inclusive_and_raised_by_its_flag() {
     ]);
     assert_eq!(status, 0, "{out}");
     assert!(output.exists());
+
+    // migrate bakes the mapped roughness texture under the same limit.
+    let migrated = dir.path().join("out/migrated.gltf");
+    let (status, out, _) = velvet(&[
+        "migrate",
+        s(&path),
+        "-o",
+        s(&migrated),
+        "--max-image-pixels",
+        "15",
+    ]);
+    assert_eq!(status, 1, "{out}");
+    assert!(
+        out.contains("4 × 4 = 16 pixels, over the limit of 15 (raise it with --max-image-pixels)"),
+        "{out}"
+    );
+    assert!(!migrated.exists());
+    let (status, out, _) = velvet(&["migrate", s(&path), "-o", s(&migrated)]);
+    assert_eq!(status, 0, "{out}");
 }
 
 #[test]

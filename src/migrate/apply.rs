@@ -127,6 +127,9 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
                 exact: false,
                 measure: true,
             },
+            max_image_pixels: crate::bake::engine::MaxImagePixels(
+                plan.asset.options.max_image_pixels,
+            ),
             ..BakeOptions::default()
         };
         for (info, result) in
