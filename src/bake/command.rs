@@ -24,6 +24,7 @@ use super::plan::{plan, BakePlan, Note, PlanOptions};
 use super::prune::Dropped;
 use crate::asset::{self, resource, write};
 use crate::diagnostics::Severity;
+use crate::migrate::apply::{copy_resources, create_parent};
 use crate::migrate::paths::{identity, jobs, relocate, Job, Relocation};
 
 pub use crate::migrate::paths::Destination;
@@ -241,26 +242,6 @@ fn slot_reports(plan: &BakePlan, names: &[String]) -> Vec<SlotReport> {
                 .collect(),
         })
         .collect()
-}
-
-fn create_parent(path: &Path) -> Result<(), String> {
-    match path.parent() {
-        Some(dir) if !dir.as_os_str().is_empty() => std::fs::create_dir_all(dir)
-            .map_err(|e| format!("cannot create folder {}: {e}", dir.display())),
-        _ => Ok(()),
-    }
-}
-
-/// Writes a relocation's resource copies.
-fn copy_resources(relocation: &Relocation) -> Result<(), String> {
-    for copy in &relocation.copies {
-        let data = std::fs::read(&copy.from)
-            .map_err(|e| format!("cannot read resource {}: {e}", copy.from.display()))?;
-        create_parent(&copy.to)?;
-        write::write_atomic(&copy.to, &data)
-            .map_err(|e| format!("cannot write resource {}: {e}", copy.to.display()))?;
-    }
-    Ok(())
 }
 
 /// Writes new image files into `dir` (each atomically; one already holding the bytes is left).

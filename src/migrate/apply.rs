@@ -101,12 +101,25 @@ pub fn plan_file(job: &Job, options: &Options) -> Result<FilePlan, String> {
     })
 }
 
-fn create_parent(path: &Path) -> Result<(), String> {
+/// Creates the folder `path` goes in, if it has one.
+pub(crate) fn create_parent(path: &Path) -> Result<(), String> {
     match path.parent() {
         Some(dir) if !dir.as_os_str().is_empty() => std::fs::create_dir_all(dir)
             .map_err(|e| format!("cannot create folder {}: {e}", dir.display())),
         _ => Ok(()),
     }
+}
+
+/// Writes a relocation's resource copies (each atomically), for migrate and bake alike.
+pub(crate) fn copy_resources(relocation: &Relocation) -> Result<(), String> {
+    for copy in &relocation.copies {
+        let data = std::fs::read(&copy.from)
+            .map_err(|e| format!("cannot read resource {}: {e}", copy.from.display()))?;
+        create_parent(&copy.to)?;
+        write::write_atomic(&copy.to, &data)
+            .map_err(|e| format!("cannot write resource {}: {e}", copy.to.display()))?;
+    }
+    Ok(())
 }
 
 /// Applies a file's plan and writes its output (and resource copies). On failure the output
@@ -166,13 +179,7 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
     if !changed && plan.in_place() {
         return Ok(Written::Untouched);
     }
-    for copy in &plan.relocation.copies {
-        let data = std::fs::read(&copy.from)
-            .map_err(|e| format!("cannot read resource {}: {e}", copy.from.display()))?;
-        create_parent(&copy.to)?;
-        write::write_atomic(&copy.to, &data)
-            .map_err(|e| format!("cannot write resource {}: {e}", copy.to.display()))?;
-    }
+    copy_resources(&plan.relocation)?;
     create_parent(&output)?;
     let bytes = if bake_plan.is_empty() {
         if changed {
