@@ -1409,3 +1409,68 @@ fn a_fallback_sheen_roughness_texture_holds_the_mapped_roughness_unless_fast() {
         .contains(&Note::RoughnessTextureFast { mapping: "fitted" }));
     assert_eq!(doc["images"].as_array().unwrap().len(), 1, "nothing baked");
 }
+
+/// Found by the property tests: black fuzz gets no fallback sheen, so nothing may be baked for
+/// one (a bake aimed at the absent sheen added an image and made the file change).
+#[test]
+fn black_fuzz_with_an_intensity_texture_bakes_nothing_and_is_left_as_it_is() {
+    let dir = tempfile::tempdir().unwrap();
+    png_file(
+        &dir.path().join("intensity.png"),
+        2,
+        1,
+        image::ColorType::L8,
+        &[0, 255],
+    );
+    let input = dir.path().join("black.gltf");
+    std::fs::write(
+        &input,
+        serde_json::to_vec_pretty(&serde_json::json!({
+            "asset": {"version": "2.0"},
+            "extensionsUsed": ["KHR_materials_fuzz"],
+            "materials": [{"extensions": {"KHR_materials_fuzz": {
+                "fuzzFactor": 1.0,
+                "fuzzColorFactor": [0.0, 0.0, 0.0],
+                "fuzzTexture": {"index": 0}
+            }}}],
+            "textures": [{"source": 0}],
+            "images": [{"uri": "intensity.png"}]
+        }))
+        .unwrap(),
+    )
+    .unwrap();
+    let output = dir.path().join("black.out.gltf");
+    let report = migrate::run(&request(
+        vec![input.clone()],
+        Destination::File(output.clone()),
+        Options::default(),
+    ))
+    .unwrap();
+    let result = &report.files[0];
+    assert_eq!(result.outcome, FileOutcome::Copied);
+    assert_eq!(result.materials[0].skipped, Some(Skip::BlackFuzz));
+    assert!(result.materials[0].bakes.is_empty());
+    assert_eq!(
+        result.materials[0].notes,
+        [
+            Note::FuzzRoughnessDefault { assumed: 0.5 },
+            Note::DarkFuzz {
+                difference: 1.0,
+                fuzz_color_max: 0.0,
+                base_color_max: 1.0
+            },
+            Note::BlackFuzz
+        ],
+        "no note of a bake"
+    );
+    assert_eq!(
+        std::fs::read(&output).unwrap(),
+        std::fs::read(&input).unwrap()
+    );
+    let mut files: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    files.sort();
+    assert_eq!(files, ["black.gltf", "black.out.gltf", "intensity.png"]);
+}

@@ -280,13 +280,19 @@ pub fn add(cx: &MaterialCx, fuzz: &Value, plan: &mut MaterialPlan) {
         return;
     }
     let (sheen, notes, bakes) = sheen_for(cx, fuzz);
-    plan.notes.extend(notes);
-    plan.bakes.extend(bakes);
     if switched_off(&sheen) {
-        // A switched-off sheen next to an active fuzz is no fallback, and contradicts it.
+        // A switched-off sheen next to an active fuzz is no fallback, and contradicts it: no
+        // sheen is written, so nothing is baked for it either.
+        plan.notes.extend(
+            notes
+                .into_iter()
+                .filter(|n| !matches!(n, Note::FallbackTextureBaked { .. })),
+        );
         plan.skip(Skip::BlackFuzz, Note::BlackFuzz);
         return;
     }
+    plan.notes.extend(notes);
+    plan.bakes.extend(bakes);
     plan.edits.push(Edit::set(
         cx.extension_pointer(layers::SHEEN),
         Value::Object(sheen),
