@@ -109,12 +109,23 @@ pub struct TextureRef {
     pub tex_coord: u64,
 }
 
+/// A glTF index: a non-negative integer, also when written with a zero fraction (`1.0`), which
+/// JSON Schema counts as an integer.
+pub fn as_index(value: &Value) -> Option<u64> {
+    value.as_u64().or_else(|| {
+        value
+            .as_f64()
+            .filter(|n| *n >= 0.0 && n.fract() == 0.0 && *n < u64::MAX as f64)
+            .map(|n| n as u64)
+    })
+}
+
 impl TextureRef {
     pub fn read(value: &Value) -> Option<TextureRef> {
         let obj = value.as_object()?;
         Some(TextureRef {
-            index: obj.get("index").and_then(Value::as_u64),
-            tex_coord: obj.get("texCoord").and_then(Value::as_u64).unwrap_or(0),
+            index: obj.get("index").and_then(as_index),
+            tex_coord: obj.get("texCoord").and_then(as_index).unwrap_or(0),
         })
     }
 }

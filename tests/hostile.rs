@@ -312,9 +312,10 @@ fn buffers_shorter_than_their_byte_length_are_reported() {
     );
     let without_bin = glb::join(doc.to_string().as_bytes(), None);
     let loaded = asset::load_bytes(&dir.path().join("short.glb"), &without_bin);
+    assert_eq!(codes(&loaded.diagnostics), ["BUFFER_MISSING_GLB_DATA"]);
     assert_eq!(
         loaded.diagnostics[0].message,
-        "buffer 0 declares 64 bytes but the GLB has no BIN chunk"
+        "buffer 0 has no uri and declares 64 bytes, but the GLB has no BIN chunk"
     );
     // A data: URI and a file: checked when read.
     write(&dir.path().join("short.bin"), [1u8, 2, 3]);
@@ -547,10 +548,10 @@ fn uris_leaving_the_folder_are_read_only_with_the_flag() {
             "{uri}"
         );
     }
-    // Remote URLs are never fetched, flag or not.
+    // Remote URLs are never fetched, flag or not: valid glTF, reported as not checked.
     let path = chair_reading(&root, "https://example.com/rgb.png");
     let (_, out, _) = velvet(&["validate", "--allow-outside-uris", s(&path)]);
-    assert!(out.contains("URI_NOT_FOLLOWED"), "{out}");
+    assert!(out.contains("warning NON_RELATIVE_URI"), "{out}");
 }
 
 #[test]
@@ -972,13 +973,26 @@ fn files_that_vanish_or_dangle_get_a_clear_error_and_the_run_goes_on() {
 #[test]
 fn a_resource_that_is_not_a_regular_file_is_not_read() {
     let dir = tempfile::tempdir().unwrap();
+    // A link to a device outside the folder is refused before anything is opened.
     std::os::unix::fs::symlink("/dev/zero", dir.path().join("zero.bin")).unwrap();
-    let doc =
-        json!({"asset": {"version": "2.0"}, "buffers": [{"byteLength": 4, "uri": "zero.bin"}]});
+    // A folder inside it is not a regular file.
+    std::fs::create_dir(dir.path().join("folder.bin")).unwrap();
+    let doc = json!({"asset": {"version": "2.0"}, "buffers": [
+        {"byteLength": 4, "uri": "zero.bin"},
+        {"byteLength": 4, "uri": "folder.bin"}
+    ]});
     let path = dir.path().join("a.gltf");
     write(&path, doc.to_string());
     let a = asset::load(&path).asset.unwrap();
     let err = a.buffer_bytes(0).unwrap_err();
+    assert_eq!(err.code, "URI_NOT_FOLLOWED");
+    assert!(
+        err.message
+            .starts_with("'zero.bin' leads out of the asset's folder through a symbolic link"),
+        "{}",
+        err.message
+    );
+    let err = a.buffer_bytes(1).unwrap_err();
     assert_eq!(err.code, "IO_ERROR");
     assert!(
         err.message.ends_with("not a regular file"),
@@ -1022,7 +1036,8 @@ fn fuzz_validate_a_position_naming_no_accessor_is_a_dangling_reference() {
             ),
         ]
     );
-    assert_eq!(report.counts.errors, 11);
+    // Ten dangling references, the out-of-range sheen factor, and the missing .bin.
+    assert_eq!(report.counts.errors, 12);
     // The smallest such document: that reference is its only fault.
     let loaded = asset::load_bytes(
         Path::new("memory/a.gltf"),
@@ -1038,7 +1053,7 @@ fn fuzz_validate_a_position_naming_no_accessor_is_a_dangling_reference() {
     );
     assert_eq!(
         report.findings[0].diagnostic.message,
-        "meshes[0].primitives[0].attributes[\"POSITION\"]: the index names no object"
+        "POSITION names accessor 5, but the asset has 0 accessors"
     );
 }
 

@@ -258,7 +258,7 @@ fn document() -> impl Strategy<Value = Value> {
                 "textures": [{"source": 0}, {"source": 1}],
                 "images": [{"uri": png_uri(true, 7)}, {"uri": png_uri(false, 91)}],
                 "scene": 0,
-                "scenes": [{"nodes": []}],
+                "scenes": [{}],
             });
             if let Some(e) = extras {
                 doc["extras"] = e;

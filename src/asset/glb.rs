@@ -64,7 +64,8 @@ pub fn split<'a>(bytes: &'a [u8], out: &mut Vec<Diagnostic>) -> Option<GlbParts<
         return None;
     }
     let declared = u32_at(bytes, 8) as usize;
-    if declared != bytes.len() {
+    // Bytes after the declared length are not part of the GLB: loaders stop at the length.
+    let end = if declared > bytes.len() || declared < HEADER_LEN {
         out.push(Diagnostic::new(
             &codes::GLB_LENGTH_MISMATCH,
             "",
@@ -73,8 +74,20 @@ pub fn split<'a>(bytes: &'a [u8], out: &mut Vec<Diagnostic>) -> Option<GlbParts<
                 bytes.len()
             ),
         ));
-    }
-    let end = bytes.len();
+        bytes.len()
+    } else {
+        if declared < bytes.len() {
+            out.push(Diagnostic::new(
+                &codes::GLB_TRAILING_DATA,
+                "",
+                format!(
+                    "the file has {} bytes after the {declared} its GLB header declares; they are ignored",
+                    bytes.len() - declared
+                ),
+            ));
+        }
+        declared
+    };
     let mut at = HEADER_LEN;
     let mut json: Option<(usize, usize)> = None;
     let mut bin: Option<(usize, usize)> = None;
@@ -150,7 +163,16 @@ pub fn split<'a>(bytes: &'a [u8], out: &mut Vec<Diagnostic>) -> Option<GlbParts<
         at = data_end;
         index += 1;
     }
-    let (json_start, json_end) = json?;
+    let Some((json_start, json_end)) = json else {
+        if end == HEADER_LEN {
+            out.push(Diagnostic::new(
+                &codes::GLB_UNEXPECTED_END,
+                "",
+                "the GLB ends after its header: it has no JSON chunk",
+            ));
+        }
+        return None;
+    };
     let json_bytes = &bytes[json_start..json_end];
     // Padding must be spaces; NULs (a common exporter mistake) would also break JSON parsers.
     if json_bytes.ends_with(&[0]) {

@@ -276,18 +276,23 @@ fn check_bin_length(json: &Value, bin: Option<&[u8]>, out: &mut Vec<Diagnostic>)
     let Some(declared) = buffer.get("byteLength").and_then(Value::as_u64) else {
         return;
     };
-    let actual = bin.map_or(0, <[u8]>::len) as u64;
-    if actual < declared {
-        out.push(Diagnostic::new(
+    match bin {
+        None => out.push(Diagnostic::new(
+            &codes::BUFFER_MISSING_GLB_DATA,
+            "/buffers/0",
+            format!(
+                "buffer 0 has no uri and declares {declared} bytes, but the GLB has no BIN chunk"
+            ),
+        )),
+        Some(bin) if (bin.len() as u64) < declared => out.push(Diagnostic::new(
             &codes::BUFFER_BYTE_LENGTH_MISMATCH,
             "/buffers/0/byteLength",
-            match bin {
-                Some(_) => format!(
-                    "buffer 0 declares {declared} bytes but the GLB's BIN chunk holds {actual}"
-                ),
-                None => format!("buffer 0 declares {declared} bytes but the GLB has no BIN chunk"),
-            },
-        ));
+            format!(
+                "buffer 0 declares {declared} bytes but the GLB's BIN chunk holds {}",
+                bin.len()
+            ),
+        )),
+        Some(_) => {}
     }
 }
 
@@ -324,7 +329,7 @@ impl Asset {
         let pointer = format!("/buffers/{index}");
         let buffer = self.json.pointer(&pointer).ok_or_else(|| {
             Diagnostic::new(
-                &crate::rules::references::UNRESOLVED_REFERENCE,
+                &codes::UNRESOLVED_REFERENCE,
                 &pointer,
                 format!("buffer {index} does not exist"),
             )
@@ -354,7 +359,7 @@ impl Asset {
         let pointer = format!("/images/{index}");
         let image = self.json.pointer(&pointer).ok_or_else(|| {
             Diagnostic::new(
-                &crate::rules::references::UNRESOLVED_REFERENCE,
+                &codes::UNRESOLVED_REFERENCE,
                 &pointer,
                 format!("image {index} does not exist"),
             )
@@ -387,7 +392,7 @@ impl Asset {
             .pointer(&format!("/bufferViews/{view_index}"))
             .ok_or_else(|| {
                 Diagnostic::new(
-                    &crate::rules::references::UNRESOLVED_REFERENCE,
+                    &codes::UNRESOLVED_REFERENCE,
                     pointer,
                     format!("bufferView {view_index} does not exist"),
                 )
@@ -417,13 +422,21 @@ impl Asset {
     }
 
     /// Where a resource URI leads under this asset's URI policy.
+    /// Unless outside URIs are allowed, a path that stays in the folder by its text but leads
+    /// out of it through a symbolic link is refused too.
     pub fn resolve(&self, uri: &str, pointer: &str) -> Result<Location, Diagnostic> {
-        resource::resolve_with(
+        let location = resource::resolve_with(
             uri,
             self.base_dir(),
             pointer,
             self.options.allow_outside_uris,
-        )
+        )?;
+        if let Location::File(path) = &location {
+            if !self.options.allow_outside_uris {
+                resource::check_inside(path, self.base_dir(), uri, pointer)?;
+            }
+        }
+        Ok(location)
     }
 
     fn read_uri(&self, uri: &str, pointer: &str) -> Result<Vec<u8>, Diagnostic> {

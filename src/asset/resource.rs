@@ -125,6 +125,45 @@ pub fn resolve_with(
     Ok(Location::File(base_dir.join(relative)))
 }
 
+/// True for a URI with a URL scheme that names no local file (`https:`, `s3:`, …): valid in
+/// glTF, never fetched by velvet. `data:` and `file:` URIs and Windows drive letters are not
+/// remote.
+pub fn is_remote(uri: &str) -> bool {
+    has_scheme(uri)
+        && !uri.starts_with("data:")
+        && file_uri_path(uri).is_none()
+        && uri.find(':').is_some_and(|colon| colon > 1)
+}
+
+/// Refuses a path that lies in `base_dir` by its text but leads out of it through a symbolic
+/// link. A path that does not exist (yet) is left to whoever opens it.
+pub fn check_inside(
+    path: &Path,
+    base_dir: &Path,
+    uri: &str,
+    pointer: &str,
+) -> Result<(), Diagnostic> {
+    let Ok(real) = std::fs::canonicalize(path) else {
+        return Ok(());
+    };
+    let base = if base_dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        base_dir
+    };
+    match std::fs::canonicalize(base) {
+        Ok(base) if real.starts_with(&base) => Ok(()),
+        _ => Err(Diagnostic::new(
+            &codes::URI_NOT_FOLLOWED,
+            pointer,
+            format!(
+                "'{uri}' leads out of the asset's folder through a symbolic link (to {}); --allow-outside-uris reads it",
+                real.display()
+            ),
+        )),
+    }
+}
+
 /// The path of a local `file:` URI (`file:///p`, `file://localhost/p` or `file:/p`), still
 /// percent-encoded; `None` for any other URI.
 fn file_uri_path(uri: &str) -> Option<&str> {

@@ -90,6 +90,24 @@ pub const IMAGE_UNRECOGNIZED_FORMAT: Code = Code::new(
     "An image's header is not PNG, JPEG, WebP or KTX2, or is damaged.",
 );
 
+/// Reported by the references rule for every index, and by the loader when a resource it is
+/// asked for names no object.
+pub const UNRESOLVED_REFERENCE: Code = Code::new(
+    "UNRESOLVED_REFERENCE",
+    Error,
+    "An index names no object: a texture, an image, an accessor, a buffer, …",
+);
+pub const BUFFER_MISSING_GLB_DATA: Code = Code::new(
+    "BUFFER_MISSING_GLB_DATA",
+    Error,
+    "A buffer without uri has no data: it is not the first buffer of a GLB that has a BIN chunk.",
+);
+pub const GLB_TRAILING_DATA: Code = Code::new(
+    "GLB_TRAILING_DATA",
+    Warning,
+    "A .glb file has bytes after the length its header declares; loaders ignore them.",
+);
+
 pub const DOCUMENT_TOO_LARGE: Code = Code::new(
     "DOCUMENT_TOO_LARGE",
     Error,
@@ -122,6 +140,7 @@ pub const LOADER: &[&Code] = &[
     &GLB_INVALID_MAGIC,
     &GLB_INVALID_VERSION,
     &GLB_LENGTH_MISMATCH,
+    &GLB_TRAILING_DATA,
     &GLB_UNEXPECTED_END,
     &GLB_CHUNK_LENGTH_UNALIGNED,
     &GLB_UNEXPECTED_FIRST_CHUNK,
@@ -133,6 +152,8 @@ pub const LOADER: &[&Code] = &[
     &BUFFER_VIEW_OUT_OF_RANGE,
     &BUFFER_BYTE_LENGTH_MISMATCH,
     &IMAGE_UNRECOGNIZED_FORMAT,
+    &UNRESOLVED_REFERENCE,
+    &BUFFER_MISSING_GLB_DATA,
 ];
 
 pub const TYPE_MISMATCH: Code = Code::new(

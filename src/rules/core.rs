@@ -1,163 +1,358 @@
-//! Core structure: the gltf crate's own validation of the whole document (indices in range,
-//! required properties, enum values), run on `gltf::json::Root` directly so that an unknown
-//! entry in extensionsRequired does not stop it. Its paths (`meshes[0].primitives[1].material`)
-//! are turned into JSON pointers.
+//! The core schema check: the whole document is validated against the official glTF 2.0 JSON
+//! schemas (`schema/core/`, the files Khronos publishes, compiled into the binary and built
+//! once per run) through jsonschema. The schemas, not a typed model, are the judge: an
+//! accessor without bufferView, a texture whose image comes from an extension, a channel
+//! target without node or an integer written `1.0` are all valid glTF and pass here.
+//!
+//! Each schema error becomes a code named as in the Khronos glTF-Validator, with a pointer to
+//! the value at fault (for a missing property, its parent object). Rules the schemas cannot
+//! express (indices in range, asset version, declarations, resources) are separate rules.
 
 use super::{Context, Rule};
 use crate::diagnostics::{codes, Code, Diagnostic, Severity};
-use gltf::json::validation::{Error as CoreError, Validate};
+use jsonschema::error::ValidationErrorKind;
+use serde_json::Value;
+use std::collections::HashMap;
+use std::sync::Arc;
 
-pub const CORE_INVALID_VALUE: Code = Code::new(
-    "CORE_INVALID_VALUE",
+macro_rules! core_schema {
+    ($name:literal) => {
+        ($name, include_str!(concat!("../../schema/core/", $name)))
+    };
+}
+
+/// The official glTF 2.0 schema files, by file name, as compiled into the binary.
+pub const CORE_SCHEMAS: &[(&str, &str)] = &[
+    core_schema!("accessor.schema.json"),
+    core_schema!("accessor.sparse.indices.schema.json"),
+    core_schema!("accessor.sparse.schema.json"),
+    core_schema!("accessor.sparse.values.schema.json"),
+    core_schema!("animation.channel.schema.json"),
+    core_schema!("animation.channel.target.schema.json"),
+    core_schema!("animation.sampler.schema.json"),
+    core_schema!("animation.schema.json"),
+    core_schema!("asset.schema.json"),
+    core_schema!("buffer.schema.json"),
+    core_schema!("bufferView.schema.json"),
+    core_schema!("camera.orthographic.schema.json"),
+    core_schema!("camera.perspective.schema.json"),
+    core_schema!("camera.schema.json"),
+    core_schema!("extension.schema.json"),
+    core_schema!("extras.schema.json"),
+    core_schema!("glTF.schema.json"),
+    core_schema!("glTFChildOfRootProperty.schema.json"),
+    core_schema!("glTFProperty.schema.json"),
+    core_schema!("glTFid.schema.json"),
+    core_schema!("image.schema.json"),
+    core_schema!("material.normalTextureInfo.schema.json"),
+    core_schema!("material.occlusionTextureInfo.schema.json"),
+    core_schema!("material.pbrMetallicRoughness.schema.json"),
+    core_schema!("material.schema.json"),
+    core_schema!("mesh.primitive.schema.json"),
+    core_schema!("mesh.schema.json"),
+    core_schema!("node.schema.json"),
+    core_schema!("sampler.schema.json"),
+    core_schema!("scene.schema.json"),
+    core_schema!("skin.schema.json"),
+    core_schema!("texture.schema.json"),
+    core_schema!("textureInfo.schema.json"),
+];
+
+pub const EMPTY_ENTITY: Code = Code::new(
+    "EMPTY_ENTITY",
     Severity::Error,
-    "The core glTF structure holds a value the glTF 2.0 schema does not allow.",
+    "An array or object that glTF requires to be non-empty is empty (\"nodes\": [], \"attributes\": {}).",
 );
-pub const CORE_STRUCTURE_INVALID: Code = Code::new(
-    "CORE_STRUCTURE_INVALID",
+pub const UNSATISFIED_DEPENDENCY: Code = Code::new(
+    "UNSATISFIED_DEPENDENCY",
     Severity::Error,
-    "The document does not have the core glTF 2.0 structure (a property of the wrong type or shape).",
+    "A property that requires another is present without it (an image's bufferView without mimeType, a scene without scenes, …).",
+);
+pub const PATTERN_MISMATCH: Code = Code::new(
+    "PATTERN_MISMATCH",
+    Severity::Error,
+    "A string does not match the pattern its schema gives (asset.version must read MAJOR.MINOR).",
+);
+pub const ONE_OF_MISMATCH: Code = Code::new(
+    "ONE_OF_MISMATCH",
+    Severity::Error,
+    "Exactly one of a set of properties must be defined and is not (an image's uri or bufferView; a camera's perspective or orthographic).",
+);
+pub const DUPLICATE_ELEMENTS: Code = Code::new(
+    "DUPLICATE_ELEMENTS",
+    Severity::Error,
+    "An array whose elements must be unique holds one twice (extensionsUsed, a scene's or node's node list).",
+);
+pub const NODE_MATRIX_TRS: Code = Code::new(
+    "NODE_MATRIX_TRS",
+    Severity::Error,
+    "A node has both a matrix and translation, rotation or scale.",
 );
 
-pub struct CoreStructure;
+/// The core schema compiled for one run.
+pub struct CoreSchema {
+    validator: jsonschema::Validator,
+}
 
-/// `meshes[0].primitives[1].attributes["TEXCOORD_0"]` → `/meshes/0/primitives/1/attributes/TEXCOORD_0`.
-pub fn path_to_pointer(path: &str) -> String {
-    let mut out = String::new();
-    let mut rest = path;
-    while !rest.is_empty() {
-        if let Some(after) = rest.strip_prefix("[\"") {
-            let end = after.find("\"]").unwrap_or(after.len());
-            out.push('/');
-            out.push_str(&crate::asset::pointer::escape(&after[..end]));
-            rest = after.get(end + 2..).unwrap_or("");
-        } else if let Some(after) = rest.strip_prefix('[') {
-            let end = after.find(']').unwrap_or(after.len());
-            out.push('/');
-            out.push_str(&after[..end]);
-            rest = after.get(end + 1..).unwrap_or("");
-        } else {
-            let rest_trim = rest.strip_prefix('.').unwrap_or(rest);
-            let end = rest_trim.find(['.', '[']).unwrap_or(rest_trim.len());
-            out.push('/');
-            out.push_str(&crate::asset::pointer::escape(&rest_trim[..end]));
-            rest = &rest_trim[end..];
+/// Serves `$ref`s between the core schema files, by the reference's last path segment.
+struct CoreRetriever(Arc<HashMap<&'static str, Value>>);
+
+impl jsonschema::Retrieve for CoreRetriever {
+    fn retrieve(
+        &self,
+        uri: &jsonschema::Uri<String>,
+    ) -> Result<Value, Box<dyn std::error::Error + Send + Sync>> {
+        let name = uri.path().as_str().rsplit('/').next().unwrap_or_default();
+        self.0
+            .get(name)
+            .cloned()
+            .ok_or_else(|| format!("no core schema file named '{name}'").into())
+    }
+}
+
+impl CoreSchema {
+    /// The official schemas compiled into velvet.
+    pub fn builtin() -> CoreSchema {
+        let files: HashMap<&'static str, Value> = CORE_SCHEMAS
+            .iter()
+            .map(|(name, text)| {
+                (
+                    *name,
+                    serde_json::from_str(text).expect("core schemas are valid JSON"),
+                )
+            })
+            .collect();
+        let root = files["glTF.schema.json"].clone();
+        let validator = jsonschema::options()
+            .with_draft(jsonschema::Draft::Draft202012)
+            // URIs are judged by the resources rule, which knows what a glTF URI may be.
+            .should_validate_formats(false)
+            .with_retriever(CoreRetriever(Arc::new(files)))
+            .build(&root)
+            .expect("core schemas compile");
+        CoreSchema { validator }
+    }
+
+    /// Validates `json`, pushing one diagnostic per schema error.
+    pub fn check(&self, json: &Value, out: &mut Vec<Diagnostic>) {
+        for error in self.validator.iter_errors(json) {
+            let at = error.instance_path().as_str().to_string();
+            let schema_path = error.schema_path().as_str().to_string();
+            let instance = error.instance().clone().into_owned();
+            out.push(diagnostic(error.kind(), &schema_path, &instance, at));
         }
     }
-    out
 }
+
+/// A value as messages quote it: strings in single quotes, the rest as JSON, long values cut.
+fn quote(value: &Value) -> String {
+    let text = match value {
+        Value::String(s) => format!("'{s}'"),
+        other => other.to_string(),
+    };
+    if text.chars().count() > 60 {
+        let cut: String = text.chars().take(57).collect();
+        format!("{cut}…")
+    } else {
+        text
+    }
+}
+
+fn property_name(value: &Value) -> String {
+    value
+        .as_str()
+        .map_or_else(|| value.to_string(), str::to_string)
+}
+
+fn diagnostic(
+    kind: &ValidationErrorKind,
+    schema_path: &str,
+    instance: &Value,
+    at: String,
+) -> Diagnostic {
+    use ValidationErrorKind as K;
+    let (code, message): (&Code, String) = match kind {
+        K::Type { kind } => (
+            &codes::TYPE_MISMATCH,
+            format!("{} is not of type {}", quote(instance), type_names(kind)),
+        ),
+        K::Minimum { limit } | K::ExclusiveMinimum { limit } => (
+            &codes::VALUE_NOT_IN_RANGE,
+            format!("{} is below the minimum {limit}", quote(instance)),
+        ),
+        K::Maximum { limit } | K::ExclusiveMaximum { limit } => (
+            &codes::VALUE_NOT_IN_RANGE,
+            format!("{} is above the maximum {limit}", quote(instance)),
+        ),
+        K::MinItems { .. } if instance.as_array().is_some_and(Vec::is_empty) => {
+            (&EMPTY_ENTITY, "the array is empty".to_string())
+        }
+        K::MinProperties { .. } if instance.as_object().is_some_and(|o| o.is_empty()) => {
+            (&EMPTY_ENTITY, "the object is empty".to_string())
+        }
+        K::MinItems { limit } | K::MaxItems { limit } => (
+            &codes::ARRAY_LENGTH_NOT_IN_LIST,
+            format!(
+                "the array has {} elements; {} {limit} allowed",
+                instance.as_array().map_or(0, Vec::len),
+                if matches!(kind, K::MinItems { .. }) {
+                    "at least"
+                } else {
+                    "at most"
+                }
+            ),
+        ),
+        K::Required { property } if schema_path.contains("/dependencies") => (
+            &UNSATISFIED_DEPENDENCY,
+            format!(
+                "'{}' must be defined here (a property present depends on it)",
+                property_name(property)
+            ),
+        ),
+        K::Required { property } => (
+            &codes::UNDEFINED_PROPERTY,
+            format!("property '{}' must be defined", property_name(property)),
+        ),
+        K::Enum { .. } | K::Constant { .. } | K::AnyOf { .. } => (
+            &codes::VALUE_NOT_IN_LIST,
+            format!("{} is not one of the values allowed here", quote(instance)),
+        ),
+        K::Pattern { pattern } => (
+            &PATTERN_MISMATCH,
+            format!("{} does not match the pattern '{pattern}'", quote(instance)),
+        ),
+        K::OneOfNotValid { .. } | K::OneOfMultipleValid { .. } => (
+            &ONE_OF_MISMATCH,
+            format!("exactly one of {} must be defined", one_of_names(&at)),
+        ),
+        K::Not { .. } if at.starts_with("/nodes/") => (
+            &NODE_MATRIX_TRS,
+            "a node has either a matrix or translation/rotation/scale, not both".to_string(),
+        ),
+        K::Not { .. } if at.starts_with("/cameras/") => (
+            &ONE_OF_MISMATCH,
+            "exactly one of 'perspective' and 'orthographic' may be defined".to_string(),
+        ),
+        K::UniqueItems => (
+            &DUPLICATE_ELEMENTS,
+            "the array holds an element twice".to_string(),
+        ),
+        other => (
+            &codes::SCHEMA_MISMATCH,
+            format!(
+                "{} does not match the glTF 2.0 schema ({other:?})",
+                quote(instance)
+            ),
+        ),
+    };
+    Diagnostic::new(code, at, message)
+}
+
+fn type_names(kind: &jsonschema::error::TypeKind) -> String {
+    match kind {
+        jsonschema::error::TypeKind::Single(t) => format!("'{t}'"),
+        jsonschema::error::TypeKind::Multiple(ts) => {
+            let names: Vec<String> = ts.iter().map(|t| format!("'{t}'")).collect();
+            names.join(" or ")
+        }
+    }
+}
+
+/// The properties a `oneOf` of `required` names, from where it stands (only an image has one).
+fn one_of_names(at: &str) -> &'static str {
+    if at.starts_with("/images/") {
+        "'uri' and 'bufferView'"
+    } else {
+        "the alternatives the schema lists"
+    }
+}
+
+pub struct CoreStructure;
 
 impl Rule for CoreStructure {
     fn codes(&self) -> &'static [&'static Code] {
         &[
-            &CORE_INVALID_VALUE,
-            &super::references::UNRESOLVED_REFERENCE,
+            &codes::TYPE_MISMATCH,
+            &codes::VALUE_NOT_IN_RANGE,
+            &codes::ARRAY_LENGTH_NOT_IN_LIST,
             &codes::UNDEFINED_PROPERTY,
-            &CORE_STRUCTURE_INVALID,
+            &codes::VALUE_NOT_IN_LIST,
+            &codes::SCHEMA_MISMATCH,
+            &EMPTY_ENTITY,
+            &UNSATISFIED_DEPENDENCY,
+            &PATTERN_MISMATCH,
+            &ONE_OF_MISMATCH,
+            &DUPLICATE_ELEMENTS,
+            &NODE_MATRIX_TRS,
         ]
     }
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
-        let text = cx.asset.json_text.trim_end_matches(['\0', ' ']);
-        let mut root: gltf::json::Root = match gltf::json::deserialize::from_str(text) {
-            Ok(root) => root,
-            Err(e) => {
-                out.push(Diagnostic::new(
-                    &CORE_STRUCTURE_INVALID,
-                    "",
-                    format!(
-                        "line {}, column {}: {}",
-                        e.line(),
-                        e.column(),
-                        e.to_string()
-                            .rsplit_once(" at line ")
-                            .map_or(e.to_string(), |(m, _)| m.to_string())
-                    ),
-                ));
-                return;
-            }
-        };
-        let dangling = take_dangling_positions(&mut root);
-        root.validate(&root, gltf::json::Path::new, &mut |path, error| {
-            let path = path();
-            // A POSITION taken out above is reported missing by the crate: it names no object.
-            let error = match error {
-                CoreError::Missing if dangling.iter().any(|d| d == path.as_str()) => {
-                    CoreError::IndexOutOfBounds
-                }
-                other => other,
-            };
-            // The crate rejects required extensions it does not implement; that is a loader's
-            // capability, not a fault of the asset.
-            if path.as_str().starts_with("extensionsRequired") {
-                return;
-            }
-            let pointer = path_to_pointer(path.as_str());
-            let (code, message) = match error {
-                CoreError::IndexOutOfBounds => (
-                    &super::references::UNRESOLVED_REFERENCE,
-                    format!("{}: the index names no object", path.as_str()),
-                ),
-                CoreError::Missing => (
-                    &codes::UNDEFINED_PROPERTY,
-                    format!("{}: required by glTF 2.0 but missing", path.as_str()),
-                ),
-                CoreError::Invalid => (
-                    &CORE_INVALID_VALUE,
-                    format!("{}: not a value glTF 2.0 allows here", path.as_str()),
-                ),
-                CoreError::Oversize => (
-                    &CORE_INVALID_VALUE,
-                    format!("{}: too large for this platform", path.as_str()),
-                ),
-                // Only raised for extensionsRequired, which is skipped above.
-                CoreError::Unsupported => return,
-            };
-            out.push(Diagnostic::new(code, pointer, message));
-        });
+        cx.schemas.core.check(cx.json(), out);
     }
-}
-
-/// gltf-json 1.4 looks up a primitive's POSITION accessor without checking the index, and
-/// panics when it names no accessor. Such attributes are taken out of the (local) document
-/// before the crate's check; their paths are returned so that the check reports them as the
-/// dangling references they are.
-fn take_dangling_positions(root: &mut gltf::json::Root) -> Vec<String> {
-    use gltf::json::{mesh::Semantic, validation::Checked};
-    let accessors = root.accessors.len();
-    let mut dangling = Vec::new();
-    for (m, mesh) in root.meshes.iter_mut().enumerate() {
-        for (p, primitive) in mesh.primitives.iter_mut().enumerate() {
-            let key = Checked::Valid(Semantic::Positions);
-            if primitive
-                .attributes
-                .get(&key)
-                .is_some_and(|i| i.value() >= accessors)
-            {
-                primitive.attributes.remove(&key);
-                dangling.push(format!(
-                    "meshes[{m}].primitives[{p}].attributes[\"POSITION\"]"
-                ));
-            }
-        }
-    }
-    dangling
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use serde_json::json;
+
+    fn codes_and_pointers(json: Value) -> Vec<(&'static str, String)> {
+        let mut out = Vec::new();
+        CoreSchema::builtin().check(&json, &mut out);
+        out.into_iter().map(|d| (d.code, d.pointer)).collect()
+    }
 
     #[test]
-    fn gltf_paths_become_pointers() {
+    fn valid_gltf_that_a_typed_model_refused_passes() {
+        let doc = json!({
+            "asset": {"version": "2.0"},
+            "scenes": [{}],
+            "accessors": [{"componentType": 5126, "count": 3, "type": "VEC3"}],
+            "textures": [{"extensions": {"EXT_texture_webp": {"source": 0}}}],
+            "animations": [{"channels": [{"sampler": 0, "target": {"path": "rotation"}}],
+                            "samplers": [{"input": 0, "output": 1.0}]}],
+            "meshes": [{"primitives": [{"attributes": {"NORMAL": 0}}]}]
+        });
+        assert_eq!(codes_and_pointers(doc), vec![]);
+    }
+
+    #[test]
+    fn schema_errors_get_khronos_codes_and_pointers_at_the_value() {
+        let doc = json!({
+            "asset": {"version": "2"},
+            "scene": 0,
+            "nodes": [],
+            "images": [{"uri": "a.png", "bufferView": 0, "mimeType": "image/png"}, {"bufferView": 0}],
+            "accessors": [{"count": 0, "type": "VEC3"}],
+            "extensionsUsed": ["A", "A"],
+            "cameras": [{"type": "perspective", "perspective": {"yfov": 1, "znear": 0.1},
+                          "orthographic": {"xmag": 1, "ymag": 1, "zfar": 2, "znear": 1}}]
+        });
+        let mut found = codes_and_pointers(doc);
+        found.sort();
+        let mut expected = vec![
+            ("PATTERN_MISMATCH", "/asset/version".to_string()),
+            ("UNSATISFIED_DEPENDENCY", "".to_string()),
+            ("EMPTY_ENTITY", "/nodes".to_string()),
+            ("ONE_OF_MISMATCH", "/images/0".to_string()),
+            ("UNSATISFIED_DEPENDENCY", "/images/1".to_string()),
+            ("UNDEFINED_PROPERTY", "/accessors/0".to_string()),
+            ("VALUE_NOT_IN_RANGE", "/accessors/0/count".to_string()),
+            ("DUPLICATE_ELEMENTS", "/extensionsUsed".to_string()),
+            ("ONE_OF_MISMATCH", "/cameras/0".to_string()),
+        ];
+        expected.sort();
+        assert_eq!(found, expected);
+    }
+
+    #[test]
+    fn a_node_with_matrix_and_trs_is_node_matrix_trs() {
+        let doc = json!({"asset": {"version": "2.0"},
+            "nodes": [{"matrix": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1], "scale": [1, 1, 1]}]});
         assert_eq!(
-            path_to_pointer("meshes[0].primitives[12].material"),
-            "/meshes/0/primitives/12/material"
+            codes_and_pointers(doc),
+            vec![("NODE_MATRIX_TRS", "/nodes/0".to_string())]
         );
-        assert_eq!(
-            path_to_pointer("meshes[0].primitives[0].attributes[\"TEXCOORD_0\"]"),
-            "/meshes/0/primitives/0/attributes/TEXCOORD_0"
-        );
-        assert_eq!(path_to_pointer("asset"), "/asset");
-        assert_eq!(path_to_pointer(""), "");
     }
 }

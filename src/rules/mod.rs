@@ -5,6 +5,7 @@
 //!
 //! Rules read the asset and push diagnostics; they never change anything.
 
+pub mod asset_version;
 pub mod clearcoat;
 pub mod core;
 pub mod declaration;
@@ -17,6 +18,7 @@ pub mod image_size;
 pub mod legacy_sheen;
 pub mod placement;
 pub mod references;
+pub mod resources;
 pub mod roughness_alpha;
 pub mod schema;
 pub mod texcoord;
@@ -50,10 +52,12 @@ pub trait Rule: Sync {
 pub static REGISTRY: &[&dyn Rule] = &[
     &core::CoreStructure,
     &schema::SchemaCheck,
+    &asset_version::AssetVersion,
     &declaration::Declaration,
     &placement::Placement,
     &exclusions::Exclusions,
     &references::References,
+    &resources::Resources,
     &texcoord::TexCoords,
     &disabled_layer::DisabledLayer,
     &roughness_alpha::RoughnessAlpha,
@@ -114,6 +118,8 @@ pub fn slot_uses<'a>(layer: &'a LayerObject<'a>) -> impl Iterator<Item = SlotUse
         })
     })
 }
+
+pub use crate::layers::as_index;
 
 /// The texCoord set a textureInfo really uses: KHR_texture_transform may override it.
 pub fn effective_tex_coord(texture_info: &Value) -> u64 {

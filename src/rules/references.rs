@@ -1,16 +1,94 @@
-//! References: a sheen or fuzz texture index must name a texture, and that texture's source
-//! (and any image-format extension's source) must name an image. A dangling index makes
-//! loaders fail or silently drop the texture.
+//! References: every index in the document must name an object. glTF links its objects by
+//! array index (a node's mesh, a primitive's accessors, a texture's image, …); an index past
+//! the end of its array makes loaders fail or silently drop the object. The schemas only say
+//! an index is a non-negative integer, so the range is checked here, for the core objects and
+//! the extensions velvet knows (image-format extensions, lights, material variants, mesh
+//! compression and instancing, and every `…Texture` of a material extension).
+//!
+//! The table [`LINKS`] is the one place an index is declared: a path pattern (`*` stands for
+//! any array index or object key, `*Texture` for a key ending in "Texture") and the pointer of
+//! the array it indexes, where `{0}` is the array index the first `*` matched.
 
-use super::{layer_objects, slot_uses, texture_sources, Context, Rule};
-use crate::diagnostics::{Code, Diagnostic, Severity};
+use super::{as_index, Context, Rule};
+use crate::asset::pointer;
+use crate::diagnostics::{codes, Code, Diagnostic};
 use serde_json::Value;
 
-pub const UNRESOLVED_REFERENCE: Code = Code::new(
-    "UNRESOLVED_REFERENCE",
-    Severity::Error,
-    "An index names no object: a texture, an image, an accessor, a buffer, …",
-);
+pub use codes::UNRESOLVED_REFERENCE;
+
+/// (where an index stands, the array it indexes).
+pub const LINKS: &[(&str, &str)] = &[
+    ("/scene", "/scenes"),
+    ("/scenes/*/nodes/*", "/nodes"),
+    ("/nodes/*/children/*", "/nodes"),
+    ("/nodes/*/mesh", "/meshes"),
+    ("/nodes/*/skin", "/skins"),
+    ("/nodes/*/camera", "/cameras"),
+    (
+        "/nodes/*/extensions/KHR_lights_punctual/light",
+        "/extensions/KHR_lights_punctual/lights",
+    ),
+    (
+        "/nodes/*/extensions/EXT_mesh_gpu_instancing/attributes/*",
+        "/accessors",
+    ),
+    ("/meshes/*/primitives/*/attributes/*", "/accessors"),
+    ("/meshes/*/primitives/*/indices", "/accessors"),
+    ("/meshes/*/primitives/*/material", "/materials"),
+    ("/meshes/*/primitives/*/targets/*/*", "/accessors"),
+    (
+        "/meshes/*/primitives/*/extensions/KHR_materials_variants/mappings/*/material",
+        "/materials",
+    ),
+    (
+        "/meshes/*/primitives/*/extensions/KHR_materials_variants/mappings/*/variants/*",
+        "/extensions/KHR_materials_variants/variants",
+    ),
+    (
+        "/meshes/*/primitives/*/extensions/KHR_draco_mesh_compression/bufferView",
+        "/bufferViews",
+    ),
+    ("/accessors/*/bufferView", "/bufferViews"),
+    ("/accessors/*/sparse/indices/bufferView", "/bufferViews"),
+    ("/accessors/*/sparse/values/bufferView", "/bufferViews"),
+    ("/bufferViews/*/buffer", "/buffers"),
+    (
+        "/bufferViews/*/extensions/EXT_meshopt_compression/buffer",
+        "/buffers",
+    ),
+    ("/images/*/bufferView", "/bufferViews"),
+    ("/textures/*/sampler", "/samplers"),
+    ("/textures/*/source", "/images"),
+    ("/textures/*/extensions/EXT_texture_webp/source", "/images"),
+    ("/textures/*/extensions/EXT_texture_avif/source", "/images"),
+    (
+        "/textures/*/extensions/KHR_texture_basisu/source",
+        "/images",
+    ),
+    ("/textures/*/extensions/MSFT_texture_dds/source", "/images"),
+    ("/skins/*/inverseBindMatrices", "/accessors"),
+    ("/skins/*/skeleton", "/nodes"),
+    ("/skins/*/joints/*", "/nodes"),
+    (
+        "/animations/*/channels/*/sampler",
+        "/animations/{0}/samplers",
+    ),
+    ("/animations/*/channels/*/target/node", "/nodes"),
+    ("/animations/*/samplers/*/input", "/accessors"),
+    ("/animations/*/samplers/*/output", "/accessors"),
+    (
+        "/materials/*/pbrMetallicRoughness/baseColorTexture/index",
+        "/textures",
+    ),
+    (
+        "/materials/*/pbrMetallicRoughness/metallicRoughnessTexture/index",
+        "/textures",
+    ),
+    ("/materials/*/normalTexture/index", "/textures"),
+    ("/materials/*/occlusionTexture/index", "/textures"),
+    ("/materials/*/emissiveTexture/index", "/textures"),
+    ("/materials/*/extensions/*/*Texture/index", "/textures"),
+];
 
 pub struct References;
 
@@ -21,43 +99,198 @@ impl Rule for References {
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
         let json = cx.json();
-        let count = |key: &str| json.get(key).and_then(Value::as_array).map_or(0, Vec::len) as u64;
-        let (textures, images) = (count("textures"), count("images"));
-        let mut checked_textures = std::collections::HashSet::new();
-        for layer in layer_objects(json) {
-            for slot in slot_uses(&layer) {
-                let Some(index) = slot.texture.index else {
-                    continue;
-                };
-                if index >= textures {
-                    out.push(Diagnostic::new(
-                        &UNRESOLVED_REFERENCE,
-                        format!("{}/index", slot.pointer),
-                        format!(
-                            "{} names texture {index}, but the asset has {textures} textures",
-                            slot.slot.texture
-                        ),
-                    ));
-                    continue;
-                }
-                if !checked_textures.insert(index) {
-                    continue;
-                }
-                let texture_pointer = format!("/textures/{index}");
-                for (source, pointer) in
-                    texture_sources(&json["textures"][index as usize], &texture_pointer)
-                {
-                    match source {
-                        Some(image) if image < images => {}
-                        Some(image) => out.push(Diagnostic::new(
-                            &UNRESOLVED_REFERENCE,
-                            pointer,
-                            format!("texture {index} (used by {}) names image {image}, but the asset has {images} images", slot.slot.texture),
-                        )),
-                        None => {}
+        for (pattern, target) in LINKS {
+            let segments: Vec<&str> = pattern.split('/').skip(1).collect();
+            walk(
+                json,
+                &segments,
+                String::new(),
+                &mut Vec::new(),
+                &mut |at, value, captured| {
+                    let Some(index) = as_index(value) else {
+                        return; // not an index: the schema check reports the type
+                    };
+                    let target = match captured.first() {
+                        Some(first) => target.replace("{0}", first),
+                        None => target.to_string(),
+                    };
+                    let len = json
+                        .pointer(&target)
+                        .and_then(Value::as_array)
+                        .map_or(0, Vec::len);
+                    if index >= len as u64 {
+                        let message = unresolved_message(&at, index, &target, len);
+                        out.push(Diagnostic::new(&UNRESOLVED_REFERENCE, at, message));
                     }
-                }
+                },
+            );
+        }
+    }
+}
+
+/// "sheenColorTexture names texture 5, but the asset has 2 textures".
+fn unresolved_message(at: &str, index: u64, target: &str, len: usize) -> String {
+    let segments: Vec<&str> = at.rsplit('/').collect();
+    let name = segments
+        .iter()
+        .find(|s| **s != "index" && s.parse::<usize>().is_err())
+        .copied()
+        .unwrap_or_default();
+    let plural = target.rsplit('/').next().unwrap_or_default();
+    let singular = plural
+        .strip_suffix("es")
+        .filter(|s| s.ends_with("sh"))
+        .or_else(|| plural.strip_suffix('s'))
+        .unwrap_or(plural);
+    let holder = match target.strip_prefix("/animations/") {
+        Some(rest) => format!("animation {}", rest.split('/').next().unwrap_or_default()),
+        None => "the asset".to_string(),
+    };
+    let noun = if len == 1 { singular } else { plural };
+    format!(
+        "{} names {singular} {index}, but {holder} has {len} {noun}",
+        pointer::unescape(name)
+    )
+}
+
+/// Calls `found` with the pointer and value of every match of `segments` under `value`;
+/// `captured` collects what each `*` matched.
+fn walk<'a>(
+    value: &'a Value,
+    segments: &[&str],
+    at: String,
+    captured: &mut Vec<String>,
+    found: &mut dyn FnMut(String, &'a Value, &[String]),
+) {
+    let Some((first, rest)) = segments.split_first() else {
+        found(at, value, captured);
+        return;
+    };
+    let mut visit = |key: String, child: &'a Value, captures: bool, captured: &mut Vec<String>| {
+        if captures {
+            captured.push(key.clone());
+        }
+        walk(child, rest, pointer::join(&at, &key), captured, found);
+        if captures {
+            captured.pop();
+        }
+    };
+    match (*first, value) {
+        ("*", Value::Array(items)) => {
+            for (i, child) in items.iter().enumerate() {
+                visit(i.to_string(), child, true, captured);
             }
         }
+        ("*", Value::Object(map)) => {
+            for (key, child) in map {
+                visit(key.clone(), child, true, captured);
+            }
+        }
+        (pattern, Value::Object(map)) if pattern.starts_with('*') => {
+            let suffix = &pattern[1..];
+            for (key, child) in map.iter().filter(|(k, _)| k.ends_with(suffix)) {
+                visit(key.clone(), child, false, captured);
+            }
+        }
+        (key, Value::Object(map)) => {
+            if let Some(child) = map.get(key) {
+                visit(key.to_string(), child, false, captured);
+            }
+        }
+        _ => {}
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    fn unresolved(doc: Value) -> Vec<String> {
+        let asset =
+            crate::asset::load_bytes(std::path::Path::new("t.gltf"), doc.to_string().as_bytes())
+                .asset
+                .unwrap();
+        let schemas = crate::rules::schema::Schemas::builtin();
+        let cx = Context {
+            asset: &asset,
+            schemas: &schemas,
+        };
+        let mut out = Vec::new();
+        References.check(&cx, &mut out);
+        out.into_iter().map(|d| d.pointer).collect()
+    }
+
+    #[test]
+    fn every_kind_of_index_is_checked_against_its_array() {
+        let doc = json!({
+            "asset": {"version": "2.0"},
+            "scene": 1,
+            "scenes": [{"nodes": [0, 2]}],
+            "nodes": [{"mesh": 0, "children": [1]}, {"extensions": {"KHR_lights_punctual": {"light": 1}}}],
+            "extensions": {"KHR_lights_punctual": {"lights": [{"type": "point"}]}},
+            "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 4}, "material": 0}]}],
+            "accessors": [{"componentType": 5126, "count": 1, "type": "VEC3"}],
+            "materials": [{"extensions": {"KHR_materials_clearcoat": {"clearcoatTexture": {"index": 2}}}}],
+            "textures": [{"extensions": {"EXT_texture_webp": {"source": 1.0}}}],
+            "images": [{"uri": "a.webp"}],
+            "animations": [{"channels": [{"sampler": 1, "target": {"path": "rotation"}}],
+                            "samplers": [{"input": 0, "output": 0}]}]
+        });
+        assert_eq!(
+            unresolved(doc),
+            vec![
+                "/scene",
+                "/scenes/0/nodes/1",
+                "/nodes/1/extensions/KHR_lights_punctual/light",
+                "/meshes/0/primitives/0/attributes/NORMAL",
+                "/textures/0/extensions/EXT_texture_webp/source",
+                "/animations/0/channels/0/sampler",
+                "/materials/0/extensions/KHR_materials_clearcoat/clearcoatTexture/index",
+            ]
+        );
+    }
+
+    #[test]
+    fn messages_name_the_property_the_kind_and_the_count() {
+        assert_eq!(
+            unresolved_message(
+                "/materials/0/extensions/KHR_materials_sheen/sheenColorTexture/index",
+                5,
+                "/textures",
+                2
+            ),
+            "sheenColorTexture names texture 5, but the asset has 2 textures"
+        );
+        assert_eq!(
+            unresolved_message("/nodes/3/mesh", 1, "/meshes", 1),
+            "mesh names mesh 1, but the asset has 1 mesh"
+        );
+        assert_eq!(
+            unresolved_message(
+                "/animations/2/channels/0/sampler",
+                4,
+                "/animations/2/samplers",
+                0
+            ),
+            "sampler names sampler 4, but animation 2 has 0 samplers"
+        );
+        assert_eq!(
+            unresolved_message("/scenes/0/nodes/1", 7, "/nodes", 3),
+            "nodes names node 7, but the asset has 3 nodes"
+        );
+    }
+
+    #[test]
+    fn indices_in_range_and_absent_optional_ones_are_clean() {
+        let doc = json!({
+            "asset": {"version": "2.0"},
+            "accessors": [{"componentType": 5126, "count": 1, "type": "SCALAR"}],
+            "textures": [{"extensions": {"KHR_texture_basisu": {"source": 0}}}],
+            "images": [{"uri": "a.ktx2"}],
+            "animations": [{"channels": [{"sampler": 0.0, "target": {"path": "weights"}}],
+                            "samplers": [{"input": 0, "output": 0}]}]
+        });
+        assert_eq!(unresolved(doc), Vec::<String>::new());
     }
 }

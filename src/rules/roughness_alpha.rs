@@ -6,7 +6,6 @@
 use super::{layer_objects, slot_uses, texture_sources, Context, Rule};
 use crate::diagnostics::{codes, Code, Diagnostic, Severity};
 use crate::layers::{self, Channels};
-use std::collections::HashSet;
 
 pub const SHEEN_ROUGHNESS_WITHOUT_ALPHA: Code = Code::new(
     "KHR_MATERIALS_SHEEN_ROUGHNESS_TEXTURE_WITHOUT_ALPHA",
@@ -36,7 +35,6 @@ impl Rule for RoughnessAlpha {
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
         let json = cx.json();
-        let mut unreadable_reported = HashSet::new();
         for layer in layer_objects(json) {
             for slot in slot_uses(&layer) {
                 if slot.slot.channels != Channels::Alpha {
@@ -78,12 +76,8 @@ impl Rule for RoughnessAlpha {
                                 ),
                             ));
                         }
-                        Ok(_) => {}
-                        Err(d) => {
-                            if unreadable_reported.insert(image) {
-                                out.push(d);
-                            }
-                        }
+                        // An unreadable image is the resources rule's finding.
+                        Ok(_) | Err(_) => {}
                     }
                 }
             }

@@ -79,6 +79,8 @@ struct LayerSchema {
 pub struct Schemas {
     sheen: LayerSchema,
     fuzz: LayerSchema,
+    /// The official glTF 2.0 schemas (always the built-in files).
+    pub core: super::core::CoreSchema,
 }
 
 /// Serves `$ref`s from the in-memory schema files, by the reference's last path segment.
@@ -163,6 +165,7 @@ impl Schemas {
         Ok(Schemas {
             sheen: layer("material.KHR_materials_sheen.schema.json")?,
             fuzz: layer("material.KHR_materials_fuzz.schema.json")?,
+            core: super::core::CoreSchema::builtin(),
         })
     }
 }

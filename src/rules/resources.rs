@@ -1,0 +1,302 @@
+//! Resources: every buffer and image a document names is checked on every run, whether or not
+//! a sheen or fuzz rule needs its bytes, because a missing or broken resource breaks the asset
+//! for every loader.
+//!
+//! For each URI: its syntax (percent-encoding, a `data:` URI's base64 and media type), its
+//! scheme (remote URLs are valid glTF but not checked), whether it leaves the asset's folder
+//! (judged on the resolved path, so a symbolic link inside the folder that points outside
+//! leaves it too), and whether the file exists — a `stat`, not a read. A small file that is a
+//! Git LFS pointer (a clone without `git lfs pull`) is named as such. A buffer file shorter than
+//! its byteLength is found from its size. For every image the header is read (never the
+//! pixels): its format must match `mimeType`. Images stored in a bufferView are checked when
+//! the buffer is already in memory (the GLB BIN chunk or a `data:` URI); an external .bin is not
+//! opened for them.
+
+use super::{Context, Rule};
+use crate::asset::resource::{self, ImageFormat, Location};
+use crate::asset::Container;
+use crate::diagnostics::{codes, Code, Diagnostic, Severity};
+use serde_json::Value;
+use std::path::Path;
+
+pub const FILE_NOT_FOUND: Code = Code::new(
+    "FILE_NOT_FOUND",
+    Severity::Error,
+    "A buffer or image URI names a file that does not exist.",
+);
+pub const GIT_LFS_POINTER: Code = Code::new(
+    "GIT_LFS_POINTER",
+    Severity::Error,
+    "A buffer or image file is a Git LFS pointer, not its content (fetch it with `git lfs pull`).",
+);
+pub const IMAGE_MIME_TYPE_INVALID: Code = Code::new(
+    "IMAGE_MIME_TYPE_INVALID",
+    Severity::Error,
+    "An image's data is in another format than its mimeType (or data: media type) declares.",
+);
+pub const BUFFER_DATA_URI_MIME_TYPE_INVALID: Code = Code::new(
+    "BUFFER_DATA_URI_MIME_TYPE_INVALID",
+    Severity::Error,
+    "A buffer's data: URI has a media type other than application/octet-stream or application/gltf-buffer.",
+);
+pub const NON_RELATIVE_URI: Code = Code::new(
+    "NON_RELATIVE_URI",
+    Severity::Warning,
+    "A resource URI with a URL scheme (https:, …): valid glTF, but not portable, and not checked.",
+);
+
+const LFS_POINTER_PREFIX: &[u8] = b"version https://git-lfs.github.com/spec/";
+/// Git LFS pointer files are about 130 bytes; anything larger is real content.
+const LFS_POINTER_MAX_LEN: u64 = 1024;
+
+pub struct Resources;
+
+impl Rule for Resources {
+    fn codes(&self) -> &'static [&'static Code] {
+        &[
+            &FILE_NOT_FOUND,
+            &GIT_LFS_POINTER,
+            &IMAGE_MIME_TYPE_INVALID,
+            &BUFFER_DATA_URI_MIME_TYPE_INVALID,
+            &codes::BUFFER_MISSING_GLB_DATA,
+            &NON_RELATIVE_URI,
+            &codes::URI_NOT_FOLLOWED,
+            &codes::INVALID_URI,
+            &codes::IO_ERROR,
+            &codes::IMAGE_UNRECOGNIZED_FORMAT,
+            &codes::BUFFER_BYTE_LENGTH_MISMATCH,
+        ]
+    }
+
+    fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
+        let json = cx.json();
+        for (index, buffer) in array(json, "buffers") {
+            check_buffer(cx, index, buffer, out);
+        }
+        for (index, image) in array(json, "images") {
+            check_image(cx, index, image, out);
+        }
+    }
+}
+
+fn array<'a>(json: &'a Value, key: &str) -> impl Iterator<Item = (usize, &'a Value)> {
+    json.get(key)
+        .and_then(Value::as_array)
+        .into_iter()
+        .flatten()
+        .enumerate()
+        .filter(|(_, v)| v.is_object())
+}
+
+fn byte_length(buffer: &Value) -> Option<u64> {
+    buffer
+        .get("byteLength")
+        .and_then(Value::as_f64)
+        .filter(|n| *n >= 0.0 && n.fract() == 0.0)
+        .map(|n| n as u64)
+}
+
+fn short_buffer(index: usize, declared: u64, actual: u64, what: &str) -> Diagnostic {
+    Diagnostic::new(
+        &codes::BUFFER_BYTE_LENGTH_MISMATCH,
+        format!("/buffers/{index}/byteLength"),
+        format!("buffer {index} declares {declared} bytes but {what} holds {actual}"),
+    )
+}
+
+fn check_buffer(cx: &Context, index: usize, buffer: &Value, out: &mut Vec<Diagnostic>) {
+    let declared = byte_length(buffer);
+    let Some(uri) = buffer.get("uri") else {
+        // The GLB's own buffer is checked against its BIN chunk on load; a buffer that an
+        // extension fills (EXT_meshopt_compression's fallback buffer) has no data of its own.
+        let glb_bin = cx.asset.container == Container::Glb && index == 0;
+        if !glb_bin && buffer.get("extensions").is_none() {
+            out.push(Diagnostic::new(
+                &codes::BUFFER_MISSING_GLB_DATA,
+                format!("/buffers/{index}"),
+                format!(
+                    "buffer {index} has no uri; only the first buffer of a GLB takes its data from the BIN chunk"
+                ),
+            ));
+        }
+        return;
+    };
+    let Some(uri) = uri.as_str() else { return }; // TYPE_MISMATCH from the schema
+    let pointer = format!("/buffers/{index}/uri");
+    match locate(cx, uri, &pointer, out) {
+        Some(Located::Data { media_type, len }) => {
+            if !matches!(
+                media_type.as_str(),
+                "application/octet-stream" | "application/gltf-buffer"
+            ) {
+                out.push(Diagnostic::new(
+                    &BUFFER_DATA_URI_MIME_TYPE_INVALID,
+                    &pointer,
+                    format!(
+                        "the data: URI's media type is '{media_type}'; a buffer's must be application/octet-stream or application/gltf-buffer"
+                    ),
+                ));
+            }
+            if let Some(declared) = declared.filter(|d| *d > len) {
+                out.push(short_buffer(index, declared, len, "its data: URI"));
+            }
+        }
+        Some(Located::File { len }) => {
+            if let Some(declared) = declared.filter(|d| *d > len) {
+                out.push(short_buffer(index, declared, len, &format!("'{uri}'")));
+            }
+        }
+        None => {}
+    }
+}
+
+fn check_image(cx: &Context, index: usize, image: &Value, out: &mut Vec<Diagnostic>) {
+    let mut declared = image
+        .get("mimeType")
+        .and_then(Value::as_str)
+        .map(|m| (m.to_string(), format!("/images/{index}/mimeType")));
+    if let Some(uri) = image.get("uri") {
+        let Some(uri) = uri.as_str() else { return };
+        let pointer = format!("/images/{index}/uri");
+        match locate(cx, uri, &pointer, out) {
+            Some(Located::Data { media_type, .. }) => {
+                if declared.is_none() && media_type.starts_with("image/") {
+                    declared = Some((media_type, pointer));
+                }
+            }
+            Some(Located::File { .. }) => {}
+            None => return,
+        }
+    } else if !view_in_memory(cx, image) {
+        return;
+    }
+    match cx.asset.image_header(index) {
+        Ok(header) => {
+            let Some((mime, pointer)) = declared else {
+                return;
+            };
+            let actual = mime_of(header.format);
+            if mime != actual {
+                out.push(Diagnostic::new(
+                    &IMAGE_MIME_TYPE_INVALID,
+                    pointer,
+                    format!("image {index} is {actual} but declares '{mime}'"),
+                ));
+            }
+        }
+        Err(d) => out.push(d),
+    }
+}
+
+fn mime_of(format: ImageFormat) -> &'static str {
+    match format {
+        ImageFormat::Png => "image/png",
+        ImageFormat::Jpeg => "image/jpeg",
+        ImageFormat::Webp => "image/webp",
+        ImageFormat::Ktx2 => "image/ktx2",
+    }
+}
+
+/// True when an image's bufferView lies in a buffer already in memory.
+fn view_in_memory(cx: &Context, image: &Value) -> bool {
+    let json = cx.json();
+    let Some(buffer) = image
+        .get("bufferView")
+        .and_then(super::as_index)
+        .and_then(|v| json.get("bufferViews")?.get(v as usize))
+        .and_then(|view| view.get("buffer"))
+        .and_then(super::as_index)
+        .and_then(|b| json.get("buffers")?.get(b as usize))
+    else {
+        return false; // a dangling index is reported by the indices rule
+    };
+    match buffer.get("uri").and_then(Value::as_str) {
+        Some(uri) => uri.starts_with("data:"),
+        None => cx.asset.bin.is_some(),
+    }
+}
+
+/// What a URI that could be followed leads to.
+enum Located {
+    Data { media_type: String, len: u64 },
+    File { len: u64 },
+}
+
+/// Resolves `uri` and checks what it leads to, pushing every fault; `None` when there is
+/// nothing further to check.
+fn locate(cx: &Context, uri: &str, pointer: &str, out: &mut Vec<Diagnostic>) -> Option<Located> {
+    if resource::is_remote(uri) {
+        out.push(Diagnostic::new(
+            &NON_RELATIVE_URI,
+            pointer,
+            format!("'{uri}' is a URL; velvet does not fetch it, so it was not checked"),
+        ));
+        return None;
+    }
+    let path = match cx.asset.resolve(uri, pointer) {
+        Ok(Location::Data { media_type, bytes }) => {
+            return Some(Located::Data {
+                media_type,
+                len: bytes.len() as u64,
+            })
+        }
+        Ok(Location::File(path)) => path,
+        Err(d) => {
+            out.push(d);
+            return None;
+        }
+    };
+    let fault = |code: &Code, detail: String| Diagnostic::new(code, pointer, detail);
+    // Asset::resolve has refused links that lead out of the folder.
+    let real = match std::fs::canonicalize(&path) {
+        Ok(real) => real,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            out.push(fault(
+                &FILE_NOT_FOUND,
+                format!("'{uri}' names {}, which does not exist", path.display()),
+            ));
+            return None;
+        }
+        Err(e) => {
+            out.push(fault(
+                &codes::IO_ERROR,
+                format!("cannot read '{uri}' ({}): {e}", path.display()),
+            ));
+            return None;
+        }
+    };
+    let meta = match std::fs::metadata(&real) {
+        Ok(meta) if meta.is_file() => meta,
+        Ok(_) => {
+            out.push(fault(
+                &codes::IO_ERROR,
+                format!("'{uri}' ({}) is not a regular file", path.display()),
+            ));
+            return None;
+        }
+        Err(e) => {
+            out.push(fault(
+                &codes::IO_ERROR,
+                format!("cannot read '{uri}' ({}): {e}", path.display()),
+            ));
+            return None;
+        }
+    };
+    if meta.len() <= LFS_POINTER_MAX_LEN && is_lfs_pointer(&real) {
+        out.push(fault(
+            &GIT_LFS_POINTER,
+            format!(
+                "'{uri}' is a Git LFS pointer file, not its content: fetch it with `git lfs pull`"
+            ),
+        ));
+        return None;
+    }
+    Some(Located::File { len: meta.len() })
+}
+
+fn is_lfs_pointer(path: &Path) -> bool {
+    let mut head = [0u8; LFS_POINTER_PREFIX.len()];
+    std::fs::File::open(path)
+        .and_then(|mut f| std::io::Read::read_exact(&mut f, &mut head))
+        .is_ok_and(|()| head == LFS_POINTER_PREFIX)
+}
