@@ -349,7 +349,8 @@ fn validate(args: ValidateArgs, color: ColorChoice, quiet: bool) -> ExitCode {
     };
     // Each file's report is written as soon as it is done (see report::Stream).
     let stdout = std::io::BufWriter::new(std::io::stdout().lock());
-    let mut stream = report::Stream::new(args.format, options, stdout);
+    let one_file = matches!(args.paths.as_slice(), [path] if path.is_file());
+    let mut stream = report::Stream::new(args.format, options, stdout).json_array(!one_file);
     let outcome = match velvet::run::validate_each(
         &validator,
         &args.paths,

@@ -60,16 +60,25 @@ pub struct FileReport {
     pub json_offset: usize,
     pub findings: Vec<Finding>,
     pub counts: Counts,
+    /// True when `--max-issues` left findings out of the listing (`omitted` of them).
     pub truncated: bool,
+    pub omitted: usize,
     pub info: Option<AssetInfo>,
 }
 
 impl FileReport {
     /// True when a finding is at or above the run's fail-on severity.
+    /// Judged on every finding, also those a `--max-issues` cap left out of the listing.
     pub fn fails(&self, settings: &Settings) -> bool {
-        self.findings
-            .iter()
-            .any(|f| settings.fail_on.fails(f.diagnostic.severity))
+        let c = self.counts;
+        [
+            (Severity::Error, c.errors),
+            (Severity::Warning, c.warnings),
+            (Severity::Info, c.infos),
+            (Severity::Hint, c.hints),
+        ]
+        .into_iter()
+        .any(|(severity, n)| n > 0 && settings.fail_on.fails(severity))
     }
 }
 
@@ -178,7 +187,7 @@ impl Validator {
                     .map(|f| f.diagnostic.pointer.as_str()),
             );
             for f in &mut report.findings {
-                if !f.diagnostic.pointer.is_empty() {
+                if !f.diagnostic.pointer.is_empty() && f.position.is_none() {
                     f.position = positions.get(&f.diagnostic.pointer).copied();
                 }
             }
@@ -203,10 +212,11 @@ impl Validator {
             }
             counts.add(d.severity);
         }
-        let truncated = settings
-            .max_issues
-            .is_some_and(|max| diagnostics.len() > max);
-        if let Some(max) = settings.max_issues {
+        let mut omitted = 0;
+        if let Some(max) = settings.max_issues.filter(|max| diagnostics.len() > *max) {
+            // The listing keeps the most severe findings: errors before warnings before infos.
+            diagnostics.sort_by_key(|d| d.severity);
+            omitted = diagnostics.len() - max;
             diagnostics.truncate(max);
         }
         FileReport {
@@ -216,12 +226,13 @@ impl Validator {
             findings: diagnostics
                 .into_iter()
                 .map(|diagnostic| Finding {
+                    position: diagnostic.position,
                     diagnostic,
-                    position: None,
                 })
                 .collect(),
             counts,
-            truncated,
+            truncated: omitted > 0,
+            omitted,
             info,
         }
     }

@@ -367,3 +367,245 @@ fn readme_codes_table_is_the_registry() {
         "regenerate with `velvet codes --format markdown`"
     );
 }
+
+// ---------------------------------------------------------------------------------------------
+// The core check: valid glTF that a stricter typed model refused
+
+/// A PNG, a lossless WebP and a KTX2 header of 2×2 pixels, written into `dir`.
+fn write_images(dir: &Path) {
+    use image::ImageEncoder;
+    let pixels = [200u8; 2 * 2 * 3];
+    let mut png = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut png)
+        .write_image(&pixels, 2, 2, image::ExtendedColorType::Rgb8)
+        .unwrap();
+    std::fs::write(dir.join("a.png"), png).unwrap();
+    let mut webp = Vec::new();
+    image::codecs::webp::WebPEncoder::new_lossless(&mut webp)
+        .write_image(&pixels, 2, 2, image::ExtendedColorType::Rgb8)
+        .unwrap();
+    std::fs::write(dir.join("a.webp"), webp).unwrap();
+    // KTX2: identifier, then vkFormat, typeSize, pixelWidth, pixelHeight (the header is all
+    // velvet reads).
+    let mut ktx2 = b"\xABKTX 20\xBB\r\n\x1A\n".to_vec();
+    for word in [0u32, 1, 2, 2] {
+        ktx2.extend_from_slice(&word.to_le_bytes());
+    }
+    ktx2.resize(80, 0);
+    std::fs::write(dir.join("a.ktx2"), ktx2).unwrap();
+}
+
+fn all_findings(path: &Path) -> Vec<String> {
+    let validator = Validator::new(Schemas::builtin(), Settings::default());
+    validator
+        .validate_file(path)
+        .findings
+        .iter()
+        .map(|f| format!("{} {}", f.diagnostic.code, f.diagnostic.pointer))
+        .collect()
+}
+
+#[test]
+fn valid_gltf_that_a_typed_model_refused_is_clean() {
+    let dir = tempfile::tempdir().unwrap();
+    write_images(dir.path());
+    let asset = json!({"version": "2.0"});
+    let cases = [
+        (
+            "an accessor without bufferView (zero-filled) and a primitive without POSITION",
+            json!({"asset": asset,
+                "accessors": [{"componentType": 5126, "count": 3, "type": "VEC3"}],
+                "meshes": [{"primitives": [{"attributes": {"NORMAL": 0}}]}]}),
+        ),
+        (
+            "a texture whose image comes from EXT_texture_webp",
+            json!({"asset": asset,
+                "extensionsUsed": ["EXT_texture_webp"], "extensionsRequired": ["EXT_texture_webp"],
+                "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],
+                "textures": [{"extensions": {"EXT_texture_webp": {"source": 0}}}],
+                "images": [{"uri": "a.webp"}]}),
+        ),
+        (
+            "a texture whose image comes from KHR_texture_basisu",
+            json!({"asset": asset,
+                "extensionsUsed": ["KHR_texture_basisu"], "extensionsRequired": ["KHR_texture_basisu"],
+                "materials": [{"emissiveTexture": {"index": 0}}],
+                "textures": [{"extensions": {"KHR_texture_basisu": {"source": 0}}}],
+                "images": [{"uri": "a.ktx2", "mimeType": "image/ktx2"}]}),
+        ),
+        (
+            "an animation channel target without node",
+            json!({"asset": asset,
+                "accessors": [{"componentType": 5126, "count": 2, "type": "SCALAR", "min": [0], "max": [1]},
+                              {"componentType": 5126, "count": 2, "type": "VEC4"}],
+                "animations": [{"channels": [{"sampler": 0, "target": {"path": "rotation"}}],
+                                "samplers": [{"input": 0, "output": 1}]}]}),
+        ),
+        (
+            "integers written as 1.0",
+            json!({"asset": asset, "scene": 0.0, "scenes": [{"nodes": [0.0]}], "nodes": [{"mesh": 0.0}],
+                "accessors": [{"componentType": 5126.0, "count": 3.0, "type": "VEC3"}],
+                "meshes": [{"primitives": [{"attributes": {"POSITION": 0.0}, "mode": 4.0}]}],
+                "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0.0, "texCoord": 0.0}}}],
+                "textures": [{"source": 0.0}], "images": [{"uri": "a.png"}]}),
+        ),
+        (
+            "a scene without nodes",
+            json!({"asset": asset, "scene": 0, "scenes": [{"name": "empty"}]}),
+        ),
+    ];
+    for (what, doc) in cases {
+        let path = dir.path().join("case.gltf");
+        std::fs::write(&path, serde_json::to_vec_pretty(&doc).unwrap()).unwrap();
+        assert_eq!(all_findings(&path), Vec::<String>::new(), "{what}");
+    }
+}
+
+#[test]
+fn every_missing_resource_is_one_file_not_found_and_nothing_else() {
+    let dir = tempfile::tempdir().unwrap();
+    let doc = json!({"asset": {"version": "2.0"},
+        "buffers": [{"byteLength": 12, "uri": "mesh.bin"}],
+        "images": [{"uri": "a.png"}, {"uri": "b%20c.jpg"}],
+        "textures": [{"source": 0}, {"source": 1}],
+        "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}},
+                       "extensions": {"KHR_materials_sheen": {"sheenColorFactor": [1, 1, 1],
+                           "sheenColorTexture": {"index": 1}, "sheenRoughnessTexture": {"index": 1}}}}],
+        "extensionsUsed": ["KHR_materials_sheen"]});
+    let path = dir.path().join("lfs-less.gltf");
+    std::fs::write(&path, serde_json::to_vec_pretty(&doc).unwrap()).unwrap();
+    assert_eq!(
+        all_findings(&path),
+        [
+            "FILE_NOT_FOUND /buffers/0/uri",
+            "FILE_NOT_FOUND /images/0/uri",
+            "FILE_NOT_FOUND /images/1/uri"
+        ]
+    );
+}
+
+#[test]
+fn a_link_inside_the_folder_that_leads_out_of_it_is_not_followed() {
+    let dir = tempfile::tempdir().unwrap();
+    let outside = dir.path().join("secret");
+    std::fs::create_dir(&outside).unwrap();
+    write_images(&outside);
+    let assets = dir.path().join("assets");
+    std::fs::create_dir(&assets).unwrap();
+    std::os::unix::fs::symlink(outside.join("a.png"), assets.join("fabric.png")).unwrap();
+    let doc = json!({"asset": {"version": "2.0"}, "images": [{"uri": "fabric.png"}]});
+    let path = assets.join("linked.gltf");
+    std::fs::write(&path, doc.to_string()).unwrap();
+    assert_eq!(all_findings(&path), ["URI_NOT_FOLLOWED /images/0/uri"]);
+    let (status, out, _) = velvet(&["validate", "--allow-outside-uris", path.to_str().unwrap()]);
+    assert_eq!(
+        (status, out.contains("URI_NOT_FOLLOWED")),
+        (0, false),
+        "{out}"
+    );
+}
+
+#[test]
+fn a_git_lfs_pointer_is_named_with_the_command_that_fetches_it() {
+    let (status, out, _) = velvet(&[
+        "validate",
+        "fixtures/validate/GIT_LFS_POINTER/triggers.gltf",
+    ]);
+    assert_eq!(status, 1);
+    assert!(
+        out.contains("error GIT_LFS_POINTER: 'pointer.png' is a Git LFS pointer file, not its content: fetch it with `git lfs pull`"),
+        "{out}"
+    );
+}
+
+#[test]
+fn a_header_only_glb_is_an_error_and_trailing_bytes_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let header_only = dir.path().join("header.glb");
+    std::fs::write(&header_only, b"glTF\x02\0\0\0\x0c\0\0\0").unwrap();
+    let (status, out, _) = velvet(&["validate", header_only.to_str().unwrap()]);
+    assert_eq!(status, 1);
+    assert!(
+        out.contains(
+            "error GLB_UNEXPECTED_END: the GLB ends after its header: it has no JSON chunk"
+        ),
+        "{out}"
+    );
+    let (status, out, _) = velvet(&[
+        "validate",
+        "fixtures/validate/GLB_TRAILING_DATA/triggers.glb",
+    ]);
+    assert_eq!(status, 0, "{out}");
+    assert!(
+        out.contains("warning GLB_TRAILING_DATA: the file has 8 bytes after the 84 its GLB header declares; they are ignored"),
+        "{out}"
+    );
+}
+
+// ---------------------------------------------------------------------------------------------
+// The issue cap and the JSON shape
+
+#[test]
+fn a_capped_run_fails_on_errors_it_does_not_list_and_lists_errors_first() {
+    let mixed = "fixtures/ci/project/assets/mixed.gltf";
+    let (status, out, _) = velvet(&["validate", "--max-issues", "1", mixed]);
+    assert_eq!(status, 1, "{out}");
+    let first = out.lines().next().unwrap();
+    assert!(first.contains(": error "), "{out}");
+    assert!(
+        out.contains(&format!("{mixed}: 5 more issues not shown (--max-issues)")),
+        "{out}"
+    );
+    assert!(
+        out.ends_with("1 file checked: 2 errors, 1 warning, 1 info, 2 hints\n"),
+        "{out}"
+    );
+    let (_, out, _) = velvet(&["validate", "--format", "json", "--max-issues", "2", mixed]);
+    let report: Value = serde_json::from_str(&out).unwrap();
+    let severities: Vec<&Value> = report["issues"]["messages"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| &m["severity"])
+        .collect();
+    assert_eq!(severities, [&json!(0), &json!(0)]);
+    assert_eq!(report["issues"]["numErrors"], 2);
+    assert_eq!(report["issues"]["truncated"], true);
+}
+
+#[test]
+fn json_shape_follows_the_arguments_not_the_number_of_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let one = dir.path().join("one.gltf");
+    std::fs::copy("fixtures/validate/TYPE_MISMATCH/clean.gltf", &one).unwrap();
+    let json_of = |args: &[&str]| -> Value {
+        let mut all = vec!["validate", "--format", "json"];
+        all.extend_from_slice(args);
+        serde_json::from_str(&velvet(&all).1).unwrap()
+    };
+    let file = json_of(&[one.to_str().unwrap()]);
+    assert!(file.is_object(), "{file}");
+    let folder = json_of(&[dir.path().to_str().unwrap()]);
+    assert_eq!(folder.as_array().map(Vec::len), Some(1), "{folder}");
+    let empty = tempfile::tempdir().unwrap();
+    let none = json_of(&[empty.path().to_str().unwrap()]);
+    assert_eq!(none, json!([]));
+}
+
+#[test]
+fn invalid_json_is_placed_at_its_line_and_column() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("broken.gltf");
+    std::fs::write(
+        &path,
+        "{\n  \"asset\": {\"version\": \"2.0\"},\n  \"nodes\": [,]\n}\n",
+    )
+    .unwrap();
+    let (status, out, _) = velvet(&["validate", path.to_str().unwrap()]);
+    assert_eq!(status, 1);
+    let first = out.lines().next().unwrap();
+    assert!(
+        first.ends_with("broken.gltf:3:13: error INVALID_JSON: line 3, column 13: expected value"),
+        "{out}"
+    );
+}

@@ -182,14 +182,21 @@ pub fn load_bytes_with(path: &Path, bytes: &[u8], options: &LoadOptions) -> Load
                 .chars()
                 .count()
                 + 1;
-            diagnostics.push(Diagnostic::new(
-                &codes::INVALID_JSON,
-                "",
-                format!(
-                    "invalid UTF-8 at line {line}, column {column} (byte {})",
-                    json_offset + at
-                ),
-            ));
+            diagnostics.push(
+                Diagnostic::new(
+                    &codes::INVALID_JSON,
+                    "",
+                    format!(
+                        "invalid UTF-8 at line {line}, column {column} (byte {})",
+                        json_offset + at
+                    ),
+                )
+                .at(crate::diagnostics::Position {
+                    line,
+                    column,
+                    offset: at,
+                }),
+            );
             return Loaded {
                 asset: None,
                 diagnostics,
@@ -200,17 +207,24 @@ pub fn load_bytes_with(path: &Path, bytes: &[u8], options: &LoadOptions) -> Load
     let parse_text = json_text.trim_end_matches(['\0', ' ']);
     let max_depth = options.max_json_depth.min(limits::JSON_DEPTH_CEILING);
     if let Some(at) = limits::find_too_deep(parse_text, max_depth) {
-        diagnostics.push(Diagnostic::new(
-            &codes::JSON_TOO_DEEP,
-            "",
-            format!(
+        diagnostics.push(
+            Diagnostic::new(
+                &codes::JSON_TOO_DEEP,
+                "",
+                format!(
                 "line {}, column {}: the JSON nests deeper than {max_depth} arrays and objects \
                  (raise the limit with --max-json-depth, at most {})",
                 at.line,
                 at.column,
                 limits::JSON_DEPTH_CEILING
             ),
-        ));
+            )
+            .at(crate::diagnostics::Position {
+                line: at.line,
+                column: at.column,
+                offset: position::offset_of(parse_text, at.line, at.column),
+            }),
+        );
         return Loaded {
             asset: None,
             diagnostics,
@@ -219,16 +233,23 @@ pub fn load_bytes_with(path: &Path, bytes: &[u8], options: &LoadOptions) -> Load
     let json: Value = match serde_json::from_str(parse_text) {
         Ok(v) => v,
         Err(e) => {
-            diagnostics.push(Diagnostic::new(
-                &codes::INVALID_JSON,
-                "",
-                format!(
-                    "line {}, column {}: {}",
-                    e.line(),
-                    e.column(),
-                    strip_position(&e.to_string())
-                ),
-            ));
+            diagnostics.push(
+                Diagnostic::new(
+                    &codes::INVALID_JSON,
+                    "",
+                    format!(
+                        "line {}, column {}: {}",
+                        e.line(),
+                        e.column(),
+                        strip_position(&e.to_string())
+                    ),
+                )
+                .at(crate::diagnostics::Position {
+                    line: e.line(),
+                    column: e.column(),
+                    offset: position::offset_of(parse_text, e.line(), e.column()),
+                }),
+            );
             return Loaded {
                 asset: None,
                 diagnostics,

@@ -9,12 +9,39 @@
 use super::pointer;
 use std::collections::{HashMap, HashSet};
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
-pub struct Position {
-    pub line: usize,
-    pub column: usize,
-    /// Byte offset of the value's first byte in the JSON text.
-    pub offset: usize,
+pub use crate::diagnostics::Position;
+
+/// The position of byte `offset` in `text` (1-based line, character column).
+pub fn at_offset(text: &str, offset: usize) -> Position {
+    let offset = offset.min(text.len());
+    let before = &text.as_bytes()[..offset];
+    let line_start = before
+        .iter()
+        .rposition(|b| *b == b'\n')
+        .map_or(0, |p| p + 1);
+    Position {
+        line: before.iter().filter(|b| **b == b'\n').count() + 1,
+        column: String::from_utf8_lossy(&before[line_start..])
+            .chars()
+            .count()
+            + 1,
+        offset,
+    }
+}
+
+/// The byte offset of 1-based `line` and character `column` in `text`.
+pub fn offset_of(text: &str, line: usize, column: usize) -> usize {
+    let line_start = if line <= 1 {
+        0
+    } else {
+        text.match_indices('\n')
+            .nth(line - 2)
+            .map_or(text.len(), |(i, _)| i + 1)
+    };
+    text[line_start..]
+        .char_indices()
+        .nth(column.saturating_sub(1))
+        .map_or(text.len(), |(i, _)| line_start + i)
 }
 
 /// Locates the values named by `pointers` in `text`. Pointers that name nothing are absent

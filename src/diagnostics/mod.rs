@@ -81,6 +81,20 @@ pub struct Diagnostic {
     pub message: String,
     pub severity: Severity,
     pub pointer: String,
+    /// Where in the JSON text the finding stands when no pointer can name it (a syntax error).
+    #[serde(skip)]
+    pub position: Option<Position>,
+}
+
+/// A place in a JSON text.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct Position {
+    /// 1-based line.
+    pub line: usize,
+    /// 1-based column, in characters.
+    pub column: usize,
+    /// Byte offset in the JSON text.
+    pub offset: usize,
 }
 
 impl Diagnostic {
@@ -90,6 +104,15 @@ impl Diagnostic {
             message: message.into(),
             severity: code.severity,
             pointer: pointer.into(),
+            position: None,
+        }
+    }
+
+    /// The same finding placed at `position` in the JSON text.
+    pub fn at(self, position: Position) -> Diagnostic {
+        Diagnostic {
+            position: Some(position),
+            ..self
         }
     }
 }

@@ -85,9 +85,9 @@ pub fn render(format: Format, reports: &[FileReport], options: &Options) -> Stri
 }
 
 /// Writes a run's reports as they come, one file at a time, keeping only the totals: a run over
-/// many files holds one file's report, not all of them. The JSON report is an object for one
-/// file and an array for several, so the first report waits for the second to tell which;
-/// each element is written as the array would print it. SARIF is one log for the whole run
+/// many files holds one file's report, not all of them. The JSON report's shape is chosen per
+/// invocation, never per count: a run over one file argument gives the report object, any
+/// other run an array (empty when no file was found), each element written as it is done. SARIF is one log for the whole run
 /// and is written at the end. Write errors (a closed pipe) are ignored: the run's outcome is
 /// its exit status.
 pub struct Stream<W: std::io::Write> {
@@ -97,6 +97,7 @@ pub struct Stream<W: std::io::Write> {
     kept: Vec<FileReport>,
     files: usize,
     totals: [usize; 4],
+    json_array: bool,
 }
 
 /// A JSON report as an element of the pretty-printed array of several: every line indented.
@@ -123,7 +124,14 @@ impl<W: std::io::Write> Stream<W> {
             kept: Vec::new(),
             files: 0,
             totals: [0; 4],
+            json_array: true,
         }
+    }
+
+    /// Whether JSON output is an array of reports (the default) or the one report object of a
+    /// run over a single file argument.
+    pub fn json_array(self, json_array: bool) -> Stream<W> {
+        Stream { json_array, ..self }
     }
 
     /// Takes the next file's report (in input order).
@@ -148,17 +156,12 @@ impl<W: std::io::Write> Stream<W> {
             ),
             Format::Jsonl => json::render_lines(one),
             Format::Github => github::render(one),
-            Format::Json => match self.files {
-                1 => {
-                    self.kept.push(report);
-                    return;
-                }
-                2 => {
-                    let first = self.kept.pop().expect("the first report waits");
-                    format!("[\n{},\n{}", json_element(&first), json_element(&report))
-                }
-                _ => format!(",\n{}", json_element(&report)),
-            },
+            Format::Json if !self.json_array => {
+                self.kept.push(report);
+                return;
+            }
+            Format::Json if self.files == 1 => format!("[\n{}", json_element(&report)),
+            Format::Json => format!(",\n{}", json_element(&report)),
             Format::Sarif => {
                 self.kept.push(report);
                 return;
@@ -176,7 +179,8 @@ impl<W: std::io::Write> Stream<W> {
     pub fn finish(mut self) {
         let text = match self.format {
             Format::Text if !self.options.quiet => text::summary(self.files, self.totals),
-            Format::Json if self.files >= 2 => "\n]\n".to_string(),
+            Format::Json if self.json_array && self.files == 0 => "[]\n".to_string(),
+            Format::Json if self.json_array => "\n]\n".to_string(),
             Format::Json | Format::Sarif => render(self.format, &self.kept, &self.options),
             _ => String::new(),
         };

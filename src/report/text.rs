@@ -62,7 +62,12 @@ pub fn render_with(reports: &[FileReport], options: &Options) -> String {
             }
         }
         if report.truncated {
-            let _ = writeln!(out, "{file}: further issues not shown (--max-issues)");
+            let _ = writeln!(
+                out,
+                "{file}: {} more issue{} not shown (--max-issues)",
+                report.omitted,
+                if report.omitted == 1 { "" } else { "s" }
+            );
         }
         let c = report.counts;
         for (t, n) in totals
