@@ -266,9 +266,9 @@ fn truncation_is_reported_in_github_and_sarif_output() {
     ]);
     assert_eq!(
         stdout(&o),
-        "::notice file=assets/mixed.gltf,line=11,col=24,title=UNEXPECTED_PROPERTY::unexpected property 'sheenGlow' \
-         (at /materials/0/extensions/KHR_materials_sheen/sheenGlow)\n\
-         ::notice file=assets/mixed.gltf,title=velvet::further issues not shown (max-issues)\n"
+        "::error file=assets/mixed.gltf,line=18,col=31,title=UNDECLARED_EXTENSION::KHR_materials_fuzz is used but not declared in extensionsUsed \
+         (at /materials/1/extensions/KHR_materials_fuzz)\n\
+         ::notice file=assets/mixed.gltf,title=velvet::5 more issues not shown (--max-issues)\n"
     );
     let o = velvet(&[
         "validate",
@@ -283,7 +283,7 @@ fn truncation_is_reported_in_github_and_sarif_output() {
     let notes = &log["runs"][0]["invocations"][0]["toolExecutionNotifications"];
     assert_eq!(
         notes[0]["message"]["text"],
-        "further issues not shown (max-issues)"
+        "5 more issues not shown (--max-issues)"
     );
     assert_eq!(
         notes[0]["locations"][0]["physicalLocation"]["artifactLocation"]["uri"],

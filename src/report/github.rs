@@ -70,7 +70,8 @@ pub fn render(reports: &[FileReport]) -> String {
         if report.truncated {
             let _ = writeln!(
                 out,
-                "::notice file={file},title=velvet::further issues not shown (max-issues)"
+                "::notice file={file},title=velvet::{}",
+                super::omitted_note(report.omitted)
             );
         }
     }

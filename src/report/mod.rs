@@ -22,6 +22,14 @@ pub fn display_path(path: &Path) -> String {
     shown.to_string_lossy().replace('\\', "/")
 }
 
+/// What a report says of the findings a `--max-issues` cap left out of its listing.
+pub fn omitted_note(omitted: usize) -> String {
+    format!(
+        "{omitted} more issue{} not shown (--max-issues)",
+        if omitted == 1 { "" } else { "s" }
+    )
+}
+
 /// The output formats of `velvet validate`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum Format {
@@ -243,7 +251,8 @@ mod tests {
                 for n in 0..4 {
                     let all = reports(n);
                     let mut out = Vec::new();
-                    let mut stream = Stream::new(format, options, &mut out);
+                    // render() gives one report as an object, as a single-file run does.
+                    let mut stream = Stream::new(format, options, &mut out).json_array(n != 1);
                     for r in all.clone() {
                         stream.push(r);
                     }
@@ -256,5 +265,18 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn json_of_a_run_over_a_folder_is_an_array_even_for_one_file() {
+        let mut out = Vec::new();
+        let mut stream = Stream::new(Format::Json, Options::default(), &mut out);
+        stream.push(reports(1).remove(0));
+        stream.finish();
+        let value: serde_json::Value = serde_json::from_slice(&out).unwrap();
+        assert_eq!(value.as_array().map(Vec::len), Some(1));
+        let mut out = Vec::new();
+        Stream::new(Format::Json, Options::default(), &mut out).finish();
+        assert_eq!(out, b"[]\n");
     }
 }

@@ -129,9 +129,14 @@ struct Invocation<'a> {
 }
 
 #[derive(Serialize)]
+struct OwnedText {
+    text: String,
+}
+
+#[derive(Serialize)]
 struct Notification<'a> {
     level: &'static str,
-    message: Text<'static>,
+    message: OwnedText,
     locations: [Location<'a>; 1],
 }
 
@@ -246,8 +251,8 @@ fn log<'a>(reports: &'a [FileReport], artifacts: &'a [ArtifactLocation]) -> Log<
         if report.truncated {
             notifications.push(Notification {
                 level: "note",
-                message: Text {
-                    text: "further issues not shown (max-issues)",
+                message: OwnedText {
+                    text: super::omitted_note(report.omitted),
                 },
                 locations: [Location {
                     physical_location: PhysicalLocation {

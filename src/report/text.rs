@@ -62,12 +62,7 @@ pub fn render_with(reports: &[FileReport], options: &Options) -> String {
             }
         }
         if report.truncated {
-            let _ = writeln!(
-                out,
-                "{file}: {} more issue{} not shown (--max-issues)",
-                report.omitted,
-                if report.omitted == 1 { "" } else { "s" }
-            );
+            let _ = writeln!(out, "{file}: {}", super::omitted_note(report.omitted));
         }
         let c = report.counts;
         for (t, n) in totals

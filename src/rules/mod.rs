@@ -6,6 +6,7 @@
 //! Rules read the asset and push diagnostics; they never change anything.
 
 pub mod asset_version;
+pub mod attributes;
 pub mod clearcoat;
 pub mod core;
 pub mod declaration;
@@ -57,6 +58,7 @@ pub static REGISTRY: &[&dyn Rule] = &[
     &placement::Placement,
     &exclusions::Exclusions,
     &references::References,
+    &attributes::Attributes,
     &resources::Resources,
     &texcoord::TexCoords,
     &disabled_layer::DisabledLayer,
