@@ -393,6 +393,9 @@ fn write_images(dir: &Path) {
     }
     ktx2.resize(80, 0);
     std::fs::write(dir.join("a.ktx2"), ktx2).unwrap();
+    // Formats velvet does not read: their headers are not velvet's to judge.
+    std::fs::write(dir.join("a.dds"), b"DDS \x7c\0\0\0").unwrap();
+    std::fs::write(dir.join("a.avif"), b"\0\0\0\x1cftypavif").unwrap();
 }
 
 fn all_findings(path: &Path) -> Vec<String> {
@@ -448,6 +451,14 @@ fn valid_gltf_that_a_typed_model_refused_is_clean() {
                 "meshes": [{"primitives": [{"attributes": {"POSITION": 0.0}, "mode": 4.0}]}],
                 "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0.0, "texCoord": 0.0}}}],
                 "textures": [{"source": 0.0}], "images": [{"uri": "a.png"}]}),
+        ),
+        (
+            "images in formats that extensions bring (DDS with its mimeType, AVIF by its name)",
+            json!({"asset": asset,
+                "extensionsUsed": ["MSFT_texture_dds", "EXT_texture_avif"],
+                "textures": [{"extensions": {"MSFT_texture_dds": {"source": 0}}},
+                             {"extensions": {"EXT_texture_avif": {"source": 1}}}],
+                "images": [{"uri": "a.dds", "mimeType": "image/vnd-ms.dds"}, {"uri": "a.avif"}]}),
         ),
         (
             "a scene without nodes",

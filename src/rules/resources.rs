@@ -160,7 +160,7 @@ fn check_image(cx: &Context, index: usize, image: &Value, out: &mut Vec<Diagnost
         let pointer = format!("/images/{index}/uri");
         match locate(cx, uri, &pointer, out) {
             Some(Located::Data { media_type, .. }) => {
-                if declared.is_none() && media_type.starts_with("image/") {
+                if declared.is_none() && KNOWN_MIME_TYPES.contains(&media_type.as_str()) {
                     declared = Some((media_type, pointer));
                 }
             }
@@ -168,6 +168,18 @@ fn check_image(cx: &Context, index: usize, image: &Value, out: &mut Vec<Diagnost
             None => return,
         }
     } else if !view_in_memory(cx, image) {
+        return;
+    }
+    // An image in a format velvet does not read (DDS, AVIF, … from their extensions) is
+    // valid glTF; its header is not velvet's to judge.
+    if declared
+        .as_ref()
+        .is_some_and(|(mime, _)| !KNOWN_MIME_TYPES.contains(&mime.as_str()))
+        || image
+            .get("uri")
+            .and_then(Value::as_str)
+            .is_some_and(|uri| !uri.starts_with("data:") && other_format_extension(uri))
+    {
         return;
     }
     match cx.asset.image_header(index) {
@@ -185,6 +197,21 @@ fn check_image(cx: &Context, index: usize, image: &Value, out: &mut Vec<Diagnost
             }
         }
         Err(d) => out.push(d),
+    }
+}
+
+/// The image media types whose headers velvet reads.
+const KNOWN_MIME_TYPES: [&str; 4] = ["image/png", "image/jpeg", "image/webp", "image/ktx2"];
+
+/// True for a file name whose extension names an image format velvet does not read.
+fn other_format_extension(uri: &str) -> bool {
+    let name = uri.rsplit('/').next().unwrap_or(uri);
+    match name.rsplit_once('.') {
+        Some((_, ext)) => !matches!(
+            ext.to_ascii_lowercase().as_str(),
+            "png" | "jpg" | "jpeg" | "webp" | "ktx2"
+        ),
+        None => false,
     }
 }
 
