@@ -1,10 +1,14 @@
 //! Human-readable report: one line per finding, `file:line:column: severity CODE message`,
 //! then the pointer; a summary line at the end. Colour (ANSI, via anstyle) only when asked.
+//!
+//! A file's findings are printed in file order, and a code found more than once in a file is
+//! printed once, followed by a line with how many more there are and where the first
+//! [`SHOWN`] of them stand (see [`fold`]); `--no-fold` prints each one.
 
-use super::{display_path, Options};
+use super::{display_path, fold, Options};
 use crate::asset::Container;
 use crate::diagnostics::Severity;
-use crate::validate::FileReport;
+use crate::validate::{FileReport, Finding};
 use anstyle::{AnsiColor, Style};
 use std::fmt::Write;
 
@@ -36,19 +40,31 @@ pub fn render_with(reports: &[FileReport], options: &Options) -> String {
     let mut totals = [0usize; 4];
     for report in reports {
         let file = display_path(&report.path);
-        for f in &report.findings {
-            let d = &f.diagnostic;
-            let place = match (f.position, report.container) {
-                (Some(p), Some(Container::Glb)) => {
-                    format!("{file}: byte {}", report.json_offset + p.offset)
-                }
-                (Some(p), _) => format!("{file}:{}:{}", p.line, p.column),
-                (None, _) => file.clone(),
-            };
+        let place = |f: &Finding| match (f.position, report.container) {
+            (Some(p), Some(Container::Glb)) => {
+                format!("{file}: byte {}", report.json_offset + p.offset)
+            }
+            (Some(p), _) => format!("{file}:{}:{}", p.line, p.column),
+            (None, _) => file.clone(),
+        };
+        let sorted = fold::by_position(&report.findings);
+        let groups = if options.no_fold {
+            sorted
+                .iter()
+                .map(|f| fold::Group {
+                    first: f,
+                    rest: Vec::new(),
+                })
+                .collect()
+        } else {
+            fold::fold(&sorted)
+        };
+        for group in groups {
+            let d = &group.first.diagnostic;
             let _ = writeln!(
                 out,
                 "{}: {} {}: {}",
-                paint(Style::new().bold(), &place),
+                paint(Style::new().bold(), &place(group.first)),
                 paint(severity_style(d.severity), d.severity.as_str()),
                 paint(Style::new().bold(), d.code),
                 d.message
@@ -59,6 +75,10 @@ pub fn render_with(reports: &[FileReport], options: &Options) -> String {
                     "    {}",
                     paint(Style::new().dimmed(), &format!("at {}", d.pointer))
                 );
+            }
+            if !group.rest.is_empty() {
+                let line = folded_line(&group.rest, report.container, report.json_offset);
+                let _ = writeln!(out, "    {}", paint(Style::new().dimmed(), &line));
             }
         }
         if report.truncated {
@@ -77,6 +97,34 @@ pub fn render_with(reports: &[FileReport], options: &Options) -> String {
     }
     out += &summary(reports.len(), totals);
     out
+}
+
+/// Positions listed on a folded entry's line before it ends in `…`.
+pub const SHOWN: usize = 5;
+
+/// The line under a folded entry: how many more findings of its code the file has, and where
+/// the first [`SHOWN`] of them stand (`line:column`, `byte N` in a .glb, or the pointer of a
+/// finding without a position).
+fn folded_line(rest: &[&Finding], container: Option<Container>, json_offset: usize) -> String {
+    let mut places: Vec<String> = rest
+        .iter()
+        .take(SHOWN)
+        .map(|f| match (f.position, container) {
+            (Some(p), Some(Container::Glb)) => format!("byte {}", json_offset + p.offset),
+            (Some(p), _) => format!("{}:{}", p.line, p.column),
+            (None, _) if !f.diagnostic.pointer.is_empty() => f.diagnostic.pointer.clone(),
+            (None, _) => "the whole file".to_string(),
+        })
+        .collect();
+    if rest.len() > SHOWN {
+        places.push("…".to_string());
+    }
+    format!(
+        "and {} more at {} ({} in all; --no-fold prints each)",
+        rest.len(),
+        places.join(", "),
+        rest.len() + 1
+    )
 }
 
 /// The closing line: files checked and findings per severity (`totals`: errors, warnings,
