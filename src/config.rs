@@ -264,7 +264,9 @@ impl Layer {
         }
         let fail_on = match raw.fail_on {
             Some(text) => Some(parse_fail_on(&text).ok_or_else(|| {
-                format!("fail-on: \"{text}\" is not one of \"error\", \"warning\", \"info\", \"hint\"")
+                format!(
+                    "fail-on: \"{text}\" is not one of \"error\", \"warning\", \"info\", \"hint\""
+                )
             })?),
             None => None,
         };
@@ -754,10 +756,9 @@ mod tests {
     #[test]
     fn command_line_ignore_adds_to_the_files_ignore_and_takes_codes_off_its_only() {
         let file_ignore = Layer::parse("ignore = [\"TYPE_MISMATCH\"]").unwrap();
-        let file_only =
-            Layer::parse("only = [\"TYPE_MISMATCH\", \"VALUE_NOT_IN_RANGE\"]").unwrap();
-        let cli = Layer::command_line(None, &["UNEXPECTED_PROPERTY".into()], &[], &[], None)
-            .unwrap();
+        let file_only = Layer::parse("only = [\"TYPE_MISMATCH\", \"VALUE_NOT_IN_RANGE\"]").unwrap();
+        let cli =
+            Layer::command_line(None, &["UNEXPECTED_PROPERTY".into()], &[], &[], None).unwrap();
         let file = PathBuf::from("/p/velvet.toml");
         let c = Config::combine(Some((file.clone(), file_ignore.clone())), &cli);
         assert_eq!(

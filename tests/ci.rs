@@ -845,3 +845,473 @@ fn man_page_renders_and_writes_one_page_per_command() {
         validate_page.contains("\\-\\-format") && validate_page.contains(".SH \"EXIT STATUS\"")
     );
 }
+
+// ---------------------------------------------------------------- at scale: shards and lists
+
+/// A library of `n` generated assets in nested folders, of different sizes (padding in
+/// extras), names in mixed case, about half with findings (a switched-off sheen that is
+/// textured, an unknown property, a legacy draft property), and a file that is not an asset.
+fn library(dir: &Path, n: usize) {
+    for i in 0..n {
+        let folder = dir
+            .join(format!("set{}", i % 3))
+            .join(format!("part{}", i % 2));
+        std::fs::create_dir_all(&folder).unwrap();
+        let sheen = match i % 4 {
+            0 => r#""sheenColorFactor":[0.5,0.4,0.3]"#.to_string(),
+            1 => format!(r#""sheenColorFactor":[0.5,0.4,0.3],"odd{i}":1"#),
+            2 => r#""sheenColorFactor":[1,1,1],"sheenFactor":0.5"#.to_string(),
+            _ => r#""sheenColorFactor":[0.2,0.2,0.2],"sheenRoughnessFactor":2"#.to_string(),
+        };
+        let text = format!(
+            "{{\n  \"asset\": {{\"version\": \"2.0\"}},\n  \"extensionsUsed\": [\"KHR_materials_sheen\"],\n  \"materials\": [{{\"extensions\": {{\"KHR_materials_sheen\": {{{sheen}}}}}}}],\n  \"extras\": {{\"pad\": \"{}\"}}\n}}\n",
+            "x".repeat((i * 7919) % 20_000)
+        );
+        let ext = if i % 5 == 0 { "GLTF" } else { "gltf" };
+        std::fs::write(folder.join(format!("asset {i:02}.{ext}")), text).unwrap();
+    }
+    std::fs::write(dir.join("set0/readme.txt"), "not an asset").unwrap();
+}
+
+/// Reports of a `--format jsonl` run by file name relative to `base`, in output order.
+fn jsonl_by_name(out: &str, base: &str) -> Vec<(String, Value)> {
+    out.lines()
+        .map(|l| {
+            let mut report: Value = serde_json::from_str(l).unwrap();
+            let uri = report["uri"].as_str().unwrap().to_string();
+            let name = uri
+                .strip_prefix(base)
+                .unwrap_or_else(|| panic!("{uri} lies under {base}"))
+                .trim_start_matches('/')
+                .to_string();
+            report["uri"] = Value::String(name.clone());
+            (name, report)
+        })
+        .collect()
+}
+
+#[test]
+fn four_shards_report_every_file_once_exactly_as_one_run_does() {
+    let dir = tempfile::tempdir().unwrap();
+    library(&dir.path().join("lib"), 30);
+    let whole = velvet_in(dir.path(), &["validate", "--format", "jsonl", "lib"]);
+    assert_eq!(whole.status.code(), Some(1), "the library has errors");
+    let whole = jsonl_by_name(&stdout(&whole), "lib");
+    assert_eq!(whole.len(), 30);
+    let mut union: Vec<(String, Value)> = Vec::new();
+    let mut bytes = Vec::new();
+    for k in 1..=4 {
+        let shard = format!("{k}/4");
+        let o = velvet_in(
+            dir.path(),
+            &["validate", "--format", "jsonl", "--shard", &shard, "lib"],
+        );
+        assert!(o.status.code() == Some(0) || o.status.code() == Some(1));
+        let part = jsonl_by_name(&stdout(&o), "lib");
+        assert!(!part.is_empty(), "shard {shard} has files");
+        // The same shard from another working directory, by an absolute path, holds the
+        // same files: the split depends on paths below the argument, not on how it is named.
+        let absolute = dir.path().join("lib");
+        let elsewhere = velvet_in(
+            &project(),
+            &[
+                "validate",
+                "--format",
+                "jsonl",
+                "--shard",
+                &shard,
+                absolute.to_str().unwrap(),
+            ],
+        );
+        let names = |r: &[(String, Value)]| r.iter().map(|(n, _)| n.clone()).collect::<Vec<_>>();
+        assert_eq!(
+            names(&jsonl_by_name(
+                &stdout(&elsewhere),
+                absolute.to_str().unwrap()
+            )),
+            names(&part),
+            "shard {shard}"
+        );
+        bytes.push(
+            part.iter()
+                .map(|(n, _)| {
+                    std::fs::metadata(dir.path().join("lib").join(n))
+                        .unwrap()
+                        .len()
+                })
+                .sum::<u64>(),
+        );
+        union.extend(part);
+    }
+    union.sort_by(|a, b| a.0.cmp(&b.0));
+    let mut expected = whole.clone();
+    expected.sort_by(|a, b| a.0.cmp(&b.0));
+    assert_eq!(
+        union, expected,
+        "every file once, with the report of the single run"
+    );
+    // Balanced by bytes: no shard carries more than another plus the largest file and the
+    // per-file allowance.
+    let largest = whole
+        .iter()
+        .map(|(n, _)| {
+            std::fs::metadata(dir.path().join("lib").join(n))
+                .unwrap()
+                .len()
+        })
+        .max()
+        .unwrap();
+    let (max, min) = (bytes.iter().max().unwrap(), bytes.iter().min().unwrap());
+    assert!(max - min <= largest + 4096, "{bytes:?}, largest {largest}");
+}
+
+#[test]
+fn shards_of_migrate_write_together_what_one_run_writes() {
+    let dir = tempfile::tempdir().unwrap();
+    library(&dir.path().join("lib"), 12);
+    let o = velvet_in(dir.path(), &["migrate", "lib", "--out-dir", "one"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    for k in 1..=3 {
+        let shard = format!("{k}/3");
+        let o = velvet_in(
+            dir.path(),
+            &["migrate", "lib", "--out-dir", "sharded", "--shard", &shard],
+        );
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    }
+    let one = snapshot_tree(&dir.path().join("one"));
+    assert_eq!(one.len(), 12);
+    assert_eq!(snapshot_tree(&dir.path().join("sharded")), one);
+    // Bake's dry run over shards lists each file once.
+    let mut listed = Vec::new();
+    for k in 1..=3 {
+        let shard = format!("{k}/3");
+        let o = velvet_in(
+            dir.path(),
+            &[
+                "bake",
+                "lib",
+                "--dry-run",
+                "--format",
+                "json",
+                "--shard",
+                &shard,
+            ],
+        );
+        let report: Value = serde_json::from_str(&stdout(&o)).unwrap();
+        for f in report["files"].as_array().unwrap() {
+            listed.push(f["input"].as_str().unwrap().to_string());
+        }
+    }
+    listed.sort();
+    let mut all: Vec<String> = all_files(&dir.path().join("lib"))
+        .into_iter()
+        .filter(|f| !f.ends_with(".txt"))
+        .map(|f| format!("lib/{f}"))
+        .collect();
+    all.sort();
+    assert_eq!(listed, all);
+}
+
+#[test]
+fn a_bad_shard_is_a_usage_error() {
+    let o = velvet(&["validate", "--shard", "5/4", "assets"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("5/4: expected K/N with 1 <= K <= N, e.g. 2/4"),
+        "{}",
+        stderr(&o)
+    );
+}
+
+/// Runs velvet in `dir` with `input` on standard input.
+fn velvet_stdin(dir: &Path, args: &[&str], input: &[u8]) -> Output {
+    use std::io::Write as _;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_velvet"))
+        .current_dir(dir)
+        .args(args)
+        .env_remove("NO_COLOR")
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    child.stdin.take().unwrap().write_all(input).unwrap();
+    child.wait_with_output().unwrap()
+}
+
+#[test]
+fn files_from_standard_input_takes_nul_separated_names_with_spaces_and_newlines() {
+    let dir = tempfile::tempdir().unwrap();
+    let clean = std::fs::read(project().join("assets/clean.gltf")).unwrap();
+    std::fs::create_dir_all(dir.path().join("sub dir")).unwrap();
+    for name in [
+        "a b.gltf",
+        "new\nline.gltf",
+        "sub dir/c.GLTF",
+        "unlisted.gltf",
+    ] {
+        std::fs::write(dir.path().join(name), &clean).unwrap();
+    }
+    std::fs::write(dir.path().join("notes.txt"), "not an asset").unwrap();
+    // As `git diff --name-only -z` prints them: NUL after each, other files among them.
+    let list = b"a b.gltf\0notes.txt\0new\nline.gltf\0deleted.txt\0sub dir/c.GLTF\0";
+    let o = velvet_stdin(
+        dir.path(),
+        &["validate", "--format", "jsonl", "--files-from", "-"],
+        list,
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let uris: Vec<String> = stdout(&o)
+        .lines()
+        .map(|l| {
+            serde_json::from_str::<Value>(l).unwrap()["uri"]
+                .as_str()
+                .unwrap()
+                .to_string()
+        })
+        .collect();
+    assert_eq!(uris, ["a b.gltf", "new\nline.gltf", "sub dir/c.GLTF"]);
+    // One per line, from a file, with command-line paths besides.
+    std::fs::write(dir.path().join("list.txt"), "a b.gltf\r\nsub dir\n").unwrap();
+    let o = velvet_in(
+        dir.path(),
+        &[
+            "validate",
+            "-q",
+            "--files-from",
+            "list.txt",
+            "unlisted.gltf",
+        ],
+    );
+    assert_eq!(o.status.code(), Some(0));
+    let o = velvet_in(
+        dir.path(),
+        &[
+            "validate",
+            "--format",
+            "jsonl",
+            "--files-from",
+            "list.txt",
+            "unlisted.gltf",
+        ],
+    );
+    let uris: Vec<String> = stdout(&o)
+        .lines()
+        .map(|l| {
+            serde_json::from_str::<Value>(l).unwrap()["uri"]
+                .as_str()
+                .unwrap()
+                .to_string()
+        })
+        .collect();
+    assert_eq!(uris, ["unlisted.gltf", "a b.gltf", "sub dir/c.GLTF"]);
+    // A listed asset that does not exist is named; a list with no asset checks nothing and
+    // passes (a change that touched no asset).
+    let o = velvet_stdin(
+        dir.path(),
+        &["validate", "--files-from", "-"],
+        b"gone.glb\n",
+    );
+    assert_eq!(o.status.code(), Some(2));
+    assert_eq!(
+        stderr(&o),
+        "velvet: --files-from -: gone.glb (entry 1) does not exist\n"
+    );
+    let o = velvet_stdin(
+        dir.path(),
+        &["validate", "--files-from", "-"],
+        b"notes.txt\n",
+    );
+    assert_eq!(o.status.code(), Some(0));
+    assert_eq!(
+        stdout(&o),
+        "0 files checked: 0 errors, 0 warnings, 0 info, 0 hints\n"
+    );
+    // migrate and bake take lists too.
+    let o = velvet_stdin(
+        dir.path(),
+        &[
+            "migrate",
+            "--dry-run",
+            "--format",
+            "json",
+            "--files-from",
+            "-",
+        ],
+        b"new\nline.gltf\0",
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let report: Value = serde_json::from_str(&stdout(&o)).unwrap();
+    assert_eq!(report["files"][0]["input"], "new\nline.gltf");
+    assert_eq!(report["files"].as_array().unwrap().len(), 1);
+    let o = velvet_stdin(
+        dir.path(),
+        &["bake", "--dry-run", "--format", "json", "--files-from", "-"],
+        b"a b.gltf\n",
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let report: Value = serde_json::from_str(&stdout(&o)).unwrap();
+    assert_eq!(report["files"][0]["input"], "a b.gltf");
+}
+
+// ---------------------------------------------------------------- paths and exit status
+
+#[test]
+fn missing_paths_and_folders_without_assets_are_usage_errors_in_every_command() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir_all(dir.path().join("empty")).unwrap();
+    std::fs::create_dir_all(dir.path().join("docs/deeper")).unwrap();
+    std::fs::write(dir.path().join("docs/deeper/notes.txt"), "not an asset").unwrap();
+    let cases: [(&[&str], &str); 6] = [
+        (&["validate", "asets"], "asets: no such file or folder"),
+        (
+            &["validate", "empty"],
+            "empty: no .gltf or .glb file in this folder or below",
+        ),
+        (
+            &["validate", "docs"],
+            "docs: no .gltf or .glb file in this folder or below",
+        ),
+        (
+            &["migrate", "--dry-run", "nope.gltf"],
+            "nope.gltf: no such file or folder",
+        ),
+        (
+            &["bake", "--dry-run", "empty"],
+            "empty: no .gltf or .glb file in this folder or below",
+        ),
+        (
+            &["bake", "--dry-run", "nope"],
+            "nope: no such file or folder",
+        ),
+    ];
+    for (args, message) in cases {
+        let o = velvet_in(dir.path(), args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}");
+        assert_eq!(stderr(&o), format!("velvet: {message}\n"), "{args:?}");
+        assert!(o.stdout.is_empty(), "{args:?}");
+    }
+}
+
+#[test]
+fn fail_on_hint_fails_a_file_whose_only_findings_are_hints() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("fuzz.gltf"),
+        r#"{"asset":{"version":"2.0"},"extensionsUsed":["KHR_materials_fuzz"],"materials":[{"extensions":{"KHR_materials_fuzz":{"fuzzFactor":1}}}]}"#,
+    )
+    .unwrap();
+    let status = |args: &[&str]| velvet_in(dir.path(), args).status.code();
+    let o = velvet_in(dir.path(), &["validate", "fuzz.gltf"]);
+    assert!(stdout(&o).ends_with("1 file checked: 0 errors, 0 warnings, 0 info, 2 hints\n"));
+    assert_eq!(o.status.code(), Some(0));
+    assert_eq!(
+        status(&["validate", "--fail-on", "info", "fuzz.gltf"]),
+        Some(0)
+    );
+    assert_eq!(
+        status(&["validate", "--fail-on", "hint", "fuzz.gltf"]),
+        Some(1)
+    );
+    std::fs::write(dir.path().join("velvet.toml"), "fail-on = \"hint\"\n").unwrap();
+    assert_eq!(status(&["validate", "fuzz.gltf"]), Some(1));
+    assert_eq!(
+        status(&["validate", "--fail-on", "error", "fuzz.gltf"]),
+        Some(0)
+    );
+}
+
+#[test]
+fn command_line_ignore_adds_to_the_files_ignore() {
+    // nested/velvet.toml ignores VALUE_NOT_IN_RANGE; the command line adds UNEXPECTED_PROPERTY.
+    let codes = |args: &[&str]| -> Vec<String> {
+        let (_, r) = json_reports(args);
+        let mut codes: Vec<String> = r[0]["issues"]["messages"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|m| m["code"].as_str().unwrap().to_string())
+            .collect();
+        codes.dedup();
+        codes
+    };
+    let file_only = codes(&["nested/minified.gltf"]);
+    assert!(
+        file_only.contains(&"UNEXPECTED_PROPERTY".to_string()),
+        "{file_only:?}"
+    );
+    assert!(!file_only.contains(&"VALUE_NOT_IN_RANGE".to_string()));
+    let both = codes(&["--ignore", "UNEXPECTED_PROPERTY", "nested/minified.gltf"]);
+    assert!(
+        !both.contains(&"UNEXPECTED_PROPERTY".to_string()),
+        "{both:?}"
+    );
+    assert!(
+        !both.contains(&"VALUE_NOT_IN_RANGE".to_string()),
+        "{both:?}"
+    );
+    let o = velvet(&["config", "nested", "--ignore", "UNEXPECTED_PROPERTY"]);
+    assert!(stdout(&o).contains(
+        "ignore = [\"UNEXPECTED_PROPERTY\", \"VALUE_NOT_IN_RANGE\"]  # velvet.toml and command line\n"
+    ));
+    let help = stdout(&velvet(&["validate", "--help"]));
+    assert!(
+        help.contains("adds to the codes velvet.toml ignores"),
+        "{help}"
+    );
+}
+
+#[test]
+fn bench_is_not_in_the_users_help_but_still_runs() {
+    let help = stdout(&velvet(&["--help"]));
+    assert!(!help.contains("bench"), "{help}");
+    assert!(help.contains("validate") && help.contains("migrate") && help.contains("bake"));
+    let o = velvet(&["bench", "--help"]);
+    assert_eq!(o.status.code(), Some(0));
+    assert!(stdout(&o).contains("accuracy"));
+}
+
+// ---------------------------------------------------------------- folded, ordered text output
+
+#[test]
+fn text_output_folds_a_repeated_code_and_lists_findings_in_file_order() {
+    let dir = tempfile::tempdir().unwrap();
+    // Eight unknown properties in one sheen object, a legacy draft property, and an
+    // out-of-range roughness before them in the file.
+    let odd: Vec<String> = (0..8).map(|i| format!("\"odd{i}\": {i}")).collect();
+    let text = format!(
+        "{{\n\"asset\": {{\"version\": \"2.0\"}},\n\"extensionsUsed\": [\"KHR_materials_sheen\"],\n\"materials\": [{{\"extensions\": {{\"KHR_materials_sheen\": {{\n\"sheenRoughnessFactor\": 3,\n\"sheenFactor\": 1,\n{}\n}}}}}}]\n}}\n",
+        odd.join(",\n")
+    );
+    std::fs::write(dir.path().join("many.gltf"), text).unwrap();
+    let o = velvet_in(dir.path(), &["validate", "--color", "never", "many.gltf"]);
+    assert_eq!(o.status.code(), Some(1));
+    let p = "/materials/0/extensions/KHR_materials_sheen";
+    assert_eq!(
+        stdout(&o),
+        format!(
+            "many.gltf:5:25: error VALUE_NOT_IN_RANGE: 3 is greater than the maximum of 1.0\n    at {p}/sheenRoughnessFactor\n\
+             many.gltf:6:16: warning KHR_MATERIALS_SHEEN_LEGACY_DRAFT: sheenFactor belongs to the pre-ratification KHR_materials_sheen draft and is ignored by ratified loaders; `velvet migrate` upgrades it\n    at {p}/sheenFactor\n\
+             many.gltf:7:9: warning UNEXPECTED_PROPERTY: unexpected property 'odd0'\n    at {p}/odd0\n\
+             \x20   and 7 more at 8:9, 9:9, 10:9, 11:9, 12:9, … (8 in all; --no-fold prints each)\n\
+             1 file checked: 1 error, 9 warnings, 0 info, 0 hints\n"
+        )
+    );
+    let o = velvet_in(
+        dir.path(),
+        &["validate", "--color", "never", "--no-fold", "many.gltf"],
+    );
+    let lines: Vec<String> = stdout(&o)
+        .lines()
+        .filter(|l| !l.starts_with(' '))
+        .map(|l| l.split(": ").take(2).collect::<Vec<_>>().join(": "))
+        .collect();
+    let mut expected = vec![
+        "many.gltf:5:25: error VALUE_NOT_IN_RANGE".to_string(),
+        "many.gltf:6:16: warning KHR_MATERIALS_SHEEN_LEGACY_DRAFT".to_string(),
+    ];
+    expected.extend((7..15).map(|l| format!("many.gltf:{l}:9: warning UNEXPECTED_PROPERTY")));
+    expected.push("1 file checked: 1 error, 9 warnings, 0 info, 0 hints".to_string());
+    assert_eq!(lines, expected);
+}

@@ -18,8 +18,8 @@
 //!   longest-processing-time rule), so no shard carries more than the lightest one plus the
 //!   largest file.
 
-use std::collections::BinaryHeap;
 use std::cmp::Reverse;
+use std::collections::BinaryHeap;
 use std::fmt;
 use std::io::{self, Read};
 use std::path::{Component, Path, PathBuf};
@@ -210,7 +210,10 @@ pub fn read_list(list: &Path) -> Result<Vec<PathBuf>, InputError> {
     };
     let bytes = if list == Path::new("-") {
         let mut bytes = Vec::new();
-        io::stdin().lock().read_to_end(&mut bytes).map_err(unreadable)?;
+        io::stdin()
+            .lock()
+            .read_to_end(&mut bytes)
+            .map_err(unreadable)?;
         bytes
     } else {
         std::fs::read(list).map_err(unreadable)?
@@ -300,7 +303,10 @@ impl Shard {
         let items: Vec<(String, usize, u64)> = files
             .iter()
             .map(|f| {
-                let input = inputs.get(f.input).map(PathBuf::as_path).unwrap_or(Path::new(""));
+                let input = inputs
+                    .get(f.input)
+                    .map(PathBuf::as_path)
+                    .unwrap_or(Path::new(""));
                 let size = std::fs::metadata(&f.path).map_or(0, |m| m.len());
                 (shard_key(input, &f.path), f.input, size + FILE_COST)
             })
@@ -324,7 +330,8 @@ pub fn assign(items: &[(String, usize, u64)], count: usize) -> Vec<usize> {
         let (kb, ib, wb) = &items[b];
         wb.cmp(wa).then_with(|| ka.cmp(kb)).then_with(|| ia.cmp(ib))
     });
-    let mut loads: BinaryHeap<Reverse<(u64, usize)>> = (0..count).map(|s| Reverse((0, s))).collect();
+    let mut loads: BinaryHeap<Reverse<(u64, usize)>> =
+        (0..count).map(|s| Reverse((0, s))).collect();
     let mut shard_of = vec![0; items.len()];
     for i in order {
         let Some(Reverse((load, shard))) = loads.pop() else {
@@ -355,14 +362,29 @@ mod tests {
 
     #[test]
     fn shard_keys_are_relative_to_the_argument_and_use_slashes() {
-        assert_eq!(shard_key(Path::new("assets"), Path::new("assets/a/b.gltf")), "a/b.gltf");
         assert_eq!(
-            shard_key(Path::new("/ci/x/assets"), Path::new("/ci/x/assets/a/b.gltf")),
+            shard_key(Path::new("assets"), Path::new("assets/a/b.gltf")),
             "a/b.gltf"
         );
-        assert_eq!(shard_key(Path::new("./assets"), Path::new("./assets/b.glb")), "b.glb");
-        assert_eq!(shard_key(Path::new("./a/b.gltf"), Path::new("./a/b.gltf")), "a/b.gltf");
-        assert_eq!(shard_key(Path::new("/a/b.gltf"), Path::new("/a/b.gltf")), "/a/b.gltf");
+        assert_eq!(
+            shard_key(
+                Path::new("/ci/x/assets"),
+                Path::new("/ci/x/assets/a/b.gltf")
+            ),
+            "a/b.gltf"
+        );
+        assert_eq!(
+            shard_key(Path::new("./assets"), Path::new("./assets/b.glb")),
+            "b.glb"
+        );
+        assert_eq!(
+            shard_key(Path::new("./a/b.gltf"), Path::new("./a/b.gltf")),
+            "a/b.gltf"
+        );
+        assert_eq!(
+            shard_key(Path::new("/a/b.gltf"), Path::new("/a/b.gltf")),
+            "/a/b.gltf"
+        );
     }
 
     fn items(weights: &[u64]) -> Vec<(String, usize, u64)> {
@@ -412,7 +434,10 @@ mod tests {
                 .map(|(_, p)| p.unwrap().to_string_lossy().into_owned())
                 .collect()
         };
-        assert_eq!(paths(b"a.gltf\r\nb c.glb\n\nd.gltf"), ["a.gltf", "b c.glb", "d.gltf"]);
+        assert_eq!(
+            paths(b"a.gltf\r\nb c.glb\n\nd.gltf"),
+            ["a.gltf", "b c.glb", "d.gltf"]
+        );
         assert_eq!(
             paths(b"a\nb.gltf\0c d.glb\0\0"),
             ["a\nb.gltf", "c d.glb"],
@@ -420,7 +445,10 @@ mod tests {
         );
         assert!(parse_list(b"").is_empty());
         assert_eq!(
-            parse_list(b"\n\nx.gltf\n").iter().map(|e| e.0).collect::<Vec<_>>(),
+            parse_list(b"\n\nx.gltf\n")
+                .iter()
+                .map(|e| e.0)
+                .collect::<Vec<_>>(),
             [1],
             "entries are numbered without the empty ones"
         );
