@@ -363,11 +363,11 @@ fn codes_command_lists_every_registered_code_once() {
 }
 
 #[test]
-fn readme_codes_table_is_the_registry() {
-    let readme = std::fs::read_to_string("README.md").unwrap();
+fn codes_table_in_the_docs_is_the_registry() {
+    let readme = std::fs::read_to_string("docs/codes.md").unwrap();
     let start = readme
         .find("<!-- codes:start -->\n")
-        .expect("README has the codes table markers")
+        .expect("docs/codes.md has the codes table markers")
         + "<!-- codes:start -->\n".len();
     let end = readme.find("<!-- codes:end -->").unwrap();
     let (_, table, _) = velvet(&["codes", "--format", "markdown"]);
