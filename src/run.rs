@@ -1,4 +1,5 @@
-//! A `velvet validate` run over many inputs: find the asset files, give each the configuration
+//! A `velvet validate` run over many inputs: find the asset files (with `--shard`, one part of
+//! them; see [`crate::asset::discover`]), give each the configuration
 //! found for it (see [`crate::config`]), leave out excluded files, validate the rest in
 //! parallel, and decide whether the run failed. A configuration error stops the run before any
 //! file is read: a broken velvet.toml is a usage error, not a finding.

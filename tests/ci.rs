@@ -627,6 +627,7 @@ fn hooks_file_declares_both_hooks_for_gltf_and_glb() {
         assert_eq!(h.language, "rust");
         let p = regex::Regex::new(&h.files).unwrap();
         assert!(p.is_match("a/b.gltf") && p.is_match("b.glb"));
+        assert!(p.is_match("UPPER.GLTF") && p.is_match("a/Mixed.Glb"));
         assert!(!p.is_match("a.gltf.bak") && !p.is_match("a.bin") && !p.is_match("velvet.toml"));
     }
 }
@@ -1314,4 +1315,246 @@ fn text_output_folds_a_repeated_code_and_lists_findings_in_file_order() {
     expected.extend((7..15).map(|l| format!("many.gltf:{l}:9: warning UNEXPECTED_PROPERTY")));
     expected.push("1 file checked: 1 error, 9 warnings, 0 info, 0 hints".to_string());
     assert_eq!(lines, expected);
+}
+
+// ---------------------------------------------------------------- the README's snippets
+
+fn readme() -> String {
+    std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("README.md")).unwrap()
+}
+
+/// The first fenced block of `lang` after the heading line `heading` in `text`.
+fn block_after(text: &str, heading: &str, lang: &str) -> String {
+    let at = text
+        .find(&format!("\n{heading}\n"))
+        .unwrap_or_else(|| panic!("{heading} is in the text"));
+    let fence = format!("```{lang}\n");
+    let start = at + text[at..].find(&fence).unwrap() + fence.len();
+    let end = start + text[start..].find("```\n").unwrap();
+    text[start..end].to_string()
+}
+
+/// A copy of `from` at `to`, folders included.
+fn copy_tree(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap() {
+        let p = e.unwrap().path();
+        let target = to.join(p.file_name().unwrap());
+        if p.is_dir() {
+            copy_tree(&p, &target);
+        } else {
+            std::fs::copy(&p, &target).unwrap();
+        }
+    }
+}
+
+/// Runs a shell command line in `dir` with the velvet under test first on PATH.
+fn shell(dir: &Path, line: &str) -> Output {
+    let bin = Path::new(env!("CARGO_BIN_EXE_velvet")).parent().unwrap();
+    let path = format!(
+        "{}:{}",
+        bin.display(),
+        std::env::var("PATH").unwrap_or_default()
+    );
+    let mut cmd = Command::new("sh");
+    cmd.current_dir(dir).arg("-c").arg(line).env("PATH", path);
+    for var in ["NO_COLOR", "CLICOLOR", "CLICOLOR_FORCE", "TERM", "CI"] {
+        cmd.env_remove(var);
+    }
+    cmd.output().unwrap()
+}
+
+const INSTALL: &str = "cargo install --locked --git \"$VELVET_GIT_URL\" velvet";
+
+#[test]
+fn readme_pre_commit_snippet_runs_as_pre_commit_runs_it_with_mixed_case_names() {
+    let text = block_after(&readme(), "### pre-commit", "yaml");
+    let config: Value = serde_yaml_ng::from_str(&text).expect("the snippet is YAML");
+    let repo = &config["repos"][0];
+    assert_eq!(
+        repo["repo"], "local",
+        "no rev to name: the hook runs the installed velvet"
+    );
+    let hook = &repo["hooks"][0];
+    assert_eq!(hook["language"], "system");
+    let hook = Hook {
+        id: hook["id"].as_str().unwrap().to_string(),
+        entry: hook["entry"].as_str().unwrap().to_string(),
+        language: hook["language"].as_str().unwrap().to_string(),
+        files: hook["files"].as_str().unwrap().to_string(),
+    };
+    assert_eq!(hook.id, "velvet-validate");
+    // The hooks velvet's repository ships select the same files.
+    for shipped in hooks() {
+        assert_eq!(shipped.files, hook.files, "{}", shipped.id);
+    }
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join("models")).unwrap();
+    std::fs::copy(
+        project().join("assets/mixed.gltf"),
+        dir.path().join("models/UPPER.GLTF"),
+    )
+    .unwrap();
+    std::fs::copy(
+        project().join("assets/clean.gltf"),
+        dir.path().join("models/Chair.Gltf"),
+    )
+    .unwrap();
+    std::fs::write(dir.path().join("models/notes.txt"), "not an asset").unwrap();
+    let (ok, out) = run_hook(&hook, dir.path(), 100);
+    assert!(!ok, "{out}");
+    assert!(
+        out.contains("models/UPPER.GLTF:10:43: error UNRESOLVED_REFERENCE"),
+        "{out}"
+    );
+    assert!(
+        out.ends_with("2 files checked: 2 errors, 2 warnings, 0 info, 2 hints\n"),
+        "{out}"
+    );
+    std::fs::remove_file(dir.path().join("models/UPPER.GLTF")).unwrap();
+    let (ok, out) = run_hook(&hook, dir.path(), 100);
+    assert!(ok, "{out}");
+    assert_eq!(
+        out,
+        "1 file checked: 0 errors, 0 warnings, 0 info, 0 hints\n"
+    );
+}
+
+#[test]
+fn readme_github_actions_snippet_runs_as_written() {
+    let text = block_after(
+        &readme(),
+        "### GitHub Actions, with findings in code scanning",
+        "yaml",
+    );
+    let workflow: Value = serde_yaml_ng::from_str(&text).expect("the workflow is YAML");
+    let job = &workflow["jobs"]["velvet"];
+    assert_eq!(job["permissions"]["security-events"], "write");
+    assert_eq!(job["env"]["VELVET_GIT_URL"], "${{ vars.VELVET_GIT_URL }}");
+    let steps = job["steps"].as_array().unwrap();
+    let runs: Vec<&str> = steps.iter().filter_map(|s| s["run"].as_str()).collect();
+    assert_eq!(runs[0], INSTALL);
+    let dir = tempfile::tempdir().unwrap();
+    copy_tree(&project(), dir.path());
+    let o = shell(dir.path(), runs[1]);
+    assert_eq!(
+        o.status.code(),
+        Some(1),
+        "the project has errors: the step fails"
+    );
+    let log: Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("velvet.sarif")).unwrap()).unwrap();
+    assert_eq!(log["version"], "2.1.0");
+    assert_eq!(log["runs"][0]["results"].as_array().unwrap().len(), 12);
+    let upload = steps
+        .iter()
+        .find(|s| {
+            s["uses"]
+                .as_str()
+                .is_some_and(|u| u.starts_with("github/codeql-action/upload-sarif@"))
+        })
+        .expect("an upload step");
+    assert_eq!(
+        upload["if"], "always()",
+        "findings are uploaded when the step failed"
+    );
+    assert_eq!(upload["with"]["sarif_file"], "velvet.sarif");
+    assert_eq!(upload["with"]["category"], "velvet");
+}
+
+#[test]
+fn readme_gitlab_snippet_runs_as_written() {
+    let text = block_after(&readme(), "### GitLab CI", "yaml");
+    let config: Value = serde_yaml_ng::from_str(&text).expect("the job is YAML");
+    let job = &config["velvet"];
+    let script: Vec<&str> = job["script"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|l| l.as_str().unwrap())
+        .collect();
+    assert_eq!(script[0], INSTALL);
+    let dir = tempfile::tempdir().unwrap();
+    copy_tree(&project(), dir.path());
+    let o = shell(dir.path(), script[1]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "the SARIF line never fails the job"
+    );
+    let log: Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("velvet.sarif")).unwrap()).unwrap();
+    assert_eq!(log["runs"][0]["results"].as_array().unwrap().len(), 12);
+    let o = shell(dir.path(), script[2]);
+    assert_eq!(
+        o.status.code(),
+        Some(1),
+        "the coloured run sets the job's status"
+    );
+    assert!(stdout(&o).contains(ESC));
+    assert_eq!(job["artifacts"]["when"], "always");
+    assert_eq!(job["artifacts"]["paths"][0], "velvet.sarif");
+}
+
+#[test]
+fn readme_output_example_is_what_velvet_prints() {
+    let readme = readme();
+    let start = readme
+        .find("```text\n$ velvet validate assets/mixed.gltf\n")
+        .unwrap();
+    let body = &readme[start + "```text\n".len()..];
+    let body = &body[..body.find("```\n").unwrap()];
+    let (command, shown) = body.split_once('\n').unwrap();
+    let args: Vec<&str> = command.split_whitespace().skip(2).collect();
+    let o = velvet(&args);
+    assert_eq!(o.status.code(), Some(1));
+    assert_eq!(stdout(&o), shown);
+}
+
+#[test]
+fn every_yaml_snippet_in_the_readme_and_ci_docs_parses() {
+    let docs = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/ci.md");
+    for (name, text) in [
+        ("README.md", readme()),
+        ("docs/ci.md", std::fs::read_to_string(docs).unwrap()),
+    ] {
+        let mut rest = text.as_str();
+        let mut blocks = 0;
+        while let Some(at) = rest.find("```yaml\n") {
+            let body = &rest[at + 8..];
+            let end = body.find("```\n").unwrap();
+            let snippet = &body[..end];
+            serde_yaml_ng::from_str::<Value>(snippet)
+                .unwrap_or_else(|e| panic!("{name}: {e}\n{snippet}"));
+            for line in snippet.lines().filter(|l| l.contains("rev:")) {
+                panic!("{name}: a snippet names a rev, which must exist: {line}");
+            }
+            blocks += 1;
+            rest = &body[end..];
+        }
+        assert!(blocks >= 3, "{name}");
+    }
+}
+
+#[test]
+fn readme_first_commands_are_the_ci_test_command_and_the_binary_it_builds() {
+    let block = block_after(&readme(), "## From a clone: the first two commands", "sh");
+    let commands: Vec<&str> = block
+        .lines()
+        .map(|l| l.split('#').next().unwrap().trim())
+        .collect();
+    assert_eq!(commands.len(), 2);
+    assert_eq!(commands[0], "cargo test --locked");
+    let ci =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(".ci/run")).unwrap();
+    assert_eq!(
+        ci.lines().last(),
+        Some(commands[0]),
+        ".ci/run runs the README's test command"
+    );
+    // The second runs the binary the test build made, on a file that exists.
+    let words: Vec<&str> = commands[1].split_whitespace().collect();
+    assert_eq!(words[0], "target/debug/velvet");
+    let o = velvet_in(Path::new(env!("CARGO_MANIFEST_DIR")), &words[1..]);
+    assert_eq!(o.status.code(), Some(0), "{}", stdout(&o));
 }
