@@ -1558,3 +1558,154 @@ fn readme_first_commands_are_the_ci_test_command_and_the_binary_it_builds() {
     let o = velvet_in(Path::new(env!("CARGO_MANIFEST_DIR")), &words[1..]);
     assert_eq!(o.status.code(), Some(0), "{}", stdout(&o));
 }
+
+/// Runs a shell line in `dir` with extra environment variables.
+fn shell_with(dir: &Path, line: &str, env: &[(&str, String)]) -> Output {
+    let bin = Path::new(env!("CARGO_BIN_EXE_velvet")).parent().unwrap();
+    let path = format!(
+        "{}:{}",
+        bin.display(),
+        std::env::var("PATH").unwrap_or_default()
+    );
+    Command::new("sh")
+        .current_dir(dir)
+        .arg("-c")
+        .arg(line)
+        .env("PATH", path)
+        .envs(env.iter().map(|(k, v)| (*k, v.as_str())))
+        .output()
+        .unwrap()
+}
+
+/// The sorted lines of the jsonl reports in `text`, each report's `uri` kept.
+fn sorted_lines(text: &str) -> Vec<String> {
+    let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+    lines.sort();
+    lines
+}
+
+#[test]
+fn ci_docs_shard_recipes_cover_the_library_once_as_written() {
+    let docs =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/ci.md")).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    library(&dir.path().join("assets"), 17);
+    let whole = velvet_in(dir.path(), &["validate", "--format", "jsonl", "assets/"]);
+    let whole = sorted_lines(&stdout(&whole));
+    assert_eq!(whole.len(), 17);
+
+    // GitLab `parallel:`: each copy's script with its CI_NODE_INDEX, then the report job.
+    let gitlab: Value =
+        serde_yaml_ng::from_str(&block_after(&docs, "### GitLab `parallel:`", "yaml")).unwrap();
+    let total = gitlab["velvet"]["parallel"].as_u64().unwrap();
+    let script: Vec<&str> = gitlab["velvet"]["script"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|l| l.as_str().unwrap())
+        .collect();
+    assert_eq!(script[0], INSTALL);
+    for k in 1..=total {
+        let env = [
+            ("CI_NODE_INDEX", k.to_string()),
+            ("CI_NODE_TOTAL", total.to_string()),
+        ];
+        assert_eq!(
+            shell_with(dir.path(), script[1], &env).status.code(),
+            Some(0)
+        );
+        let status = shell_with(dir.path(), script[2], &env).status.code();
+        assert!(status == Some(0) || status == Some(1), "{status:?}");
+    }
+    let report = gitlab["velvet-report"]["script"][0].as_str().unwrap();
+    assert_eq!(shell_with(dir.path(), report, &[]).status.code(), Some(0));
+    let merged = std::fs::read_to_string(dir.path().join("velvet.jsonl")).unwrap();
+    assert_eq!(
+        sorted_lines(&merged),
+        whole,
+        "the parts' reports are the whole run's"
+    );
+
+    // GitHub Actions matrix: one SARIF log per part, every file's results once among them.
+    let github: Value =
+        serde_yaml_ng::from_str(&block_after(&docs, "### GitHub Actions matrix", "yaml")).unwrap();
+    let job = &github["jobs"]["velvet"];
+    let shards: Vec<u64> = job["strategy"]["matrix"]["shard"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_u64().unwrap())
+        .collect();
+    let steps = job["steps"].as_array().unwrap();
+    let run = steps
+        .iter()
+        .filter_map(|s| s["run"].as_str())
+        .nth(1)
+        .unwrap();
+    assert!(run.contains(&format!("/{} ", shards.len())), "{run}");
+    let mut results = 0;
+    let mut categories = Vec::new();
+    for k in &shards {
+        let line = run.replace("${{ matrix.shard }}", &k.to_string());
+        shell_with(dir.path(), &line, &[]);
+        let log: Value =
+            serde_json::from_slice(&std::fs::read(dir.path().join("velvet.sarif")).unwrap())
+                .unwrap();
+        results += log["runs"][0]["results"].as_array().unwrap().len();
+        let upload = steps
+            .iter()
+            .find(|s| s["with"]["category"].is_string())
+            .unwrap();
+        categories.push(
+            upload["with"]["category"]
+                .as_str()
+                .unwrap()
+                .replace("${{ matrix.shard }}", &k.to_string()),
+        );
+    }
+    let single = velvet_in(dir.path(), &["validate", "--format", "sarif", "assets/"]);
+    let single: Value = serde_json::from_str(&stdout(&single)).unwrap();
+    assert_eq!(
+        results,
+        single["runs"][0]["results"].as_array().unwrap().len()
+    );
+    categories.dedup();
+    assert_eq!(categories.len(), shards.len(), "a category per part");
+
+    // Kubernetes Indexed Job: each index's command, the volumes' paths put in a temporary
+    // folder, writes its part; the parts together are the whole run.
+    let k8s: Value =
+        serde_yaml_ng::from_str(&block_after(&docs, "### Kubernetes Indexed Job", "yaml")).unwrap();
+    let completions = k8s["spec"]["completions"].as_u64().unwrap();
+    let container = &k8s["spec"]["template"]["spec"]["containers"][0];
+    assert_eq!(container["command"][1], "-c");
+    let line = container["args"][0].as_str().unwrap();
+    assert!(line.contains(&format!("+ 1))/{completions}\"")), "{line}");
+    let reports = dir.path().join("reports");
+    std::fs::create_dir(&reports).unwrap();
+    let line = line
+        .replace("/library/", &format!("{}/", dir.path().display()))
+        .replace("/reports/", &format!("{}/", reports.display()));
+    for index in 0..completions {
+        shell_with(
+            dir.path(),
+            &line,
+            &[("JOB_COMPLETION_INDEX", index.to_string())],
+        );
+    }
+    let mut merged = String::new();
+    for index in 0..completions {
+        merged += &std::fs::read_to_string(reports.join(format!("velvet-{index}.jsonl"))).unwrap();
+    }
+    // The reports name files by the absolute path the pods were given.
+    let absolute = sorted_lines(&stdout(&velvet_in(
+        dir.path(),
+        &[
+            "validate",
+            "--format",
+            "jsonl",
+            dir.path().join("assets").to_str().unwrap(),
+        ],
+    )));
+    assert_eq!(sorted_lines(&merged), absolute);
+}
