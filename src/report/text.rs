@@ -142,3 +142,68 @@ pub fn summary(files: usize, totals: [usize; 4]) -> String {
         if totals[3] == 1 { "" } else { "s" },
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::asset::position::Position;
+    use crate::diagnostics::Diagnostic;
+    use crate::validate::Counts;
+
+    fn finding(code: &'static str, pointer: &str, at: Option<(usize, usize, usize)>) -> Finding {
+        Finding {
+            diagnostic: Diagnostic {
+                code,
+                message: format!("{code} {pointer}"),
+                severity: Severity::Warning,
+                pointer: pointer.to_string(),
+            },
+            position: at.map(|(line, column, offset)| Position {
+                line,
+                column,
+                offset,
+            }),
+        }
+    }
+
+    fn report(container: Container, findings: Vec<Finding>) -> FileReport {
+        FileReport {
+            path: "x/a.glb".into(),
+            container: Some(container),
+            json_offset: 20,
+            counts: Counts {
+                warnings: findings.len(),
+                ..Counts::default()
+            },
+            findings,
+            truncated: false,
+            info: None,
+        }
+    }
+
+    #[test]
+    fn a_folded_glb_entry_lists_byte_offsets_and_pointers_of_findings_without_a_position() {
+        let findings: Vec<Finding> = (0..7)
+            .map(|i| finding("A", &format!("/p/{i}"), Some((1, 1, 100 - i * 10))))
+            .chain([finding("A", "/absent", None), finding("B", "", None)])
+            .collect();
+        let text = render(&[report(Container::Glb, findings)]);
+        assert_eq!(
+            text,
+            "x/a.glb: warning A: A /absent\n    at /absent\n\
+             \x20   and 7 more at byte 60, byte 70, byte 80, byte 90, byte 100, … (8 in all; --no-fold prints each)\n\
+             x/a.glb: warning B: B \n\
+             1 file checked: 0 errors, 9 warnings, 0 info, 0 hints\n"
+        );
+        let short = vec![
+            finding("A", "/p/1", Some((3, 4, 30))),
+            finding("A", "/p/0", Some((2, 5, 10))),
+        ];
+        let text = render(&[report(Container::Gltf, short)]);
+        assert_eq!(
+            text,
+            "x/a.glb:2:5: warning A: A /p/0\n    at /p/0\n    and 1 more at 3:4 (2 in all; --no-fold prints each)\n\
+             1 file checked: 0 errors, 2 warnings, 0 info, 0 hints\n"
+        );
+    }
+}
