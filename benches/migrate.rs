@@ -3,7 +3,7 @@
 //! every conversion: ratified sheen (factors, and textures in fast mode), fuzz without a
 //! fallback, the legacy sheen draft, switched-off layers and plain materials.
 //!
-//! Run: `cargo bench --bench migrate`. The README's figures come from this.
+//! Run: `cargo bench --bench migrate` (see docs/performance.md).
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use serde_json::{json, Value};

@@ -9,9 +9,11 @@
 //! names it: a typo in a CI configuration must not silently switch a check off.
 //!
 //! Precedence is per key: a command-line flag over the file, the file over the built-in
-//! default. `ignore` and `only` are one choice (which codes to report): the higher layer's
-//! choice replaces the lower's, and one layer may not set both. Severity overrides merge per
-//! code. Exclude globs come from the file only and are relative to its folder.
+//! default. `ignore` and `only` are one choice (which codes to report), and one layer may not
+//! set both: a command-line `--ignore` adds its codes to the file's choice (so a pre-commit
+//! `args: [--ignore X]` keeps what velvet.toml ignores), a command-line `--only` replaces it.
+//! Severity overrides merge per code. Exclude globs come from the file only and are relative
+//! to its folder.
 
 use crate::diagnostics::{self, FailOn, Settings, Severity};
 use globset::{Glob, GlobBuilder, GlobSet, GlobSetBuilder};
@@ -56,6 +58,8 @@ pub enum Source {
     Default,
     File,
     CommandLine,
+    /// The file's list with the command line's codes added (`ignore`).
+    FileAndCommandLine,
 }
 
 impl Source {
@@ -64,6 +68,7 @@ impl Source {
             Source::Default => "default",
             Source::File => FILE_NAME,
             Source::CommandLine => "command line",
+            Source::FileAndCommandLine => "velvet.toml and command line",
         }
     }
 }
@@ -147,6 +152,7 @@ pub fn parse_fail_on(text: &str) -> Option<FailOn> {
         "error" => Some(FailOn::Error),
         "warning" => Some(FailOn::Warning),
         "info" => Some(FailOn::Info),
+        "hint" => Some(FailOn::Hint),
         _ => None,
     }
 }
@@ -156,6 +162,7 @@ fn fail_on_name(f: FailOn) -> &'static str {
         FailOn::Error => "error",
         FailOn::Warning => "warning",
         FailOn::Info => "info",
+        FailOn::Hint => "hint",
     }
 }
 
@@ -176,6 +183,25 @@ pub fn selection(
         (Some(list), None) => Ok(Some(Selection::Ignore(codes(list, "ignore")?))),
         (None, Some(list)) => Ok(Some(Selection::Only(codes(list, "only")?))),
         (None, None) => Ok(None),
+    }
+}
+
+/// The codes reported under the command line's choice over the file's. A command-line
+/// `--ignore` adds to what the file leaves out: to its `ignore` list, or it takes codes off its
+/// `only` list. A command-line `--only` replaces the file's choice.
+fn combine_selection(cli: &Option<Selection>, file: &Option<Selection>) -> (Selection, Source) {
+    match (cli, file) {
+        (Some(Selection::Ignore(more)), Some(Selection::Ignore(listed))) => (
+            Selection::Ignore(listed.union(more).cloned().collect()),
+            Source::FileAndCommandLine,
+        ),
+        (Some(Selection::Ignore(more)), Some(Selection::Only(listed))) => (
+            Selection::Only(listed.difference(more).cloned().collect()),
+            Source::FileAndCommandLine,
+        ),
+        (Some(cli), _) => (cli.clone(), Source::CommandLine),
+        (None, Some(file)) => (file.clone(), Source::File),
+        (None, None) => (Selection::All, Source::Default),
     }
 }
 
@@ -238,7 +264,9 @@ impl Layer {
         }
         let fail_on = match raw.fail_on {
             Some(text) => Some(parse_fail_on(&text).ok_or_else(|| {
-                format!("fail-on: \"{text}\" is not one of \"error\", \"warning\", \"info\"")
+                format!(
+                    "fail-on: \"{text}\" is not one of \"error\", \"warning\", \"info\", \"hint\""
+                )
             })?),
             None => None,
         };
@@ -348,7 +376,7 @@ impl Config {
             }
         }
         let max_issues = pick(&cli.max_issues, &file_layer.max_issues, 0);
-        let selection = pick(&cli.selection, &file_layer.selection, Selection::All);
+        let selection = combine_selection(&cli.selection, &file_layer.selection);
         let fail_on = pick(&cli.fail_on, &file_layer.fail_on, FailOn::Error);
         let mut overrides: BTreeMap<String, (Severity, Source)> = file_layer
             .overrides
@@ -666,8 +694,12 @@ mod tests {
             "max-issues: -1 is negative (0 means no limit)"
         );
         assert_eq!(
-            Layer::parse("fail-on = \"hint\"").unwrap_err(),
-            "fail-on: \"hint\" is not one of \"error\", \"warning\", \"info\""
+            Layer::parse("fail-on = \"hints\"").unwrap_err(),
+            "fail-on: \"hints\" is not one of \"error\", \"warning\", \"info\", \"hint\""
+        );
+        assert_eq!(
+            Layer::parse("fail-on = \"hint\"").unwrap().fail_on,
+            Some(FailOn::Hint)
         );
         assert!(Layer::parse("[override]\nTYPE_MISMATCH = 4")
             .unwrap_err()
@@ -715,6 +747,63 @@ mod tests {
         );
         assert_eq!(c.settings().max_issues, Some(2));
         assert!(c.settings().ignore.contains("TYPE_MISMATCH"));
+    }
+
+    fn codes(list: &[&str]) -> BTreeSet<String> {
+        list.iter().map(|c| c.to_string()).collect()
+    }
+
+    #[test]
+    fn command_line_ignore_adds_to_the_files_ignore_and_takes_codes_off_its_only() {
+        let file_ignore = Layer::parse("ignore = [\"TYPE_MISMATCH\"]").unwrap();
+        let file_only = Layer::parse("only = [\"TYPE_MISMATCH\", \"VALUE_NOT_IN_RANGE\"]").unwrap();
+        let cli =
+            Layer::command_line(None, &["UNEXPECTED_PROPERTY".into()], &[], &[], None).unwrap();
+        let file = PathBuf::from("/p/velvet.toml");
+        let c = Config::combine(Some((file.clone(), file_ignore.clone())), &cli);
+        assert_eq!(
+            c.selection,
+            (
+                Selection::Ignore(codes(&["TYPE_MISMATCH", "UNEXPECTED_PROPERTY"])),
+                Source::FileAndCommandLine
+            )
+        );
+        assert_eq!(
+            c.settings().ignore,
+            codes(&["TYPE_MISMATCH", "UNEXPECTED_PROPERTY"])
+        );
+        assert!(c
+            .to_toml()
+            .contains("ignore = [\"TYPE_MISMATCH\", \"UNEXPECTED_PROPERTY\"]  # velvet.toml and command line\n"));
+        let cli_only_off =
+            Layer::command_line(None, &["VALUE_NOT_IN_RANGE".into()], &[], &[], None).unwrap();
+        let c = Config::combine(Some((file.clone(), file_only.clone())), &cli_only_off);
+        assert_eq!(
+            c.selection,
+            (
+                Selection::Only(codes(&["TYPE_MISMATCH"])),
+                Source::FileAndCommandLine
+            )
+        );
+        // Without a file the command line's list is the list; `--only` replaces the file's.
+        let c = Config::combine(None, &cli);
+        assert_eq!(
+            c.selection,
+            (
+                Selection::Ignore(codes(&["UNEXPECTED_PROPERTY"])),
+                Source::CommandLine
+            )
+        );
+        let cli_only =
+            Layer::command_line(None, &[], &["VALUE_NOT_IN_RANGE".into()], &[], None).unwrap();
+        let c = Config::combine(Some((file, file_ignore)), &cli_only);
+        assert_eq!(
+            c.selection,
+            (
+                Selection::Only(codes(&["VALUE_NOT_IN_RANGE"])),
+                Source::CommandLine
+            )
+        );
     }
 
     #[test]

@@ -6,6 +6,7 @@ use clap::{CommandFactory, Parser, Subcommand, ValueEnum};
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use velvet::asset::discover::{self, Shard};
 use velvet::cli_docs::{self, EXIT_STATUS, EXIT_STATUS_ALL};
 use velvet::config::{self, Layer, Resolver};
 use velvet::diagnostics::{self, FailOn, Settings};
@@ -65,8 +66,9 @@ enum Command {
         #[arg(long, value_name = "DIR")]
         dir: Option<PathBuf>,
     },
-    /// Numeric reports: what velvet's shading methods cost and how far they are off.
-    #[command(subcommand)]
+    /// Numeric reports for developers: what velvet's shading methods cost and how far they are
+    /// off (docs/shading.md). Not part of the user interface.
+    #[command(subcommand, hide = true)]
     Bench(velvet::shading::bench::BenchCommand),
 }
 
@@ -79,10 +81,10 @@ struct SettingsArgs {
     /// Report at most N issues per file (the report then says truncated); 0: no limit.
     #[arg(long, value_name = "N")]
     max_issues: Option<usize>,
-    /// Leave out issues with this code (repeatable).
+    /// Leave out issues with this code (repeatable); adds to the codes velvet.toml ignores.
     #[arg(long, value_name = "CODE", conflicts_with = "only")]
     ignore: Vec<String>,
-    /// Report only issues with this code (repeatable).
+    /// Report only issues with this code (repeatable); replaces velvet.toml's ignore/only.
     #[arg(long, value_name = "CODE")]
     only: Vec<String>,
     /// Give CODE another severity: error, warning, info, hint or 0-3 (repeatable).
@@ -123,14 +125,47 @@ impl LoadArgs {
     }
 }
 
+/// The files a command works on, shared by `validate`, `migrate` and `bake`.
+#[derive(clap::Args)]
+struct InputArgs {
+    /// Files and folders (folders are searched for *.gltf and *.glb, in any letter case).
+    #[arg(required_unless_present = "files_from")]
+    paths: Vec<PathBuf>,
+    /// Also take the paths listed in FILE ('-': standard input), one per line or NUL-separated
+    /// (as `git diff --name-only -z` prints them). Entries other than folders and .gltf/.glb
+    /// files are skipped.
+    #[arg(long, value_name = "FILE")]
+    files_from: Option<PathBuf>,
+    /// Work on part K of N of the files found (e.g. 2/4): N jobs given the same inputs each
+    /// take a different part, every file in exactly one, parts of similar size in bytes.
+    #[arg(long, value_name = "K/N")]
+    shard: Option<Shard>,
+}
+
+impl InputArgs {
+    /// The paths named on the command line and in the list, checked: a path that does not
+    /// exist, or a folder without any asset, is a usage error.
+    fn resolve(&self) -> Result<Vec<PathBuf>, discover::InputError> {
+        let mut paths = self.paths.clone();
+        if let Some(list) = &self.files_from {
+            paths.extend(discover::read_list(list)?);
+        }
+        discover::check_inputs(&paths)?;
+        Ok(paths)
+    }
+}
+
 #[derive(clap::Args)]
 struct ValidateArgs {
-    /// Files and folders to check (folders are searched for *.gltf and *.glb).
-    #[arg(required = true)]
-    paths: Vec<PathBuf>,
+    #[command(flatten)]
+    input: InputArgs,
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Text)]
     format: Format,
+    /// Text output: print every finding, instead of one per code and file with a count and
+    /// the first positions of the others.
+    #[arg(long)]
+    no_fold: bool,
     #[command(flatten)]
     settings: SettingsArgs,
     /// Read schema files from DIR instead of the built-in ones (files absent there stay built-in).
@@ -145,9 +180,8 @@ struct ValidateArgs {
     after_help = "Exit status: 0 done, 1 a file failed (the others are still baked), 2 usage error (nothing written)."
 )]
 struct BakeArgs {
-    /// Files and folders to bake (folders are searched for *.gltf and *.glb).
-    #[arg(required = true)]
-    paths: Vec<PathBuf>,
+    #[command(flatten)]
+    input: InputArgs,
     /// The output file (one input only).
     #[arg(short, long, value_name = "FILE", conflicts_with_all = ["out_dir", "in_place"])]
     output: Option<PathBuf>,
@@ -211,6 +245,7 @@ enum FailOnArg {
     Error,
     Warning,
     Info,
+    Hint,
 }
 
 fn usage_error(message: impl std::fmt::Display) -> ExitCode {
@@ -299,6 +334,7 @@ fn resolver(args: &SettingsArgs) -> Result<Resolver, config::ConfigError> {
         FailOnArg::Error => FailOn::Error,
         FailOnArg::Warning => FailOn::Warning,
         FailOnArg::Info => FailOn::Info,
+        FailOnArg::Hint => FailOn::Hint,
     });
     let layer = Layer::command_line(
         args.max_issues,
@@ -329,6 +365,10 @@ fn show_config(path: Option<PathBuf>, args: SettingsArgs) -> ExitCode {
 }
 
 fn validate(args: ValidateArgs, color: ColorChoice, quiet: bool) -> ExitCode {
+    let paths = match args.input.resolve() {
+        Ok(p) => p,
+        Err(e) => return usage_error(e),
+    };
     let mut resolver = match resolver(&args.settings) {
         Ok(r) => r,
         Err(e) => return usage_error(e),
@@ -346,14 +386,20 @@ fn validate(args: ValidateArgs, color: ColorChoice, quiet: bool) -> ExitCode {
     let options = report::Options {
         color: args.format == Format::Text && color.for_stdout(),
         quiet,
+        no_fold: args.no_fold,
     };
     // Each file's report is written as soon as it is done (see report::Stream).
     let stdout = std::io::BufWriter::new(std::io::stdout().lock());
-    let one_file = matches!(args.paths.as_slice(), [path] if path.is_file());
+    // One report object for a run over one file named on the command line; an array for
+    // anything else (folders, several files, a list, a shard), whatever it finds.
+    let one_file = args.input.files_from.is_none()
+        && args.input.shard.is_none()
+        && matches!(args.input.paths.as_slice(), [path] if path.is_file());
     let mut stream = report::Stream::new(args.format, options, stdout).json_array(!one_file);
-    let outcome = match velvet::run::validate_each(
+    let outcome = match velvet::run::validate_shard_each(
         &validator,
-        &args.paths,
+        &paths,
+        args.input.shard,
         &mut resolver,
         progress.as_ref(),
         &mut |r| match &progress {
@@ -381,9 +427,8 @@ fn validate(args: ValidateArgs, color: ColorChoice, quiet: bool) -> ExitCode {
     after_help = "Exit status: 0 done, 1 a file failed (the others are still migrated) or, with --check, a file would change, 2 usage error (nothing written)."
 )]
 struct MigrateArgs {
-    /// Files and folders to migrate (folders are searched for *.gltf and *.glb).
-    #[arg(required = true)]
-    paths: Vec<PathBuf>,
+    #[command(flatten)]
+    input: InputArgs,
     /// Write the one input's output here (same container as the input).
     #[arg(short = 'o', long = "output", value_name = "FILE", conflicts_with_all = ["out_dir", "in_place"])]
     output: Option<PathBuf>,
@@ -443,6 +488,10 @@ enum MigrateFormat {
 
 fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
     use velvet::migrate::{self, Destination};
+    let paths = match args.input.resolve() {
+        Ok(p) => p,
+        Err(e) => return usage_error(e),
+    };
     let destination = match (args.output, args.out_dir, args.in_place) {
         (Some(file), _, _) => Destination::File(file),
         (_, Some(dir), _) => Destination::Dir(dir),
@@ -450,7 +499,7 @@ fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
         _ => Destination::None,
     };
     let request = migrate::Request {
-        inputs: args.paths,
+        inputs: paths,
         destination,
         options: migrate::Options {
             refresh_fallback: args.refresh_fallback,
@@ -468,9 +517,18 @@ fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
         dry_run: args.dry_run || args.check,
         progress: !quiet,
     };
-    let report = match migrate::run(&request) {
-        Ok(report) => report,
-        Err(e) => return usage_error(e),
+    // A list that names no asset (a change that touched none) is nothing to do, not an error.
+    let report = if request.inputs.is_empty() {
+        migrate::RunReport {
+            dry_run: request.dry_run,
+            files: Vec::new(),
+            summary: migrate::Summary::default(),
+        }
+    } else {
+        match migrate::run_shard(&request, args.input.shard) {
+            Ok(report) => report,
+            Err(e) => return usage_error(e),
+        }
     };
     print!(
         "{}",
@@ -488,6 +546,10 @@ fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
 
 fn bake(args: BakeArgs, quiet: bool) -> ExitCode {
     use velvet::bake::command::{self, Destination, Options, Request};
+    let paths = match args.input.resolve() {
+        Ok(p) => p,
+        Err(e) => return usage_error(e),
+    };
     let destination = match (args.output, args.out_dir, args.in_place) {
         (Some(file), _, _) => Destination::File(file),
         (_, Some(dir), _) => Destination::Dir(dir),
@@ -495,7 +557,7 @@ fn bake(args: BakeArgs, quiet: bool) -> ExitCode {
         _ => Destination::None,
     };
     let request = Request {
-        inputs: args.paths,
+        inputs: paths,
         destination,
         dry_run: args.dry_run,
         options: Options {
@@ -516,9 +578,14 @@ fn bake(args: BakeArgs, quiet: bool) -> ExitCode {
         },
         progress: !quiet,
     };
-    let results = match command::run(&request) {
-        Ok(r) => r,
-        Err(e) => return usage_error(e),
+    // A list that names no asset (a change that touched none) is nothing to do, not an error.
+    let results = if request.inputs.is_empty() {
+        Vec::new()
+    } else {
+        match command::run_shard(&request, args.input.shard) {
+            Ok(r) => r,
+            Err(e) => return usage_error(e),
+        }
     };
     match args.format {
         BakeFormat::Text => print!("{}", command::render_text(&results, args.dry_run)),

@@ -1,4 +1,5 @@
-//! A `velvet validate` run over many inputs: find the asset files, give each the configuration
+//! A `velvet validate` run over many inputs: find the asset files (with `--shard`, one part of
+//! them; see [`crate::asset::discover`]), give each the configuration
 //! found for it (see [`crate::config`]), leave out excluded files, validate the rest in
 //! parallel, and decide whether the run failed. A configuration error stops the run before any
 //! file is read: a broken velvet.toml is a usage error, not a finding.
@@ -7,7 +8,7 @@
 //! order as soon as its batch is done, so that a run over ten thousand files holds one batch of
 //! reports, not ten thousand (see [`validate_each`]).
 
-use crate::asset::discover;
+use crate::asset::discover::{self, Shard};
 use crate::config::{ConfigError, Resolver};
 use crate::validate::{FileReport, Validator};
 use rayon::prelude::*;
@@ -65,10 +66,23 @@ pub fn validate_each(
     progress: Option<&indicatif::ProgressBar>,
     sink: &mut dyn FnMut(FileReport),
 ) -> Result<Totals, ConfigError> {
-    let (files, walk_errors) = discover::collect(inputs);
-    let mut planned = Vec::with_capacity(files.len());
+    validate_shard_each(validator, inputs, None, resolver, progress, sink)
+}
+
+/// Validates like [`validate_each`], only the files of `shard` when one is given (see
+/// [`Shard`]): N runs over shards 1/N … N/N together report every file exactly once.
+pub fn validate_shard_each(
+    validator: &Validator,
+    inputs: &[PathBuf],
+    shard: Option<Shard>,
+    resolver: &mut Resolver,
+    progress: Option<&indicatif::ProgressBar>,
+    sink: &mut dyn FnMut(FileReport),
+) -> Result<Totals, ConfigError> {
+    let (found, walk_errors) = discover::find(inputs, shard);
+    let mut planned = Vec::with_capacity(found.len());
     let mut excluded = Vec::new();
-    for file in files {
+    for file in found.into_iter().map(|f| f.path) {
         let config = resolver.for_path(&file)?;
         if config.excludes(&crate::config::absolute(&file)) {
             excluded.push(file);

@@ -627,6 +627,7 @@ fn hooks_file_declares_both_hooks_for_gltf_and_glb() {
         assert_eq!(h.language, "rust");
         let p = regex::Regex::new(&h.files).unwrap();
         assert!(p.is_match("a/b.gltf") && p.is_match("b.glb"));
+        assert!(p.is_match("UPPER.GLTF") && p.is_match("a/Mixed.Glb"));
         assert!(!p.is_match("a.gltf.bak") && !p.is_match("a.bin") && !p.is_match("velvet.toml"));
     }
 }
@@ -844,4 +845,869 @@ fn man_page_renders_and_writes_one_page_per_command() {
     assert!(
         validate_page.contains("\\-\\-format") && validate_page.contains(".SH \"EXIT STATUS\"")
     );
+}
+
+// ---------------------------------------------------------------- at scale: shards and lists
+
+/// A library of `n` generated assets in nested folders, of different sizes (padding in
+/// extras), names in mixed case, about half with findings (a switched-off sheen that is
+/// textured, an unknown property, a legacy draft property), and a file that is not an asset.
+fn library(dir: &Path, n: usize) {
+    for i in 0..n {
+        let folder = dir
+            .join(format!("set{}", i % 3))
+            .join(format!("part{}", i % 2));
+        std::fs::create_dir_all(&folder).unwrap();
+        let sheen = match i % 4 {
+            0 => r#""sheenColorFactor":[0.5,0.4,0.3]"#.to_string(),
+            1 => format!(r#""sheenColorFactor":[0.5,0.4,0.3],"odd{i}":1"#),
+            2 => r#""sheenColorFactor":[1,1,1],"sheenFactor":0.5"#.to_string(),
+            _ => r#""sheenColorFactor":[0.2,0.2,0.2],"sheenRoughnessFactor":2"#.to_string(),
+        };
+        let text = format!(
+            "{{\n  \"asset\": {{\"version\": \"2.0\"}},\n  \"extensionsUsed\": [\"KHR_materials_sheen\"],\n  \"materials\": [{{\"extensions\": {{\"KHR_materials_sheen\": {{{sheen}}}}}}}],\n  \"extras\": {{\"pad\": \"{}\"}}\n}}\n",
+            "x".repeat((i * 7919) % 20_000)
+        );
+        let ext = if i % 5 == 0 { "GLTF" } else { "gltf" };
+        std::fs::write(folder.join(format!("asset {i:02}.{ext}")), text).unwrap();
+    }
+    std::fs::write(dir.join("set0/readme.txt"), "not an asset").unwrap();
+}
+
+/// Reports of a `--format jsonl` run by file name relative to `base`, in output order.
+fn jsonl_by_name(out: &str, base: &str) -> Vec<(String, Value)> {
+    out.lines()
+        .map(|l| {
+            let mut report: Value = serde_json::from_str(l).unwrap();
+            let uri = report["uri"].as_str().unwrap().to_string();
+            let name = uri
+                .strip_prefix(base)
+                .unwrap_or_else(|| panic!("{uri} lies under {base}"))
+                .trim_start_matches('/')
+                .to_string();
+            report["uri"] = Value::String(name.clone());
+            (name, report)
+        })
+        .collect()
+}
+
+#[test]
+fn four_shards_report_every_file_once_exactly_as_one_run_does() {
+    let dir = tempfile::tempdir().unwrap();
+    library(&dir.path().join("lib"), 30);
+    let whole = velvet_in(dir.path(), &["validate", "--format", "jsonl", "lib"]);
+    assert_eq!(whole.status.code(), Some(1), "the library has errors");
+    let whole = jsonl_by_name(&stdout(&whole), "lib");
+    assert_eq!(whole.len(), 30);
+    let mut union: Vec<(String, Value)> = Vec::new();
+    let mut bytes = Vec::new();
+    for k in 1..=4 {
+        let shard = format!("{k}/4");
+        let o = velvet_in(
+            dir.path(),
+            &["validate", "--format", "jsonl", "--shard", &shard, "lib"],
+        );
+        assert!(o.status.code() == Some(0) || o.status.code() == Some(1));
+        let part = jsonl_by_name(&stdout(&o), "lib");
+        assert!(!part.is_empty(), "shard {shard} has files");
+        // The same shard from another working directory, by an absolute path, holds the
+        // same files: the split depends on paths below the argument, not on how it is named.
+        let absolute = dir.path().join("lib");
+        let elsewhere = velvet_in(
+            &project(),
+            &[
+                "validate",
+                "--format",
+                "jsonl",
+                "--shard",
+                &shard,
+                absolute.to_str().unwrap(),
+            ],
+        );
+        let names = |r: &[(String, Value)]| r.iter().map(|(n, _)| n.clone()).collect::<Vec<_>>();
+        assert_eq!(
+            names(&jsonl_by_name(
+                &stdout(&elsewhere),
+                absolute.to_str().unwrap()
+            )),
+            names(&part),
+            "shard {shard}"
+        );
+        bytes.push(
+            part.iter()
+                .map(|(n, _)| {
+                    std::fs::metadata(dir.path().join("lib").join(n))
+                        .unwrap()
+                        .len()
+                })
+                .sum::<u64>(),
+        );
+        union.extend(part);
+    }
+    union.sort_by(|a, b| a.0.cmp(&b.0));
+    let mut expected = whole.clone();
+    expected.sort_by(|a, b| a.0.cmp(&b.0));
+    assert_eq!(
+        union, expected,
+        "every file once, with the report of the single run"
+    );
+    // Balanced by bytes: no shard carries more than another plus the largest file and the
+    // per-file allowance.
+    let largest = whole
+        .iter()
+        .map(|(n, _)| {
+            std::fs::metadata(dir.path().join("lib").join(n))
+                .unwrap()
+                .len()
+        })
+        .max()
+        .unwrap();
+    let (max, min) = (bytes.iter().max().unwrap(), bytes.iter().min().unwrap());
+    assert!(max - min <= largest + 4096, "{bytes:?}, largest {largest}");
+}
+
+#[test]
+fn shards_of_migrate_write_together_what_one_run_writes() {
+    let dir = tempfile::tempdir().unwrap();
+    library(&dir.path().join("lib"), 12);
+    let o = velvet_in(dir.path(), &["migrate", "lib", "--out-dir", "one"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    for k in 1..=3 {
+        let shard = format!("{k}/3");
+        let o = velvet_in(
+            dir.path(),
+            &["migrate", "lib", "--out-dir", "sharded", "--shard", &shard],
+        );
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    }
+    let one = snapshot_tree(&dir.path().join("one"));
+    assert_eq!(one.len(), 12);
+    assert_eq!(snapshot_tree(&dir.path().join("sharded")), one);
+    // Bake's dry run over shards lists each file once.
+    let mut listed = Vec::new();
+    for k in 1..=3 {
+        let shard = format!("{k}/3");
+        let o = velvet_in(
+            dir.path(),
+            &[
+                "bake",
+                "lib",
+                "--dry-run",
+                "--format",
+                "json",
+                "--shard",
+                &shard,
+            ],
+        );
+        let report: Value = serde_json::from_str(&stdout(&o)).unwrap();
+        for f in report["files"].as_array().unwrap() {
+            listed.push(f["input"].as_str().unwrap().to_string());
+        }
+    }
+    listed.sort();
+    let mut all: Vec<String> = all_files(&dir.path().join("lib"))
+        .into_iter()
+        .filter(|f| !f.ends_with(".txt"))
+        .map(|f| format!("lib/{f}"))
+        .collect();
+    all.sort();
+    assert_eq!(listed, all);
+}
+
+#[test]
+fn a_bad_shard_is_a_usage_error() {
+    let o = velvet(&["validate", "--shard", "5/4", "assets"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("5/4: expected K/N with 1 <= K <= N, e.g. 2/4"),
+        "{}",
+        stderr(&o)
+    );
+}
+
+/// Runs velvet in `dir` with `input` on standard input.
+fn velvet_stdin(dir: &Path, args: &[&str], input: &[u8]) -> Output {
+    use std::io::Write as _;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_velvet"))
+        .current_dir(dir)
+        .args(args)
+        .env_remove("NO_COLOR")
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    child.stdin.take().unwrap().write_all(input).unwrap();
+    child.wait_with_output().unwrap()
+}
+
+#[test]
+fn files_from_standard_input_takes_nul_separated_names_with_spaces_and_newlines() {
+    let dir = tempfile::tempdir().unwrap();
+    let clean = std::fs::read(project().join("assets/clean.gltf")).unwrap();
+    std::fs::create_dir_all(dir.path().join("sub dir")).unwrap();
+    for name in [
+        "a b.gltf",
+        "new\nline.gltf",
+        "sub dir/c.GLTF",
+        "unlisted.gltf",
+    ] {
+        std::fs::write(dir.path().join(name), &clean).unwrap();
+    }
+    std::fs::write(dir.path().join("notes.txt"), "not an asset").unwrap();
+    // As `git diff --name-only -z` prints them: NUL after each, other files among them.
+    let list = b"a b.gltf\0notes.txt\0new\nline.gltf\0deleted.txt\0sub dir/c.GLTF\0";
+    let o = velvet_stdin(
+        dir.path(),
+        &["validate", "--format", "jsonl", "--files-from", "-"],
+        list,
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let uris: Vec<String> = stdout(&o)
+        .lines()
+        .map(|l| {
+            serde_json::from_str::<Value>(l).unwrap()["uri"]
+                .as_str()
+                .unwrap()
+                .to_string()
+        })
+        .collect();
+    assert_eq!(uris, ["a b.gltf", "new\nline.gltf", "sub dir/c.GLTF"]);
+    // One per line, from a file, with command-line paths besides.
+    std::fs::write(dir.path().join("list.txt"), "a b.gltf\r\nsub dir\n").unwrap();
+    let o = velvet_in(
+        dir.path(),
+        &[
+            "validate",
+            "-q",
+            "--files-from",
+            "list.txt",
+            "unlisted.gltf",
+        ],
+    );
+    assert_eq!(o.status.code(), Some(0));
+    let o = velvet_in(
+        dir.path(),
+        &[
+            "validate",
+            "--format",
+            "jsonl",
+            "--files-from",
+            "list.txt",
+            "unlisted.gltf",
+        ],
+    );
+    let uris: Vec<String> = stdout(&o)
+        .lines()
+        .map(|l| {
+            serde_json::from_str::<Value>(l).unwrap()["uri"]
+                .as_str()
+                .unwrap()
+                .to_string()
+        })
+        .collect();
+    assert_eq!(uris, ["unlisted.gltf", "a b.gltf", "sub dir/c.GLTF"]);
+    // A listed asset that does not exist is named; a list with no asset checks nothing and
+    // passes (a change that touched no asset).
+    let o = velvet_stdin(
+        dir.path(),
+        &["validate", "--files-from", "-"],
+        b"gone.glb\n",
+    );
+    assert_eq!(o.status.code(), Some(2));
+    assert_eq!(
+        stderr(&o),
+        "velvet: --files-from -: gone.glb (entry 1) does not exist\n"
+    );
+    let o = velvet_stdin(
+        dir.path(),
+        &["validate", "--files-from", "-"],
+        b"notes.txt\n",
+    );
+    assert_eq!(o.status.code(), Some(0));
+    assert_eq!(
+        stdout(&o),
+        "0 files checked: 0 errors, 0 warnings, 0 info, 0 hints\n"
+    );
+    // migrate and bake take lists too.
+    let o = velvet_stdin(
+        dir.path(),
+        &[
+            "migrate",
+            "--dry-run",
+            "--format",
+            "json",
+            "--files-from",
+            "-",
+        ],
+        b"new\nline.gltf\0",
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let report: Value = serde_json::from_str(&stdout(&o)).unwrap();
+    assert_eq!(report["files"][0]["input"], "new\nline.gltf");
+    assert_eq!(report["files"].as_array().unwrap().len(), 1);
+    let o = velvet_stdin(
+        dir.path(),
+        &["bake", "--dry-run", "--format", "json", "--files-from", "-"],
+        b"a b.gltf\n",
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let report: Value = serde_json::from_str(&stdout(&o)).unwrap();
+    assert_eq!(report["files"][0]["input"], "a b.gltf");
+}
+
+// ---------------------------------------------------------------- paths and exit status
+
+#[test]
+fn missing_paths_and_folders_without_assets_are_usage_errors_in_every_command() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir_all(dir.path().join("empty")).unwrap();
+    std::fs::create_dir_all(dir.path().join("docs/deeper")).unwrap();
+    std::fs::write(dir.path().join("docs/deeper/notes.txt"), "not an asset").unwrap();
+    let cases: [(&[&str], &str); 6] = [
+        (&["validate", "asets"], "asets: no such file or folder"),
+        (
+            &["validate", "empty"],
+            "empty: no .gltf or .glb file in this folder or below",
+        ),
+        (
+            &["validate", "docs"],
+            "docs: no .gltf or .glb file in this folder or below",
+        ),
+        (
+            &["migrate", "--dry-run", "nope.gltf"],
+            "nope.gltf: no such file or folder",
+        ),
+        (
+            &["bake", "--dry-run", "empty"],
+            "empty: no .gltf or .glb file in this folder or below",
+        ),
+        (
+            &["bake", "--dry-run", "nope"],
+            "nope: no such file or folder",
+        ),
+    ];
+    for (args, message) in cases {
+        let o = velvet_in(dir.path(), args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}");
+        assert_eq!(stderr(&o), format!("velvet: {message}\n"), "{args:?}");
+        assert!(o.stdout.is_empty(), "{args:?}");
+    }
+}
+
+#[test]
+fn fail_on_hint_fails_a_file_whose_only_findings_are_hints() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("fuzz.gltf"),
+        r#"{"asset":{"version":"2.0"},"extensionsUsed":["KHR_materials_fuzz"],"materials":[{"extensions":{"KHR_materials_fuzz":{"fuzzFactor":1}}}]}"#,
+    )
+    .unwrap();
+    let status = |args: &[&str]| velvet_in(dir.path(), args).status.code();
+    let o = velvet_in(dir.path(), &["validate", "fuzz.gltf"]);
+    assert!(stdout(&o).ends_with("1 file checked: 0 errors, 0 warnings, 0 info, 2 hints\n"));
+    assert_eq!(o.status.code(), Some(0));
+    assert_eq!(
+        status(&["validate", "--fail-on", "info", "fuzz.gltf"]),
+        Some(0)
+    );
+    assert_eq!(
+        status(&["validate", "--fail-on", "hint", "fuzz.gltf"]),
+        Some(1)
+    );
+    std::fs::write(dir.path().join("velvet.toml"), "fail-on = \"hint\"\n").unwrap();
+    assert_eq!(status(&["validate", "fuzz.gltf"]), Some(1));
+    assert_eq!(
+        status(&["validate", "--fail-on", "error", "fuzz.gltf"]),
+        Some(0)
+    );
+}
+
+#[test]
+fn command_line_ignore_adds_to_the_files_ignore() {
+    // nested/velvet.toml ignores VALUE_NOT_IN_RANGE; the command line adds UNEXPECTED_PROPERTY.
+    let codes = |args: &[&str]| -> Vec<String> {
+        let (_, r) = json_reports(args);
+        let mut codes: Vec<String> = r[0]["issues"]["messages"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|m| m["code"].as_str().unwrap().to_string())
+            .collect();
+        codes.dedup();
+        codes
+    };
+    let file_only = codes(&["nested/minified.gltf"]);
+    assert!(
+        file_only.contains(&"UNEXPECTED_PROPERTY".to_string()),
+        "{file_only:?}"
+    );
+    assert!(!file_only.contains(&"VALUE_NOT_IN_RANGE".to_string()));
+    let both = codes(&["--ignore", "UNEXPECTED_PROPERTY", "nested/minified.gltf"]);
+    assert!(
+        !both.contains(&"UNEXPECTED_PROPERTY".to_string()),
+        "{both:?}"
+    );
+    assert!(
+        !both.contains(&"VALUE_NOT_IN_RANGE".to_string()),
+        "{both:?}"
+    );
+    let o = velvet(&["config", "nested", "--ignore", "UNEXPECTED_PROPERTY"]);
+    assert!(stdout(&o).contains(
+        "ignore = [\"UNEXPECTED_PROPERTY\", \"VALUE_NOT_IN_RANGE\"]  # velvet.toml and command line\n"
+    ));
+    let help = stdout(&velvet(&["validate", "--help"]));
+    assert!(
+        help.contains("adds to the codes velvet.toml ignores"),
+        "{help}"
+    );
+}
+
+#[test]
+fn bench_is_not_in_the_users_help_but_still_runs() {
+    let help = stdout(&velvet(&["--help"]));
+    assert!(!help.contains("bench"), "{help}");
+    assert!(help.contains("validate") && help.contains("migrate") && help.contains("bake"));
+    let o = velvet(&["bench", "--help"]);
+    assert_eq!(o.status.code(), Some(0));
+    assert!(stdout(&o).contains("accuracy"));
+}
+
+// ---------------------------------------------------------------- folded, ordered text output
+
+#[test]
+fn text_output_folds_a_repeated_code_and_lists_findings_in_file_order() {
+    let dir = tempfile::tempdir().unwrap();
+    // Eight unknown properties in one sheen object, a legacy draft property, and an
+    // out-of-range roughness before them in the file.
+    let odd: Vec<String> = (0..8).map(|i| format!("\"odd{i}\": {i}")).collect();
+    let text = format!(
+        "{{\n\"asset\": {{\"version\": \"2.0\"}},\n\"extensionsUsed\": [\"KHR_materials_sheen\"],\n\"materials\": [{{\"extensions\": {{\"KHR_materials_sheen\": {{\n\"sheenRoughnessFactor\": 3,\n\"sheenFactor\": 1,\n{}\n}}}}}}]\n}}\n",
+        odd.join(",\n")
+    );
+    std::fs::write(dir.path().join("many.gltf"), text).unwrap();
+    let o = velvet_in(dir.path(), &["validate", "--color", "never", "many.gltf"]);
+    assert_eq!(o.status.code(), Some(1));
+    let p = "/materials/0/extensions/KHR_materials_sheen";
+    assert_eq!(
+        stdout(&o),
+        format!(
+            "many.gltf:5:25: error VALUE_NOT_IN_RANGE: 3 is greater than the maximum of 1.0\n    at {p}/sheenRoughnessFactor\n\
+             many.gltf:6:16: warning KHR_MATERIALS_SHEEN_LEGACY_DRAFT: sheenFactor belongs to the pre-ratification KHR_materials_sheen draft and is ignored by ratified loaders; `velvet migrate` upgrades it\n    at {p}/sheenFactor\n\
+             many.gltf:7:9: warning UNEXPECTED_PROPERTY: unexpected property 'odd0'\n    at {p}/odd0\n\
+             \x20   and 7 more at 8:9, 9:9, 10:9, 11:9, 12:9, … (8 in all; --no-fold prints each)\n\
+             1 file checked: 1 error, 9 warnings, 0 info, 0 hints\n"
+        )
+    );
+    let o = velvet_in(
+        dir.path(),
+        &["validate", "--color", "never", "--no-fold", "many.gltf"],
+    );
+    let lines: Vec<String> = stdout(&o)
+        .lines()
+        .filter(|l| !l.starts_with(' '))
+        .map(|l| l.split(": ").take(2).collect::<Vec<_>>().join(": "))
+        .collect();
+    let mut expected = vec![
+        "many.gltf:5:25: error VALUE_NOT_IN_RANGE".to_string(),
+        "many.gltf:6:16: warning KHR_MATERIALS_SHEEN_LEGACY_DRAFT".to_string(),
+    ];
+    expected.extend((7..15).map(|l| format!("many.gltf:{l}:9: warning UNEXPECTED_PROPERTY")));
+    expected.push("1 file checked: 1 error, 9 warnings, 0 info, 0 hints".to_string());
+    assert_eq!(lines, expected);
+}
+
+// ---------------------------------------------------------------- the README's snippets
+
+fn readme() -> String {
+    std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("README.md")).unwrap()
+}
+
+/// The first fenced block of `lang` after the heading line `heading` in `text`.
+fn block_after(text: &str, heading: &str, lang: &str) -> String {
+    let at = text
+        .find(&format!("\n{heading}\n"))
+        .unwrap_or_else(|| panic!("{heading} is in the text"));
+    let fence = format!("```{lang}\n");
+    let start = at + text[at..].find(&fence).unwrap() + fence.len();
+    let end = start + text[start..].find("```\n").unwrap();
+    text[start..end].to_string()
+}
+
+/// A copy of `from` at `to`, folders included.
+fn copy_tree(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap() {
+        let p = e.unwrap().path();
+        let target = to.join(p.file_name().unwrap());
+        if p.is_dir() {
+            copy_tree(&p, &target);
+        } else {
+            std::fs::copy(&p, &target).unwrap();
+        }
+    }
+}
+
+/// Runs a shell command line in `dir` with the velvet under test first on PATH.
+fn shell(dir: &Path, line: &str) -> Output {
+    let bin = Path::new(env!("CARGO_BIN_EXE_velvet")).parent().unwrap();
+    let path = format!(
+        "{}:{}",
+        bin.display(),
+        std::env::var("PATH").unwrap_or_default()
+    );
+    let mut cmd = Command::new("sh");
+    cmd.current_dir(dir).arg("-c").arg(line).env("PATH", path);
+    for var in ["NO_COLOR", "CLICOLOR", "CLICOLOR_FORCE", "TERM", "CI"] {
+        cmd.env_remove(var);
+    }
+    cmd.output().unwrap()
+}
+
+const INSTALL: &str = "cargo install --locked --git \"$VELVET_GIT_URL\" velvet";
+
+#[test]
+fn readme_pre_commit_snippet_runs_as_pre_commit_runs_it_with_mixed_case_names() {
+    let text = block_after(&readme(), "### pre-commit", "yaml");
+    let config: Value = serde_yaml_ng::from_str(&text).expect("the snippet is YAML");
+    let repo = &config["repos"][0];
+    assert_eq!(
+        repo["repo"], "local",
+        "no rev to name: the hook runs the installed velvet"
+    );
+    let hook = &repo["hooks"][0];
+    assert_eq!(hook["language"], "system");
+    let hook = Hook {
+        id: hook["id"].as_str().unwrap().to_string(),
+        entry: hook["entry"].as_str().unwrap().to_string(),
+        language: hook["language"].as_str().unwrap().to_string(),
+        files: hook["files"].as_str().unwrap().to_string(),
+    };
+    assert_eq!(hook.id, "velvet-validate");
+    // The hooks velvet's repository ships select the same files.
+    for shipped in hooks() {
+        assert_eq!(shipped.files, hook.files, "{}", shipped.id);
+    }
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join("models")).unwrap();
+    std::fs::copy(
+        project().join("assets/mixed.gltf"),
+        dir.path().join("models/UPPER.GLTF"),
+    )
+    .unwrap();
+    std::fs::copy(
+        project().join("assets/clean.gltf"),
+        dir.path().join("models/Chair.Gltf"),
+    )
+    .unwrap();
+    std::fs::write(dir.path().join("models/notes.txt"), "not an asset").unwrap();
+    let (ok, out) = run_hook(&hook, dir.path(), 100);
+    assert!(!ok, "{out}");
+    assert!(
+        out.contains("models/UPPER.GLTF:10:43: error UNRESOLVED_REFERENCE"),
+        "{out}"
+    );
+    assert!(
+        out.ends_with("2 files checked: 2 errors, 2 warnings, 0 info, 2 hints\n"),
+        "{out}"
+    );
+    std::fs::remove_file(dir.path().join("models/UPPER.GLTF")).unwrap();
+    let (ok, out) = run_hook(&hook, dir.path(), 100);
+    assert!(ok, "{out}");
+    assert_eq!(
+        out,
+        "1 file checked: 0 errors, 0 warnings, 0 info, 0 hints\n"
+    );
+}
+
+#[test]
+fn readme_github_actions_snippet_runs_as_written() {
+    let text = block_after(
+        &readme(),
+        "### GitHub Actions, with findings in code scanning",
+        "yaml",
+    );
+    let workflow: Value = serde_yaml_ng::from_str(&text).expect("the workflow is YAML");
+    let job = &workflow["jobs"]["velvet"];
+    assert_eq!(job["permissions"]["security-events"], "write");
+    assert_eq!(job["env"]["VELVET_GIT_URL"], "${{ vars.VELVET_GIT_URL }}");
+    let steps = job["steps"].as_array().unwrap();
+    let runs: Vec<&str> = steps.iter().filter_map(|s| s["run"].as_str()).collect();
+    assert_eq!(runs[0], INSTALL);
+    let dir = tempfile::tempdir().unwrap();
+    copy_tree(&project(), dir.path());
+    let o = shell(dir.path(), runs[1]);
+    assert_eq!(
+        o.status.code(),
+        Some(1),
+        "the project has errors: the step fails"
+    );
+    let log: Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("velvet.sarif")).unwrap()).unwrap();
+    assert_eq!(log["version"], "2.1.0");
+    assert_eq!(log["runs"][0]["results"].as_array().unwrap().len(), 12);
+    let upload = steps
+        .iter()
+        .find(|s| {
+            s["uses"]
+                .as_str()
+                .is_some_and(|u| u.starts_with("github/codeql-action/upload-sarif@"))
+        })
+        .expect("an upload step");
+    assert_eq!(
+        upload["if"], "always()",
+        "findings are uploaded when the step failed"
+    );
+    assert_eq!(upload["with"]["sarif_file"], "velvet.sarif");
+    assert_eq!(upload["with"]["category"], "velvet");
+}
+
+#[test]
+fn readme_gitlab_snippet_runs_as_written() {
+    let text = block_after(&readme(), "### GitLab CI", "yaml");
+    let config: Value = serde_yaml_ng::from_str(&text).expect("the job is YAML");
+    let job = &config["velvet"];
+    let script: Vec<&str> = job["script"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|l| l.as_str().unwrap())
+        .collect();
+    assert_eq!(script[0], INSTALL);
+    let dir = tempfile::tempdir().unwrap();
+    copy_tree(&project(), dir.path());
+    let o = shell(dir.path(), script[1]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "the SARIF line never fails the job"
+    );
+    let log: Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("velvet.sarif")).unwrap()).unwrap();
+    assert_eq!(log["runs"][0]["results"].as_array().unwrap().len(), 12);
+    let o = shell(dir.path(), script[2]);
+    assert_eq!(
+        o.status.code(),
+        Some(1),
+        "the coloured run sets the job's status"
+    );
+    assert!(stdout(&o).contains(ESC));
+    assert_eq!(job["artifacts"]["when"], "always");
+    assert_eq!(job["artifacts"]["paths"][0], "velvet.sarif");
+}
+
+#[test]
+fn readme_output_example_is_what_velvet_prints() {
+    let readme = readme();
+    let start = readme
+        .find("```text\n$ velvet validate assets/mixed.gltf\n")
+        .unwrap();
+    let body = &readme[start + "```text\n".len()..];
+    let body = &body[..body.find("```\n").unwrap()];
+    let (command, shown) = body.split_once('\n').unwrap();
+    let args: Vec<&str> = command.split_whitespace().skip(2).collect();
+    let o = velvet(&args);
+    assert_eq!(o.status.code(), Some(1));
+    assert_eq!(stdout(&o), shown);
+}
+
+#[test]
+fn every_yaml_snippet_in_the_readme_and_ci_docs_parses() {
+    let docs = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/ci.md");
+    for (name, text) in [
+        ("README.md", readme()),
+        ("docs/ci.md", std::fs::read_to_string(docs).unwrap()),
+    ] {
+        let mut rest = text.as_str();
+        let mut blocks = 0;
+        while let Some(at) = rest.find("```yaml\n") {
+            let body = &rest[at + 8..];
+            let end = body.find("```\n").unwrap();
+            let snippet = &body[..end];
+            serde_yaml_ng::from_str::<Value>(snippet)
+                .unwrap_or_else(|e| panic!("{name}: {e}\n{snippet}"));
+            let revs: Vec<&str> = snippet.lines().filter(|l| l.contains("rev:")).collect();
+            assert!(
+                revs.is_empty(),
+                "{name}: a snippet names a rev, which would have to exist: {revs:?}"
+            );
+            blocks += 1;
+            rest = &body[end..];
+        }
+        assert!(blocks >= 3, "{name}");
+    }
+}
+
+#[test]
+fn readme_first_commands_are_the_ci_test_command_and_the_binary_it_builds() {
+    let block = block_after(&readme(), "## From a clone: the first two commands", "sh");
+    let commands: Vec<&str> = block
+        .lines()
+        .map(|l| l.split('#').next().unwrap().trim())
+        .collect();
+    assert_eq!(commands.len(), 2);
+    assert_eq!(commands[0], "cargo test --locked");
+    let ci =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(".ci/run")).unwrap();
+    assert_eq!(
+        ci.lines().last(),
+        Some(commands[0]),
+        ".ci/run runs the README's test command"
+    );
+    // The second runs the binary the test build made, on a file that exists.
+    let words: Vec<&str> = commands[1].split_whitespace().collect();
+    assert_eq!(words[0], "target/debug/velvet");
+    let o = velvet_in(Path::new(env!("CARGO_MANIFEST_DIR")), &words[1..]);
+    assert_eq!(o.status.code(), Some(0), "{}", stdout(&o));
+}
+
+/// Runs a shell line in `dir` with extra environment variables.
+fn shell_with(dir: &Path, line: &str, env: &[(&str, String)]) -> Output {
+    let bin = Path::new(env!("CARGO_BIN_EXE_velvet")).parent().unwrap();
+    let path = format!(
+        "{}:{}",
+        bin.display(),
+        std::env::var("PATH").unwrap_or_default()
+    );
+    Command::new("sh")
+        .current_dir(dir)
+        .arg("-c")
+        .arg(line)
+        .env("PATH", path)
+        .envs(env.iter().map(|(k, v)| (*k, v.as_str())))
+        .output()
+        .unwrap()
+}
+
+/// The sorted lines of the jsonl reports in `text`, each report's `uri` kept.
+fn sorted_lines(text: &str) -> Vec<String> {
+    let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+    lines.sort();
+    lines
+}
+
+#[test]
+fn ci_docs_shard_recipes_cover_the_library_once_as_written() {
+    let docs =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/ci.md")).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    library(&dir.path().join("assets"), 17);
+    let whole = velvet_in(dir.path(), &["validate", "--format", "jsonl", "assets/"]);
+    let whole = sorted_lines(&stdout(&whole));
+    assert_eq!(whole.len(), 17);
+
+    // GitLab `parallel:`: each copy's script with its CI_NODE_INDEX, then the report job.
+    let gitlab: Value =
+        serde_yaml_ng::from_str(&block_after(&docs, "### GitLab `parallel:`", "yaml")).unwrap();
+    let total = gitlab["velvet"]["parallel"].as_u64().unwrap();
+    let script: Vec<&str> = gitlab["velvet"]["script"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|l| l.as_str().unwrap())
+        .collect();
+    assert_eq!(script[0], INSTALL);
+    for k in 1..=total {
+        let env = [
+            ("CI_NODE_INDEX", k.to_string()),
+            ("CI_NODE_TOTAL", total.to_string()),
+        ];
+        assert_eq!(
+            shell_with(dir.path(), script[1], &env).status.code(),
+            Some(0)
+        );
+        let status = shell_with(dir.path(), script[2], &env).status.code();
+        assert!(status == Some(0) || status == Some(1), "{status:?}");
+    }
+    let report = gitlab["velvet-report"]["script"][0].as_str().unwrap();
+    assert_eq!(shell_with(dir.path(), report, &[]).status.code(), Some(0));
+    let merged = std::fs::read_to_string(dir.path().join("velvet.jsonl")).unwrap();
+    assert_eq!(
+        sorted_lines(&merged),
+        whole,
+        "the parts' reports are the whole run's"
+    );
+
+    // GitHub Actions matrix: one SARIF log per part, every file's results once among them.
+    let github: Value =
+        serde_yaml_ng::from_str(&block_after(&docs, "### GitHub Actions matrix", "yaml")).unwrap();
+    let job = &github["jobs"]["velvet"];
+    let shards: Vec<u64> = job["strategy"]["matrix"]["shard"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_u64().unwrap())
+        .collect();
+    let steps = job["steps"].as_array().unwrap();
+    let run = steps
+        .iter()
+        .filter_map(|s| s["run"].as_str())
+        .nth(1)
+        .unwrap();
+    assert!(run.contains(&format!("/{} ", shards.len())), "{run}");
+    let mut results = 0;
+    let mut categories = Vec::new();
+    for k in &shards {
+        let line = run.replace("${{ matrix.shard }}", &k.to_string());
+        shell_with(dir.path(), &line, &[]);
+        let log: Value =
+            serde_json::from_slice(&std::fs::read(dir.path().join("velvet.sarif")).unwrap())
+                .unwrap();
+        results += log["runs"][0]["results"].as_array().unwrap().len();
+        let upload = steps
+            .iter()
+            .find(|s| s["with"]["category"].is_string())
+            .unwrap();
+        categories.push(
+            upload["with"]["category"]
+                .as_str()
+                .unwrap()
+                .replace("${{ matrix.shard }}", &k.to_string()),
+        );
+    }
+    let single = velvet_in(dir.path(), &["validate", "--format", "sarif", "assets/"]);
+    let single: Value = serde_json::from_str(&stdout(&single)).unwrap();
+    assert_eq!(
+        results,
+        single["runs"][0]["results"].as_array().unwrap().len()
+    );
+    categories.dedup();
+    assert_eq!(categories.len(), shards.len(), "a category per part");
+
+    // Kubernetes Indexed Job: each index's command, the volumes' paths put in a temporary
+    // folder, writes its part; the parts together are the whole run.
+    let k8s: Value =
+        serde_yaml_ng::from_str(&block_after(&docs, "### Kubernetes Indexed Job", "yaml")).unwrap();
+    let completions = k8s["spec"]["completions"].as_u64().unwrap();
+    let container = &k8s["spec"]["template"]["spec"]["containers"][0];
+    assert_eq!(container["command"][1], "-c");
+    let line = container["args"][0].as_str().unwrap();
+    assert!(line.contains(&format!("+ 1))/{completions}\"")), "{line}");
+    let reports = dir.path().join("reports");
+    std::fs::create_dir(&reports).unwrap();
+    let line = line
+        .replace("/library/", &format!("{}/", dir.path().display()))
+        .replace("/reports/", &format!("{}/", reports.display()));
+    for index in 0..completions {
+        shell_with(
+            dir.path(),
+            &line,
+            &[("JOB_COMPLETION_INDEX", index.to_string())],
+        );
+    }
+    let mut merged = String::new();
+    for index in 0..completions {
+        merged += &std::fs::read_to_string(reports.join(format!("velvet-{index}.jsonl"))).unwrap();
+    }
+    // The reports name files by the absolute path the pods were given.
+    let absolute = sorted_lines(&stdout(&velvet_in(
+        dir.path(),
+        &[
+            "validate",
+            "--format",
+            "jsonl",
+            dir.path().join("assets").to_str().unwrap(),
+        ],
+    )));
+    assert_eq!(sorted_lines(&merged), absolute);
 }

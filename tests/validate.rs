@@ -290,7 +290,7 @@ fn several_files_give_an_array_or_json_lines() {
 }
 
 #[test]
-fn folders_are_searched_recursively_and_a_missing_file_does_not_stop_the_run() {
+fn folders_are_searched_recursively_and_a_missing_path_is_a_usage_error() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::create_dir_all(dir.path().join("a/b")).unwrap();
     std::fs::copy(
@@ -304,15 +304,13 @@ fn folders_are_searched_recursively_and_a_missing_file_does_not_stop_the_run() {
     )
     .unwrap();
     std::fs::write(dir.path().join("a/notes.txt"), "not an asset").unwrap();
-    let missing = dir.path().join("missing.gltf");
     let (status, out, _) = velvet(&[
         "validate",
         "--format",
         "jsonl",
         dir.path().to_str().unwrap(),
-        missing.to_str().unwrap(),
     ]);
-    assert_eq!(status, 1);
+    assert_eq!(status, 0);
     let lines: Vec<Value> = out
         .lines()
         .map(|l| serde_json::from_str(l).unwrap())
@@ -329,10 +327,22 @@ fn folders_are_searched_recursively_and_a_missing_file_does_not_stop_the_run() {
                 .to_string()
         })
         .collect();
-    assert_eq!(uris, ["one.GLTF", "two.glb", "missing.gltf"]);
-    assert_eq!(lines[2]["issues"]["messages"][0]["code"], "IO_ERROR");
+    assert_eq!(uris, ["one.GLTF", "two.glb"]);
     assert_eq!(lines[0]["issues"]["numErrors"], 0);
     assert_eq!(lines[1]["issues"]["numErrors"], 0);
+    // A path that does not exist stops the run before anything is read, naming the path.
+    let missing = dir.path().join("missing.gltf");
+    let (status, out, err) = velvet(&[
+        "validate",
+        dir.path().to_str().unwrap(),
+        missing.to_str().unwrap(),
+    ]);
+    assert_eq!(status, 2);
+    assert_eq!(out, "");
+    assert_eq!(
+        err,
+        format!("velvet: {}: no such file or folder\n", missing.display())
+    );
 }
 
 #[test]
@@ -353,11 +363,11 @@ fn codes_command_lists_every_registered_code_once() {
 }
 
 #[test]
-fn readme_codes_table_is_the_registry() {
-    let readme = std::fs::read_to_string("README.md").unwrap();
+fn codes_table_in_the_docs_is_the_registry() {
+    let readme = std::fs::read_to_string("docs/codes.md").unwrap();
     let start = readme
         .find("<!-- codes:start -->\n")
-        .expect("README has the codes table markers")
+        .expect("docs/codes.md has the codes table markers")
         + "<!-- codes:start -->\n".len();
     let end = readme.find("<!-- codes:end -->").unwrap();
     let (_, table, _) = velvet(&["codes", "--format", "markdown"]);
@@ -598,9 +608,10 @@ fn json_shape_follows_the_arguments_not_the_number_of_files() {
     assert!(file.is_object(), "{file}");
     let folder = json_of(&[dir.path().to_str().unwrap()]);
     assert_eq!(folder.as_array().map(Vec::len), Some(1), "{folder}");
-    let empty = tempfile::tempdir().unwrap();
-    let none = json_of(&[empty.path().to_str().unwrap()]);
-    assert_eq!(none, json!([]));
+    let both = json_of(&[one.to_str().unwrap(), one.to_str().unwrap()]);
+    assert_eq!(both.as_array().map(Vec::len), Some(2), "{both}");
+    let sharded = json_of(&["--shard", "1/1", one.to_str().unwrap()]);
+    assert_eq!(sharded.as_array().map(Vec::len), Some(1), "{sharded}");
 }
 
 #[test]

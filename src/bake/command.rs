@@ -22,6 +22,7 @@ use super::engine::{bake, BakeOptions, MaxImagePixels};
 use super::kernel::KernelOptions;
 use super::plan::{plan, BakePlan, Note, PlanOptions};
 use super::prune::Dropped;
+use crate::asset::discover::Shard;
 use crate::asset::{self, resource, write};
 use crate::diagnostics::Severity;
 use crate::migrate::apply::{copy_resources, create_parent};
@@ -374,7 +375,17 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
 
 /// Runs a request: every file in parallel; folders that cannot be read become failed results.
 pub fn run(request: &Request) -> Result<Vec<FileResult>, UsageError> {
-    let (jobs, walk_errors) = jobs(&request.inputs, &request.destination, request.dry_run)?;
+    run_shard(request, None)
+}
+
+/// Runs like [`run`] over the files of one shard only (see [`Shard`]).
+pub fn run_shard(request: &Request, shard: Option<Shard>) -> Result<Vec<FileResult>, UsageError> {
+    let (jobs, walk_errors) = jobs(
+        &request.inputs,
+        &request.destination,
+        request.dry_run,
+        shard,
+    )?;
     let claims = Claims::default();
     let bar = (request.progress && jobs.len() > 1 && std::io::stderr().is_terminal())
         .then(|| indicatif::ProgressBar::new(jobs.len() as u64));

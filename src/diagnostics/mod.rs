@@ -3,7 +3,7 @@
 //!
 //! Rules declare their own codes next to their logic (see `crate::rules`); `all_codes` gathers
 //! them with the loader's and the schema check's into the one list that `velvet codes`, the
-//! README table and the SARIF rule list are generated from.
+//! codes table in docs/codes.md and the SARIF rule list are generated from.
 
 pub mod codes;
 pub mod settings;

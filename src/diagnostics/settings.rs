@@ -11,6 +11,8 @@ pub enum FailOn {
     Error,
     Warning,
     Info,
+    /// Any finding fails, hints included.
+    Hint,
 }
 
 impl FailOn {
@@ -19,6 +21,7 @@ impl FailOn {
             FailOn::Error => Severity::Error,
             FailOn::Warning => Severity::Warning,
             FailOn::Info => Severity::Info,
+            FailOn::Hint => Severity::Hint,
         };
         severity <= limit
     }

@@ -7,6 +7,7 @@ use super::note::{Conversion, Level, Note, Skip};
 use super::paths::{jobs, Destination, Job, ResourceCopy};
 use super::plan::MaterialPlan;
 use super::{Options, UsageError};
+use crate::asset::discover::Shard;
 use crate::bake::command::Claims;
 use crate::edit::Edit;
 use rayon::prelude::*;
@@ -158,7 +159,17 @@ fn migrate_one(job: &Job, options: &Options, dry_run: bool, claims: &Claims) -> 
 
 /// Runs a request. `Err` is a usage error: nothing was read or written.
 pub fn run(request: &Request) -> Result<RunReport, UsageError> {
-    let (jobs, walk_errors) = jobs(&request.inputs, &request.destination, request.dry_run)?;
+    run_shard(request, None)
+}
+
+/// Runs like [`run`] over the files of one shard only (see [`Shard`]).
+pub fn run_shard(request: &Request, shard: Option<Shard>) -> Result<RunReport, UsageError> {
+    let (jobs, walk_errors) = jobs(
+        &request.inputs,
+        &request.destination,
+        request.dry_run,
+        shard,
+    )?;
     let claims = Claims::default();
     let bar = (request.progress && std::io::stderr().is_terminal() && jobs.len() > 1).then(|| {
         let bar = indicatif::ProgressBar::new(jobs.len() as u64);

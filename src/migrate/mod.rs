@@ -22,7 +22,7 @@ pub mod roughness;
 pub mod sheen_to_fuzz;
 pub mod textures;
 
-pub use batch::{run, FileOutcome, FileResult, Request, RunReport, Summary};
+pub use batch::{run, run_shard, FileOutcome, FileResult, Request, RunReport, Summary};
 pub use note::{Conversion, Level, Note, Skip};
 pub use paths::Destination;
 pub use plan::{plan_document, DocumentPlan, MaterialPlan};

@@ -71,12 +71,13 @@ fn container_extension(path: &Path) -> Option<&'static str> {
 /// Folders that could not be walked, with their error.
 pub type WalkErrors = Vec<(PathBuf, io::Error)>;
 
-/// Pairs every input file (folders walked) with its output, or refuses the request.
-/// Folders that cannot be read are returned with their error.
+/// Pairs every input file (folders walked; with a shard, that shard's files) with its output,
+/// or refuses the request. Folders that cannot be read are returned with their error.
 pub fn jobs(
     inputs: &[PathBuf],
     destination: &Destination,
     dry_run: bool,
+    shard: Option<discover::Shard>,
 ) -> Result<(Vec<Job>, WalkErrors), UsageError> {
     if inputs.is_empty() {
         return Err(UsageError::NoInputs);
@@ -103,25 +104,22 @@ pub fn jobs(
         }
     }
     let mut jobs = Vec::new();
-    let mut walk_errors = Vec::new();
-    for input in inputs {
-        let (files, errors) = discover::collect(std::slice::from_ref(input));
-        walk_errors.extend(errors);
-        for file in files {
-            let output = match destination {
-                Destination::None => None,
-                Destination::InPlace => Some(file.clone()),
-                Destination::File(output) => Some(output.clone()),
-                Destination::Dir(dir) => Some(match file.strip_prefix(input) {
-                    Ok(relative) if !relative.as_os_str().is_empty() => dir.join(relative),
-                    _ => dir.join(file.file_name().unwrap_or(file.as_os_str())),
-                }),
-            };
-            jobs.push(Job {
-                input: file,
-                output,
-            });
-        }
+    let (found, walk_errors) = discover::find(inputs, shard);
+    for discover::Found { path: file, input } in found {
+        let input = &inputs[input];
+        let output = match destination {
+            Destination::None => None,
+            Destination::InPlace => Some(file.clone()),
+            Destination::File(output) => Some(output.clone()),
+            Destination::Dir(dir) => Some(match file.strip_prefix(input) {
+                Ok(relative) if !relative.as_os_str().is_empty() => dir.join(relative),
+                _ => dir.join(file.file_name().unwrap_or(file.as_os_str())),
+            }),
+        };
+        jobs.push(Job {
+            input: file,
+            output,
+        });
     }
     if *destination != Destination::InPlace {
         let inputs: HashMap<PathBuf, &Path> = jobs

@@ -3,6 +3,7 @@
 //! Actions workflow commands. Renderers only format; they decide nothing. This module also
 //! owns the choices that shape output on a terminal: the format, colour, and the progress bar.
 
+pub mod fold;
 pub mod github;
 pub mod json;
 pub mod sarif;
@@ -79,6 +80,8 @@ pub struct Options {
     pub color: bool,
     /// Findings only: no summary line (text output; machine formats are always complete).
     pub quiet: bool,
+    /// Text output: every finding on its own, instead of one entry per code and file.
+    pub no_fold: bool,
 }
 
 /// Renders `reports` in `format`.
@@ -247,6 +250,7 @@ mod tests {
                 let options = Options {
                     color: false,
                     quiet,
+                    no_fold: false,
                 };
                 for n in 0..4 {
                     let all = reports(n);

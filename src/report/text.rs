@@ -1,10 +1,14 @@
 //! Human-readable report: one line per finding, `file:line:column: severity CODE message`,
 //! then the pointer; a summary line at the end. Colour (ANSI, via anstyle) only when asked.
+//!
+//! A file's findings are printed in file order, and a code found more than once in a file is
+//! printed once, followed by a line with how many more there are and where the first
+//! [`SHOWN`] of them stand (see [`fold`]); `--no-fold` prints each one.
 
-use super::{display_path, Options};
+use super::{display_path, fold, Options};
 use crate::asset::Container;
 use crate::diagnostics::Severity;
-use crate::validate::FileReport;
+use crate::validate::{FileReport, Finding};
 use anstyle::{AnsiColor, Style};
 use std::fmt::Write;
 
@@ -36,19 +40,31 @@ pub fn render_with(reports: &[FileReport], options: &Options) -> String {
     let mut totals = [0usize; 4];
     for report in reports {
         let file = display_path(&report.path);
-        for f in &report.findings {
-            let d = &f.diagnostic;
-            let place = match (f.position, report.container) {
-                (Some(p), Some(Container::Glb)) => {
-                    format!("{file}: byte {}", report.json_offset + p.offset)
-                }
-                (Some(p), _) => format!("{file}:{}:{}", p.line, p.column),
-                (None, _) => file.clone(),
-            };
+        let place = |f: &Finding| match (f.position, report.container) {
+            (Some(p), Some(Container::Glb)) => {
+                format!("{file}: byte {}", report.json_offset + p.offset)
+            }
+            (Some(p), _) => format!("{file}:{}:{}", p.line, p.column),
+            (None, _) => file.clone(),
+        };
+        let sorted = fold::by_position(&report.findings);
+        let groups = if options.no_fold {
+            sorted
+                .iter()
+                .map(|f| fold::Group {
+                    first: f,
+                    rest: Vec::new(),
+                })
+                .collect()
+        } else {
+            fold::fold(&sorted)
+        };
+        for group in groups {
+            let d = &group.first.diagnostic;
             let _ = writeln!(
                 out,
                 "{}: {} {}: {}",
-                paint(Style::new().bold(), &place),
+                paint(Style::new().bold(), &place(group.first)),
                 paint(severity_style(d.severity), d.severity.as_str()),
                 paint(Style::new().bold(), d.code),
                 d.message
@@ -59,6 +75,10 @@ pub fn render_with(reports: &[FileReport], options: &Options) -> String {
                     "    {}",
                     paint(Style::new().dimmed(), &format!("at {}", d.pointer))
                 );
+            }
+            if !group.rest.is_empty() {
+                let line = folded_line(&group.rest, report.container, report.json_offset);
+                let _ = writeln!(out, "    {}", paint(Style::new().dimmed(), &line));
             }
         }
         if report.truncated {
@@ -79,6 +99,34 @@ pub fn render_with(reports: &[FileReport], options: &Options) -> String {
     out
 }
 
+/// Positions listed on a folded entry's line before it ends in `…`.
+pub const SHOWN: usize = 5;
+
+/// The line under a folded entry: how many more findings of its code the file has, and where
+/// the first [`SHOWN`] of them stand (`line:column`, `byte N` in a .glb, or the pointer of a
+/// finding without a position).
+fn folded_line(rest: &[&Finding], container: Option<Container>, json_offset: usize) -> String {
+    let mut places: Vec<String> = rest
+        .iter()
+        .take(SHOWN)
+        .map(|f| match (f.position, container) {
+            (Some(p), Some(Container::Glb)) => format!("byte {}", json_offset + p.offset),
+            (Some(p), _) => format!("{}:{}", p.line, p.column),
+            (None, _) if !f.diagnostic.pointer.is_empty() => f.diagnostic.pointer.clone(),
+            (None, _) => "the whole file".to_string(),
+        })
+        .collect();
+    if rest.len() > SHOWN {
+        places.push("…".to_string());
+    }
+    format!(
+        "and {} more at {} ({} in all; --no-fold prints each)",
+        rest.len(),
+        places.join(", "),
+        rest.len() + 1
+    )
+}
+
 /// The closing line: files checked and findings per severity (`totals`: errors, warnings,
 /// infos, hints).
 pub fn summary(files: usize, totals: [usize; 4]) -> String {
@@ -93,4 +141,71 @@ pub fn summary(files: usize, totals: [usize; 4]) -> String {
         totals[3],
         if totals[3] == 1 { "" } else { "s" },
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::asset::position::Position;
+    use crate::diagnostics::Diagnostic;
+    use crate::validate::Counts;
+
+    fn finding(code: &'static str, pointer: &str, at: Option<(usize, usize, usize)>) -> Finding {
+        Finding {
+            diagnostic: Diagnostic {
+                code,
+                message: format!("{code} {pointer}"),
+                severity: Severity::Warning,
+                pointer: pointer.to_string(),
+                position: None,
+            },
+            position: at.map(|(line, column, offset)| Position {
+                line,
+                column,
+                offset,
+            }),
+        }
+    }
+
+    fn report(container: Container, findings: Vec<Finding>) -> FileReport {
+        FileReport {
+            path: "x/a.glb".into(),
+            container: Some(container),
+            json_offset: 20,
+            counts: Counts {
+                warnings: findings.len(),
+                ..Counts::default()
+            },
+            findings,
+            truncated: false,
+            omitted: 0,
+            info: None,
+        }
+    }
+
+    #[test]
+    fn a_folded_glb_entry_lists_byte_offsets_and_pointers_of_findings_without_a_position() {
+        let findings: Vec<Finding> = (0..7)
+            .map(|i| finding("A", &format!("/p/{i}"), Some((1, 1, 100 - i * 10))))
+            .chain([finding("A", "/absent", None), finding("B", "", None)])
+            .collect();
+        let text = render(&[report(Container::Glb, findings)]);
+        assert_eq!(
+            text,
+            "x/a.glb: warning A: A /absent\n    at /absent\n\
+             \x20   and 7 more at byte 60, byte 70, byte 80, byte 90, byte 100, … (8 in all; --no-fold prints each)\n\
+             x/a.glb: warning B: B \n\
+             1 file checked: 0 errors, 9 warnings, 0 info, 0 hints\n"
+        );
+        let short = vec![
+            finding("A", "/p/1", Some((3, 4, 30))),
+            finding("A", "/p/0", Some((2, 5, 10))),
+        ];
+        let text = render(&[report(Container::Gltf, short)]);
+        assert_eq!(
+            text,
+            "x/a.glb:2:5: warning A: A /p/0\n    at /p/0\n    and 1 more at 3:4 (2 in all; --no-fold prints each)\n\
+             1 file checked: 0 errors, 2 warnings, 0 info, 0 hints\n"
+        );
+    }
 }

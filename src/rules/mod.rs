@@ -1,7 +1,7 @@
 //! Validation rules. Each rule is one unit in its own file: the codes it emits (name, default
 //! severity, doc line), what it checks and why, and a test with a fixture that triggers it and a
 //! twin that does not. [`REGISTRY`] is the one place rules are listed; `velvet codes`, the
-//! README's table and report rule lists are generated from it.
+//! table in docs/codes.md and report rule lists are generated from it.
 //!
 //! Rules read the asset and push diagnostics; they never change anything.
 
