@@ -7,6 +7,8 @@
 //! goes last, a removed key closes the gap without moving its neighbours) and untouched numbers
 //! keep their text.
 
+pub mod splice;
+
 use crate::asset::pointer;
 use serde::Serialize;
 use serde_json::{Map, Value};

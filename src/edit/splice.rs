@@ -1,0 +1,648 @@
+//! Format-preserving output: an edited document is written as splices into its source text.
+//!
+//! Given the text a document was loaded from, the document as loaded and the document after a
+//! plan was applied, [`rewrite`] compares the two values and changes only the spans that
+//! differ: a changed value replaces its span, a new key goes after the last member of its
+//! object, a new element after the last element of its array, a removed member takes its
+//! separator with it. Every other byte — indentation, line endings, key order, number
+//! spellings (`1E-1`, `1.0`), unicode escapes, a missing final newline — comes out as it went
+//! in, so a migration's diff shows only what it changed (as toml_edit does for Cargo.toml).
+//!
+//! What velvet inserts follows the file's own layout: its indent unit (tabs or N spaces), its
+//! line ending, its spacing after `:` and `,`; an object or array written on one line stays on
+//! one line, a minified file stays minified, and arrays of numbers are inline when the file
+//! writes them so.
+//!
+//! Numbers velvet writes are rounded to [`DECIMALS`] decimal places and written as the
+//! shortest decimal that reads back as that value: an error of at most 5e-7, thirty times below
+//! one step of a 16-bit texture channel (1.5e-5), and no float noise such as
+//! `0.7499999999999999` in an output file. Numbers that already have at most that many
+//! decimals (copied from the input, or integers) keep their spelling.
+//!
+//! The span scanner is written here because serde_json gives no spans and no maintained crate
+//! offers format-preserving edits of JSON text (toml_edit's equivalent for JSON does not exist);
+//! it reads text serde_json has already accepted.
+
+use serde_json::{Map, Value};
+
+/// Decimal places of the numbers velvet writes.
+pub const DECIMALS: i32 = 6;
+
+/// The text of `after` written as splices into `text`, which holds `before`; `None` when the
+/// text cannot be scanned (the caller then writes the document afresh).
+pub fn rewrite(text: &str, before: &Value, after: &Value) -> Option<String> {
+    let root = Scanner { text, at: 0 }.value()?;
+    let layout = Layout::detect(text, &root);
+    let mut splices = Vec::new();
+    diff(text, &root, before, after, &layout, &mut splices);
+    splices.sort_by_key(|s| (s.start, s.end));
+    let mut out =
+        String::with_capacity(text.len() + splices.iter().map(|s| s.text.len()).sum::<usize>());
+    let mut at = 0;
+    for s in &splices {
+        if s.start < at {
+            return None; // overlapping splices: never produced, but never risk a broken file
+        }
+        out.push_str(&text[at..s.start]);
+        out.push_str(&s.text);
+        at = s.end;
+    }
+    out.push_str(&text[at..]);
+    Some(out)
+}
+
+/// A replacement of `text[start..end]`.
+#[derive(Debug)]
+struct Splice {
+    start: usize,
+    end: usize,
+    text: String,
+}
+
+/// A value's place in the source text: `text[start..end]`.
+#[derive(Debug)]
+struct Span {
+    start: usize,
+    end: usize,
+    node: Node,
+}
+
+#[derive(Debug)]
+enum Node {
+    Scalar,
+    /// Members as (where the key's opening quote stands, the value).
+    Object(Vec<(usize, Span)>),
+    Array(Vec<Span>),
+}
+
+struct Scanner<'a> {
+    text: &'a str,
+    at: usize,
+}
+
+impl Scanner<'_> {
+    fn peek(&self) -> Option<u8> {
+        self.text.as_bytes().get(self.at).copied()
+    }
+
+    fn skip_ws(&mut self) {
+        while matches!(self.peek(), Some(b' ' | b'\t' | b'\n' | b'\r')) {
+            self.at += 1;
+        }
+    }
+
+    fn eat(&mut self, byte: u8) -> Option<()> {
+        self.skip_ws();
+        (self.peek()? == byte).then(|| self.at += 1)
+    }
+
+    fn string(&mut self) -> Option<()> {
+        self.at += 1; // the opening quote
+        loop {
+            match self.peek()? {
+                b'"' => {
+                    self.at += 1;
+                    return Some(());
+                }
+                b'\\' => self.at += 2,
+                _ => self.at += 1,
+            }
+        }
+    }
+
+    fn value(&mut self) -> Option<Span> {
+        self.skip_ws();
+        let start = self.at;
+        let node = match self.peek()? {
+            b'{' => {
+                self.at += 1;
+                let mut members = Vec::new();
+                self.skip_ws();
+                if self.peek()? == b'}' {
+                    self.at += 1;
+                } else {
+                    loop {
+                        self.skip_ws();
+                        let key_start = self.at;
+                        if self.peek()? != b'"' {
+                            return None;
+                        }
+                        self.string()?;
+                        self.eat(b':')?;
+                        members.push((key_start, self.value()?));
+                        self.skip_ws();
+                        match self.peek()? {
+                            b',' => self.at += 1,
+                            b'}' => {
+                                self.at += 1;
+                                break;
+                            }
+                            _ => return None,
+                        }
+                    }
+                }
+                Node::Object(members)
+            }
+            b'[' => {
+                self.at += 1;
+                let mut items = Vec::new();
+                self.skip_ws();
+                if self.peek()? == b']' {
+                    self.at += 1;
+                } else {
+                    loop {
+                        items.push(self.value()?);
+                        self.skip_ws();
+                        match self.peek()? {
+                            b',' => self.at += 1,
+                            b']' => {
+                                self.at += 1;
+                                break;
+                            }
+                            _ => return None,
+                        }
+                    }
+                }
+                Node::Array(items)
+            }
+            b'"' => {
+                self.string()?;
+                Node::Scalar
+            }
+            _ => {
+                while matches!(self.peek(), Some(b) if !matches!(b, b',' | b'}' | b']' | b' ' | b'\t' | b'\n' | b'\r'))
+                {
+                    self.at += 1;
+                }
+                if self.at == start {
+                    return None;
+                }
+                Node::Scalar
+            }
+        };
+        Some(Span {
+            start,
+            end: self.at,
+            node,
+        })
+    }
+}
+
+/// How the file is laid out, read once.
+struct Layout {
+    /// The indent unit; `None` for a minified file (no line breaks).
+    unit: Option<String>,
+    newline: &'static str,
+    /// Between a key and its value (`": "` or `":"`, from the first member in the file).
+    colon: String,
+    /// Between the elements of a one-line container (`", "` or `","`).
+    inline_comma: String,
+    /// Whether arrays of numbers are written on one line in a pretty file.
+    inline_number_arrays: bool,
+}
+
+impl Layout {
+    fn detect(text: &str, root: &Span) -> Layout {
+        let newline = if text.contains("\r\n") { "\r\n" } else { "\n" };
+        let pretty = text.trim_end().contains('\n');
+        let unit = pretty.then(|| {
+            let unit = text.lines().skip(1).find_map(|line| {
+                let unit: String = line
+                    .chars()
+                    .take_while(|c| *c == ' ' || *c == '\t')
+                    .collect();
+                (!unit.is_empty()).then_some(unit)
+            });
+            unit.unwrap_or_else(|| "  ".to_string())
+        });
+        let mut layout = Layout {
+            unit,
+            newline,
+            colon: ":".to_string(),
+            inline_comma: ",".to_string(),
+            inline_number_arrays: false,
+        };
+        let mut seen_colon = false;
+        let mut seen_comma = false;
+        let mut seen_numbers = false;
+        visit(root, &mut |span| {
+            if let (Node::Object(members), false) = (&span.node, seen_colon) {
+                if let Some((key, value)) = members.first() {
+                    let between = &text[*key..value.start];
+                    // The key's closing quote is the last '"' before the colon.
+                    if let Some(colon) = between.rfind(':') {
+                        let quote = between[..colon].rfind('"').unwrap_or(0);
+                        layout.colon = between[quote + 1..].to_string();
+                        seen_colon = true;
+                    }
+                }
+            }
+            match &span.node {
+                Node::Object(members) if members.len() >= 2 => {
+                    if !seen_comma && !text[span.start..span.end].contains('\n') {
+                        layout.inline_comma = text[members[0].1.end..members[1].0].to_string();
+                        seen_comma = true;
+                    }
+                }
+                Node::Array(items) if items.len() >= 2 => {
+                    let one_line = !text[span.start..span.end].contains('\n');
+                    if !seen_comma && one_line {
+                        layout.inline_comma = text[items[0].end..items[1].start].to_string();
+                        seen_comma = true;
+                    }
+                    let numbers = items.iter().all(|i| {
+                        matches!(i.node, Node::Scalar)
+                            && matches!(text.as_bytes()[i.start], b'-' | b'0'..=b'9')
+                    });
+                    if numbers && !seen_numbers {
+                        layout.inline_number_arrays = one_line;
+                        seen_numbers = true;
+                    }
+                }
+                _ => {}
+            }
+        });
+        layout
+    }
+
+    /// Renders `value` whose first line starts at indentation `indent`; `inline` keeps it on
+    /// one line.
+    fn render(&self, value: &Value, indent: &str, inline: bool) -> String {
+        let mut out = String::new();
+        self.write(value, indent, inline || self.unit.is_none(), &mut out);
+        out
+    }
+
+    fn write(&self, value: &Value, indent: &str, inline: bool, out: &mut String) {
+        match value {
+            Value::Object(map) if !map.is_empty() => self.write_object(map, indent, inline, out),
+            Value::Array(items) if !items.is_empty() => {
+                let inline =
+                    inline || (self.inline_number_arrays && items.iter().all(Value::is_number));
+                if inline {
+                    out.push('[');
+                    for (i, item) in items.iter().enumerate() {
+                        if i > 0 {
+                            out.push_str(&self.inline_comma);
+                        }
+                        self.write(item, indent, true, out);
+                    }
+                    out.push(']');
+                } else {
+                    let inner = format!("{indent}{}", self.unit.as_deref().unwrap_or(""));
+                    out.push('[');
+                    for (i, item) in items.iter().enumerate() {
+                        if i > 0 {
+                            out.push(',');
+                        }
+                        out.push_str(self.newline);
+                        out.push_str(&inner);
+                        self.write(item, &inner, false, out);
+                    }
+                    out.push_str(self.newline);
+                    out.push_str(indent);
+                    out.push(']');
+                }
+            }
+            Value::Number(n) => out.push_str(&number_text(n)),
+            other => out.push_str(&other.to_string()),
+        }
+    }
+
+    fn write_object(&self, map: &Map<String, Value>, indent: &str, inline: bool, out: &mut String) {
+        if inline {
+            out.push('{');
+            for (i, (key, value)) in map.iter().enumerate() {
+                if i > 0 {
+                    out.push_str(&self.inline_comma);
+                }
+                out.push_str(&Value::String(key.clone()).to_string());
+                out.push_str(&self.colon);
+                self.write(value, indent, true, out);
+            }
+            out.push('}');
+            return;
+        }
+        let inner = format!("{indent}{}", self.unit.as_deref().unwrap_or(""));
+        out.push('{');
+        for (i, (key, value)) in map.iter().enumerate() {
+            if i > 0 {
+                out.push(',');
+            }
+            out.push_str(self.newline);
+            out.push_str(&inner);
+            out.push_str(&Value::String(key.clone()).to_string());
+            out.push_str(&self.colon);
+            self.write(value, &inner, false, out);
+        }
+        out.push_str(self.newline);
+        out.push_str(indent);
+        out.push('}');
+    }
+}
+
+fn visit(span: &Span, f: &mut dyn FnMut(&Span)) {
+    f(span);
+    match &span.node {
+        Node::Object(members) => members.iter().for_each(|(_, v)| visit(v, f)),
+        Node::Array(items) => items.iter().for_each(|v| visit(v, f)),
+        Node::Scalar => {}
+    }
+}
+
+/// A number as velvet writes it: its own spelling when it has at most [`DECIMALS`] decimals,
+/// otherwise rounded to that many and written as the shortest decimal that reads back.
+pub fn number_text(n: &serde_json::Number) -> String {
+    let text = n.to_string();
+    let decimals = match text.find(['e', 'E']) {
+        Some(_) => usize::MAX,
+        None => text.find('.').map_or(0, |dot| text.len() - dot - 1),
+    };
+    if decimals <= DECIMALS as usize {
+        return text;
+    }
+    let Some(x) = n.as_f64() else { return text };
+    let scale = 10f64.powi(DECIMALS);
+    let rounded = (x * scale).round() / scale;
+    if rounded == 0.0 {
+        return "0".to_string();
+    }
+    // Display writes the shortest decimal that reads back as the same f64.
+    format!("{rounded}")
+}
+
+/// The indentation of the line `at` lies on.
+fn line_indent(text: &str, at: usize) -> &str {
+    let line_start = text[..at].rfind('\n').map_or(0, |p| p + 1);
+    let line = &text[line_start..];
+    let len = line.len() - line.trim_start_matches([' ', '\t']).len();
+    &line[..len]
+}
+
+fn one_line(text: &str, span: &Span) -> bool {
+    !text[span.start..span.end].contains('\n')
+}
+
+fn diff(
+    text: &str,
+    span: &Span,
+    before: &Value,
+    after: &Value,
+    layout: &Layout,
+    out: &mut Vec<Splice>,
+) {
+    if before == after {
+        return;
+    }
+    match (&span.node, before, after) {
+        (Node::Object(members), Value::Object(b), Value::Object(a)) if members.len() == b.len() => {
+            diff_object(text, span, members, b, a, layout, out)
+        }
+        (Node::Array(items), Value::Array(b), Value::Array(a))
+            if items.len() == b.len() && a.len() >= b.len() =>
+        {
+            for ((item, old), new) in items.iter().zip(b).zip(a) {
+                diff(text, item, old, new, layout, out);
+            }
+            if a.len() > b.len() {
+                append(
+                    text,
+                    span,
+                    items.last().map(|i| i.end),
+                    &a[b.len()..],
+                    layout,
+                    out,
+                );
+            }
+        }
+        _ => replace(text, span, after, layout, out),
+    }
+}
+
+/// Writes `after` over `span`: on one line where the old value was a one-line container, laid
+/// out over lines (at the indentation of the line it starts on) where it was a scalar or a
+/// multi-line container.
+fn replace(text: &str, span: &Span, after: &Value, layout: &Layout, out: &mut Vec<Splice>) {
+    let was_one_line_container = !matches!(span.node, Node::Scalar) && one_line(text, span);
+    out.push(Splice {
+        start: span.start,
+        end: span.end,
+        text: layout.render(after, line_indent(text, span.start), was_one_line_container),
+    });
+}
+
+#[allow(clippy::too_many_arguments)]
+fn diff_object(
+    text: &str,
+    span: &Span,
+    members: &[(usize, Span)],
+    before: &Map<String, Value>,
+    after: &Map<String, Value>,
+    layout: &Layout,
+    out: &mut Vec<Splice>,
+) {
+    let removed: Vec<bool> = before.keys().map(|k| !after.contains_key(k)).collect();
+    let added: Vec<(&String, &Value)> = after
+        .iter()
+        .filter(|(k, _)| !before.contains_key(*k))
+        .collect();
+    let any_removed = removed.iter().any(|r| *r);
+    if any_removed && (!added.is_empty() || removed.iter().all(|r| *r)) {
+        // Members both leave and arrive, or all leave: the object is written anew, in place.
+        return replace(text, span, &Value::Object(after.clone()), layout, out);
+    }
+    for (i, ((key_start, value), (key, old))) in members.iter().zip(before).enumerate() {
+        if removed[i] {
+            let (start, end) = match (i, members.get(i + 1)) {
+                // A member after the first takes the separator before it.
+                (i, _) if i > 0 => (members[i - 1].1.end, value.end),
+                // The first member takes the separator after it.
+                (_, Some((next_key, _))) => (*key_start, *next_key),
+                (_, None) => unreachable!("an object whose members all leave is replaced"),
+            };
+            out.push(Splice {
+                start,
+                end,
+                text: String::new(),
+            });
+        } else {
+            diff(text, value, old, &after[key], layout, out);
+        }
+    }
+    if added.is_empty() {
+        return;
+    }
+    let inline = layout.unit.is_none() || (one_line(text, span) && !members.is_empty());
+    let mut insert = String::new();
+    match members.last() {
+        Some((last_key, last_value)) => {
+            let indent = line_indent(text, *last_key).to_string();
+            let separator = if inline {
+                members
+                    .get(1)
+                    .map(|(k, _)| text[members[0].1.end..*k].to_string())
+                    .unwrap_or_else(|| layout.inline_comma.clone())
+            } else {
+                format!(",{}{indent}", layout.newline)
+            };
+            for (key, value) in &added {
+                insert.push_str(&separator);
+                insert.push_str(&Value::String((*key).clone()).to_string());
+                insert.push_str(&layout.colon);
+                insert.push_str(&layout.render(value, &indent, inline));
+            }
+            out.push(Splice {
+                start: last_value.end,
+                end: last_value.end,
+                text: insert,
+            });
+        }
+        None => {
+            // An empty object: written anew with its members.
+            replace(text, span, &Value::Object(after.clone()), layout, out);
+        }
+    }
+}
+
+fn append(
+    text: &str,
+    span: &Span,
+    last_end: Option<usize>,
+    items: &[Value],
+    layout: &Layout,
+    out: &mut Vec<Splice>,
+) {
+    let Some(last_end) = last_end else {
+        // An empty array: written anew with its elements.
+        let mut all = Vec::with_capacity(items.len());
+        all.extend_from_slice(items);
+        return replace(text, span, &Value::Array(all), layout, out);
+    };
+    let inline = layout.unit.is_none() || one_line(text, span);
+    let Node::Array(existing) = &span.node else {
+        return;
+    };
+    let indent = line_indent(text, existing[existing.len() - 1].start).to_string();
+    let separator = if inline {
+        existing
+            .get(1)
+            .map(|second| text[existing[0].end..second.start].to_string())
+            .unwrap_or_else(|| layout.inline_comma.clone())
+    } else {
+        format!(",{}{indent}", layout.newline)
+    };
+    let mut insert = String::new();
+    for item in items {
+        insert.push_str(&separator);
+        insert.push_str(&layout.render(item, &indent, inline));
+    }
+    out.push(Splice {
+        start: last_end,
+        end: last_end,
+        text: insert,
+    });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Applies `edit` to the parsed `text` and splices the result back.
+    fn edited(text: &str, edit: impl FnOnce(&mut Value)) -> String {
+        let before: Value = serde_json::from_str(text).unwrap();
+        let mut after = before.clone();
+        edit(&mut after);
+        let out = rewrite(text, &before, &after).unwrap();
+        let reread: Value = serde_json::from_str(&out).unwrap();
+        assert_eq!(
+            reread, after,
+            "the spliced text reads back as the edited document"
+        );
+        out
+    }
+
+    fn add_fuzz(doc: &mut Value) {
+        doc["materials"][0]["extensions"]["KHR_materials_fuzz"] =
+            serde_json::json!({"fuzzColorFactor": [0.5, 0.25, 1.0], "fuzzRoughnessFactor": 0.5});
+    }
+
+    #[test]
+    fn a_key_goes_into_its_object_in_the_files_layout() {
+        let text = "{\n\t\"materials\": [\n\t\t{\n\t\t\t\"extensions\": {\n\t\t\t\t\"KHR_materials_sheen\": {\"sheenColorFactor\": [1, 1, 1]}\n\t\t\t}\n\t\t}\n\t]\n}";
+        let out = edited(text, add_fuzz);
+        assert_eq!(
+            out,
+            "{\n\t\"materials\": [\n\t\t{\n\t\t\t\"extensions\": {\n\t\t\t\t\"KHR_materials_sheen\": {\"sheenColorFactor\": [1, 1, 1]},\n\t\t\t\t\"KHR_materials_fuzz\": {\n\t\t\t\t\t\"fuzzColorFactor\": [0.5, 0.25, 1.0],\n\t\t\t\t\t\"fuzzRoughnessFactor\": 0.5\n\t\t\t\t}\n\t\t\t}\n\t\t}\n\t]\n}"
+        );
+    }
+
+    #[test]
+    fn a_minified_file_stays_minified_and_crlf_stays_crlf() {
+        let text = r#"{"materials":[{"extensions":{"KHR_materials_sheen":{"sheenRoughnessFactor":1E-1}}}]}"#;
+        assert_eq!(
+            edited(text, add_fuzz),
+            r#"{"materials":[{"extensions":{"KHR_materials_sheen":{"sheenRoughnessFactor":1E-1},"KHR_materials_fuzz":{"fuzzColorFactor":[0.5,0.25,1.0],"fuzzRoughnessFactor":0.5}}}]}"#
+        );
+        let text = "{\r\n  \"asset\": {\"version\": \"2.0\"},\r\n  \"extensionsUsed\": [\r\n    \"KHR_materials_sheen\"\r\n  ]\r\n}\r\n";
+        let out = edited(text, |d| {
+            d["extensionsUsed"]
+                .as_array_mut()
+                .unwrap()
+                .push("KHR_materials_fuzz".into())
+        });
+        assert_eq!(
+            out,
+            "{\r\n  \"asset\": {\"version\": \"2.0\"},\r\n  \"extensionsUsed\": [\r\n    \"KHR_materials_sheen\",\r\n    \"KHR_materials_fuzz\"\r\n  ]\r\n}\r\n"
+        );
+    }
+
+    #[test]
+    fn one_line_objects_stay_on_one_line_and_untouched_spellings_stay() {
+        let text = "{\n    \"a\": {\"x\": 1.0, \"y\": \"\\u00e9\"},\n    \"b\": 3E2\n}";
+        let out = edited(text, |d| d["a"]["z"] = serde_json::json!([1, 2]));
+        assert_eq!(
+            out,
+            "{\n    \"a\": {\"x\": 1.0, \"y\": \"\\u00e9\", \"z\": [1, 2]},\n    \"b\": 3E2\n}"
+        );
+    }
+
+    #[test]
+    fn a_changed_value_replaces_its_span_and_a_removed_member_takes_its_separator() {
+        let text = "{\n  \"a\": 0.5,\n  \"b\": [1, 2],\n  \"c\": true\n}\n";
+        let out = edited(text, |d| {
+            d["a"] = serde_json::json!(0.25);
+            d.as_object_mut().unwrap().remove("b");
+        });
+        assert_eq!(out, "{\n  \"a\": 0.25,\n  \"c\": true\n}\n");
+        // A computed value with float noise is written rounded.
+        let before: Value = serde_json::from_str(text).unwrap();
+        let mut after = before.clone();
+        after["a"] = serde_json::json!(0.7499999999999999);
+        assert_eq!(
+            rewrite(text, &before, &after).unwrap(),
+            "{\n  \"a\": 0.75,\n  \"b\": [1, 2],\n  \"c\": true\n}\n"
+        );
+        let out = edited(text, |d| {
+            d.as_object_mut().unwrap().remove("a");
+        });
+        assert_eq!(out, "{\n  \"b\": [1, 2],\n  \"c\": true\n}\n");
+    }
+
+    #[test]
+    fn numbers_are_rounded_to_six_decimals_and_written_shortest() {
+        let n = |x: f64| number_text(&serde_json::Number::from_f64(x).unwrap());
+        assert_eq!(n(0.7499999999999999), "0.75");
+        assert_eq!(n(7.590065448456657e-8), "0");
+        assert_eq!(n(0.1234565), "0.123457");
+        assert_eq!(n(0.5), "0.5");
+        assert_eq!(n(1.0), "1.0");
+        let spelled: serde_json::Number = serde_json::from_str("1E-1").unwrap();
+        assert_eq!(number_text(&spelled), "0.1");
+    }
+
+    #[test]
+    fn an_unchanged_document_is_the_same_text() {
+        let text = "{ \"a\" :[ 1 ,2 ] ,\"b\":{} }";
+        assert_eq!(edited(text, |_| {}), text);
+    }
+}
