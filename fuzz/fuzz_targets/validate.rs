@@ -22,12 +22,15 @@ fuzz_target!(|data: &[u8]| {
     let path = Path::new("/nonexistent/fuzz.gltf");
     let loaded = velvet_fuzz::load("/nonexistent/fuzz.gltf", data);
     let report = validator().validate_loaded(path, loaded);
-    let options = report::Options {
-        color: false,
-        quiet: false,
-    };
     let reports = [report];
-    for format in [Format::Text, Format::Json, Format::Sarif, Format::Github] {
-        let _ = report::render(format, &reports, &options);
+    for no_fold in [false, true] {
+        let options = report::Options {
+            color: false,
+            quiet: false,
+            no_fold,
+        };
+        for format in [Format::Text, Format::Json, Format::Sarif, Format::Github] {
+            let _ = report::render(format, &reports, &options);
+        }
     }
 });

@@ -94,30 +94,14 @@ pub struct CoreSchema {
     validator: jsonschema::Validator,
 }
 
-/// Serves `$ref`s between the core schema files, by the reference's last path segment.
-struct CoreRetriever(Arc<HashMap<&'static str, Value>>);
-
-impl jsonschema::Retrieve for CoreRetriever {
-    fn retrieve(
-        &self,
-        uri: &jsonschema::Uri<String>,
-    ) -> Result<Value, Box<dyn std::error::Error + Send + Sync>> {
-        let name = uri.path().as_str().rsplit('/').next().unwrap_or_default();
-        self.0
-            .get(name)
-            .cloned()
-            .ok_or_else(|| format!("no core schema file named '{name}'").into())
-    }
-}
-
 impl CoreSchema {
     /// The official schemas compiled into velvet.
     pub fn builtin() -> CoreSchema {
-        let files: HashMap<&'static str, Value> = CORE_SCHEMAS
+        let files: HashMap<String, Value> = CORE_SCHEMAS
             .iter()
             .map(|(name, text)| {
                 (
-                    *name,
+                    name.to_string(),
                     serde_json::from_str(text).expect("core schemas are valid JSON"),
                 )
             })
@@ -127,7 +111,7 @@ impl CoreSchema {
             .with_draft(jsonschema::Draft::Draft202012)
             // URIs are judged by the resources rule, which knows what a glTF URI may be.
             .should_validate_formats(false)
-            .with_retriever(CoreRetriever(Arc::new(files)))
+            .with_retriever(super::schema::FileRetriever(Arc::new(files)))
             .build(&root)
             .expect("core schemas compile");
         CoreSchema { validator }

@@ -274,26 +274,13 @@ fn locate(cx: &Context, uri: &str, pointer: &str, out: &mut Vec<Diagnostic>) -> 
         }
     };
     let fault = |code: &Code, detail: String| Diagnostic::new(code, pointer, detail);
-    // Asset::resolve has refused links that lead out of the folder.
-    let real = match std::fs::canonicalize(&path) {
-        Ok(real) => real,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-            out.push(fault(
-                &FILE_NOT_FOUND,
-                format!("'{uri}' names {}, which does not exist", path.display()),
-            ));
-            return None;
-        }
-        Err(e) => {
-            out.push(fault(
-                &codes::IO_ERROR,
-                format!("cannot read '{uri}' ({}): {e}", path.display()),
-            ));
-            return None;
-        }
-    };
-    let meta = match std::fs::metadata(&real) {
-        Ok(meta) if meta.is_file() => meta,
+    // Asset::resolve has refused links that lead out of the folder. A stat, not a read.
+    let found = std::fs::canonicalize(&path).and_then(|real| {
+        let meta = std::fs::metadata(&real)?;
+        Ok((real, meta))
+    });
+    let (real, meta) = match found {
+        Ok((real, meta)) if meta.is_file() => (real, meta),
         Ok(_) => {
             out.push(fault(
                 &codes::IO_ERROR,
@@ -302,10 +289,17 @@ fn locate(cx: &Context, uri: &str, pointer: &str, out: &mut Vec<Diagnostic>) -> 
             return None;
         }
         Err(e) => {
-            out.push(fault(
-                &codes::IO_ERROR,
-                format!("cannot read '{uri}' ({}): {e}", path.display()),
-            ));
+            out.push(if e.kind() == std::io::ErrorKind::NotFound {
+                fault(
+                    &FILE_NOT_FOUND,
+                    format!("'{uri}' names {}, which does not exist", path.display()),
+                )
+            } else {
+                fault(
+                    &codes::IO_ERROR,
+                    format!("cannot read '{uri}' ({}): {e}", path.display()),
+                )
+            });
             return None;
         }
     };

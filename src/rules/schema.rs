@@ -83,8 +83,8 @@ pub struct Schemas {
     pub core: super::core::CoreSchema,
 }
 
-/// Serves `$ref`s from the in-memory schema files, by the reference's last path segment.
-struct FileRetriever(Arc<HashMap<String, Value>>);
+/// Serves `$ref`s from in-memory schema files, by the reference's last path segment.
+pub(crate) struct FileRetriever(pub(crate) Arc<HashMap<String, Value>>);
 
 impl jsonschema::Retrieve for FileRetriever {
     fn retrieve(
