@@ -63,13 +63,16 @@ impl Rule for Declaration {
             .map(|(_, n)| n)
             .collect();
         let mut reported = BTreeSet::new();
-        let mut at = String::new();
-        extension_objects(json, &mut at, &mut |pointer, name| {
+        extension_objects(json, &mut Vec::new(), &mut |path, name| {
             // One finding per extension: the first place it is used.
             if !declared.contains(name) && reported.insert(name.to_string()) {
+                let at: String = path
+                    .iter()
+                    .map(|t| format!("/{}", pointer::escape(t)))
+                    .collect();
                 out.push(Diagnostic::new(
                     &UNDECLARED_EXTENSION,
-                    pointer,
+                    at,
                     format!("{name} is used but not declared in extensionsUsed"),
                 ));
             }
@@ -104,43 +107,45 @@ impl Rule for Declaration {
     }
 }
 
-/// Calls `found` with the pointer and name of every extension object: every key of an
+/// Calls `found` with the path and name of every extension object: every key of an
 /// `extensions` object of a glTF property, including properties nested in extensions
 /// (a KHR_texture_transform inside a sheen texture). `extras` hold application data, not glTF
-/// properties, and are not searched.
-fn extension_objects(value: &Value, at: &mut String, found: &mut dyn FnMut(&str, &str)) {
-    let len = at.len();
+/// properties, and are not searched. The path is kept as tokens (array indices as text) and
+/// made a pointer only for what is reported.
+fn extension_objects<'a>(
+    value: &'a Value,
+    path: &mut Vec<std::borrow::Cow<'a, str>>,
+    found: &mut dyn FnMut(&[std::borrow::Cow<'a, str>], &str),
+) {
     match value {
         Value::Object(map) => {
             for (key, child) in map {
                 if key == "extras" {
                     continue;
                 }
-                at.push('/');
-                at.push_str(&pointer::escape(key));
+                path.push(key.as_str().into());
                 if key == "extensions" {
                     if let Value::Object(exts) = child {
                         for (name, ext) in exts {
-                            let inner = at.len();
-                            at.push('/');
-                            at.push_str(&pointer::escape(name));
-                            found(at, name);
-                            extension_objects(ext, at, found);
-                            at.truncate(inner);
+                            path.push(name.as_str().into());
+                            found(path, name);
+                            extension_objects(ext, path, found);
+                            path.pop();
                         }
                     }
-                } else {
-                    extension_objects(child, at, found);
+                } else if child.is_object() || child.is_array() {
+                    extension_objects(child, path, found);
                 }
-                at.truncate(len);
+                path.pop();
             }
         }
         Value::Array(items) => {
             for (i, child) in items.iter().enumerate() {
-                at.push('/');
-                at.push_str(&i.to_string());
-                extension_objects(child, at, found);
-                at.truncate(len);
+                if child.is_object() || child.is_array() {
+                    path.push(i.to_string().into());
+                    extension_objects(child, path, found);
+                    path.pop();
+                }
             }
         }
         _ => {}

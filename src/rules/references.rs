@@ -99,31 +99,39 @@ impl Rule for References {
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
         let json = cx.json();
+        let array_len = |target: &str| {
+            json.pointer(target)
+                .and_then(Value::as_array)
+                .map_or(0, Vec::len)
+        };
         for (pattern, target) in LINKS {
             let segments: Vec<&str> = pattern.split('/').skip(1).collect();
-            walk(
-                json,
-                &segments,
-                String::new(),
-                &mut Vec::new(),
-                &mut |at, value, captured| {
-                    let Some(index) = as_index(value) else {
-                        return; // not an index: the schema check reports the type
-                    };
-                    let target = match captured.first() {
-                        Some(first) => target.replace("{0}", first),
-                        None => target.to_string(),
-                    };
-                    let len = json
-                        .pointer(&target)
-                        .and_then(Value::as_array)
-                        .map_or(0, Vec::len);
-                    if index >= len as u64 {
-                        let message = unresolved_message(&at, index, &target, len);
-                        out.push(Diagnostic::new(&UNRESOLVED_REFERENCE, at, message));
+            // Most targets are fixed: their length is read once per pattern.
+            let fixed_len = (!target.contains("{0}")).then(|| array_len(target));
+            walk(json, &segments, &mut Vec::new(), &mut |path, value| {
+                let Some(index) = as_index(value) else {
+                    return; // not an index: the schema check reports the type
+                };
+                let (target, len) = match fixed_len {
+                    Some(len) if index < len as u64 => return,
+                    Some(len) => (target.to_string(), len),
+                    None => {
+                        // `{0}` is the array index the pattern's first `*` matched.
+                        let first = path.get(1).map_or(String::new(), Token::text);
+                        let target = target.replace("{0}", &first);
+                        let len = array_len(&target);
+                        (target, len)
                     }
-                },
-            );
+                };
+                if index >= len as u64 {
+                    let at: String = path
+                        .iter()
+                        .map(|t| format!("/{}", pointer::escape(&t.text())))
+                        .collect();
+                    let message = unresolved_message(&at, index, &target, len);
+                    out.push(Diagnostic::new(&UNRESOLVED_REFERENCE, at, message));
+                }
+            });
         }
     }
 }
@@ -153,48 +161,59 @@ fn unresolved_message(at: &str, index: u64, target: &str, len: usize) -> String 
     )
 }
 
-/// Calls `found` with the pointer and value of every match of `segments` under `value`;
-/// `captured` collects what each `*` matched.
+/// One step of a path into the document.
+#[derive(Clone, Copy)]
+enum Token<'a> {
+    Index(usize),
+    Key(&'a str),
+}
+
+impl Token<'_> {
+    fn text(&self) -> String {
+        match self {
+            Token::Index(i) => i.to_string(),
+            Token::Key(k) => k.to_string(),
+        }
+    }
+}
+
+/// Calls `found` with the path and value of every match of `segments` under `value`. The
+/// path is kept as tokens and turned into a pointer only for what is reported.
 fn walk<'a>(
     value: &'a Value,
     segments: &[&str],
-    at: String,
-    captured: &mut Vec<String>,
-    found: &mut dyn FnMut(String, &'a Value, &[String]),
+    path: &mut Vec<Token<'a>>,
+    found: &mut dyn FnMut(&[Token<'a>], &'a Value),
 ) {
     let Some((first, rest)) = segments.split_first() else {
-        found(at, value, captured);
+        found(path, value);
         return;
     };
-    let mut visit = |key: String, child: &'a Value, captures: bool, captured: &mut Vec<String>| {
-        if captures {
-            captured.push(key.clone());
-        }
-        walk(child, rest, pointer::join(&at, &key), captured, found);
-        if captures {
-            captured.pop();
-        }
+    let mut visit = |token: Token<'a>, child: &'a Value, path: &mut Vec<Token<'a>>| {
+        path.push(token);
+        walk(child, rest, path, found);
+        path.pop();
     };
     match (*first, value) {
         ("*", Value::Array(items)) => {
             for (i, child) in items.iter().enumerate() {
-                visit(i.to_string(), child, true, captured);
+                visit(Token::Index(i), child, path);
             }
         }
         ("*", Value::Object(map)) => {
             for (key, child) in map {
-                visit(key.clone(), child, true, captured);
+                visit(Token::Key(key), child, path);
             }
         }
         (pattern, Value::Object(map)) if pattern.starts_with('*') => {
             let suffix = &pattern[1..];
             for (key, child) in map.iter().filter(|(k, _)| k.ends_with(suffix)) {
-                visit(key.clone(), child, false, captured);
+                visit(Token::Key(key), child, path);
             }
         }
         (key, Value::Object(map)) => {
-            if let Some(child) = map.get(key) {
-                visit(key.to_string(), child, false, captured);
+            if let Some((key, child)) = map.get_key_value(key) {
+                visit(Token::Key(key), child, path);
             }
         }
         _ => {}
