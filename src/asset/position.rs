@@ -7,7 +7,7 @@
 //! Columns count characters (not bytes), both 1-based.
 
 use super::pointer;
-use std::collections::{HashMap, HashSet};
+use std::collections::HashMap;
 
 pub use crate::diagnostics::Position;
 
@@ -44,31 +44,39 @@ pub fn offset_of(text: &str, line: usize, column: usize) -> usize {
         .map_or(text.len(), |(i, _)| line_start + i)
 }
 
+/// The pointers asked for, as a tree of their tokens: the scanner descends along it, so each
+/// value costs one lookup of its key, not a hash of its whole path.
+#[derive(Default)]
+struct Wanted {
+    /// The pointer text, when a pointer ends here.
+    pointer: Option<String>,
+    children: HashMap<String, Wanted>,
+}
+
 /// Locates the values named by `pointers` in `text`. Pointers that name nothing are absent
 /// from the result.
 pub fn locate<'p>(
     text: &str,
     pointers: impl IntoIterator<Item = &'p str>,
 ) -> HashMap<String, Position> {
-    let wanted: HashSet<Vec<String>> = pointers.into_iter().map(pointer::tokens).collect();
-    let mut prefixes: HashSet<Vec<String>> = HashSet::new();
-    for w in &wanted {
-        for n in 0..=w.len() {
-            prefixes.insert(w[..n].to_vec());
+    let mut wanted = Wanted::default();
+    for p in pointers {
+        let mut node = &mut wanted;
+        for token in pointer::tokens(p) {
+            node = node.children.entry(token).or_default();
         }
+        node.pointer = Some(p.to_string());
     }
     let mut scanner = Scanner {
         bytes: text.as_bytes(),
         text,
         at: 0,
-        wanted: &wanted,
-        prefixes: &prefixes,
-        path: Vec::new(),
         found: HashMap::new(),
         line_starts: line_starts(text),
+        index_text: String::new(),
     };
     scanner.skip_ws();
-    scanner.value();
+    scanner.value(Some(&wanted));
     scanner.found
 }
 
@@ -87,14 +95,13 @@ struct Scanner<'a> {
     bytes: &'a [u8],
     text: &'a str,
     at: usize,
-    wanted: &'a HashSet<Vec<String>>,
-    prefixes: &'a HashSet<Vec<String>>,
-    path: Vec<String>,
     found: HashMap<String, Position>,
     line_starts: Vec<usize>,
+    /// Reused for array indices as keys.
+    index_text: String,
 }
 
-impl Scanner<'_> {
+impl<'a> Scanner<'a> {
     fn position(&self, offset: usize) -> Position {
         let line = self.line_starts.partition_point(|&s| s <= offset);
         let start = self.line_starts[line - 1];
@@ -116,31 +123,27 @@ impl Scanner<'_> {
         }
     }
 
-    /// Scans one value at `self.at`; records it if wanted, descends if on the way.
-    fn value(&mut self) {
-        if self.wanted.contains(&self.path) {
-            let pointer: String = self
-                .path
-                .iter()
-                .map(|s| format!("/{}", pointer::escape(s)))
-                .collect();
+    /// Scans one value at `self.at`; records it if wanted, descends if a wanted pointer lies
+    /// below it.
+    fn value(&mut self, wanted: Option<&Wanted>) {
+        if let Some(pointer) = wanted.and_then(|w| w.pointer.as_ref()) {
             let pos = self.position(self.at);
-            self.found.insert(pointer, pos);
+            self.found.insert(pointer.clone(), pos);
         }
-        let descend = self.prefixes.contains(&self.path);
-        match self.peek() {
-            Some(b'{') if descend => self.object(),
-            Some(b'[') if descend => self.array(),
-            Some(b'{' | b'[') => self.skip_container(),
-            Some(b'"') => {
+        let below = wanted.filter(|w| !w.children.is_empty());
+        match (self.peek(), below) {
+            (Some(b'{'), Some(w)) => self.object(w),
+            (Some(b'['), Some(w)) => self.array(w),
+            (Some(b'{' | b'['), _) => self.skip_container(),
+            (Some(b'"'), _) => {
                 self.string();
             }
-            Some(_) => self.scalar(),
-            None => {}
+            (Some(_), _) => self.scalar(),
+            (None, _) => {}
         }
     }
 
-    fn object(&mut self) {
+    fn object(&mut self, wanted: &Wanted) {
         self.at += 1;
         loop {
             self.skip_ws();
@@ -160,9 +163,8 @@ impl Scanner<'_> {
                         self.at += 1;
                     }
                     self.skip_ws();
-                    self.path.push(key);
-                    self.value();
-                    self.path.pop();
+                    let child = wanted.children.get(key.as_ref());
+                    self.value(child);
                 }
                 Some(_) => {
                     // Not JSON we understand: stop rather than guess.
@@ -173,7 +175,7 @@ impl Scanner<'_> {
         }
     }
 
-    fn array(&mut self) {
+    fn array(&mut self, wanted: &Wanted) {
         self.at += 1;
         let mut index = 0usize;
         loop {
@@ -189,16 +191,18 @@ impl Scanner<'_> {
                     continue;
                 }
                 Some(_) => {
-                    self.path.push(index.to_string());
-                    self.value();
-                    self.path.pop();
+                    use std::fmt::Write;
+                    self.index_text.clear();
+                    let _ = write!(self.index_text, "{index}");
+                    let child = wanted.children.get(self.index_text.as_str());
+                    self.value(child);
                 }
             }
         }
     }
 
-    /// Reads a string token, returning its decoded content.
-    fn string(&mut self) -> String {
+    /// Reads a string token, returning its decoded content (borrowed when it has no escapes).
+    fn string(&mut self) -> std::borrow::Cow<'a, str> {
         let start = self.at;
         self.at += 1;
         while let Some(b) = self.peek() {
@@ -209,8 +213,15 @@ impl Scanner<'_> {
                 _ => {}
             }
         }
-        let raw = &self.text[start..self.at.min(self.bytes.len())];
-        serde_json::from_str::<String>(raw).unwrap_or_else(|_| raw.trim_matches('"').to_string())
+        let text: &'a str = self.text;
+        let raw = &text[start..self.at.min(self.bytes.len())];
+        if !raw.contains('\\') && raw.len() >= 2 && raw.ends_with('"') {
+            return std::borrow::Cow::Borrowed(&raw[1..raw.len() - 1]);
+        }
+        std::borrow::Cow::Owned(
+            serde_json::from_str::<String>(raw)
+                .unwrap_or_else(|_| raw.trim_matches('"').to_string()),
+        )
     }
 
     fn scalar(&mut self) {
@@ -255,6 +266,16 @@ impl Scanner<'_> {
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn truncated_text_with_a_multibyte_key_is_scanned_without_panic() {
+        for text in ["{\"é", "{\"a\\\"é"] {
+            assert!(locate(text, ["/é/1/ü"]).is_empty(), "{text}");
+        }
+        // A key cut off at the end of the text: its value is placed at the end.
+        assert_eq!(at("{\"é\": [1, {\"ü", "/é/1/ü"), Some((1, 14)));
+    }
+
     use super::*;
 
     fn at(text: &str, p: &str) -> Option<(usize, usize)> {
