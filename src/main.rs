@@ -178,8 +178,13 @@ struct BakeArgs {
     /// PNG compression effort for new images.
     #[arg(long, value_enum, default_value_t = Compression::Fast)]
     compression: Compression,
-    /// Copy relative resources next to outputs in another folder instead of rewriting URIs.
+    /// An output in another folder refers back to the input's resources (URIs rewritten to
+    /// lead there) instead of getting its own copies beside it (the default).
     #[arg(long)]
+    rewrite_uris: bool,
+    /// Copy (or hard-link) resources beside outputs in another folder: the default, kept so
+    /// that existing scripts run.
+    #[arg(long, hide = true, conflicts_with = "rewrite_uris")]
     copy_resources: bool,
     #[arg(long, value_enum, default_value_t = BakeFormat::Text)]
     format: BakeFormat,
@@ -421,8 +426,13 @@ struct MigrateArgs {
     /// Regenerate the sheen fallback of materials that already have fuzz and sheen.
     #[arg(long)]
     refresh_fallback: bool,
-    /// Copy relative resources next to outputs in another folder instead of rewriting URIs.
+    /// An output in another folder refers back to the input's resources (URIs rewritten to
+    /// lead there) instead of getting its own copies beside it (the default).
     #[arg(long)]
+    rewrite_uris: bool,
+    /// Copy (or hard-link) resources beside outputs in another folder: the default, kept so
+    /// that existing scripts run.
+    #[arg(long, hide = true, conflicts_with = "rewrite_uris")]
     copy_resources: bool,
     #[command(flatten)]
     load: LoadArgs,
@@ -461,7 +471,7 @@ fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
                 RoughnessArg::Identity => migrate::roughness::RoughnessMapping::Identity,
             },
             fast: args.fast,
-            copy_resources: args.copy_resources,
+            rewrite_uris: args.rewrite_uris,
             load: args.load.options(),
         },
         dry_run: args.dry_run || args.check,
@@ -510,7 +520,7 @@ fn bake(args: BakeArgs, quiet: bool) -> ExitCode {
                 Compression::Balanced => velvet::bake::PngCompression::Default,
                 Compression::Best => velvet::bake::PngCompression::Best,
             },
-            copy_resources: args.copy_resources,
+            rewrite_uris: args.rewrite_uris,
             load: args.load.options(),
         },
         progress: !quiet,

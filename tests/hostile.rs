@@ -577,7 +577,7 @@ fn writing_never_follows_outside_uris_and_outputs_stay_in_the_out_dir() {
         "--out-dir",
         s(&out_dir),
         "--allow-outside-uris",
-        "--copy-resources",
+        "--rewrite-uris",
     ]);
     assert_eq!(status, 0, "{out}");
     let (status, out, _) = velvet(&[
@@ -586,7 +586,7 @@ fn writing_never_follows_outside_uris_and_outputs_stay_in_the_out_dir() {
         "--out-dir",
         s(&out_dir.join("migrated")),
         "--allow-outside-uris",
-        "--copy-resources",
+        "--rewrite-uris",
     ]);
     assert_eq!(status, 0, "{out}");
 
@@ -600,10 +600,10 @@ fn writing_never_follows_outside_uris_and_outputs_stay_in_the_out_dir() {
         new,
         [
             // The name's separators became '_': the file stays in the output folder.
-            Path::new("out/.._.._.._escaped.sheenColor.sheenRoughness.png"),
+            Path::new("out/.._.._.._escaped.sheenColor.sheenRoughness.672616e9c6e7.png"),
             Path::new("out/chair.gltf"),
             // migrate's fitted roughness bakes the mapped roughness texture beside its output.
-            Path::new("out/migrated/.._.._.._escaped.fuzzRoughness.png"),
+            Path::new("out/migrated/.._.._.._escaped.fuzzRoughness.b57a40da0739.png"),
             Path::new("out/migrated/chair.gltf"),
         ]
     );
@@ -961,10 +961,12 @@ fn files_that_vanish_or_dangle_get_a_clear_error_and_the_run_goes_on() {
     );
     assert_eq!(
         tree(&out_dir).into_keys().collect::<Vec<_>>(),
-        // c.gltf and the fuzz roughness texture its fitted mapping bakes.
+        // c.gltf, the fuzz roughness texture its fitted mapping bakes (named with a hash of
+        // its bytes), and the source texture, copied so that the output is self-contained.
         [
             PathBuf::from("c.gltf"),
-            PathBuf::from("tex.fuzzRoughness.png")
+            PathBuf::from("tex.fuzzRoughness.b57a40da0739.png"),
+            PathBuf::from("tex.png")
         ]
     );
 }

@@ -49,7 +49,8 @@ fn options_for(case: &Path) -> Options {
             match flag {
                 "--report" => options.report = true,
                 "--refresh-fallback" => options.refresh_fallback = true,
-                "--copy-resources" => options.copy_resources = true,
+                "--copy-resources" => options.rewrite_uris = false,
+                "--rewrite-uris" => options.rewrite_uris = true,
                 "--roughness identity" => options.roughness = RoughnessMapping::Identity,
                 other => panic!("{}: unknown flag {other}", case.display()),
             }
@@ -659,14 +660,18 @@ fn uris(path: &Path) -> Vec<String> {
 }
 
 #[test]
-fn outputs_in_another_folder_rewrite_relative_uris_to_the_inputs_resources() {
+fn rewrite_uris_makes_outputs_in_another_folder_refer_to_the_inputs_resources() {
     let dir = tempfile::tempdir().unwrap();
     let input = asset_with_resources(dir.path());
     let out = dir.path().join("migrated");
+    let options = Options {
+        rewrite_uris: true,
+        ..Options::default()
+    };
     let report = migrate::run(&request(
         vec![dir.path().join("assets")],
         Destination::Dir(out.clone()),
-        Options::default(),
+        options,
     ))
     .unwrap();
     let output = out.join("chair/chair.gltf");
@@ -705,14 +710,11 @@ fn outputs_in_another_folder_rewrite_relative_uris_to_the_inputs_resources() {
 }
 
 #[test]
-fn copy_resources_keeps_uris_and_copies_the_files() {
+fn outputs_in_another_folder_keep_their_uris_and_get_copies_of_the_files() {
     let dir = tempfile::tempdir().unwrap();
     let input = asset_with_resources(dir.path());
     let output = dir.path().join("elsewhere/chair.gltf");
-    let options = Options {
-        copy_resources: true,
-        ..Options::default()
-    };
+    let options = Options::default();
     let report = migrate::run(&request(
         vec![input],
         Destination::File(output.clone()),
@@ -1055,7 +1057,7 @@ fn exact_mode_bakes_the_sheen_strength_and_normalised_colour_texel_by_texel() {
     // The sheen fallback still reads the original texture, and the new textures keep its sampler.
     let sheen = &doc["materials"][0]["extensions"]["KHR_materials_sheen"];
     assert_eq!(sheen["sheenColorTexture"]["index"], 0);
-    assert_eq!(doc["images"][0]["uri"], "../sheen.png");
+    assert_eq!(doc["images"][0]["uri"], "sheen.png");
     for pointer in ["fuzzTexture", "fuzzColorTexture"] {
         let t = fuzz[pointer]["index"].as_u64().unwrap() as usize;
         assert_eq!(doc["textures"][t]["sampler"], 0, "{pointer}");
@@ -1473,4 +1475,226 @@ fn black_fuzz_with_an_intensity_texture_bakes_nothing_and_is_left_as_it_is() {
         .collect();
     files.sort();
     assert_eq!(files, ["black.gltf", "black.out.gltf", "intensity.png"]);
+}
+
+// ---- A library: reproducible, self-contained output; bare paths; links ----
+
+/// Every file under `dir` (relative path → bytes).
+fn tree(dir: &Path) -> std::collections::BTreeMap<PathBuf, Vec<u8>> {
+    let mut out = std::collections::BTreeMap::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for entry in std::fs::read_dir(&d).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                stack.push(path);
+            } else {
+                let bytes = std::fs::read(&path).unwrap();
+                out.insert(path.strip_prefix(dir).unwrap().to_path_buf(), bytes);
+            }
+        }
+    }
+    out
+}
+
+/// A folder of assets that share image names: in `lib/` and `lib/sub/`, six .gltf files each
+/// reading a roughness texture `rough.png` (its own in each folder) with its own factor, so
+/// their baked textures would collide on a name made from the image name alone.
+fn library(root: &Path) -> PathBuf {
+    let lib = root.join("lib");
+    for (folder, seed) in [("", 0u8), ("sub", 40)] {
+        let dir = lib.join(folder);
+        std::fs::create_dir_all(&dir).unwrap();
+        let data: Vec<u8> = (0..16u8)
+            .flat_map(|i| [i * 9, 200, 50, i.wrapping_mul(17).wrapping_add(seed)])
+            .collect();
+        png_file(&dir.join("rough.png"), 4, 4, image::ColorType::Rgba8, &data);
+        std::fs::write(dir.join("mesh.bin"), [7u8; 12]).unwrap();
+        for k in 0..6 {
+            let doc = serde_json::json!({
+                "asset": {"version": "2.0"},
+                "extensionsUsed": ["KHR_materials_sheen"],
+                "buffers": [{"uri": "mesh.bin", "byteLength": 12}],
+                "materials": [{"extensions": {"KHR_materials_sheen": {
+                    "sheenColorFactor": [0.8, 0.6, 0.4],
+                    "sheenRoughnessFactor": 0.3 + 0.1 * k as f64,
+                    "sheenRoughnessTexture": {"index": 0}
+                }}}],
+                "textures": [{"source": 0}],
+                "images": [{"uri": "rough.png"}]
+            });
+            std::fs::write(
+                dir.join(format!("asset{k}.gltf")),
+                serde_json::to_vec_pretty(&doc).unwrap(),
+            )
+            .unwrap();
+        }
+    }
+    lib
+}
+
+fn velvet_in(dir: &Path, env: &[(&str, &str)], args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_velvet"))
+        .current_dir(dir)
+        .envs(env.iter().copied())
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn one_and_four_threads_give_byte_identical_trees() {
+    let dir = tempfile::tempdir().unwrap();
+    library(dir.path());
+    for (threads, out) in [("1", "one"), ("4", "four")] {
+        let (status, stdout, stderr) = velvet_in(
+            dir.path(),
+            &[("RAYON_NUM_THREADS", threads)],
+            &["migrate", "lib", "--out-dir", out],
+        );
+        assert_eq!(status, 0, "{stdout}{stderr}");
+    }
+    for (a, b) in [("one", "four")] {
+        let (a, b) = (tree(&dir.path().join(a)), tree(&dir.path().join(b)));
+        assert_eq!(a.keys().collect::<Vec<_>>(), b.keys().collect::<Vec<_>>());
+        assert!(a == b, "the trees hold the same bytes");
+        // 12 documents, 2 copied sources, 2 copied buffers, and the baked textures.
+        assert!(a.len() > 16, "{:?}", a.keys().collect::<Vec<_>>());
+    }
+}
+
+#[test]
+fn an_out_dir_tree_moved_elsewhere_validates_clean() {
+    let dir = tempfile::tempdir().unwrap();
+    let lib = library(dir.path());
+    let out = dir.path().join("out");
+    let report = migrate::run(&request(
+        vec![lib],
+        Destination::Dir(out.clone()),
+        Options::default(),
+    ))
+    .unwrap();
+    assert!(!report.failed(), "{}", render::text(&report));
+    let moved = dir.path().join("far/away/moved");
+    std::fs::create_dir_all(moved.parent().unwrap()).unwrap();
+    std::fs::rename(&out, &moved).unwrap();
+    let mut checked = 0;
+    for (path, bytes) in tree(&moved) {
+        if path.extension().is_some_and(|e| e == "gltf") {
+            let doc: Value = serde_json::from_slice(&bytes).unwrap();
+            for uri in ["/buffers/0/uri", "/images/0/uri", "/images/1/uri"] {
+                if let Some(uri) = doc.pointer(uri).and_then(Value::as_str) {
+                    assert!(!uri.contains(".."), "{}: {uri}", path.display());
+                }
+            }
+            assert_eq!(errors(&moved.join(&path)), Vec::new(), "{}", path.display());
+            checked += 1;
+        }
+    }
+    assert_eq!(checked, 12);
+}
+
+#[test]
+fn bare_relative_names_in_the_current_folder_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let lib = library(dir.path());
+    let (status, stdout, stderr) = velvet_in(
+        &lib,
+        &[],
+        &["migrate", "asset0.gltf", "-o", "asset0.fuzz.gltf"],
+    );
+    assert_eq!(status, 0, "{stdout}{stderr}");
+    let doc: Value =
+        serde_json::from_slice(&std::fs::read(lib.join("asset0.fuzz.gltf")).unwrap()).unwrap();
+    assert_eq!(doc["buffers"][0]["uri"], "mesh.bin");
+    assert!(doc["materials"][0]["extensions"]["KHR_materials_fuzz"].is_object());
+    assert_eq!(errors(&lib.join("asset0.fuzz.gltf")), Vec::new());
+    // A bare output name in another folder's input works too.
+    let (status, stdout, stderr) = velvet_in(
+        dir.path(),
+        &[],
+        &["migrate", "lib/sub/asset1.gltf", "-o", "moved.gltf"],
+    );
+    assert_eq!(status, 0, "{stdout}{stderr}");
+    assert_eq!(errors(&dir.path().join("moved.gltf")), Vec::new());
+    assert_eq!(
+        std::fs::read(dir.path().join("mesh.bin")).unwrap(),
+        [7u8; 12]
+    );
+}
+
+#[cfg(unix)]
+#[test]
+fn a_link_to_a_file_outside_the_input_folder_is_refused_and_nothing_of_it_is_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let lib = library(dir.path());
+    // The secret is a valid PNG, so that a bake would happily read it.
+    let secret: Vec<u8> = (0..16u8).flat_map(|i| [i, 1, 2, 251 - i]).collect();
+    png_file(
+        &dir.path().join("secret.png"),
+        4,
+        4,
+        image::ColorType::Rgba8,
+        &secret,
+    );
+    let secret_bytes = std::fs::read(dir.path().join("secret.png")).unwrap();
+    std::fs::remove_file(lib.join("rough.png")).unwrap();
+    std::os::unix::fs::symlink(dir.path().join("secret.png"), lib.join("rough.png")).unwrap();
+    // A link that stays inside the folder is followed (and copied as a regular file).
+    std::fs::rename(lib.join("mesh.bin"), lib.join("sub/real.bin")).unwrap();
+    std::os::unix::fs::symlink("sub/real.bin", lib.join("mesh.bin")).unwrap();
+    let out = dir.path().join("out");
+    for fast in [false, true] {
+        let report = migrate::run(&request(
+            vec![lib.clone()],
+            Destination::Dir(out.clone()),
+            Options {
+                fast,
+                ..Options::default()
+            },
+        ))
+        .unwrap();
+        assert_eq!(report.summary.failed, 6, "{}", render::text(&report));
+        for file in report
+            .files
+            .iter()
+            .filter(|f| f.input.parent() == Some(&lib))
+        {
+            let FileOutcome::Failed { error } = &file.outcome else {
+                panic!("{:?}", file.outcome)
+            };
+            assert!(
+                error.contains("'rough.png'") && error.contains("outside the input's folder"),
+                "{error}"
+            );
+        }
+    }
+    let written = tree(&out);
+    assert!(written.keys().all(|p| p.starts_with("sub")), "{written:?}");
+    for (path, bytes) in &written {
+        assert_ne!(bytes, &secret_bytes, "{}", path.display());
+        assert!(
+            !std::fs::symlink_metadata(out.join(path))
+                .unwrap()
+                .file_type()
+                .is_symlink(),
+            "{}",
+            path.display()
+        );
+    }
+    // bake refuses it too.
+    let (status, stdout, _) = velvet(&[
+        "bake",
+        lib.join("asset0.gltf").to_str().unwrap(),
+        "-o",
+        dir.path().join("baked/asset0.gltf").to_str().unwrap(),
+    ]);
+    assert_eq!(status, 1, "{stdout}");
+    assert!(stdout.contains("'rough.png'"), "{stdout}");
+    assert!(!dir.path().join("baked").exists() || tree(&dir.path().join("baked")).is_empty());
 }

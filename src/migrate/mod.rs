@@ -45,8 +45,9 @@ pub struct Options {
     /// Never bake a texture only to map roughness: copy it (identity) where a texture would
     /// need the bake, and say so.
     pub fast: bool,
-    /// Copy relative resources next to an output in another folder instead of rewriting URIs.
-    pub copy_resources: bool,
+    /// An output in another folder refers back to the input's resources (URIs rewritten)
+    /// instead of getting its own copies (the default: a self-contained output).
+    pub rewrite_uris: bool,
     /// Limits and URI policy for reading inputs and their resources.
     pub load: crate::asset::LoadOptions,
 }

@@ -324,7 +324,7 @@ impl Note {
             Note::UrisRewritten { count, leaves_folder } => {
                 let mut m = format!("{count} relative URI{} rewritten so that the output finds the input's resources", if *count == 1 { "" } else { "s" });
                 if *leaves_folder {
-                    m += "; they lead out of the output's folder, which velvet itself does not follow (--copy-resources makes a self-contained output)";
+                    m += "; they lead out of the output's folder, which velvet itself does not follow (without --rewrite-uris the output gets its own copies)";
                 }
                 m
             }
