@@ -9,6 +9,7 @@ use std::process::ExitCode;
 use velvet::cli_docs::{self, EXIT_STATUS, EXIT_STATUS_ALL};
 use velvet::config::{self, Layer, Resolver};
 use velvet::diagnostics::{self, FailOn, Settings};
+use velvet::migrate;
 use velvet::report::{self, ColorChoice, Format};
 use velvet::rules::schema::Schemas;
 use velvet::validate::Validator;
@@ -423,6 +424,10 @@ struct MigrateArgs {
     /// texture, and say so.
     #[arg(long)]
     fast: bool,
+    /// The largest roughness difference a shared mapped roughness texture may leave, per
+    /// material, before a dearer plan is taken; `exact` bakes one texture per material.
+    #[arg(long, value_name = "DIFFERENCE|exact", default_value = "0.01")]
+    roughness_budget: migrate::budget::Budget,
     /// Regenerate the sheen fallback of materials that already have fuzz and sheen.
     #[arg(long)]
     refresh_fallback: bool,
@@ -451,7 +456,7 @@ enum MigrateFormat {
 }
 
 fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
-    use velvet::migrate::{self, Destination};
+    use velvet::migrate::Destination;
     let destination = match (args.output, args.out_dir, args.in_place) {
         (Some(file), _, _) => Destination::File(file),
         (_, Some(dir), _) => Destination::Dir(dir),
@@ -471,6 +476,7 @@ fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
                 RoughnessArg::Identity => migrate::roughness::RoughnessMapping::Identity,
             },
             fast: args.fast,
+            budget: args.roughness_budget,
             rewrite_uris: args.rewrite_uris,
             load: args.load.options(),
         },

@@ -382,7 +382,12 @@ pub fn apply(
             .pointer_mut(&slot.layer_pointer)
             .and_then(Value::as_object_mut)
         {
-            layer.insert(slot.factor_key.to_owned(), slot.identity());
+            layer.insert(
+                slot.factor_key.to_owned(),
+                slot.written_factor
+                    .clone()
+                    .unwrap_or_else(|| slot.identity()),
+            );
         }
     }
     let dropped = prune(

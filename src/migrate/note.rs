@@ -178,6 +178,22 @@ pub enum Note {
     ResourcesCopied { count: usize },
     /// A resource to copy is missing; its URI is left as it was.
     ResourceMissing { uri: String },
+    /// The texture plan of a mapped roughness texture, with its measured worst-case error.
+    RoughnessPlan {
+        property: String,
+        plan: super::budget::TexturePlan,
+        factor_key: String,
+        factor: f64,
+        max_error: f64,
+        /// `None`: the exact setting.
+        budget: Option<f64>,
+    },
+    /// The best roughness lies below the floor renderers honour alike: the floor is written.
+    RoughnessFloor {
+        property: String,
+        best: f64,
+        written: f64,
+    },
 }
 
 fn rgb(c: [f64; 3]) -> String {
@@ -201,7 +217,17 @@ impl Note {
             | Note::FallbackTextureBaked { .. }
             | Note::ExactBaked
             | Note::BakeError { .. }
-            | Note::LegacyRoughnessBaked { .. } => Level::Info,
+            | Note::LegacyRoughnessBaked { .. }
+            | Note::RoughnessFloor { .. } => Level::Info,
+            Note::RoughnessPlan {
+                max_error, budget, ..
+            } => {
+                if budget.is_some_and(|b| *max_error > b) {
+                    Level::Warning
+                } else {
+                    Level::Info
+                }
+            }
             Note::UrisRewritten { leaves_folder, .. } => {
                 if *leaves_folder {
                     Level::Warning
@@ -330,6 +356,21 @@ impl Note {
             }
             Note::ResourcesCopied { count } => format!("{count} resource{} copied next to the output", if *count == 1 { "" } else { "s" }),
             Note::ResourceMissing { uri } => format!("resource '{uri}' does not exist: not copied, its URI is left as it was"),
+            Note::RoughnessPlan { property, plan, factor_key, factor, max_error, budget } => {
+                let verdict = match budget {
+                    Some(b) if max_error <= b => format!("within the budget {b}"),
+                    Some(b) => format!("{:.4} over the budget {b}: no plan comes closer than this exact bake", max_error - b),
+                    None => "exact to the nearest code, as asked".to_string(),
+                };
+                format!(
+                    "{property}: {}, {factor_key} {factor}; largest roughness difference from the exact mapping {max_error:.4}, {verdict}",
+                    plan.describe()
+                )
+            }
+            Note::RoughnessFloor { property, best, written } => format!(
+                "{property}: the best match, {best:.4}, lies below {written} (the floor renderers honour alike), so {written} is written: {:.4} rougher than the best match",
+                written - best
+            ),
         }
     }
 
