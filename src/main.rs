@@ -173,9 +173,13 @@ struct BakeArgs {
     /// Keep JPEG textures as JPEG (lossy) instead of lossless PNG.
     #[arg(long)]
     keep_format: bool,
-    /// Measure and print each output's largest error in codes.
+    /// Measure and print each output's largest error in codes (and show every slot and
+    /// output, as --verbose).
     #[arg(long)]
     report: bool,
+    /// Show every slot baked and every output written under its file's line.
+    #[arg(long, short)]
+    verbose: bool,
     /// PNG compression effort for new images.
     #[arg(long, value_enum, default_value_t = Compression::Fast)]
     compression: Compression,
@@ -406,9 +410,13 @@ struct MigrateArgs {
     check: bool,
     #[arg(long, value_enum, default_value_t = MigrateFormat::Text)]
     format: MigrateFormat,
-    /// Decode sheen colour textures to measure what the fast conversion changes.
+    /// Decode sheen colour textures to measure what the fast conversion changes (and show
+    /// every material's notes, as --verbose).
     #[arg(long)]
     report: bool,
+    /// Show every material with something to say, and its notes, under its file's line.
+    #[arg(long, short)]
+    verbose: bool,
     /// Bake a fuzzTexture and a normalised fuzzColorTexture from each sheen colour texture so
     /// that the fuzz matches the sheen texel by texel (lobe and base attenuation).
     #[arg(long)]
@@ -490,7 +498,16 @@ fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
     print!(
         "{}",
         match args.format {
-            MigrateFormat::Text => migrate::render::text(&report),
+            MigrateFormat::Text => migrate::render::text(
+                &report,
+                if quiet {
+                    migrate::render::Detail::Quiet
+                } else if args.verbose || args.report {
+                    migrate::render::Detail::Verbose
+                } else {
+                    migrate::render::Detail::Normal
+                }
+            ),
             MigrateFormat::Json => migrate::render::json(&report),
         }
     );
@@ -536,7 +553,20 @@ fn bake(args: BakeArgs, quiet: bool) -> ExitCode {
         Err(e) => return usage_error(e),
     };
     match args.format {
-        BakeFormat::Text => print!("{}", command::render_text(&results, args.dry_run)),
+        BakeFormat::Text => print!(
+            "{}",
+            command::render_text(
+                &results,
+                args.dry_run,
+                if quiet {
+                    migrate::render::Detail::Quiet
+                } else if args.verbose || args.report || args.dry_run {
+                    migrate::render::Detail::Verbose
+                } else {
+                    migrate::render::Detail::Normal
+                }
+            )
+        ),
         BakeFormat::Json => print!("{}", command::render_json(&results)),
     }
     if results.iter().any(|r| r.failed()) {

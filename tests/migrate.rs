@@ -836,7 +836,7 @@ fn dry_run_prints_the_plan_and_writes_nothing() {
         report.files[0].outcome,
         FileOutcome::Planned { changes: true }
     );
-    let text = render::text(&report);
+    let text = render::text(&report, render::Detail::Verbose);
     assert!(
         text.contains("  material 0 \"champagne\": sheen → fuzz\n"),
         "{text}"
@@ -848,7 +848,7 @@ fn dry_run_prints_the_plan_and_writes_nothing() {
         text.contains("  declare KHR_materials_fuzz in /extensionsUsed\n"),
         "{text}"
     );
-    assert!(text.ends_with("1 file: 1 would change, 0 unchanged, 0 failed\nmaterials: 3 migrated (3 sheen → fuzz); 0 skipped; 0 warnings\n"), "{text}");
+    assert!(text.ends_with("1 file: 1 would change, 0 unchanged, 0 failed; no texture to add\nmaterials: 3 migrated (3 sheen → fuzz); 0 skipped; 0 warnings\n"), "{text}");
     let json: Value = serde_json::from_str(&render::json(&report)).unwrap();
     assert_eq!(json["files"][0]["status"], "planned");
     assert_eq!(json["files"][0]["materials"][0]["edits"][0]["op"], "set");
@@ -1627,7 +1627,11 @@ fn an_out_dir_tree_moved_elsewhere_validates_clean() {
         Options::default(),
     ))
     .unwrap();
-    assert!(!report.failed(), "{}", render::text(&report));
+    assert!(
+        !report.failed(),
+        "{}",
+        render::text(&report, render::Detail::Verbose)
+    );
     let moved = dir.path().join("far/away/moved");
     std::fs::create_dir_all(moved.parent().unwrap()).unwrap();
     std::fs::rename(&out, &moved).unwrap();
@@ -1707,7 +1711,12 @@ fn a_link_to_a_file_outside_the_input_folder_is_refused_and_nothing_of_it_is_wri
             },
         ))
         .unwrap();
-        assert_eq!(report.summary.failed, 6, "{}", render::text(&report));
+        assert_eq!(
+            report.summary.failed,
+            6,
+            "{}",
+            render::text(&report, render::Detail::Verbose)
+        );
         for file in report
             .files
             .iter()

@@ -26,6 +26,7 @@ use crate::asset::{self, resource, write};
 use crate::diagnostics::Severity;
 use crate::migrate::apply::{copy_resources, create_parent};
 use crate::migrate::paths::{identity, jobs, relocate, Job, Relocation};
+use crate::migrate::render::{added, bytes, files_line, plural, Detail};
 
 pub use crate::migrate::paths::Destination;
 pub use crate::migrate::UsageError;
@@ -482,8 +483,10 @@ pub struct Summary {
     pub failed: usize,
     /// Slots baked.
     pub slots: usize,
-    /// Outputs written.
+    /// New textures written (in a dry run, planned).
     pub textures: usize,
+    /// Their encoded size in bytes (0 in a dry run).
+    pub bytes: usize,
 }
 
 /// Sums up results.
@@ -500,31 +503,80 @@ pub fn summary(results: &[FileResult]) -> Summary {
             _ => s.unchanged += 1,
         }
         s.slots += r.slots.len();
-        s.textures += r.outputs.len();
+        let written: Vec<_> = r.outputs.iter().filter(|o| o.image.is_some()).collect();
+        s.textures += if matches!(r.outcome, Outcome::Planned { .. }) {
+            r.slots
+                .iter()
+                .flat_map(|slot| &slot.outputs)
+                .collect::<HashSet<_>>()
+                .len()
+        } else {
+            written.len()
+        };
+        s.bytes += written.iter().map(|o| o.bytes).sum::<usize>();
     }
     s
 }
 
-/// The text report.
-pub fn render_text(results: &[FileResult], dry_run: bool) -> String {
+/// The text report, worded as `velvet migrate`'s: a line per file (slots, textures added,
+/// warnings), the slots and outputs under it when verbose, failed files only when quiet, then
+/// the summary.
+pub fn render_text(results: &[FileResult], dry_run: bool, detail: Detail) -> String {
     use std::fmt::Write as _;
     let mut out = String::new();
     for r in results {
+        if detail == Detail::Quiet && !r.failed() {
+            continue;
+        }
         let target = r
             .output
             .as_ref()
             .filter(|o| **o != r.input)
-            .map(|o| format!(" -> {}", o.display()))
+            .map(|o| format!(" → {}", o.display()))
             .unwrap_or_default();
+        let warnings = r
+            .notes
+            .iter()
+            .filter(|n| n.level == super::plan::Level::Warning)
+            .count();
+        let added_bytes = r
+            .outputs
+            .iter()
+            .filter(|o| o.image.is_some())
+            .map(|o| o.bytes)
+            .sum();
+        let textures = if dry_run {
+            r.slots
+                .iter()
+                .flat_map(|s| &s.outputs)
+                .collect::<HashSet<_>>()
+                .len()
+        } else {
+            r.outputs.iter().filter(|o| o.image.is_some()).count()
+        };
+        let counts = format!(
+            " ({}, {}, {})",
+            plural(r.slots.len(), "slot", "slots"),
+            added(textures, added_bytes, dry_run),
+            plural(warnings, "warning", "warnings")
+        );
+        let warned = if warnings > 0 {
+            format!(" ({})", plural(warnings, "warning", "warnings"))
+        } else {
+            String::new()
+        };
         let status = match &r.outcome {
-            Outcome::Changed => "baked".to_owned(),
-            Outcome::Copied => "nothing to bake (copied)".to_owned(),
-            Outcome::Untouched => "nothing to bake".to_owned(),
-            Outcome::Planned { changes: true } => "would bake".to_owned(),
-            Outcome::Planned { changes: false } => "nothing to bake".to_owned(),
-            Outcome::Failed { error } => format!("failed: {error}"),
+            Outcome::Changed => format!("baked{counts}"),
+            Outcome::Copied => format!("nothing to bake, copied as it is{warned}"),
+            Outcome::Untouched => format!("nothing to bake, left as it is{warned}"),
+            Outcome::Planned { changes: true } => format!("would bake{counts}"),
+            Outcome::Planned { changes: false } => format!("nothing to bake{warned}"),
+            Outcome::Failed { error } => format!("FAILED: {error}"),
         };
         let _ = writeln!(out, "{}{target}: {status}", r.input.display());
+        if detail != Detail::Verbose {
+            continue;
+        }
         for s in &r.slots {
             let _ = writeln!(
                 out,
@@ -536,27 +588,38 @@ pub fn render_text(results: &[FileResult], dry_run: bool) -> String {
         }
         for o in &r.outputs {
             let mut line = format!(
-                "  output {}: {}x{} {}-bit {}, {}",
+                "  output {}: {}x{} {}-bit {}, {}, {}",
                 o.name,
                 o.width,
                 o.height,
                 o.bits,
                 o.mime_type.unwrap_or("-"),
-                o.stored
+                o.stored,
+                bytes(o.bytes)
             );
             if let Some(e) = o.max_error {
-                let _ = write!(line, ", max error {e:.4} codes");
+                let verdict = if e <= 0.5 + 1e-9 {
+                    "within the half code rounding allows"
+                } else {
+                    "more than rounding alone"
+                };
+                let _ = write!(line, ", max error {e:.4} codes, {verdict}");
             }
             if o.clamped > 0 {
-                let _ = write!(line, ", {} texels clamped", o.clamped);
+                let _ = write!(
+                    line,
+                    ", {} texels clamped to the channel's range",
+                    o.clamped
+                );
             }
             let _ = writeln!(out, "{line}");
         }
         if !r.dropped_images.is_empty() {
             let _ = writeln!(
                 out,
-                "  dropped images {:?} ({} bytes cut from the BIN chunk)",
-                r.dropped_images, r.dropped_bin_bytes
+                "  dropped images {:?} ({} cut from the BIN chunk)",
+                r.dropped_images,
+                bytes(r.dropped_bin_bytes)
             );
         }
         for n in &r.notes {
@@ -567,17 +630,21 @@ pub fn render_text(results: &[FileResult], dry_run: bool) -> String {
             let _ = writeln!(out, "  {level} {}: {}", n.pointer, n.message);
         }
     }
+    if detail == Detail::Quiet {
+        return out;
+    }
     let s = summary(results);
     let _ = writeln!(
         out,
-        "{} file(s): {} {}, {} unchanged, {} failed; {} slot(s), {} texture(s) written",
-        s.files,
-        s.changed,
-        if dry_run { "to bake" } else { "baked" },
-        s.unchanged,
-        s.failed,
-        s.slots,
-        s.textures
+        "{}; {}",
+        files_line(
+            s.files,
+            s.changed,
+            if dry_run { "would bake" } else { "baked" },
+            s.unchanged,
+            s.failed
+        ),
+        added(s.textures, s.bytes, dry_run)
     );
     out
 }

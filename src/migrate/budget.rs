@@ -235,7 +235,7 @@ fn fit_shared(codes: &Codes, mapping: &Curve, factors: &[f64]) -> Curve {
             );
         }
     }
-    Curve::sampled(&format!("{}, fitted for shared use", mapping.name()), &g)
+    Curve::sampled(&format!("{} (shared fit)", mapping.name()), &g)
         .expect("every code's sample is finite")
 }
 

@@ -269,14 +269,21 @@ impl Note {
                 "sheenColorTexture became fuzzColorTexture as it is: the lobe colour is exact, but the base is now attenuated by fuzzFactor {w:?} instead of the per-texel maximum of the sheen colour (--report measures the difference)"
             ),
             Note::AttenuationMeasured { image, texels, w, max, mean } => format!(
-                "attenuation difference |{w:?} − max3(sheenColor)| over the {texels} texels of image {image}: max {max:.4}, mean {mean:.4}"
+                "attenuation difference |{w:?} − max3(sheenColor)| over the {texels} texels of image {image}: max {max:.4}, mean {mean:.4}; {}",
+                if *max <= super::fallback::DARK_FUZZ_THRESHOLD {
+                    format!("within {} everywhere, not visible", super::fallback::DARK_FUZZ_THRESHOLD)
+                } else {
+                    format!("{:.4} over {} at worst (--exact bakes it away)", max - super::fallback::DARK_FUZZ_THRESHOLD, super::fallback::DARK_FUZZ_THRESHOLD)
+                }
             ),
             Note::LayerDifference { mapping, sheen_roughness, fuzz_roughness, max_difference, at_mu, reflectance_max, reflectance_rms, poor_match, fuzz_model, clamped } => {
                 let mut m = format!(
                     "layer difference ({mapping} roughness mapping, sheen {sheen_roughness:.4} → fuzz {fuzz_roughness:.4}, {fuzz_model}): |max3·E − w·R| over view angles max {reflectance_max:.4}, cosine-weighted rms {reflectance_rms:.4}; base attenuation differs by at most {max_difference:.4}, at view cosine {at_mu:.3}"
                 );
                 if *poor_match {
-                    m += &format!(" (sheen roughness below {}: no fuzz roughness matches it well)", crate::shading::mapping::POOR_MATCH_BELOW);
+                    m += &format!("; a poor match: below sheen roughness {} no fuzz roughness matches a sheen well", crate::shading::mapping::POOR_MATCH_BELOW);
+                } else {
+                    m += "; the closest fuzz the fitted mapping finds (see docs/shading.md for its bounds)";
                 }
                 if *clamped > 0 {
                     m += &format!(" ({clamped} attenuations clamped at 0 where the albedo exceeds 1)");
@@ -313,7 +320,12 @@ impl Note {
                 "--exact cannot bake this material's textures ({reason}): sheenColorTexture became fuzzColorTexture as it is (the fast mode)"
             ),
             Note::BakeError { pointer, image, max_codes, clamped } => {
-                let mut m = format!("{pointer}: {image} differs from the exact f64 result by at most {max_codes:.3} codes (quantisation)");
+                let verdict = if *max_codes <= 0.5 + 1e-9 {
+                    "within the half code rounding allows"
+                } else {
+                    "more than rounding alone (the texture is read through a curve or resampled)"
+                };
+                let mut m = format!("{pointer}: {image} differs from the exact f64 result by at most {max_codes:.3} codes, {verdict}");
                 if *clamped > 0 {
                     m += &format!("; {clamped} values clamped to the channel's range");
                 }
@@ -323,7 +335,8 @@ impl Note {
                 "fuzzTexture and fuzzColorTexture cannot be combined into one sheen colour texture ({reason}): the fallback sheen uses the factors instead"
             ),
             Note::DarkFuzz { difference, fuzz_color_max, base_color_max } => format!(
-                "the fuzz (max colour {fuzz_color_max:?}) is darker than the base (max colour {base_color_max:?}): sheen only adds light, so where the fuzz darkens the base, loaders without fuzz show it brighter by up to {difference:.4} of the layer's reflectance (from the factors; textures can make it larger)"
+                "the fuzz blends the base towards its colour (brightest channel {fuzz_color_max:?}), which darkens a base whose brightest channel is {base_color_max:?}; sheen only adds light, so loaders without fuzz show it brighter by up to {difference:.4} of the layer's reflectance, over the {} velvet reports from (from the factors; textures can make it larger)",
+                super::fallback::DARK_FUZZ_THRESHOLD
             ),
             Note::BlackFuzz => {
                 "the fuzz colour is black: a sheen of that colour is switched off, so no sheen can stand for it; no fallback is written (loaders without fuzz show no layer)".into()
