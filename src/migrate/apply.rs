@@ -198,16 +198,27 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
     }
     let mut names = names.into_inner().unwrap_or_else(|e| e.into_inner());
     let names_dir = names.dir().to_path_buf();
-    let edits: Vec<_> = plan
+    // The edits are applied where they lie in the plan (a large document's are not copied).
+    let mut changed = false;
+    let groups = plan
         .document
-        .edits()
-        .chain(&plan.relocation.edits)
-        .cloned()
-        .collect();
-    let changed = edit::apply(&mut plan.asset.json, &edits)
-        .map_err(|e| format!("{}: {e}", plan.input.display()))?;
+        .materials
+        .iter()
+        .map(|m| m.edits.as_slice())
+        .chain([
+            plan.document.declarations.as_slice(),
+            plan.relocation.edits.as_slice(),
+        ]);
+    for edits in groups {
+        changed |= edit::apply(&mut plan.asset.json, edits)
+            .map_err(|e| format!("{}: {e}", plan.input.display()))?;
+    }
     if !changed && plan.in_place() {
         return Ok(Written::Untouched);
+    }
+    if changed {
+        // The input's bytes are written only when nothing changed.
+        plan.bytes = Vec::new();
     }
     create_parent(&output)?;
     let bytes = if bake_plan.is_empty() {

@@ -188,11 +188,25 @@ fn minimax(f: impl Fn(f64) -> f64, iterations: usize) -> f64 {
     (lo + hi) / 2.0
 }
 
+/// How many factors a joint fit follows at most.
+const FIT_FACTORS: usize = 33;
+
 /// The shared texture's curve g for a source texture read by materials with `factors`: a joint
 /// minimax fit of f'·g(t) ≈ α(f·t) over the codes present, by alternation (each factor's
-/// best f' for g, then each code's best g for those f'), started from g = α. Sampled at every
+/// best f' for g, then each code's best g for those f'), started from g = α, over `factors`
+/// (sorted). Sampled at every
 /// code of the channel's depth (codes not present keep α), so the bake reads g exactly there.
 fn fit_shared(codes: &Codes, mapping: &Curve, factors: &[f64]) -> Curve {
+    // At most FIT_FACTORS factors, evenly spread over the sorted ones (the smallest and largest
+    // included): the fit follows the extremes, and every material is checked afterwards.
+    let n = factors.len();
+    let factors: Vec<f64> = if n <= FIT_FACTORS {
+        factors.to_vec()
+    } else {
+        (0..FIT_FACTORS)
+            .map(|k| factors[k * (n - 1) / (FIT_FACTORS - 1)])
+            .collect()
+    };
     let max = f64::from(codes.max);
     let mut g: Vec<f64> = (0..=codes.max)
         .map(|j| mapping.eval(f64::from(j) / max))
