@@ -20,8 +20,9 @@
 //! plan within the budget is taken; a material no plan brings within it gets the exact bake,
 //! reported with how far over it is. [`Budget::Exact`] takes the exact bake for every material.
 //!
-//! Planning decodes each source image once (the codes present per channel), and only when some
-//! material maps a roughness texture.
+//! Planning decodes the source images of mapped roughness textures (the codes present per
+//! channel), only when some material maps one; each texture's materials are planned in
+//! parallel with the others'.
 
 use super::note::Note;
 use super::plan::MaterialPlan;
@@ -29,8 +30,9 @@ use super::roughness;
 use super::textures::Contents;
 use crate::asset::Asset;
 use crate::bake::{codec, srgb, Channel, Curve, Pixels};
+use rayon::prelude::*;
 use serde::Serialize;
-use std::collections::{BTreeMap, HashMap};
+use std::collections::BTreeMap;
 
 /// The default budget: the largest roughness difference a plan may leave, in roughness units.
 /// 0.01 is 2.5 codes of an 8-bit roughness texture, below the mapping's own stated deviation
@@ -320,34 +322,33 @@ pub fn plan(asset: &Asset, materials: &mut [MaterialPlan], budget: Budget) {
             }
         }
     }
-    let mut decoded: HashMap<(usize, u8), Result<Codes, String>> = HashMap::new();
-    for ((_, _, _), slots) in groups {
-        let first = &materials[slots[0].material].bakes[slots[0].bake];
-        let Contents::Roughness {
-            channel,
-            curve: Some(curve),
-            ..
-        } = first.contents.clone()
-        else {
-            continue;
-        };
-        let images: Vec<usize> = first.sources.iter().map(|(_, i)| *i).collect();
-        let mut sources = Vec::with_capacity(images.len());
-        let mut failed = None;
-        for image in images {
-            let codes = decoded
-                .entry((image, channel as u8))
-                .or_insert_with(|| codes_of(asset, image, channel));
-            match codes {
-                Ok(c) => sources.push(c.clone()),
-                Err(e) => failed = Some(e.clone()),
-            }
-        }
-        if failed.is_some() {
-            // The bake itself fails on this image and says why; it stays as planned (exact).
-            continue;
-        }
-        let choices = choose(&slots, &sources, &curve, budget);
+    // Each group is planned on its own (in parallel): its images decoded for the codes present,
+    // then its choices made. A group whose image cannot be decoded keeps its exact bakes; the
+    // bake itself then fails on that image and says why.
+    let groups: Vec<Vec<Slot>> = groups.into_values().collect();
+    let planned: Vec<Option<Vec<Choice>>> = groups
+        .par_iter()
+        .map(|slots| {
+            let first = &materials[slots[0].material].bakes[slots[0].bake];
+            let Contents::Roughness {
+                channel,
+                curve: Some(curve),
+                ..
+            } = &first.contents
+            else {
+                return None;
+            };
+            let sources: Vec<Codes> = first
+                .sources
+                .iter()
+                .map(|(_, image)| codes_of(asset, *image, *channel))
+                .collect::<Result<_, _>>()
+                .ok()?;
+            Some(choose(slots, &sources, curve, budget))
+        })
+        .collect();
+    for (slots, choices) in groups.iter().zip(planned) {
+        let Some(choices) = choices else { continue };
         for (slot, choice) in slots.iter().zip(choices) {
             let material = &mut materials[slot.material];
             let bake = &mut material.bakes[slot.bake];
