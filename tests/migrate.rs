@@ -1600,14 +1600,23 @@ fn one_and_four_threads_give_byte_identical_trees() {
     let dir = tempfile::tempdir().unwrap();
     library(dir.path());
     for (threads, out) in [("1", "one"), ("4", "four")] {
-        let (status, stdout, stderr) = velvet_in(
-            dir.path(),
-            &[("RAYON_NUM_THREADS", threads)],
-            &["migrate", "lib", "--out-dir", out],
-        );
-        assert_eq!(status, 0, "{stdout}{stderr}");
+        for (budget, dir_name) in [("0.01", out.to_string()), ("exact", format!("{out}-exact"))] {
+            let (status, stdout, stderr) = velvet_in(
+                dir.path(),
+                &[("RAYON_NUM_THREADS", threads)],
+                &[
+                    "migrate",
+                    "lib",
+                    "--out-dir",
+                    &dir_name,
+                    "--roughness-budget",
+                    budget,
+                ],
+            );
+            assert_eq!(status, 0, "{stdout}{stderr}");
+        }
     }
-    for (a, b) in [("one", "four")] {
+    for (a, b) in [("one", "four"), ("one-exact", "four-exact")] {
         let (a, b) = (tree(&dir.path().join(a)), tree(&dir.path().join(b)));
         assert_eq!(a.keys().collect::<Vec<_>>(), b.keys().collect::<Vec<_>>());
         assert!(a == b, "the trees hold the same bytes");
@@ -1754,4 +1763,98 @@ fn a_link_to_a_file_outside_the_input_folder_is_refused_and_nothing_of_it_is_wri
     assert_eq!(status, 1, "{stdout}");
     assert!(stdout.contains("'rough.png'"), "{stdout}");
     assert!(!dir.path().join("baked").exists() || tree(&dir.path().join("baked")).is_empty());
+}
+
+/// Three materials read one roughness texture (alpha 192–255, each code once) with nearby
+/// factors: the default budget shares one fitted texture, a zero budget and the exact setting
+/// bake one per material; in every case the error reported equals the error measured from the
+/// decoded output.
+#[test]
+fn the_roughness_plan_shares_a_texture_within_the_budget_and_bakes_per_material_otherwise() {
+    use migrate::budget::{Budget, TexturePlan, DEFAULT_BUDGET};
+    let dir = tempfile::tempdir().unwrap();
+    let data: Vec<u8> = (0..64u8).flat_map(|k| [10, 20, 30, 192 + k]).collect();
+    png_file(
+        &dir.path().join("rough.png"),
+        8,
+        8,
+        image::ColorType::Rgba8,
+        &data,
+    );
+    let factors = [0.30, 0.35, 0.40];
+    let materials: Vec<Value> = factors
+        .iter()
+        .map(|f| {
+            serde_json::json!({"extensions": {"KHR_materials_sheen": {
+                "sheenColorFactor": [0.5, 0.5, 0.5],
+                "sheenRoughnessFactor": f,
+                "sheenRoughnessTexture": {"index": 0}
+            }}})
+        })
+        .collect();
+    let json = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_materials_sheen"],
+        "materials": materials,
+        "textures": [{"source": 0}],
+        "images": [{"uri": "rough.png"}]
+    });
+    for (budget, added, plan, bound) in [
+        (Budget::default(), 1, TexturePlan::Shared, DEFAULT_BUDGET),
+        (Budget::Within(0.0), 3, TexturePlan::Exact, 0.5 / 255.0),
+        (Budget::Exact, 3, TexturePlan::Exact, 0.5 / 255.0),
+    ] {
+        let (output, doc, result) = migrate_document(
+            dir.path(),
+            "cloth",
+            json.clone(),
+            &format!("{budget:?}.gltf"),
+            Options {
+                budget,
+                ..Options::default()
+            },
+        );
+        assert_eq!(result.textures_added, added, "{budget:?}");
+        assert_eq!(doc["images"].as_array().unwrap().len(), 1 + added);
+        for (m, &f) in factors.iter().enumerate() {
+            let (plan_of, reported) = result.materials[m]
+                .notes
+                .iter()
+                .find_map(|n| match n {
+                    Note::RoughnessPlan {
+                        plan, max_error, ..
+                    } => Some((*plan, *max_error)),
+                    _ => None,
+                })
+                .expect("every mapped texture's plan is reported");
+            assert_eq!(plan_of, plan, "{budget:?} material {m}");
+            let fuzz = &doc["materials"][m]["extensions"]["KHR_materials_fuzz"];
+            let factor = fuzz["fuzzRoughnessFactor"].as_f64().unwrap();
+            let (_, pixels) = texture_pixels(
+                &output,
+                &format!("/materials/{m}/extensions/KHR_materials_fuzz/fuzzRoughnessTexture"),
+            );
+            let measured = pixels
+                .iter()
+                .enumerate()
+                .map(|(k, p)| {
+                    let exact = roughness::map(
+                        f * (192 + k) as f64 / 255.0,
+                        Direction::SheenToFuzz,
+                        RoughnessMapping::Fitted,
+                    );
+                    (factor * p[3] as f64 / 255.0 - exact).abs()
+                })
+                .fold(0.0, f64::max);
+            assert!(
+                (measured - reported).abs() < 1e-12,
+                "{budget:?} material {m}: reported {reported}, measured {measured}"
+            );
+            assert!(
+                measured <= bound + 1e-12,
+                "{budget:?} material {m}: {measured}"
+            );
+        }
+        assert!(errors(&output).is_empty(), "{:?}", errors(&output));
+    }
 }
