@@ -3,11 +3,12 @@
 //! `#[path]`) and from the command line:
 //!
 //!     cargo run --release --example corpus -- OUT_DIR [MATERIALS] [FILES]
-//!     cargo run --release --example corpus -- --library OUT_DIR
+//!     cargo run --release --example corpus -- --library OUT_DIR [LOWEST_ALPHA]
 //!
 //! `--library` writes OUT_DIR/library.gltf (about 10 MB: 20,000 ratified sheen materials, every
 //! factor different, the odd ones with a sheen roughness texture drawn from 4 shared 256² PNGs,
-//! OUT_DIR/fabric0.png … fabric3.png, whose alpha holds every code) and its mesh buffer.
+//! OUT_DIR/fabric0.png … fabric3.png, whose alpha holds every code from LOWEST_ALPHA, default
+//! 0, to 255) and its mesh buffer.
 //!
 //! writes OUT_DIR/large.gltf (MATERIALS materials, default 20000) and OUT_DIR/small/ (FILES
 //! files, default 500). The materials cycle through the shapes real assets have: ratified sheen
@@ -131,12 +132,14 @@ pub fn library_document(count: usize) -> Value {
     doc
 }
 
-/// A 256×256 RGBA PNG whose alpha holds a different pattern per `k` and every code.
-pub fn fabric_png(k: usize) -> Vec<u8> {
+/// A 256×256 RGBA PNG whose alpha holds a different pattern per `k` and every code from
+/// `lowest` to 255.
+pub fn fabric_png(k: usize, lowest: u8) -> Vec<u8> {
+    let span = 256 - usize::from(lowest);
     let mut pixels = Vec::with_capacity(256 * 256 * 4);
     for y in 0..256usize {
         for x in 0..256usize {
-            let alpha = (x + (y * (2 * k + 1)) + 37 * k) % 256;
+            let alpha = usize::from(lowest) + (x + (y * (2 * k + 1)) + 37 * k) % span;
             pixels.extend([x as u8, y as u8, (128 + 40 * k) as u8, alpha as u8]);
         }
     }
@@ -152,8 +155,8 @@ pub fn fabric_png(k: usize) -> Vec<u8> {
     bytes
 }
 
-/// Writes the library (20,000 materials) into `dir`.
-pub fn write_library(dir: &Path, materials: usize) -> std::io::Result<()> {
+/// Writes the library (`materials` materials) into `dir`.
+pub fn write_library(dir: &Path, materials: usize, lowest_alpha: u8) -> std::io::Result<()> {
     std::fs::create_dir_all(dir)?;
     std::fs::write(
         dir.join("library.gltf"),
@@ -161,7 +164,10 @@ pub fn write_library(dir: &Path, materials: usize) -> std::io::Result<()> {
     )?;
     std::fs::write(dir.join("mesh.bin"), [0u8; 60])?;
     for k in 0..LIBRARY_TEXTURES {
-        std::fs::write(dir.join(format!("fabric{k}.png")), fabric_png(k))?;
+        std::fs::write(
+            dir.join(format!("fabric{k}.png")),
+            fabric_png(k, lowest_alpha),
+        )?;
     }
     Ok(())
 }
@@ -173,7 +179,8 @@ fn main() {
             eprintln!("usage: corpus --library OUT_DIR");
             std::process::exit(2);
         };
-        if let Err(e) = write_library(Path::new(dir), 20_000) {
+        let lowest = args.get(2).and_then(|a| a.parse().ok()).unwrap_or(0);
+        if let Err(e) = write_library(Path::new(dir), 20_000, lowest) {
             eprintln!("corpus: cannot write {dir}: {e}");
             std::process::exit(1);
         }
