@@ -24,7 +24,7 @@ use std::sync::Mutex;
 pub struct FilePlan {
     pub input: PathBuf,
     pub output: Option<PathBuf>,
-    /// The input's bytes, written as they are when nothing changes.
+    /// The input's bytes, kept when the plan changes nothing (then written as they are).
     pub bytes: Vec<u8>,
     pub asset: Asset,
     pub document: DocumentPlan,
@@ -90,6 +90,13 @@ pub fn plan_file(job: &Job, options: &Options) -> Result<FilePlan, String> {
         Some(output) if output != &job.input => relocate(&asset, output, options.rewrite_uris)
             .map_err(|e| format!("{}: {e}", job.input.display()))?,
         _ => Relocation::default(),
+    };
+    // The input's bytes are written as they are only when the plan changes nothing; a large
+    // document that changes does not keep them.
+    let bytes = if document.is_empty() && relocation.edits.is_empty() {
+        bytes
+    } else {
+        Vec::new()
     };
     Ok(FilePlan {
         input: job.input.clone(),
@@ -225,6 +232,10 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
         copy_resources(&plan.relocation, &plan.asset.json)?;
         if changed {
             write::to_bytes(&plan.asset, &plan.asset.json, plan.asset.bin.as_deref())
+        } else if plan.bytes.is_empty() {
+            // Edits that set what was there already: the input's own bytes, read again.
+            asset::read(&plan.input, &plan.asset.options)
+                .map_err(|d| format!("cannot read {}: {}", plan.input.display(), d.message))?
         } else {
             std::mem::take(&mut plan.bytes)
         }

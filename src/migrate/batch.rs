@@ -128,12 +128,11 @@ fn migrate_one(job: &Job, options: &Options, dry_run: bool, claims: &Claims) -> 
             Err(error) => FileOutcome::Failed { error },
         }
     };
-    let planned_textures =
-        super::textures::bake_plan(plan.document.materials.iter().flat_map(|m| &m.bakes))
-            .map_or(0, |p| p.recipes.len());
     let written: Vec<_> = plan.baked.iter().filter(|o| o.image.is_some()).collect();
     let (textures_added, bytes_added) = if dry_run {
-        (planned_textures, 0)
+        let planned =
+            super::textures::bake_plan(plan.document.materials.iter().flat_map(|m| &m.bakes));
+        (planned.map_or(0, |p| p.recipes.len()), 0)
     } else {
         (written.len(), written.iter().map(|o| o.bytes).sum())
     };
