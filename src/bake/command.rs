@@ -249,6 +249,10 @@ fn slot_reports(plan: &BakePlan, names: &[String]) -> Vec<SlotReport> {
         .collect()
 }
 
+/// What [`file_sink`] returns: a [`Sink`](super::Sink) it owns.
+pub(crate) type FileSink<'s> =
+    Box<dyn Fn(super::OutputId, &mut super::Baked) -> Result<(), String> + Sync + 's>;
+
 /// A [`Sink`](super::Sink) that writes each output as a file into `dir` as soon as it is encoded
 /// (named from the source image, the slots and a hash of the bytes, claimed through `names`)
 /// and drops its bytes. Only for a .gltf whose new images are files.
@@ -256,7 +260,7 @@ pub(crate) fn file_sink<'s, 'c: 's>(
     names: &'s Mutex<FileNames<'c>>,
     images: &'s Value,
     plan: &'s BakePlan,
-) -> Box<dyn Fn(super::OutputId, &mut super::Baked) -> Result<(), String> + Sync + 's> {
+) -> FileSink<'s> {
     Box::new(move |id, baked| {
         let Some((format, bytes)) = baked.encoded.take() else {
             return Ok(());
