@@ -1,7 +1,14 @@
 //! Generates the benchmark corpus: one .gltf with many sheen/fuzz materials, and a folder of
-//! small .gltf files. Used by `benches/` (through `#[path]`) and from the command line:
+//! small .gltf files; or a library asset for migrating at scale. Used by `benches/` (through
+//! `#[path]`) and from the command line:
 //!
 //!     cargo run --release --example corpus -- OUT_DIR [MATERIALS] [FILES]
+//!     cargo run --release --example corpus -- --library OUT_DIR [LOWEST_ALPHA]
+//!
+//! `--library` writes OUT_DIR/library.gltf (about 10 MB: 20,000 ratified sheen materials, every
+//! factor different, the odd ones with a sheen roughness texture drawn from 4 shared 256² PNGs,
+//! OUT_DIR/fabric0.png … fabric3.png, whose alpha holds every code from LOWEST_ALPHA, default
+//! 0, to 255) and its mesh buffer.
 //!
 //! writes OUT_DIR/large.gltf (MATERIALS materials, default 20000) and OUT_DIR/small/ (FILES
 //! files, default 500). The materials cycle through the shapes real assets have: ratified sheen
@@ -90,8 +97,95 @@ pub fn write(dir: &Path, materials: usize, files: usize) -> std::io::Result<()> 
     Ok(())
 }
 
+/// The number of shared roughness textures of the library.
+pub const LIBRARY_TEXTURES: usize = 4;
+
+/// Material `i` of the library: a ratified sheen whose colour and roughness differ from every
+/// other material's; odd materials read roughness texture `i / 2 % 4`.
+pub fn library_material(i: usize, count: usize) -> Value {
+    let t = i as f64 / count as f64;
+    let mut sheen = json!({
+        "sheenColorFactor": [0.2 + 0.7 * t, 0.5, 0.9 - 0.6 * t],
+        "sheenRoughnessFactor": 0.12 + 0.85 * t
+    });
+    if i % 2 == 1 {
+        sheen["sheenRoughnessTexture"] = json!({"index": i / 2 % LIBRARY_TEXTURES});
+    }
+    json!({"name": format!("cloth{i}"), "extensions": {"KHR_materials_sheen": sheen}})
+}
+
+/// The library document: `count` materials, one mesh per material.
+pub fn library_document(count: usize) -> Value {
+    let mut doc = document(0);
+    doc["asset"]["generator"] = json!("velvet library corpus");
+    doc["extensionsUsed"] = json!(["KHR_materials_sheen"]);
+    doc["materials"] = (0..count).map(|i| library_material(i, count)).collect();
+    doc["meshes"] = (0..count)
+        .map(|i| json!({"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1}, "material": i}]}))
+        .collect();
+    doc["textures"] = (0..LIBRARY_TEXTURES)
+        .map(|k| json!({"source": k}))
+        .collect();
+    doc["images"] = (0..LIBRARY_TEXTURES)
+        .map(|k| json!({"uri": format!("fabric{k}.png")}))
+        .collect();
+    doc
+}
+
+/// A 256×256 RGBA PNG whose alpha holds a different pattern per `k` and every code from
+/// `lowest` to 255.
+pub fn fabric_png(k: usize, lowest: u8) -> Vec<u8> {
+    let span = 256 - usize::from(lowest);
+    let mut pixels = Vec::with_capacity(256 * 256 * 4);
+    for y in 0..256usize {
+        for x in 0..256usize {
+            let alpha = usize::from(lowest) + (x + (y * (2 * k + 1)) + 37 * k) % span;
+            pixels.extend([x as u8, y as u8, (128 + 40 * k) as u8, alpha as u8]);
+        }
+    }
+    let mut bytes = Vec::new();
+    image::ImageEncoder::write_image(
+        image::codecs::png::PngEncoder::new(&mut bytes),
+        &pixels,
+        256,
+        256,
+        image::ExtendedColorType::Rgba8,
+    )
+    .expect("encoding a PNG in memory cannot fail");
+    bytes
+}
+
+/// Writes the library (`materials` materials) into `dir`.
+pub fn write_library(dir: &Path, materials: usize, lowest_alpha: u8) -> std::io::Result<()> {
+    std::fs::create_dir_all(dir)?;
+    std::fs::write(
+        dir.join("library.gltf"),
+        serde_json::to_vec_pretty(&library_document(materials))?,
+    )?;
+    std::fs::write(dir.join("mesh.bin"), [0u8; 60])?;
+    for k in 0..LIBRARY_TEXTURES {
+        std::fs::write(
+            dir.join(format!("fabric{k}.png")),
+            fabric_png(k, lowest_alpha),
+        )?;
+    }
+    Ok(())
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.first().map(String::as_str) == Some("--library") {
+        let Some(dir) = args.get(1) else {
+            eprintln!("usage: corpus --library OUT_DIR");
+            std::process::exit(2);
+        };
+        let lowest = args.get(2).and_then(|a| a.parse().ok()).unwrap_or(0);
+        if let Err(e) = write_library(Path::new(dir), 20_000, lowest) {
+            eprintln!("corpus: cannot write {dir}: {e}");
+            std::process::exit(1);
+        }
+        return;
+    }
     let Some(dir) = args.first() else {
         eprintln!("usage: corpus OUT_DIR [MATERIALS] [FILES]");
         std::process::exit(2);

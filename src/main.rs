@@ -10,6 +10,7 @@ use velvet::asset::discover::{self, Shard};
 use velvet::cli_docs::{self, EXIT_STATUS, EXIT_STATUS_ALL};
 use velvet::config::{self, Layer, Resolver};
 use velvet::diagnostics::{self, FailOn, Settings};
+use velvet::migrate;
 use velvet::report::{self, ColorChoice, Format};
 use velvet::rules::schema::Schemas;
 use velvet::validate::Validator;
@@ -206,14 +207,23 @@ struct BakeArgs {
     /// Keep JPEG textures as JPEG (lossy) instead of lossless PNG.
     #[arg(long)]
     keep_format: bool,
-    /// Measure and print each output's largest error in codes.
+    /// Measure and print each output's largest error in codes (and show every slot and
+    /// output, as --verbose).
     #[arg(long)]
     report: bool,
+    /// Show every slot baked and every output written under its file's line.
+    #[arg(long, short)]
+    verbose: bool,
     /// PNG compression effort for new images.
     #[arg(long, value_enum, default_value_t = Compression::Fast)]
     compression: Compression,
-    /// Copy relative resources next to outputs in another folder instead of rewriting URIs.
+    /// An output in another folder refers back to the input's resources (URIs rewritten to
+    /// lead there) instead of getting its own copies beside it (the default).
     #[arg(long)]
+    rewrite_uris: bool,
+    /// Copy (or hard-link) resources beside outputs in another folder: the default, kept so
+    /// that existing scripts run.
+    #[arg(long, hide = true, conflicts_with = "rewrite_uris")]
     copy_resources: bool,
     #[arg(long, value_enum, default_value_t = BakeFormat::Text)]
     format: BakeFormat,
@@ -446,9 +456,13 @@ struct MigrateArgs {
     check: bool,
     #[arg(long, value_enum, default_value_t = MigrateFormat::Text)]
     format: MigrateFormat,
-    /// Decode sheen colour textures to measure what the fast conversion changes.
+    /// Decode sheen colour textures to measure what the fast conversion changes (and show
+    /// every material's notes, as --verbose).
     #[arg(long)]
     report: bool,
+    /// Show every material with something to say, and its notes, under its file's line.
+    #[arg(long, short)]
+    verbose: bool,
     /// Bake a fuzzTexture and a normalised fuzzColorTexture from each sheen colour texture so
     /// that the fuzz matches the sheen texel by texel (lobe and base attenuation).
     #[arg(long)]
@@ -464,11 +478,20 @@ struct MigrateArgs {
     /// texture, and say so.
     #[arg(long)]
     fast: bool,
+    /// The largest roughness difference a shared mapped roughness texture may leave, per
+    /// material, before a dearer plan is taken; `exact` bakes one texture per material.
+    #[arg(long, value_name = "DIFFERENCE|exact", default_value = "0.01")]
+    roughness_budget: migrate::budget::Budget,
     /// Regenerate the sheen fallback of materials that already have fuzz and sheen.
     #[arg(long)]
     refresh_fallback: bool,
-    /// Copy relative resources next to outputs in another folder instead of rewriting URIs.
+    /// An output in another folder refers back to the input's resources (URIs rewritten to
+    /// lead there) instead of getting its own copies beside it (the default).
     #[arg(long)]
+    rewrite_uris: bool,
+    /// Copy (or hard-link) resources beside outputs in another folder: the default, kept so
+    /// that existing scripts run.
+    #[arg(long, hide = true, conflicts_with = "rewrite_uris")]
     copy_resources: bool,
     #[command(flatten)]
     load: LoadArgs,
@@ -511,7 +534,8 @@ fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
                 RoughnessArg::Identity => migrate::roughness::RoughnessMapping::Identity,
             },
             fast: args.fast,
-            copy_resources: args.copy_resources,
+            budget: args.roughness_budget,
+            rewrite_uris: args.rewrite_uris,
             load: args.load.options(),
         },
         dry_run: args.dry_run || args.check,
@@ -533,7 +557,16 @@ fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
     print!(
         "{}",
         match args.format {
-            MigrateFormat::Text => migrate::render::text(&report),
+            MigrateFormat::Text => migrate::render::text(
+                &report,
+                if quiet {
+                    migrate::render::Detail::Quiet
+                } else if args.verbose || args.report {
+                    migrate::render::Detail::Verbose
+                } else {
+                    migrate::render::Detail::Normal
+                }
+            ),
             MigrateFormat::Json => migrate::render::json(&report),
         }
     );
@@ -573,7 +606,7 @@ fn bake(args: BakeArgs, quiet: bool) -> ExitCode {
                 Compression::Balanced => velvet::bake::PngCompression::Default,
                 Compression::Best => velvet::bake::PngCompression::Best,
             },
-            copy_resources: args.copy_resources,
+            rewrite_uris: args.rewrite_uris,
             load: args.load.options(),
         },
         progress: !quiet,
@@ -588,7 +621,20 @@ fn bake(args: BakeArgs, quiet: bool) -> ExitCode {
         }
     };
     match args.format {
-        BakeFormat::Text => print!("{}", command::render_text(&results, args.dry_run)),
+        BakeFormat::Text => print!(
+            "{}",
+            command::render_text(
+                &results,
+                args.dry_run,
+                if quiet {
+                    migrate::render::Detail::Quiet
+                } else if args.verbose || args.report || args.dry_run {
+                    migrate::render::Detail::Verbose
+                } else {
+                    migrate::render::Detail::Normal
+                }
+            )
+        ),
         BakeFormat::Json => print!("{}", command::render_json(&results)),
     }
     if results.iter().any(|r| r.failed()) {

@@ -55,6 +55,35 @@ fn png(layout: Layout, codes: Vec<u8>) -> Vec<u8> {
     codec::encode(&p, OutputFormat::Png, EncodeOptions::default()).unwrap()
 }
 
+/// The one file in `dir` named `<stem>.<hash>.<ext>`, whose hash is that of its bytes (new
+/// image names follow from their content).
+#[track_caller]
+fn named(dir: &Path, stem: &str, ext: &str) -> String {
+    let found: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .filter(|n| {
+            n.strip_prefix(stem)
+                .and_then(|rest| rest.strip_prefix('.'))
+                .and_then(|rest| rest.strip_suffix(ext))
+                .and_then(|rest| rest.strip_suffix('.'))
+                .is_some_and(|hash| hash.len() == 12 && hash.bytes().all(|b| b.is_ascii_hexdigit()))
+        })
+        .collect();
+    assert_eq!(
+        found.len(),
+        1,
+        "{stem}.*.{ext} in {}: {found:?}",
+        dir.display()
+    );
+    let bytes = std::fs::read(dir.join(&found[0])).unwrap();
+    assert_eq!(
+        found[0],
+        format!("{stem}.{}.{ext}", velvet::bake::apply::content_hash(&bytes))
+    );
+    found.into_iter().next().unwrap()
+}
+
 fn decode(bytes: &[u8]) -> Pixels {
     codec::decode(bytes).unwrap().0
 }
@@ -196,12 +225,14 @@ fn gltf_colour_and_roughness_of_one_image_are_baked_once_into_one_file() {
     );
     assert_eq!(
         out["images"],
-        json!([{"name": "fabric.sheenColor.sheenRoughness", "uri": "fabric.sheenColor.sheenRoughness.png"}])
+        json!([{"name": "fabric.sheenColor.sheenRoughness", "uri": named(&out_dir, "fabric.sheenColor.sheenRoughness", "png")}])
     );
     assert_eq!(result.dropped_images, vec![0]);
 
-    let baked =
-        decode(&std::fs::read(out_dir.join("fabric.sheenColor.sheenRoughness.png")).unwrap());
+    let baked = decode(
+        &std::fs::read(out_dir.join(named(&out_dir, "fabric.sheenColor.sheenRoughness", "png")))
+            .unwrap(),
+    );
     assert_eq!(
         (baked.width(), baked.height(), baked.layout()),
         (4, 4, Layout::Rgba)
@@ -250,22 +281,19 @@ fn a_gltf_written_to_another_folder_keeps_its_other_resources_reachable() {
     let out = read_json(&output);
     assert_eq!(
         out["images"],
-        json!([{"uri": "../base.png"}, {"name": "sheen.sheenColor", "uri": "sheen.sheenColor.png"}])
+        json!([{"uri": "base.png"}, {"name": "sheen.sheenColor", "uri": named(&dir.path().join("deeper"), "sheen.sheenColor", "png")}])
     );
     assert_eq!(out["textures"], json!([{"source": 0}, {"source": 1}]));
-    // The kept image is reached by a URI that climbs out of the output's folder, which
-    // validate refuses to follow.
-    assert_eq!(
-        validation_errors(&output),
-        ["URI_NOT_FOLLOWED /images/0/uri: '../base.png' climbs out of the asset's folder (--allow-outside-uris reads it)"]
-    );
+    assert_eq!(validation_errors(&output), Vec::<String>::new());
     let loaded = asset::load(&output).asset.unwrap();
     let baked = decode(&loaded.image_bytes(1).unwrap());
     let expected: Vec<u8> = rgba(2)[..48].iter().map(|&c| colour(c, 0.5)).collect();
     assert_eq!(codes8(&baked), expected);
-    // velvet's own loader does not follow URIs out of an asset's folder; the file is there.
-    let base = std::fs::read(output.parent().unwrap().join("../base.png")).unwrap();
+    // The base colour image is copied beside the output (the output is self-contained), and
+    // the replaced sheen source, which nothing reads any more, is not.
+    let base = std::fs::read(output.parent().unwrap().join("base.png")).unwrap();
     assert_eq!(decode(&base).layout(), Layout::Rgb);
+    assert!(!output.parent().unwrap().join("sheen.png").exists());
 }
 
 #[test]
@@ -632,25 +660,28 @@ fn jpeg_becomes_lossless_png_unless_kept_and_webp_stays_webp_with_its_fallback()
     assert_eq!(
         out["images"],
         json!([
-            {"name": "a.sheenColor", "uri": "a.sheenColor.png"},
-            {"name": "b.sheenRoughness", "uri": "b.sheenRoughness.png"},
-            {"name": "b.sheenRoughness", "uri": "b.sheenRoughness.webp"}
+            {"name": "a.sheenColor", "uri": named(dir.path(), "a.sheenColor", "png")},
+            {"name": "b.sheenRoughness", "uri": named(dir.path(), "b.sheenRoughness", "png")},
+            {"name": "b.sheenRoughness", "uri": named(dir.path(), "b.sheenRoughness", "webp")}
         ])
     );
     assert_eq!(
         out["textures"],
         json!([{"source": 0}, {"source": 1, "extensions": {"EXT_texture_webp": {"source": 2}}}])
     );
-    let read = |name: &str| codec::decode(&std::fs::read(dir.path().join(name)).unwrap()).unwrap();
-    let (webp_out, format) = read("b.sheenRoughness.webp");
+    let read = |stem: &str, ext: &str| {
+        codec::decode(&std::fs::read(dir.path().join(named(dir.path(), stem, ext))).unwrap())
+            .unwrap()
+    };
+    let (webp_out, format) = read("b.sheenRoughness", "webp");
     assert_eq!(format, codec::ImageFormat::Webp);
     let expected: Vec<u8> = rgba(6)
         .chunks(4)
         .flat_map(|p| [p[0], p[1], p[2], linear(p[3], 0.5)])
         .collect();
     assert_eq!(codes8(&webp_out), expected, "lossless");
-    assert_eq!(codes8(&read("b.sheenRoughness.png").0), expected);
-    let (png_out, format) = read("a.sheenColor.png");
+    assert_eq!(codes8(&read("b.sheenRoughness", "png").0), expected);
+    let (png_out, format) = read("a.sheenColor", "png");
     assert_eq!(format, codec::ImageFormat::Png);
     let jpeg_codes = codes8(&decode(&jpeg));
     assert_eq!(
@@ -668,7 +699,10 @@ fn jpeg_becomes_lossless_png_unless_kept_and_webp_stays_webp_with_its_fallback()
     };
     run_one(&input, &kept, options);
     let out = read_json(&kept);
-    assert_eq!(out["images"][0]["uri"], json!("a.sheenColor.jpg"));
+    assert_eq!(
+        out["images"][0]["uri"],
+        json!(named(dir.path(), "a.sheenColor", "jpg"))
+    );
 }
 
 #[test]
@@ -791,7 +825,8 @@ fn one_failing_file_does_not_stop_the_others_and_leaves_no_output() {
         .find(|r| r.input.ends_with("good.gltf"))
         .unwrap();
     assert_eq!(good.outcome, Outcome::Changed);
-    assert!(out.join("good.gltf").exists() && out.join("t.sheenColor.png").exists());
+    assert!(out.join("good.gltf").exists());
+    named(&out, "t.sheenColor", "png");
     assert_eq!(
         validation_errors(&out.join("good.gltf")),
         Vec::<String>::new()

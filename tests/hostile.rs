@@ -396,7 +396,7 @@ fn a_forged_100000_square_png_is_refused_before_any_pixel_buffer_is_allocated() 
     let (status, out, _) = velvet(&["bake", s(&path), "-o", s(&output)]);
     assert_eq!(status, 1, "{out}");
     assert!(
-        out.contains("failed: cannot bake image 0: sheenColor + sheenRoughness: image 0: PNG: the image declares 100000 × 100000 = 10000000000 pixels, over the limit of 268435456 (raise it with --max-image-pixels)"),
+        out.contains("FAILED: cannot bake image 0: sheenColor + sheenRoughness: image 0: PNG: the image declares 100000 × 100000 = 10000000000 pixels, over the limit of 268435456 (raise it with --max-image-pixels)"),
         "{out}"
     );
     assert_eq!(tree(dir.path()), before);
@@ -578,7 +578,7 @@ fn writing_never_follows_outside_uris_and_outputs_stay_in_the_out_dir() {
         "--out-dir",
         s(&out_dir),
         "--allow-outside-uris",
-        "--copy-resources",
+        "--rewrite-uris",
     ]);
     assert_eq!(status, 0, "{out}");
     let (status, out, _) = velvet(&[
@@ -587,7 +587,7 @@ fn writing_never_follows_outside_uris_and_outputs_stay_in_the_out_dir() {
         "--out-dir",
         s(&out_dir.join("migrated")),
         "--allow-outside-uris",
-        "--copy-resources",
+        "--rewrite-uris",
     ]);
     assert_eq!(status, 0, "{out}");
 
@@ -601,10 +601,10 @@ fn writing_never_follows_outside_uris_and_outputs_stay_in_the_out_dir() {
         new,
         [
             // The name's separators became '_': the file stays in the output folder.
-            Path::new("out/.._.._.._escaped.sheenColor.sheenRoughness.png"),
+            Path::new("out/.._.._.._escaped.sheenColor.sheenRoughness.672616e9c6e7.png"),
             Path::new("out/chair.gltf"),
             // migrate's fitted roughness bakes the mapped roughness texture beside its output.
-            Path::new("out/migrated/.._.._.._escaped.fuzzRoughness.png"),
+            Path::new("out/migrated/.._.._.._escaped.fuzzRoughness.665bcce6978c.png"),
             Path::new("out/migrated/chair.gltf"),
         ]
     );
@@ -962,10 +962,12 @@ fn files_that_vanish_or_dangle_get_a_clear_error_and_the_run_goes_on() {
     );
     assert_eq!(
         tree(&out_dir).into_keys().collect::<Vec<_>>(),
-        // c.gltf and the fuzz roughness texture its fitted mapping bakes.
+        // c.gltf, the fuzz roughness texture its fitted mapping bakes (named with a hash of
+        // its bytes), and the source texture, copied so that the output is self-contained.
         [
             PathBuf::from("c.gltf"),
-            PathBuf::from("tex.fuzzRoughness.png")
+            PathBuf::from("tex.fuzzRoughness.665bcce6978c.png"),
+            PathBuf::from("tex.png")
         ]
     );
 }
@@ -1075,8 +1077,12 @@ fn bake_leaves_a_document_whose_arrays_are_not_arrays_of_objects() {
         let input = dir.path().join(format!("{key}.glb"));
         write(&input, glb::join(doc.to_string().as_bytes(), Some(&rgba)));
         let output = dir.path().join(format!("{key}.out.glb"));
-        let (status, out, _) = velvet(&["bake", s(&input), "-o", s(&output)]);
+        let (status, out, _) = velvet(&["bake", s(&input), "-o", s(&output), "--verbose"]);
         assert_eq!(status, 0, "{out}");
+        assert!(
+            out.contains("nothing to bake, copied as it is (1 warning)"),
+            "{out}"
+        );
         assert!(
             out.contains(&format!(
                 "warning /{key}: {key} is not an array of objects, as glTF requires; nothing is baked"

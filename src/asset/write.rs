@@ -1,6 +1,6 @@
 //! Writing assets: serialising an edited document in the input's own JSON style, packing GLBs,
 //! and the atomic write (a temporary file in the target folder, renamed into place) that every
-//! output of velvet goes through.
+//! output of velvet goes through, resource copies included ([`copy_atomic`]).
 //!
 //! The atomic write carries a fault-injection seam for the tests of the "nothing lost"
 //! guarantee, set by the environment variable `VELVET_TEST_WRITE_FAULT` (read once per
@@ -146,6 +146,41 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
     Ok(())
 }
 
+/// How [`copy_atomic`] placed a file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Placed {
+    /// A hard link to the source (same filesystem): no bytes copied.
+    Linked,
+    /// A copy of the bytes.
+    Copied,
+}
+
+/// Places a regular file holding `from`'s bytes at `to`, atomically: a hard link made under a
+/// temporary name in `to`'s folder and renamed into place where the filesystem allows it, else
+/// a copy through [`write_atomic`]. `from` should be a resolved path (a link to a link is not
+/// made: `link(2)` does not follow a symbolic link, so the caller passes its target).
+pub fn copy_atomic(from: &Path, to: &Path) -> io::Result<Placed> {
+    static LINKS: AtomicUsize = AtomicUsize::new(0);
+    let dir = match to.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    if injected_fault().is_none() {
+        let n = LINKS.fetch_add(1, Ordering::Relaxed);
+        let tmp = dir.join(format!(".velvet-{}-{n}.link", std::process::id()));
+        if std::fs::hard_link(from, &tmp).is_ok() {
+            let renamed = std::fs::rename(&tmp, to);
+            // rename(2) does nothing when both names are links to one file already (an
+            // earlier run's copy): the temporary name is then still there.
+            let _ = std::fs::remove_file(&tmp);
+            return renamed.map(|()| Placed::Linked);
+        }
+    }
+    let bytes = std::fs::read(from)?;
+    write_atomic(to, &bytes)?;
+    Ok(Placed::Copied)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -204,6 +239,31 @@ mod tests {
             .map(|e| e.unwrap().file_name())
             .collect();
         assert_eq!(names, vec![std::ffi::OsString::from("out.gltf")]);
+    }
+
+    #[test]
+    fn copies_are_regular_files_holding_the_source_and_replace_atomically() {
+        let dir = tempfile::tempdir().unwrap();
+        let from = dir.path().join("from.bin");
+        std::fs::write(&from, b"resource").unwrap();
+        let to = dir.path().join("to.bin");
+        std::fs::write(&to, b"old").unwrap();
+        let placed = copy_atomic(&from, &to).unwrap();
+        assert_eq!(placed, Placed::Linked, "one filesystem allows a hard link");
+        assert_eq!(std::fs::read(&to).unwrap(), b"resource");
+        assert!(std::fs::symlink_metadata(&to)
+            .unwrap()
+            .file_type()
+            .is_file());
+        let mut names: Vec<_> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().into_string().unwrap())
+            .collect();
+        names.sort();
+        assert_eq!(names, ["from.bin", "to.bin"], "no temporary name is left");
+        // Again, onto the link made the first time: still no temporary name left.
+        assert_eq!(copy_atomic(&from, &to).unwrap(), Placed::Linked);
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
     }
 
     #[test]

@@ -99,9 +99,10 @@ const PATH_SEGMENT: &percent_encoding::AsciiSet = &percent_encoding::NON_ALPHANU
     .remove(b'_')
     .remove(b'~');
 
-/// The name an image goes by: its `name`, else its URI's file stem, else `image<N>`.
-fn image_base_name(json: &Value, image: usize) -> String {
-    let entry = &json["images"][image];
+/// The name an image goes by: its `name`, else its URI's file stem, else `image<N>`
+/// (`images` is the document's `images` array).
+fn image_base_name(images: &Value, image: usize) -> String {
+    let entry = &images[image];
     if let Some(name) = entry
         .get("name")
         .and_then(Value::as_str)
@@ -122,6 +123,51 @@ fn image_base_name(json: &Value, image: usize) -> String {
         }
     }
     format!("image{image}")
+}
+
+/// What an output is called (`<image>.<labels>`, e.g. `fabric.fuzzRoughness`): the source
+/// image's name and the slots it serves, from the document's `images` array as loaded.
+pub fn output_name(images: &Value, info: &super::plan::OutputInfo) -> String {
+    format!(
+        "{}.{}",
+        image_base_name(images, info.image),
+        info.labels.join(".")
+    )
+}
+
+/// A 64-bit FNV-1a hash of `bytes` as 12 hex digits: part of a new file's name, so that the
+/// name follows from what the file holds, never from which thread wrote first.
+pub fn content_hash(bytes: &[u8]) -> String {
+    let mut hash: u64 = 0xcbf2_9ce4_8422_2325;
+    for &b in bytes {
+        hash ^= u64::from(b);
+        hash = hash.wrapping_mul(0x0100_0000_01b3);
+    }
+    format!("{:012x}", hash >> 16)
+}
+
+/// The file names an output named `name` holding `bytes` tries, in order:
+/// `<name>.<hash>.<ext>`, then `<name>.<hash>.<n>.<ext>` (n = 2, 3, …) should a name be
+/// taken by other content.
+pub fn file_candidates(
+    name: &str,
+    format: OutputFormat,
+    bytes: &[u8],
+) -> impl Iterator<Item = String> {
+    let stem = format!("{}.{}", file_safe(name), content_hash(bytes));
+    let ext = format.extension();
+    (1..).map(move |n| {
+        if n == 1 {
+            format!("{stem}.{ext}")
+        } else {
+            format!("{stem}.{n}.{ext}")
+        }
+    })
+}
+
+/// The URI of a file next to the document.
+pub fn file_uri(file: &str) -> String {
+    percent_encoding::utf8_percent_encode(file, PATH_SEGMENT).to_string()
 }
 
 /// A file name made safe: path separators and control characters become '_'.
@@ -192,7 +238,8 @@ pub fn apply(
     options: ApplyOptions,
     names: &mut dyn Names,
 ) -> Applied {
-    let source_json = json.clone();
+    // Names come from the images as loaded (only they are kept, not the whole document).
+    let source_images = json.get("images").cloned().unwrap_or(Value::Null);
     let mut files = Vec::new();
     let mut notes = Vec::new();
     let bin_usable = bin_usable(&json, container);
@@ -211,11 +258,10 @@ pub fn apply(
         .enumerate()
         .map(|(i, b)| {
             let info = &plan.outputs[i];
-            let base = image_base_name(&source_json, info.image);
             OutputReport {
                 output: OutputId(i),
                 source_image: info.image,
-                name: format!("{base}.{}", info.labels.join(".")),
+                name: output_name(&source_images, info),
                 image: None,
                 stored: "collapsed into factors".to_owned(),
                 width: b.width,
@@ -261,12 +307,32 @@ pub fn apply(
             let id = source.output;
             let image = match image_of.get(&id) {
                 Some(&i) => i,
+                None if baked[id.0].stored.is_some() && !bin_usable && !options.embed => {
+                    // Already written next to the output as it was encoded.
+                    let stored = baked[id.0].stored.clone().expect("checked");
+                    let report = &mut outputs[id.0];
+                    let images = json
+                        .as_object_mut()
+                        .expect("the document is an object")
+                        .entry("images")
+                        .or_insert_with(|| json!([]))
+                        .as_array_mut()
+                        .expect("images is an array");
+                    images.push(json!({"name": report.name, "uri": file_uri(&stored.name)}));
+                    let index = images.len() - 1;
+                    report.stored = stored.name;
+                    report.mime_type = Some(stored.format.mime_type());
+                    report.bytes = stored.bytes;
+                    report.image = Some(index);
+                    image_of.insert(id, index);
+                    index
+                }
                 None => {
                     // The bytes move into the document: each output is held once.
                     let (format, bytes) = baked[id.0]
                         .encoded
                         .take()
-                        .expect("a non-uniform output is encoded");
+                        .expect("a non-uniform output is encoded or stored");
                     let size = bytes.len();
                     let report = &mut outputs[id.0];
                     let (index, stored) = add_image(
@@ -316,7 +382,12 @@ pub fn apply(
             .pointer_mut(&slot.layer_pointer)
             .and_then(Value::as_object_mut)
         {
-            layer.insert(slot.factor_key.to_owned(), slot.identity());
+            layer.insert(
+                slot.factor_key.to_owned(),
+                slot.written_factor
+                    .clone()
+                    .unwrap_or_else(|| slot.identity()),
+            );
         }
     }
     let dropped = prune(
@@ -366,8 +437,8 @@ fn bin_usable(json: &Value, container: Container) -> bool {
 
 /// Adds one encoded image to a document and returns its index in `images` and where its bytes
 /// went: in a GLB, a new bufferView at the 4-byte-aligned end of the BIN chunk (`bin`, created
-/// with its buffer when absent); in a .gltf, a file next to the output (named `<name>.<ext>`,
-/// or `<name>.<n>.<ext>` when `names` refuses a name; returned in `files` for the caller to
+/// with its buffer when absent); in a .gltf, a file next to the output (named by
+/// [`file_candidates`]: the first name `names` accepts; returned in `files` for the caller to
 /// write), or a `data:` URI when `embed` (or when a GLB's buffer 0 is not its BIN chunk).
 #[allow(clippy::too_many_arguments)]
 pub fn add_image(
@@ -414,19 +485,10 @@ pub fn add_image(
             "data: URI".to_owned(),
         )
     } else {
-        let stem = file_safe(name);
-        let ext = format.extension();
-        let file = (1..)
-            .map(|n| {
-                if n == 1 {
-                    format!("{stem}.{ext}")
-                } else {
-                    format!("{stem}.{n}.{ext}")
-                }
-            })
+        let file = file_candidates(name, format, &bytes)
             .find(|candidate| names.claim(candidate, &bytes))
             .expect("some name is free");
-        let uri = percent_encoding::utf8_percent_encode(&file, PATH_SEGMENT).to_string();
+        let uri = file_uri(&file);
         files.push(NewFile {
             name: file.clone(),
             bytes,

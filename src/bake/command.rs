@@ -18,7 +18,7 @@ use serde_json::Value;
 
 use super::apply::{apply, ApplyOptions, Names, OutputReport};
 use super::codec::{EncodeOptions, PngCompression};
-use super::engine::{bake, BakeOptions, MaxImagePixels};
+use super::engine::{bake_into, BakeOptions, MaxImagePixels};
 use super::kernel::KernelOptions;
 use super::plan::{plan, BakePlan, Note, PlanOptions};
 use super::prune::Dropped;
@@ -27,6 +27,7 @@ use crate::asset::{self, resource, write};
 use crate::diagnostics::Severity;
 use crate::migrate::apply::{copy_resources, create_parent};
 use crate::migrate::paths::{identity, jobs, relocate, Job, Relocation};
+use crate::migrate::render::{added, bytes, files_line, plural, Detail};
 
 pub use crate::migrate::paths::Destination;
 pub use crate::migrate::UsageError;
@@ -46,8 +47,9 @@ pub struct Options {
     pub report: bool,
     /// PNG compression effort.
     pub png: PngCompression,
-    /// Copy relative resources next to an output in another folder instead of rewriting URIs.
-    pub copy_resources: bool,
+    /// An output in another folder refers back to the input's resources (URIs rewritten)
+    /// instead of getting its own copies (the default: a self-contained output).
+    pub rewrite_uris: bool,
     /// Limits and URI policy for reading inputs and their images.
     pub load: asset::LoadOptions,
 }
@@ -144,10 +146,12 @@ impl FileResult {
     }
 }
 
-/// File names claimed in one run, across files (several assets may write into one folder).
+/// File names claimed in one run, across files (several assets may write into one folder),
+/// each with the hash and length of what it holds. Names carry a hash of their content, so two
+/// files claiming one name mean the same bytes, whichever claims first.
 #[derive(Default)]
 pub struct Claims {
-    claimed: Mutex<HashMap<PathBuf, Vec<u8>>>,
+    claimed: Mutex<HashMap<PathBuf, (String, usize)>>,
 }
 
 /// The names one output may use: not a file the document references, not the document
@@ -210,13 +214,14 @@ impl Names for FileNames<'_> {
             .claimed
             .lock()
             .unwrap_or_else(|e| e.into_inner());
+        let held = (super::apply::content_hash(bytes), bytes.len());
         if let Some(existing) = claimed.get(&path) {
-            return existing == bytes;
+            return *existing == held;
         }
         if path.exists() && std::fs::read(&path).map_or(true, |b| b != bytes) {
             return false;
         }
-        claimed.insert(path.clone(), bytes.to_vec());
+        claimed.insert(path.clone(), held);
         self.taken.insert(path);
         true
     }
@@ -245,19 +250,57 @@ fn slot_reports(plan: &BakePlan, names: &[String]) -> Vec<SlotReport> {
         .collect()
 }
 
+/// What [`file_sink`] returns: a [`Sink`](super::Sink) it owns.
+pub(crate) type FileSink<'s> =
+    Box<dyn Fn(super::OutputId, &mut super::Baked) -> Result<(), String> + Sync + 's>;
+
+/// A [`Sink`](super::Sink) that writes each output as a file into `dir` as soon as it is encoded
+/// (named from the source image, the slots and a hash of the bytes, claimed through `names`)
+/// and drops its bytes. Only for a .gltf whose new images are files.
+pub(crate) fn file_sink<'s, 'c: 's>(
+    names: &'s Mutex<FileNames<'c>>,
+    images: &'s Value,
+    plan: &'s BakePlan,
+) -> FileSink<'s> {
+    Box::new(move |id, baked| {
+        let Some((format, bytes)) = baked.encoded.take() else {
+            return Ok(());
+        };
+        let name = super::apply::output_name(images, &plan.outputs[id.0]);
+        let (dir, file) = {
+            let mut names = names.lock().unwrap_or_else(|e| e.into_inner());
+            let file = super::apply::file_candidates(&name, format, &bytes)
+                .find(|candidate| names.claim(candidate, &bytes))
+                .expect("some name is free");
+            (names.dir().to_path_buf(), file)
+        };
+        write_new_file(&dir, &file, &bytes)?;
+        baked.stored = Some(super::StoredFile {
+            name: file,
+            format,
+            bytes: bytes.len(),
+        });
+        Ok(())
+    })
+}
+
 /// Writes new image files into `dir` (each atomically; one already holding the bytes is left).
 pub(crate) fn write_new_files(dir: &Path, files: &[super::apply::NewFile]) -> Result<(), String> {
-    std::fs::create_dir_all(dir)
-        .map_err(|e| format!("cannot create folder {}: {e}", dir.display()))?;
     for file in files {
-        let path = dir.join(&file.name);
-        if std::fs::read(&path).is_ok_and(|b| b == file.bytes) {
-            continue;
-        }
-        write::write_atomic(&path, &file.bytes)
-            .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        write_new_file(dir, &file.name, &file.bytes)?;
     }
     Ok(())
+}
+
+/// Writes one new file into `dir` atomically, unless it already holds `bytes`.
+pub(crate) fn write_new_file(dir: &Path, name: &str, bytes: &[u8]) -> Result<(), String> {
+    std::fs::create_dir_all(dir)
+        .map_err(|e| format!("cannot create folder {}: {e}", dir.display()))?;
+    let path = dir.join(name);
+    if std::fs::read(&path).is_ok_and(|b| b == bytes) {
+        return Ok(());
+    }
+    write::write_atomic(&path, bytes).map_err(|e| format!("cannot write {}: {e}", path.display()))
 }
 
 /// Bakes one file; errors name what is wrong (the caller adds the file).
@@ -277,6 +320,7 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
         Some(asset) if errors.is_empty() => asset,
         _ => return Err(format!("cannot be baked: {}", errors.join("; "))),
     };
+    crate::migrate::paths::check_links(&asset)?;
     let plan = plan(&asset, options.plan);
     let planned_names: Vec<String> = plan
         .outputs
@@ -284,7 +328,7 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
         .map(|o| format!("image {}: {}", o.image, o.labels.join(" + ")))
         .collect();
     let relocation = match &job.output {
-        Some(output) if output != &job.input => relocate(&asset, output, options.copy_resources)?,
+        Some(output) if output != &job.input => relocate(&asset, output, options.rewrite_uris)?,
         _ => Relocation::default(),
     };
     if request.dry_run {
@@ -300,20 +344,19 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
         return Ok(result);
     }
     let output = job.output.as_deref().ok_or("no output path")?;
-    // The document as it will stand next to the output, before baking.
-    let mut json = asset.json.clone();
-    crate::edit::apply(&mut json, &relocation.edits).map_err(|e| e.to_string())?;
     if plan.is_empty() {
         let mut result = FileResult::new(input, Some(output), Outcome::Untouched);
         result.notes = plan.notes;
         if output == input {
             return Ok(result);
         }
-        copy_resources(&relocation)?;
+        copy_resources(&relocation, &asset.json)?;
         create_parent(output)?;
-        let out_bytes = if json == asset.json {
+        let out_bytes = if relocation.edits.is_empty() {
             bytes
         } else {
+            let mut json = std::mem::take(&mut asset.json);
+            crate::edit::apply(&mut json, &relocation.edits).map_err(|e| e.to_string())?;
             write::to_bytes(&asset, &json, asset.bin.as_deref())
         };
         write::write_atomic(output, &out_bytes)
@@ -335,14 +378,36 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
         },
         max_image_pixels: MaxImagePixels(options.load.max_image_pixels),
     };
+    // File names next to the output that the document already uses are not free. New image
+    // files are written as they are encoded (a .gltf with file images), so a run holds only
+    // the images in flight.
+    let names = Mutex::new(FileNames::next_to(
+        claims,
+        &asset,
+        input,
+        output,
+        &relocation,
+    ));
+    let images = asset.json.get("images").cloned().unwrap_or(Value::Null);
+    let streamed = asset.container == asset::Container::Gltf && !options.embed;
     let mut baked = Vec::with_capacity(plan.recipes.len());
-    let results = bake(&plan.recipes, &asset, &bake_options);
+    let results = {
+        let sink = file_sink(&names, &images, &plan);
+        bake_into(
+            &plan.recipes,
+            &asset,
+            &bake_options,
+            streamed.then_some(&*sink as super::Sink),
+        )
+    };
     for (name, result) in planned_names.iter().zip(results) {
         baked.push(result.map_err(|e| format!("cannot bake {name}: {e}"))?);
     }
-    // File names next to the output that the document already uses are not free.
-    let mut names = FileNames::next_to(claims, &asset, input, output, &relocation);
+    let mut names = names.into_inner().unwrap_or_else(|e| e.into_inner());
     let out_dir = names.dir().to_path_buf();
+    // The document as it will stand next to the output.
+    let mut json = std::mem::take(&mut asset.json);
+    crate::edit::apply(&mut json, &relocation.edits).map_err(|e| e.to_string())?;
     let bin = asset.bin.take();
     let applied = apply(
         json,
@@ -355,7 +420,7 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
         },
         &mut names,
     );
-    copy_resources(&relocation)?;
+    copy_resources(&relocation, &applied.json)?;
     write_new_files(&out_dir, &applied.files)?;
     let out_bytes = write::to_bytes(&asset, &applied.json, applied.bin.as_deref());
     write::write_atomic(output, &out_bytes)
@@ -433,8 +498,10 @@ pub struct Summary {
     pub failed: usize,
     /// Slots baked.
     pub slots: usize,
-    /// Outputs written.
+    /// New textures written (in a dry run, planned).
     pub textures: usize,
+    /// Their encoded size in bytes (0 in a dry run).
+    pub bytes: usize,
 }
 
 /// Sums up results.
@@ -451,31 +518,80 @@ pub fn summary(results: &[FileResult]) -> Summary {
             _ => s.unchanged += 1,
         }
         s.slots += r.slots.len();
-        s.textures += r.outputs.len();
+        let written: Vec<_> = r.outputs.iter().filter(|o| o.image.is_some()).collect();
+        s.textures += if matches!(r.outcome, Outcome::Planned { .. }) {
+            r.slots
+                .iter()
+                .flat_map(|slot| &slot.outputs)
+                .collect::<HashSet<_>>()
+                .len()
+        } else {
+            written.len()
+        };
+        s.bytes += written.iter().map(|o| o.bytes).sum::<usize>();
     }
     s
 }
 
-/// The text report.
-pub fn render_text(results: &[FileResult], dry_run: bool) -> String {
+/// The text report, worded as `velvet migrate`'s: a line per file (slots, textures added,
+/// warnings), the slots and outputs under it when verbose, failed files only when quiet, then
+/// the summary.
+pub fn render_text(results: &[FileResult], dry_run: bool, detail: Detail) -> String {
     use std::fmt::Write as _;
     let mut out = String::new();
     for r in results {
+        if detail == Detail::Quiet && !r.failed() {
+            continue;
+        }
         let target = r
             .output
             .as_ref()
             .filter(|o| **o != r.input)
-            .map(|o| format!(" -> {}", o.display()))
+            .map(|o| format!(" → {}", o.display()))
             .unwrap_or_default();
+        let warnings = r
+            .notes
+            .iter()
+            .filter(|n| n.level == super::plan::Level::Warning)
+            .count();
+        let added_bytes = r
+            .outputs
+            .iter()
+            .filter(|o| o.image.is_some())
+            .map(|o| o.bytes)
+            .sum();
+        let textures = if dry_run {
+            r.slots
+                .iter()
+                .flat_map(|s| &s.outputs)
+                .collect::<HashSet<_>>()
+                .len()
+        } else {
+            r.outputs.iter().filter(|o| o.image.is_some()).count()
+        };
+        let counts = format!(
+            " ({}, {}, {})",
+            plural(r.slots.len(), "slot", "slots"),
+            added(textures, added_bytes, dry_run),
+            plural(warnings, "warning", "warnings")
+        );
+        let warned = if warnings > 0 {
+            format!(" ({})", plural(warnings, "warning", "warnings"))
+        } else {
+            String::new()
+        };
         let status = match &r.outcome {
-            Outcome::Changed => "baked".to_owned(),
-            Outcome::Copied => "nothing to bake (copied)".to_owned(),
-            Outcome::Untouched => "nothing to bake".to_owned(),
-            Outcome::Planned { changes: true } => "would bake".to_owned(),
-            Outcome::Planned { changes: false } => "nothing to bake".to_owned(),
-            Outcome::Failed { error } => format!("failed: {error}"),
+            Outcome::Changed => format!("baked{counts}"),
+            Outcome::Copied => format!("nothing to bake, copied as it is{warned}"),
+            Outcome::Untouched => format!("nothing to bake, left as it is{warned}"),
+            Outcome::Planned { changes: true } => format!("would bake{counts}"),
+            Outcome::Planned { changes: false } => format!("nothing to bake{warned}"),
+            Outcome::Failed { error } => format!("FAILED: {error}"),
         };
         let _ = writeln!(out, "{}{target}: {status}", r.input.display());
+        if detail != Detail::Verbose {
+            continue;
+        }
         for s in &r.slots {
             let _ = writeln!(
                 out,
@@ -487,27 +603,38 @@ pub fn render_text(results: &[FileResult], dry_run: bool) -> String {
         }
         for o in &r.outputs {
             let mut line = format!(
-                "  output {}: {}x{} {}-bit {}, {}",
+                "  output {}: {}x{} {}-bit {}, {}, {}",
                 o.name,
                 o.width,
                 o.height,
                 o.bits,
                 o.mime_type.unwrap_or("-"),
-                o.stored
+                o.stored,
+                bytes(o.bytes)
             );
             if let Some(e) = o.max_error {
-                let _ = write!(line, ", max error {e:.4} codes");
+                let verdict = if e <= 0.5 + 1e-9 {
+                    "within the half code rounding allows"
+                } else {
+                    "more than rounding alone"
+                };
+                let _ = write!(line, ", max error {e:.4} codes, {verdict}");
             }
             if o.clamped > 0 {
-                let _ = write!(line, ", {} texels clamped", o.clamped);
+                let _ = write!(
+                    line,
+                    ", {} texels clamped to the channel's range",
+                    o.clamped
+                );
             }
             let _ = writeln!(out, "{line}");
         }
         if !r.dropped_images.is_empty() {
             let _ = writeln!(
                 out,
-                "  dropped images {:?} ({} bytes cut from the BIN chunk)",
-                r.dropped_images, r.dropped_bin_bytes
+                "  dropped images {:?} ({} cut from the BIN chunk)",
+                r.dropped_images,
+                bytes(r.dropped_bin_bytes)
             );
         }
         for n in &r.notes {
@@ -518,17 +645,21 @@ pub fn render_text(results: &[FileResult], dry_run: bool) -> String {
             let _ = writeln!(out, "  {level} {}: {}", n.pointer, n.message);
         }
     }
+    if detail == Detail::Quiet {
+        return out;
+    }
     let s = summary(results);
     let _ = writeln!(
         out,
-        "{} file(s): {} {}, {} unchanged, {} failed; {} slot(s), {} texture(s) written",
-        s.files,
-        s.changed,
-        if dry_run { "to bake" } else { "baked" },
-        s.unchanged,
-        s.failed,
-        s.slots,
-        s.textures
+        "{}; {}",
+        files_line(
+            s.files,
+            s.changed,
+            if dry_run { "would bake" } else { "baked" },
+            s.unchanged,
+            s.failed
+        ),
+        added(s.textures, s.bytes, dry_run)
     );
     out
 }

@@ -151,9 +151,27 @@ pub struct Baked {
     pub encoded: Option<(OutputFormat, Vec<u8>)>,
     /// The codes (per stored channel) when every texel is equal and `collapse_uniform` is set.
     pub uniform: Option<Vec<u32>>,
+    /// Where a [`Sink`] already wrote the encoded image (then `encoded` is `None`).
+    pub stored: Option<StoredFile>,
     /// Per-channel statistics.
     pub stats: KernelStats,
 }
+
+/// An output a [`Sink`] wrote as a file as soon as it was encoded.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct StoredFile {
+    /// The file name, next to the output document.
+    pub name: String,
+    /// The encoded format.
+    pub format: OutputFormat,
+    /// The encoded size in bytes.
+    pub bytes: usize,
+}
+
+/// Takes each output as soon as it is encoded (from any worker thread), typically to write it
+/// and drop its bytes, so that a run holds the encoded images in flight only, not all of them.
+/// It may move `encoded` out and set `stored`; an `Err` fails that output.
+pub type Sink<'a> = &'a (dyn Fn(OutputId, &mut Baked) -> Result<(), String> + Sync);
 
 /// Why one output could not be made.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -180,6 +198,9 @@ pub enum BakeError {
     /// The output could not be encoded.
     #[error(transparent)]
     Encode(CodecError),
+    /// The sink could not store the output.
+    #[error("{0}")]
+    Store(String),
 }
 
 impl BakeError {
@@ -235,11 +256,21 @@ pub fn bake(
     source: &dyn ImageSource,
     options: &BakeOptions,
 ) -> Vec<Result<Baked, BakeError>> {
+    bake_into(set, source, options, None)
+}
+
+/// [`bake`], handing each output to `sink` as soon as it is encoded.
+pub fn bake_into(
+    set: &RecipeSet,
+    source: &dyn ImageSource,
+    options: &BakeOptions,
+    sink: Option<Sink>,
+) -> Vec<Result<Baked, BakeError>> {
     let recipes = set.recipes();
     let done: Vec<Vec<(usize, Result<Baked, BakeError>)>> = components(recipes)
         .into_par_iter()
         .with_max_len(1)
-        .map(|component| bake_component(recipes, &component, source, options))
+        .map(|component| bake_component(recipes, &component, source, options, sink))
         .collect();
     let mut results: Vec<Option<Result<Baked, BakeError>>> = vec![None; recipes.len()];
     for (i, result) in done.into_iter().flatten() {
@@ -265,6 +296,7 @@ fn bake_component(
     component: &[usize],
     source: &dyn ImageSource,
     options: &BakeOptions,
+    sink: Option<Sink>,
 ) -> Vec<(usize, Result<Baked, BakeError>)> {
     let mut images: Vec<ImageId> = component
         .iter()
@@ -326,6 +358,13 @@ fn bake_component(
                 (None, Some(format)) => bake_one(recipe, &pixels, own, format, options),
                 (None, None) => unreachable!("a decoded image has a format"),
             };
+            let result = match (result, sink) {
+                (Ok(mut baked), Some(sink)) => match sink(OutputId(i), &mut baked) {
+                    Ok(()) => Ok(baked),
+                    Err(e) => Err(BakeError::Store(e)),
+                },
+                (result, _) => result,
+            };
             (i, result)
         })
         .collect()
@@ -368,6 +407,7 @@ fn bake_one(
         source_format,
         encoded,
         uniform,
+        stored: None,
         stats,
     })
 }

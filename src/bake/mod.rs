@@ -22,7 +22,10 @@ pub mod recipe;
 pub mod srgb;
 
 pub use codec::{CodecError, EncodeOptions, ImageFormat, OutputFormat, PngCompression};
-pub use engine::{bake, BakeError, BakeOptions, Baked, ImageSource, OutputId, RecipeSet};
+pub use engine::{
+    bake, bake_into, BakeError, BakeOptions, Baked, ImageSource, OutputId, RecipeSet, Sink,
+    StoredFile,
+};
 pub use kernel::{ChannelStats, KernelOptions, KernelStats};
 pub use pixels::{Depth, Layout, Pixels, Samples};
 pub use recipe::{

@@ -79,6 +79,9 @@ pub struct SlotPlan {
     pub texture: usize,
     /// The factor baked into the texture (one or three components).
     pub factor: Vec<f64>,
+    /// The factor written after the bake: `None` for the identity.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub written_factor: Option<Value>,
     /// Per source of the texture (pointer suffix within the texture, e.g. `/source`): the image
     /// read now and the output that replaces it.
     #[serde(skip)]
@@ -407,6 +410,7 @@ pub fn plan(asset: &Asset, options: PlanOptions) -> BakePlan {
                 layer_pointer: layer.pointer.clone(),
                 texture: texture_index as usize,
                 factor: factor.clone(),
+                written_factor: None,
                 sources: Vec::new(),
             });
             for (k, (within, image, grey)) in sources.into_iter().enumerate() {

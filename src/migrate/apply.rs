@@ -12,18 +12,19 @@ use super::textures;
 use super::Options;
 use crate::asset::{self, write, Asset};
 use crate::bake::apply::{apply as bake_apply, ApplyOptions, OutputReport};
-use crate::bake::command::{write_new_files, Claims, FileNames};
-use crate::bake::{bake, BakeOptions, KernelOptions};
+use crate::bake::command::{file_sink, write_new_files, Claims, FileNames};
+use crate::bake::{bake_into, BakeOptions, KernelOptions};
 use crate::diagnostics::Severity;
 use crate::edit;
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 
 /// Everything known about one file before anything is written.
 #[derive(Debug)]
 pub struct FilePlan {
     pub input: PathBuf,
     pub output: Option<PathBuf>,
-    /// The input's bytes, written as they are when nothing changes.
+    /// The input's bytes, kept when the plan changes nothing (then written as they are).
     pub bytes: Vec<u8>,
     pub asset: Asset,
     pub document: DocumentPlan,
@@ -83,11 +84,19 @@ pub fn plan_file(job: &Job, options: &Options) -> Result<FilePlan, String> {
             ))
         }
     };
+    super::paths::check_links(&asset).map_err(|e| format!("{}: {e}", job.input.display()))?;
     let document = plan_document(&asset, options);
     let relocation = match &job.output {
-        Some(output) if output != &job.input => relocate(&asset, output, options.copy_resources)
+        Some(output) if output != &job.input => relocate(&asset, output, options.rewrite_uris)
             .map_err(|e| format!("{}: {e}", job.input.display()))?,
         _ => Relocation::default(),
+    };
+    // The input's bytes are written as they are only when the plan changes nothing; a large
+    // document that changes does not keep them.
+    let bytes = if document.is_empty() && relocation.edits.is_empty() {
+        bytes
+    } else {
+        Vec::new()
     };
     Ok(FilePlan {
         input: job.input.clone(),
@@ -110,13 +119,25 @@ pub(crate) fn create_parent(path: &Path) -> Result<(), String> {
     }
 }
 
-/// Writes a relocation's resource copies (each atomically), for migrate and bake alike.
-pub(crate) fn copy_resources(relocation: &Relocation) -> Result<(), String> {
-    for copy in &relocation.copies {
-        let data = std::fs::read(&copy.from)
+/// Places a relocation's resource copies that the written document `json` still names (each a
+/// regular file, hard-linked or copied atomically from the resolved source), for migrate and
+/// bake alike.
+pub(crate) fn copy_resources(
+    relocation: &Relocation,
+    json: &serde_json::Value,
+) -> Result<(), String> {
+    let used = super::paths::relative_uris(json);
+    for copy in relocation
+        .copies
+        .iter()
+        .filter(|c| used.contains(&c.uri.as_str()))
+    {
+        let from = copy
+            .from
+            .canonicalize()
             .map_err(|e| format!("cannot read resource {}: {e}", copy.from.display()))?;
         create_parent(&copy.to)?;
-        write::write_atomic(&copy.to, &data)
+        write::copy_atomic(&from, &copy.to)
             .map_err(|e| format!("cannot write resource {}: {e}", copy.to.display()))?;
     }
     Ok(())
@@ -133,6 +154,16 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
     // Textures are baked first, from the document as loaded (its URIs not yet relocated).
     let bake_plan = textures::bake_plan(plan.document.materials.iter().flat_map(|m| &m.bakes))
         .map_err(|e| format!("{}: {e}", plan.input.display()))?;
+    // Names for new image files, from the document's URIs before they are relocated. In a
+    // .gltf whose new images are files, each is written as soon as it is encoded, so the run
+    // holds only the images in flight, however many there are.
+    let names = Mutex::new(FileNames::next_to(
+        claims,
+        &plan.asset,
+        &plan.input,
+        &output,
+        &plan.relocation,
+    ));
     let mut baked = Vec::with_capacity(bake_plan.recipes.len());
     if !bake_plan.is_empty() {
         let options = BakeOptions {
@@ -145,12 +176,23 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
             ),
             ..BakeOptions::default()
         };
-        for (info, result) in
-            bake_plan
-                .outputs
-                .iter()
-                .zip(bake(&bake_plan.recipes, &plan.asset, &options))
-        {
+        let images = plan
+            .asset
+            .json
+            .get("images")
+            .cloned()
+            .unwrap_or(serde_json::Value::Null);
+        let streamed = plan.asset.container == asset::Container::Gltf && !plan.embed;
+        let results = {
+            let sink = file_sink(&names, &images, &bake_plan);
+            bake_into(
+                &bake_plan.recipes,
+                &plan.asset,
+                &options,
+                streamed.then_some(&*sink as crate::bake::Sink),
+            )
+        };
+        for (info, result) in bake_plan.outputs.iter().zip(results) {
             baked.push(result.map_err(|e| {
                 format!(
                     "{}: cannot bake {} of image {}: {e}",
@@ -161,29 +203,39 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
             })?);
         }
     }
-    // Names for new image files, from the document's URIs before they are relocated.
-    let mut names = (!bake_plan.is_empty())
-        .then(|| FileNames::next_to(claims, &plan.asset, &plan.input, &output, &plan.relocation));
-    let names_dir = names
-        .as_ref()
-        .map(|n| n.dir().to_path_buf())
-        .unwrap_or_default();
-    let edits: Vec<_> = plan
+    let mut names = names.into_inner().unwrap_or_else(|e| e.into_inner());
+    let names_dir = names.dir().to_path_buf();
+    // The edits are applied where they lie in the plan (a large document's are not copied).
+    let mut changed = false;
+    let groups = plan
         .document
-        .edits()
-        .chain(&plan.relocation.edits)
-        .cloned()
-        .collect();
-    let changed = edit::apply(&mut plan.asset.json, &edits)
-        .map_err(|e| format!("{}: {e}", plan.input.display()))?;
+        .materials
+        .iter()
+        .map(|m| m.edits.as_slice())
+        .chain([
+            plan.document.declarations.as_slice(),
+            plan.relocation.edits.as_slice(),
+        ]);
+    for edits in groups {
+        changed |= edit::apply(&mut plan.asset.json, edits)
+            .map_err(|e| format!("{}: {e}", plan.input.display()))?;
+    }
     if !changed && plan.in_place() {
         return Ok(Written::Untouched);
     }
-    copy_resources(&plan.relocation)?;
+    if changed {
+        // The input's bytes are written only when nothing changed.
+        plan.bytes = Vec::new();
+    }
     create_parent(&output)?;
     let bytes = if bake_plan.is_empty() {
+        copy_resources(&plan.relocation, &plan.asset.json)?;
         if changed {
             write::to_bytes(&plan.asset, &plan.asset.json, plan.asset.bin.as_deref())
+        } else if plan.bytes.is_empty() {
+            // Edits that set what was there already: the input's own bytes, read again.
+            asset::read(&plan.input, &plan.asset.options)
+                .map_err(|d| format!("cannot read {}: {}", plan.input.display(), d.message))?
         } else {
             std::mem::take(&mut plan.bytes)
         }
@@ -196,8 +248,9 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
             &bake_plan,
             &mut baked,
             ApplyOptions { embed: plan.embed },
-            names.as_mut().expect("made with the bake plan"),
+            &mut names,
         );
+        copy_resources(&plan.relocation, &applied.json)?;
         write_new_files(&names_dir, &applied.files)?;
         let bytes = write::to_bytes(&plan.asset, &applied.json, applied.bin.as_deref());
         plan.asset.json = applied.json;

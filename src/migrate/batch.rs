@@ -17,7 +17,7 @@ use std::io::IsTerminal;
 use std::path::PathBuf;
 
 /// One `velvet migrate` invocation.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Request {
     pub inputs: Vec<PathBuf>,
     pub destination: Destination,
@@ -57,6 +57,10 @@ pub struct FileResult {
     pub copies: Vec<ResourceCopy>,
     #[serde(serialize_with = "super::plan::notes_json")]
     pub notes: Vec<Note>,
+    /// New textures (distinct baked images) the output gains; in a dry run, those planned.
+    pub textures_added: usize,
+    /// Their encoded size in bytes (0 in a dry run: nothing is encoded).
+    pub bytes_added: usize,
 }
 
 impl FileResult {
@@ -69,6 +73,8 @@ impl FileResult {
             edits: Vec::new(),
             copies: Vec::new(),
             notes: Vec::new(),
+            textures_added: 0,
+            bytes_added: 0,
         }
     }
 }
@@ -86,6 +92,9 @@ pub struct Summary {
     pub conversions: BTreeMap<Conversion, usize>,
     pub skipped: BTreeMap<Skip, usize>,
     pub warnings: usize,
+    /// New textures over all files, and their bytes.
+    pub textures_added: usize,
+    pub bytes_added: usize,
 }
 
 /// The outcome of a run: every file in input order, and the totals.
@@ -119,6 +128,14 @@ fn migrate_one(job: &Job, options: &Options, dry_run: bool, claims: &Claims) -> 
             Ok(Written::Untouched) => FileOutcome::Untouched,
             Err(error) => FileOutcome::Failed { error },
         }
+    };
+    let written: Vec<_> = plan.baked.iter().filter(|o| o.image.is_some()).collect();
+    let (textures_added, bytes_added) = if dry_run {
+        let planned =
+            super::textures::bake_plan(plan.document.materials.iter().flat_map(|m| &m.bakes));
+        (planned.map_or(0, |p| p.recipes.len()), 0)
+    } else {
+        (written.len(), written.iter().map(|o| o.bytes).sum())
     };
     let mut notes = plan.relocation.notes.clone();
     for output in &plan.baked {
@@ -154,6 +171,8 @@ fn migrate_one(job: &Job, options: &Options, dry_run: bool, claims: &Claims) -> 
         materials: plan.document.materials,
         copies: plan.relocation.copies,
         notes,
+        textures_added,
+        bytes_added,
     }
 }
 
@@ -227,6 +246,8 @@ fn summarise(files: &[FileResult]) -> Summary {
         if matches!(file.outcome, FileOutcome::Failed { .. }) {
             continue;
         }
+        s.textures_added += file.textures_added;
+        s.bytes_added += file.bytes_added;
         s.warnings += file
             .notes
             .iter()

@@ -153,7 +153,15 @@ pub fn sheen_for(
             }
         }
     }
-    let roughness = roughness::map(fuzz_roughness, Direction::FuzzToSheen, mapping);
+    let best = roughness::map(fuzz_roughness, Direction::FuzzToSheen, mapping);
+    let roughness = roughness::written(best);
+    if roughness_bakes.is_empty() && best < roughness::ROUGHNESS_FLOOR {
+        notes.push(Note::RoughnessFloor {
+            property: "sheenRoughnessFactor".into(),
+            best,
+            written: roughness,
+        });
+    }
 
     let mut sheen = Map::new();
     sheen.insert("sheenColorFactor".into(), Value::Array(color));

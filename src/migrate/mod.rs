@@ -11,6 +11,7 @@
 
 pub mod apply;
 pub mod batch;
+pub mod budget;
 pub mod fallback;
 pub mod legacy;
 pub mod measure;
@@ -30,7 +31,7 @@ pub use plan::{plan_document, DocumentPlan, MaterialPlan};
 pub use crate::edit::Edit;
 
 /// How materials are converted. The defaults are the fast, factor-only conversions.
-#[derive(Debug, Clone, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Default, PartialEq)]
 pub struct Options {
     /// Regenerate the sheen of materials that have both fuzz and sheen from their fuzz.
     pub refresh_fallback: bool,
@@ -45,8 +46,11 @@ pub struct Options {
     /// Never bake a texture only to map roughness: copy it (identity) where a texture would
     /// need the bake, and say so.
     pub fast: bool,
-    /// Copy relative resources next to an output in another folder instead of rewriting URIs.
-    pub copy_resources: bool,
+    /// An output in another folder refers back to the input's resources (URIs rewritten)
+    /// instead of getting its own copies (the default: a self-contained output).
+    pub rewrite_uris: bool,
+    /// How close a shared mapped roughness texture must come to the exact one.
+    pub budget: budget::Budget,
     /// Limits and URI policy for reading inputs and their resources.
     pub load: crate::asset::LoadOptions,
 }

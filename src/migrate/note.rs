@@ -178,6 +178,22 @@ pub enum Note {
     ResourcesCopied { count: usize },
     /// A resource to copy is missing; its URI is left as it was.
     ResourceMissing { uri: String },
+    /// The texture plan of a mapped roughness texture, with its measured worst-case error.
+    RoughnessPlan {
+        property: String,
+        plan: super::budget::TexturePlan,
+        factor_key: String,
+        factor: f64,
+        max_error: f64,
+        /// `None`: the exact setting.
+        budget: Option<f64>,
+    },
+    /// The best roughness lies below the floor renderers honour alike: the floor is written.
+    RoughnessFloor {
+        property: String,
+        best: f64,
+        written: f64,
+    },
 }
 
 fn rgb(c: [f64; 3]) -> String {
@@ -201,7 +217,17 @@ impl Note {
             | Note::FallbackTextureBaked { .. }
             | Note::ExactBaked
             | Note::BakeError { .. }
-            | Note::LegacyRoughnessBaked { .. } => Level::Info,
+            | Note::LegacyRoughnessBaked { .. }
+            | Note::RoughnessFloor { .. } => Level::Info,
+            Note::RoughnessPlan {
+                max_error, budget, ..
+            } => {
+                if budget.is_some_and(|b| *max_error > b) {
+                    Level::Warning
+                } else {
+                    Level::Info
+                }
+            }
             Note::UrisRewritten { leaves_folder, .. } => {
                 if *leaves_folder {
                     Level::Warning
@@ -243,14 +269,21 @@ impl Note {
                 "sheenColorTexture became fuzzColorTexture as it is: the lobe colour is exact, but the base is now attenuated by fuzzFactor {w:?} instead of the per-texel maximum of the sheen colour (--report measures the difference)"
             ),
             Note::AttenuationMeasured { image, texels, w, max, mean } => format!(
-                "attenuation difference |{w:?} − max3(sheenColor)| over the {texels} texels of image {image}: max {max:.4}, mean {mean:.4}"
+                "attenuation difference |{w:?} − max3(sheenColor)| over the {texels} texels of image {image}: max {max:.4}, mean {mean:.4}; {}",
+                if *max <= super::fallback::DARK_FUZZ_THRESHOLD {
+                    format!("within {} everywhere, not visible", super::fallback::DARK_FUZZ_THRESHOLD)
+                } else {
+                    format!("{:.4} over {} at worst (--exact bakes it away)", max - super::fallback::DARK_FUZZ_THRESHOLD, super::fallback::DARK_FUZZ_THRESHOLD)
+                }
             ),
             Note::LayerDifference { mapping, sheen_roughness, fuzz_roughness, max_difference, at_mu, reflectance_max, reflectance_rms, poor_match, fuzz_model, clamped } => {
                 let mut m = format!(
                     "layer difference ({mapping} roughness mapping, sheen {sheen_roughness:.4} → fuzz {fuzz_roughness:.4}, {fuzz_model}): |max3·E − w·R| over view angles max {reflectance_max:.4}, cosine-weighted rms {reflectance_rms:.4}; base attenuation differs by at most {max_difference:.4}, at view cosine {at_mu:.3}"
                 );
                 if *poor_match {
-                    m += &format!(" (sheen roughness below {}: no fuzz roughness matches it well)", crate::shading::mapping::POOR_MATCH_BELOW);
+                    m += &format!("; a poor match: below sheen roughness {} no fuzz roughness matches a sheen well", crate::shading::mapping::POOR_MATCH_BELOW);
+                } else {
+                    m += "; the closest fuzz the fitted mapping finds (see docs/shading.md for its bounds)";
                 }
                 if *clamped > 0 {
                     m += &format!(" ({clamped} attenuations clamped at 0 where the albedo exceeds 1)");
@@ -287,7 +320,12 @@ impl Note {
                 "--exact cannot bake this material's textures ({reason}): sheenColorTexture became fuzzColorTexture as it is (the fast mode)"
             ),
             Note::BakeError { pointer, image, max_codes, clamped } => {
-                let mut m = format!("{pointer}: {image} differs from the exact f64 result by at most {max_codes:.3} codes (quantisation)");
+                let verdict = if *max_codes <= 0.5 + 1e-9 {
+                    "within the half code rounding allows"
+                } else {
+                    "more than rounding alone (the texture is read through a curve or resampled)"
+                };
+                let mut m = format!("{pointer}: {image} differs from the exact f64 result by at most {max_codes:.3} codes, {verdict}");
                 if *clamped > 0 {
                     m += &format!("; {clamped} values clamped to the channel's range");
                 }
@@ -297,7 +335,8 @@ impl Note {
                 "fuzzTexture and fuzzColorTexture cannot be combined into one sheen colour texture ({reason}): the fallback sheen uses the factors instead"
             ),
             Note::DarkFuzz { difference, fuzz_color_max, base_color_max } => format!(
-                "the fuzz (max colour {fuzz_color_max:?}) is darker than the base (max colour {base_color_max:?}): sheen only adds light, so where the fuzz darkens the base, loaders without fuzz show it brighter by up to {difference:.4} of the layer's reflectance (from the factors; textures can make it larger)"
+                "the fuzz blends the base towards its colour (brightest channel {fuzz_color_max:?}), which darkens a base whose brightest channel is {base_color_max:?}; sheen only adds light, so loaders without fuzz show it brighter by up to {difference:.4} of the layer's reflectance, over the {} velvet reports from (from the factors; textures can make it larger)",
+                super::fallback::DARK_FUZZ_THRESHOLD
             ),
             Note::BlackFuzz => {
                 "the fuzz colour is black: a sheen of that colour is switched off, so no sheen can stand for it; no fallback is written (loaders without fuzz show no layer)".into()
@@ -324,12 +363,27 @@ impl Note {
             Note::UrisRewritten { count, leaves_folder } => {
                 let mut m = format!("{count} relative URI{} rewritten so that the output finds the input's resources", if *count == 1 { "" } else { "s" });
                 if *leaves_folder {
-                    m += "; they lead out of the output's folder, which velvet itself does not follow (--copy-resources makes a self-contained output)";
+                    m += "; they lead out of the output's folder, which velvet itself does not follow (without --rewrite-uris the output gets its own copies)";
                 }
                 m
             }
             Note::ResourcesCopied { count } => format!("{count} resource{} copied next to the output", if *count == 1 { "" } else { "s" }),
             Note::ResourceMissing { uri } => format!("resource '{uri}' does not exist: not copied, its URI is left as it was"),
+            Note::RoughnessPlan { property, plan, factor_key, factor, max_error, budget } => {
+                let verdict = match budget {
+                    Some(b) if max_error <= b => format!("within the budget {b}"),
+                    Some(b) => format!("{:.4} over the budget {b}: no plan comes closer than this exact bake", max_error - b),
+                    None => "exact to the nearest code, as asked".to_string(),
+                };
+                format!(
+                    "{property}: {}, {factor_key} {factor}; largest roughness difference from the exact mapping {max_error:.4}, {verdict}",
+                    plan.describe()
+                )
+            }
+            Note::RoughnessFloor { property, best, written } => format!(
+                "{property}: the best match, {best:.4}, lies below {written} (the floor renderers honour alike), so {written} is written: {:.4} rougher than the best match",
+                written - best
+            ),
         }
     }
 

@@ -5,10 +5,17 @@
 //! an output that is an input (unless in place), two inputs written to one output, and `-o`
 //! with another container than the input's.
 //!
-//! [`relocate`] keeps an output in another folder loadable: each relative buffer or image URI
-//! is rewritten to lead back to the input's folder, or, with `--copy-resources`, the resource
-//! is copied to the same relative place next to the output and its URI kept. `data:` URIs,
-//! URIs with a scheme and absolute paths need neither.
+//! [`relocate`] keeps an output in another folder loadable and self-contained: each resource a
+//! relative URI names is copied (hard-linked where the filesystem allows) to the same relative
+//! place next to the output and its URI kept, so no output URI leaves its folder and the output
+//! tree can be moved as a whole. A URI that climbs out of the input's folder cannot be kept so:
+//! the file fails, naming it. `--rewrite-uris` (the old behaviour) rewrites each URI to lead
+//! back to the input's folder instead. `data:` URIs, URIs with a scheme and absolute paths need
+//! neither.
+//!
+//! [`check_links`] refuses, before anything of the asset is read, a resource that reaches
+//! outside the input's folder through a symbolic link: it would otherwise be read, baked or
+//! copied into the output.
 
 use super::note::Note;
 use super::UsageError;
@@ -220,13 +227,76 @@ fn is_relative_path(uri: &str) -> bool {
     }
 }
 
-/// What an output written to `output` needs so that `asset`'s relative resources still load.
-pub fn relocate(asset: &Asset, output: &Path, copy_resources: bool) -> Result<Relocation, String> {
-    let from_dir = asset.base_dir();
-    let to_dir = match output.parent() {
+/// The folder a file lies in: its parent, or "." for a bare file name.
+pub fn folder_of(path: &Path) -> &Path {
+    match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
-    };
+    }
+}
+
+/// The relative URIs (buffers and images) of a document, each once, in document order.
+pub fn relative_uris(json: &Value) -> Vec<&str> {
+    let mut out: Vec<&str> = Vec::new();
+    for kind in ["buffers", "images"] {
+        for item in json
+            .get(kind)
+            .and_then(Value::as_array)
+            .into_iter()
+            .flatten()
+        {
+            if let Some(uri) = item
+                .get("uri")
+                .and_then(Value::as_str)
+                .filter(|u| is_relative_path(u))
+            {
+                if !out.contains(&uri) {
+                    out.push(uri);
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Refuses an asset with a resource that a symbolic link leads out of the asset's folder
+/// (unless `--allow-outside-uris` lets it read outside): the error names the URI and the link.
+/// Resources that do not exist are left to the steps that read them.
+pub fn check_links(asset: &Asset) -> Result<(), String> {
+    if asset.options.allow_outside_uris {
+        return Ok(());
+    }
+    let base = folder_of(&asset.path);
+    let mut real_base: Option<PathBuf> = None;
+    for uri in relative_uris(&asset.json) {
+        let Ok(resource::Location::File(path)) = resource::resolve(uri, base, "") else {
+            continue;
+        };
+        let Ok(real) = path.canonicalize() else {
+            continue;
+        };
+        let real_base = match &real_base {
+            Some(b) => b,
+            None => real_base.insert(
+                base.canonicalize()
+                    .map_err(|e| format!("cannot read folder {}: {e}", base.display()))?,
+            ),
+        };
+        if !real.starts_with(real_base) {
+            return Err(format!(
+                "'{uri}' ({}) is a symbolic link, or passes through one, to a file outside the input's folder: nothing is read, baked or copied through it",
+                path.display()
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// What an output written to `output` needs so that `asset`'s relative resources still load:
+/// copies next to it (the default), or with `rewrite_uris`, URIs that lead back.
+pub fn relocate(asset: &Asset, output: &Path, rewrite_uris: bool) -> Result<Relocation, String> {
+    let from_dir = folder_of(&asset.path);
+    let to_dir = folder_of(output);
     let mut relocation = Relocation::default();
     if identity(from_dir) == identity(to_dir) {
         return Ok(relocation);
@@ -246,33 +316,35 @@ pub fn relocate(asset: &Asset, output: &Path, copy_resources: bool) -> Result<Re
                 continue;
             };
             let pointer = format!("/{kind}/{i}/uri");
-            if copy_resources {
-                // Only resources inside the input's folder are copied: a copy must not land
-                // outside the output's folder. The others are rewritten.
-                if let Ok(resource::Location::File(from)) =
-                    resource::resolve(uri, from_dir, &pointer)
-                {
-                    if !from.is_file() {
-                        relocation.notes.push(Note::ResourceMissing {
-                            uri: uri.to_string(),
-                        });
-                    } else if !relocation.copies.iter().any(|c| c.uri == uri) {
-                        let relative = from.strip_prefix(from_dir).map_err(|_| {
-                            format!("'{uri}' does not resolve inside {}", from_dir.display())
-                        })?;
-                        relocation.copies.push(ResourceCopy {
-                            uri: uri.to_string(),
-                            from: from.clone(),
-                            to: to_dir.join(relative),
-                        });
+            if !rewrite_uris {
+                let from = match resource::resolve(uri, from_dir, &pointer) {
+                    Ok(resource::Location::File(from)) => from,
+                    _ => {
+                        return Err(format!(
+                            "'{uri}' leads out of the input's folder, so a self-contained output cannot keep it (--rewrite-uris refers to it where it is)"
+                        ))
                     }
-                    continue;
+                };
+                if !from.is_file() {
+                    relocation.notes.push(Note::ResourceMissing {
+                        uri: uri.to_string(),
+                    });
+                } else if !relocation.copies.iter().any(|c| c.uri == uri) {
+                    let relative = from.strip_prefix(from_dir).map_err(|_| {
+                        format!("'{uri}' does not resolve inside {}", from_dir.display())
+                    })?;
+                    relocation.copies.push(ResourceCopy {
+                        uri: uri.to_string(),
+                        from: from.clone(),
+                        to: to_dir.join(relative),
+                    });
                 }
+                continue;
             }
             if prefix.is_none() {
                 prefix = Some(relative_prefix(to_dir, from_dir).ok_or_else(|| {
                     format!(
-                        "no relative path leads from {} to {}; use --copy-resources",
+                        "no relative path leads from {} to {}; leave out --rewrite-uris to copy the resources",
                         to_dir.display(),
                         from_dir.display()
                     )

@@ -105,6 +105,7 @@ impl MaterialCx<'_> {
             .ok_or_else(|| "its textureInfo has no valid index".to_string())?;
         let sources = textures::sources(self.asset, texture)?;
         Ok(TextureBake {
+            written_factor: None,
             material: self.index,
             extension,
             layer_pointer: self.extension_pointer(extension),
@@ -142,9 +143,10 @@ impl DocumentPlan {
 
 /// Plans the migration of every material of `asset`.
 pub fn plan_document(asset: &Asset, options: &Options) -> DocumentPlan {
-    let materials: Vec<MaterialPlan> = (0..layers::materials(&asset.json).len())
+    let mut materials: Vec<MaterialPlan> = (0..layers::materials(&asset.json).len())
         .filter_map(|i| plan_material(asset, i, options))
         .collect();
+    super::budget::plan(asset, &mut materials, options.budget);
     let declared: Vec<&str> = asset
         .json
         .get("extensionsUsed")

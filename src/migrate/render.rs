@@ -1,11 +1,75 @@
 //! Printing a run: text for people and JSON for tools (the same values, serialised). The text
-//! gives one line per file, the materials with something to say (in a dry run every material,
-//! with its edits) and their notes, then the summary.
+//! gives one line per file (what happened, how many materials, textures and warnings) and the
+//! summary; [`Detail::Verbose`] (`--verbose`, `--report`) adds the materials with something to
+//! say and their notes, and a dry run every material with its edits; [`Detail::Quiet`] (`-q`)
+//! prints failed files only. `velvet bake` words its lines and summary the same way
+//! ([`files_line`], [`added`]).
 
 use super::batch::{FileOutcome, FileResult, RunReport, Summary};
 use super::note::Level;
 use super::plan::MaterialPlan;
 use std::fmt::Write;
+
+/// How much the text says.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Detail {
+    /// Failed files only.
+    Quiet,
+    /// One line per file, then the summary.
+    Normal,
+    /// Every material with something to say, with its notes.
+    Verbose,
+}
+
+/// `n` with the singular or plural noun.
+pub fn plural(n: usize, one: &str, many: &str) -> String {
+    if n == 1 {
+        format!("{n} {one}")
+    } else {
+        format!("{n} {many}")
+    }
+}
+
+/// A byte count for people: bytes, KiB or MiB, to three significant digits.
+pub fn bytes(n: usize) -> String {
+    let n = n as f64;
+    if n < 1024.0 {
+        format!("{n} bytes")
+    } else if n < 1024.0 * 1024.0 {
+        format!("{:.1} KiB", n / 1024.0)
+    } else {
+        format!("{:.1} MiB", n / (1024.0 * 1024.0))
+    }
+}
+
+/// "N textures added (B)", or "no texture added": what a file or run added.
+pub fn added(textures: usize, size: usize, dry_run: bool) -> String {
+    match (textures, dry_run) {
+        (0, true) => "no texture to add".to_string(),
+        (0, false) => "no texture added".to_string(),
+        (n, true) => format!("{} to add", plural(n, "texture", "textures")),
+        (n, false) => format!(
+            "{} added ({})",
+            plural(n, "texture", "textures"),
+            bytes(size)
+        ),
+    }
+}
+
+/// The summary's first line, alike for migrate and bake: "N files: X <done>, Y unchanged,
+/// Z failed".
+pub fn files_line(
+    files: usize,
+    done: usize,
+    done_word: &str,
+    unchanged: usize,
+    failed: usize,
+) -> String {
+    format!(
+        "{}: {done} {done_word}, {unchanged} unchanged, {failed} failed",
+        plural(files, "file", "files")
+    )
+}
 
 fn level(l: Level) -> &'static str {
     match l {
@@ -40,12 +104,35 @@ fn file_line(f: &FileResult, dry_run: bool) -> String {
         Some(o) if o != &f.input => format!(" → {}", o.display()),
         _ => String::new(),
     };
+    let migrated = f.materials.iter().filter(|m| m.migrated()).count();
+    let warnings = f
+        .materials
+        .iter()
+        .flat_map(|m| &m.notes)
+        .chain(&f.notes)
+        .filter(|n| n.level() == Level::Warning)
+        .count();
+    let counts = format!(
+        " ({}, {}, {})",
+        plural(migrated, "material", "materials"),
+        added(
+            f.textures_added,
+            f.bytes_added,
+            matches!(f.outcome, FileOutcome::Planned { .. })
+        ),
+        plural(warnings, "warning", "warnings")
+    );
+    let warned = if warnings > 0 {
+        format!(" ({})", plural(warnings, "warning", "warnings"))
+    } else {
+        String::new()
+    };
     let status = match &f.outcome {
-        FileOutcome::Changed => "migrated".to_string(),
-        FileOutcome::Copied => "nothing to migrate, copied as it is".to_string(),
-        FileOutcome::Untouched => "nothing to migrate, left as it is".to_string(),
-        FileOutcome::Planned { changes: true } => "would change".to_string(),
-        FileOutcome::Planned { changes: false } if dry_run => "nothing to change".to_string(),
+        FileOutcome::Changed => format!("migrated{counts}"),
+        FileOutcome::Copied => format!("nothing to migrate, copied as it is{warned}"),
+        FileOutcome::Untouched => format!("nothing to migrate, left as it is{warned}"),
+        FileOutcome::Planned { changes: true } => format!("would change{counts}"),
+        FileOutcome::Planned { changes: false } if dry_run => format!("nothing to change{warned}"),
         FileOutcome::Planned { .. } => "planned".to_string(),
         FileOutcome::Failed { error } => format!("FAILED: {error}"),
     };
@@ -106,29 +193,18 @@ fn counted<K: Copy>(
 
 /// The closing summary.
 pub fn summary_text(s: &Summary, dry_run: bool) -> String {
-    let plural = |n: usize, one: &str, many: &str| {
-        if n == 1 {
-            format!("{n} {one}")
-        } else {
-            format!("{n} {many}")
-        }
-    };
     let mut out = if dry_run {
-        format!(
-            "{}: {} would change, {} unchanged",
-            plural(s.files, "file", "files"),
+        files_line(
+            s.files,
             s.would_change,
-            s.unchanged
+            "would change",
+            s.unchanged,
+            s.failed,
         )
     } else {
-        format!(
-            "{}: {} changed, {} unchanged",
-            plural(s.files, "file", "files"),
-            s.changed,
-            s.unchanged
-        )
+        files_line(s.files, s.changed, "migrated", s.unchanged, s.failed)
     };
-    let _ = writeln!(out, ", {} failed", s.failed);
+    let _ = writeln!(out, "; {}", added(s.textures_added, s.bytes_added, dry_run));
     let _ = write!(out, "materials: {} migrated", s.materials_migrated);
     if !s.conversions.is_empty() {
         let _ = write!(out, " ({})", counted(&s.conversions, |c| c.as_str()));
@@ -142,20 +218,24 @@ pub fn summary_text(s: &Summary, dry_run: bool) -> String {
     out
 }
 
-/// The whole run as text: files that have something to say, then the summary.
-pub fn text(report: &RunReport) -> String {
+/// The whole run as text: a line per file (with its materials and notes when verbose, its
+/// plan in a dry run), then the summary; quiet, failed files only.
+pub fn text(report: &RunReport, detail: Detail) -> String {
     let mut out = String::new();
     for f in &report.files {
-        if f.materials.is_empty()
-            && f.notes.is_empty()
-            && !matches!(f.outcome, FileOutcome::Failed { .. })
-            && !report.dry_run
-        {
-            continue;
+        let failed = matches!(f.outcome, FileOutcome::Failed { .. });
+        match detail {
+            Detail::Quiet if !failed => {}
+            Detail::Quiet | Detail::Normal if !report.dry_run => {
+                out += &file_line(f, report.dry_run);
+                out.push('\n');
+            }
+            _ => out += &file_text(f, report.dry_run),
         }
-        out += &file_text(f, report.dry_run);
     }
-    out += &summary_text(&report.summary, report.dry_run);
+    if detail != Detail::Quiet {
+        out += &summary_text(&report.summary, report.dry_run);
+    }
     out
 }
 

@@ -7,12 +7,34 @@
 //! writes r(α), the other way round (`shading::mapping` defines both, ships them as tables and
 //! states their distance from the optimum). [`RoughnessMapping::Identity`] copies the value.
 //!
-//! A roughness texture cannot carry a non-linear mapping through its factor (the layer reads
-//! factor × texel): [`curve`] gives the mapping as a sampled curve for the bake engine to apply
-//! to factor × texel, texel by texel.
+//! A roughness texture cannot carry a non-linear mapping through its factor exactly (the layer
+//! reads factor × texel): [`curve`] gives the mapping as a sampled curve for the bake engine to
+//! apply to factor × texel, texel by texel, and [`budget`](super::budget) chooses how many such
+//! textures a document needs.
+//!
+//! Every roughness velvet computes is written through [`written`]: rounded to four decimals
+//! ([`ROUGHNESS_STEP`]; the tables deviate from the optimum by up to 1e-3, so further digits
+//! carry no information, only float noise) and not below [`ROUGHNESS_FLOOR`].
 
 use crate::bake::recipe::Curve;
 use crate::shading::mapping;
+
+/// The lowest roughness factor velvet writes. Renderers clamp small sheen roughness values
+/// differently before use (some near 1e-6, others up to 0.06), so a lobe below that renders
+/// differently in each; at or above 0.07 they all read the value as written. A material whose
+/// best match lies below the floor gets the floor, reported with the difference.
+pub const ROUGHNESS_FLOOR: f64 = 0.07;
+
+/// The step roughness factors are written in (four decimals).
+pub const ROUGHNESS_STEP: f64 = 1e-4;
+
+/// A roughness as velvet writes it: rounded to [`ROUGHNESS_STEP`], within
+/// [[`ROUGHNESS_FLOOR`], 1] (NaN reads as 0, so as the floor).
+pub fn written(roughness: f64) -> f64 {
+    let r = if roughness.is_nan() { 0.0 } else { roughness };
+    let rounded = (r.clamp(0.0, 1.0) * 1e4).round() / 1e4;
+    rounded.max(ROUGHNESS_FLOOR)
+}
 
 /// Which way a roughness value is carried.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -61,17 +83,17 @@ pub fn map(roughness: f64, direction: Direction, mapping: RoughnessMapping) -> f
 /// The mapping as a sampled curve on [0, 1], for the bake engine to apply per texel. The fitted
 /// curves hold the mapping's own table nodes (j/256), and both interpolate linearly between
 /// nodes, so the curve gives [`map`]'s values exactly (the test measures 0 difference); the
-/// identity is the line through (0, 0) and (1, 1). The name carries the table's version, so
-/// recipes with different tables never compare equal.
+/// identity is the line through (0, 0) and (1, 1). Recipes compare curves by their samples as
+/// well as their names, so recipes with different tables never compare equal.
 pub fn curve(direction: Direction, mapping: RoughnessMapping) -> Curve {
     let built = match (mapping, direction) {
-        (RoughnessMapping::Identity, _) => Curve::sampled("roughness identity", &[0.0, 1.0]),
+        (RoughnessMapping::Identity, _) => Curve::sampled("identity roughness", &[0.0, 1.0]),
         (RoughnessMapping::Fitted, Direction::SheenToFuzz) => Curve::sampled(
-            "roughness fitted sheen→fuzz v1",
+            "fitted sheen→fuzz roughness",
             mapping::fuzz_for_sheen_nodes(),
         ),
         (RoughnessMapping::Fitted, Direction::FuzzToSheen) => Curve::sampled(
-            "roughness fitted fuzz→sheen v1",
+            "fitted fuzz→sheen roughness",
             mapping::sheen_for_fuzz_nodes(),
         ),
     };
@@ -81,6 +103,17 @@ pub fn curve(direction: Direction, mapping: RoughnessMapping) -> Curve {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn written_values_are_rounded_and_floored() {
+        assert_eq!(written(0.555_812_345), 0.5558);
+        assert_eq!(written(7.6e-8), ROUGHNESS_FLOOR);
+        assert_eq!(written(0.0), ROUGHNESS_FLOOR);
+        assert_eq!(written(f64::NAN), ROUGHNESS_FLOOR);
+        assert_eq!(written(1.5), 1.0);
+        assert_eq!(written(0.3).to_string(), "0.3");
+        assert_eq!(written(0.1 + 0.2).to_string(), "0.3", "no float noise");
+    }
 
     #[test]
     fn identity_copies_the_value() {

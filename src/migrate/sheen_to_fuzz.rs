@@ -100,7 +100,11 @@ pub fn fuzz_for(
     if let Some(texture) = &sheen.color_texture {
         fuzz.insert("fuzzColorTexture".into(), texture.clone());
     }
-    let r = roughness::map(sheen.roughness, Direction::SheenToFuzz, mapping);
+    let r = roughness::written(roughness::map(
+        sheen.roughness,
+        Direction::SheenToFuzz,
+        mapping,
+    ));
     fuzz.insert(
         "fuzzRoughnessFactor".into(),
         number_like(Some(&sheen.roughness_value), r),
@@ -210,6 +214,14 @@ pub fn convert(cx: &MaterialCx, sheen: &Sheen, plan: &mut MaterialPlan) {
     if cx.has_extension(layers::CLEARCOAT) {
         plan.notes.push(Note::ClearcoatOrder { fallback: false });
     }
+    let best = roughness::map(sheen.roughness, Direction::SheenToFuzz, mapping);
+    if roughness_bake.is_none() && best < roughness::ROUGHNESS_FLOOR {
+        plan.notes.push(Note::RoughnessFloor {
+            property: "fuzzRoughnessFactor".into(),
+            best,
+            written: roughness::ROUGHNESS_FLOOR,
+        });
+    }
     if let Some(bake) = roughness_bake {
         plan.bakes.push(bake);
     }
@@ -283,11 +295,11 @@ mod tests {
     }
 
     #[test]
-    fn full_strength_keeps_the_colour_text_and_roughness_default_is_written() {
+    fn full_strength_keeps_the_colour_text_and_the_floored_roughness_default_is_written() {
         let sheen: Value = serde_json::from_str(r#"{"sheenColorFactor":[1,0,0.75]}"#).unwrap();
         assert_eq!(
             fuzz_text(sheen).unwrap(),
-            r#"{"fuzzFactor":1,"fuzzColorFactor":[1,0,0.75],"fuzzRoughnessFactor":0.0}"#
+            r#"{"fuzzFactor":1,"fuzzColorFactor":[1,0,0.75],"fuzzRoughnessFactor":0.07}"#
         );
     }
 

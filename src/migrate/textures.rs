@@ -198,6 +198,11 @@ pub struct TextureBake {
     pub factor_key: &'static str,
     /// The factor the slot would otherwise carry (one or three components), for reports.
     pub factor: Vec<f64>,
+    /// The factor written once the texture is baked: `None` for the identity (the factor is
+    /// baked in), a value when the texture is shared and the factor carries the material's
+    /// part (see [`budget`](super::budget)).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub written_factor: Option<f64>,
     /// The texture read (its sampler, name and extensions are kept).
     pub texture: usize,
     /// The texture's sources: where it names each image, and the image.
@@ -223,14 +228,17 @@ impl TextureBake {
 impl std::fmt::Display for TextureBake {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let images: Vec<String> = self.sources.iter().map(|(_, i)| i.to_string()).collect();
+        let factor = match self.written_factor {
+            Some(w) => format!("{} becomes {w}", self.factor_key),
+            None => format!("{} becomes the identity", self.factor_key),
+        };
         write!(
             f,
-            "bake {} from texture {} (image {}): {}; {} becomes the identity",
+            "bake {} from texture {} (image {}): {}; {factor}",
             self.texture_pointer(),
             self.texture,
             images.join(", "),
             self.contents.describe(),
-            self.factor_key
         )
     }
 }
@@ -323,6 +331,7 @@ pub fn bake_plan<'a>(bakes: impl IntoIterator<Item = &'a TextureBake>) -> Result
             layer_pointer: bake.layer_pointer.clone(),
             texture: bake.texture,
             factor: bake.factor.clone(),
+            written_factor: bake.written_factor.map(serde_json::Value::from),
             sources,
         });
     }
@@ -341,6 +350,7 @@ mod tests {
             texture_key: key,
             factor_key: "fuzzFactor",
             factor: vec![0.5],
+            written_factor: None,
             texture: 0,
             sources: vec![("/source".into(), 3)],
             contents,
