@@ -105,8 +105,24 @@ impl JsonStyle {
 /// The bytes of `asset` with `json` as its document and `bin` as its GLB BIN chunk. When
 /// `json` equals the loaded document and the BIN chunk is the loaded one, this is not called:
 /// see [`unchanged`].
+///
+/// The JSON is written as splices into the loaded text (see [`crate::edit::splice`]): every
+/// byte of the input that the edit did not change is kept. The document as loaded is read
+/// again from that text for the comparison (callers apply their edits to `asset.json` itself;
+/// writing is the rare step where a second read costs little). A GLB's chunk padding belongs
+/// to the container and is set anew.
 pub fn to_bytes(asset: &Asset, json: &Value, bin: Option<&[u8]>) -> Vec<u8> {
-    let text = JsonStyle::detect(&asset.json_text).render(json);
+    let source = match asset.container {
+        Container::Gltf => asset.json_text.as_str(),
+        Container::Glb => asset.json_text.trim_end_matches(['\0', ' ']),
+    };
+    let spliced = serde_json::from_str::<Value>(source)
+        .ok()
+        .and_then(|before| crate::edit::splice::rewrite(source, &before, json));
+    let text = match spliced {
+        Some(text) => text.into_bytes(),
+        None => JsonStyle::detect(&asset.json_text).render(json),
+    };
     match asset.container {
         Container::Gltf => text,
         Container::Glb => glb::join(&text, bin),

@@ -87,7 +87,7 @@ pub fn apply(json: &mut Value, edits: &[Edit]) -> Result<bool, EditError> {
     let mut changed = false;
     for edit in edits {
         changed |= match edit {
-            Edit::Set { pointer, value } => set(json, pointer, value.clone())?,
+            Edit::Set { pointer, value } => set(json, pointer, splice::written(value.clone()))?,
             Edit::Remove { pointer } => remove(json, pointer)?,
             Edit::DeclareUsed { extension } => declare_used(json, extension)?,
         };

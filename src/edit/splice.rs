@@ -371,6 +371,26 @@ pub fn number_text(n: &serde_json::Number) -> String {
     format!("{rounded}")
 }
 
+/// `value` with every number as velvet writes it (see [`number_text`]): edits store what the
+/// file will hold, so that planning again compares like with like.
+pub fn written(value: Value) -> Value {
+    match value {
+        Value::Number(n) => {
+            let text = number_text(&n);
+            if text == n.to_string() {
+                Value::Number(n)
+            } else {
+                serde_json::from_str(&text).map_or(Value::Number(n), Value::Number)
+            }
+        }
+        Value::Array(items) => Value::Array(items.into_iter().map(written).collect()),
+        Value::Object(map) => {
+            Value::Object(map.into_iter().map(|(k, v)| (k, written(v))).collect())
+        }
+        other => other,
+    }
+}
+
 /// The indentation of the line `at` lies on.
 fn line_indent(text: &str, at: usize) -> &str {
     let line_start = text[..at].rfind('\n').map_or(0, |p| p + 1);
@@ -472,35 +492,70 @@ fn diff_object(
     if added.is_empty() {
         return;
     }
-    let inline = layout.unit.is_none() || (one_line(text, span) && !members.is_empty());
-    let mut insert = String::new();
-    match members.last() {
-        Some((last_key, last_value)) => {
-            let indent = line_indent(text, *last_key).to_string();
-            let separator = if inline {
-                members
-                    .get(1)
-                    .map(|(k, _)| text[members[0].1.end..*k].to_string())
-                    .unwrap_or_else(|| layout.inline_comma.clone())
-            } else {
-                format!(",{}{indent}", layout.newline)
-            };
-            for (key, value) in &added {
-                insert.push_str(&separator);
-                insert.push_str(&Value::String((*key).clone()).to_string());
-                insert.push_str(&layout.colon);
-                insert.push_str(&layout.render(value, &indent, inline));
-            }
-            out.push(Splice {
-                start: last_value.end,
-                end: last_value.end,
-                text: insert,
-            });
+    if members.is_empty() {
+        // An empty object: written anew with its members.
+        return replace(text, span, &Value::Object(after.clone()), layout, out);
+    }
+    let inline = layout.unit.is_none() || one_line(text, span);
+    let indent = line_indent(text, members[0].0).to_string();
+    let separator = if inline {
+        members
+            .get(1)
+            .map(|(k, _)| text[members[0].1.end..*k].to_string())
+            .unwrap_or_else(|| layout.inline_comma.clone())
+    } else {
+        format!(",{}{indent}", layout.newline)
+    };
+    let member_text = |key: &str, value: &Value| {
+        format!(
+            "{}{}{}",
+            Value::String(key.to_string()),
+            layout.colon,
+            layout.render(value, &indent, inline)
+        )
+    };
+    // A new key goes after the member that precedes it in the edited document (the edit
+    // applier puts `extensionsUsed` after `asset`, say), or first when none does.
+    let position: std::collections::HashMap<&str, usize> = before
+        .keys()
+        .enumerate()
+        .map(|(i, k)| (k.as_str(), i))
+        .collect();
+    let mut anchor: Option<usize> = None;
+    let mut leading = String::new();
+    let mut after_member: Vec<(usize, String)> = Vec::new();
+    for (key, value) in after {
+        match position.get(key.as_str()) {
+            Some(i) => anchor = Some(*i),
+            None => match anchor {
+                None => {
+                    leading.push_str(&member_text(key, value));
+                    leading.push_str(&separator);
+                }
+                Some(i) => match after_member.last_mut() {
+                    Some((at, insert)) if *at == i => {
+                        insert.push_str(&separator);
+                        insert.push_str(&member_text(key, value));
+                    }
+                    _ => after_member.push((i, separator.clone() + &member_text(key, value))),
+                },
+            },
         }
-        None => {
-            // An empty object: written anew with its members.
-            replace(text, span, &Value::Object(after.clone()), layout, out);
-        }
+    }
+    if !leading.is_empty() {
+        out.push(Splice {
+            start: members[0].0,
+            end: members[0].0,
+            text: leading,
+        });
+    }
+    for (i, insert) in after_member {
+        let end = members[i].1.end;
+        out.push(Splice {
+            start: end,
+            end,
+            text: insert,
+        });
     }
 }
 
@@ -638,6 +693,30 @@ mod tests {
         assert_eq!(n(1.0), "1.0");
         let spelled: serde_json::Number = serde_json::from_str("1E-1").unwrap();
         assert_eq!(number_text(&spelled), "0.1");
+    }
+
+    #[test]
+    fn a_new_key_follows_the_key_before_it_in_the_edited_document() {
+        let text = "{\n  \"asset\": {\"version\": \"2.0\"},\n  \"materials\": []\n}\n";
+        let before: Value = serde_json::from_str(text).unwrap();
+        let mut after = serde_json::Map::new();
+        after.insert("first".into(), serde_json::json!(1));
+        after.insert("asset".into(), before["asset"].clone());
+        after.insert(
+            "extensionsUsed".into(),
+            serde_json::json!(["KHR_materials_fuzz"]),
+        );
+        after.insert("materials".into(), serde_json::json!([]));
+        assert_eq!(
+            rewrite(text, &before, &Value::Object(after)).unwrap(),
+            "{\n  \"first\": 1,\n  \"asset\": {\"version\": \"2.0\"},\n  \"extensionsUsed\": [\n    \"KHR_materials_fuzz\"\n  ],\n  \"materials\": []\n}\n"
+        );
+    }
+
+    #[test]
+    fn written_values_hold_what_the_file_will_hold() {
+        let value = written(serde_json::json!({"a": [0.30000000000000004, 1.0, 2], "b": "x"}));
+        assert_eq!(value.to_string(), r#"{"a":[0.3,1.0,2],"b":"x"}"#);
     }
 
     #[test]
