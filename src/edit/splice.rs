@@ -189,6 +189,7 @@ impl Scanner<'_> {
 }
 
 /// How the file is laid out, read once.
+#[derive(Clone)]
 struct Layout {
     /// The indent unit; `None` for a minified file (no line breaks).
     unit: Option<String>,
@@ -262,6 +263,19 @@ impl Layout {
                 _ => {}
             }
         });
+        layout
+    }
+
+    /// This layout with the indent unit the container at `container_start` uses for its
+    /// member at `member_start`, where the file mixes units (tabs in one place, spaces in
+    /// another).
+    fn local(&self, text: &str, container_start: usize, member_start: usize) -> Layout {
+        let outer = line_indent(text, container_start);
+        let inner = line_indent(text, member_start);
+        let mut layout = self.clone();
+        if self.unit.is_some() && inner.len() > outer.len() && inner.starts_with(outer) {
+            layout.unit = Some(inner[outer.len()..].to_string());
+        }
         layout
     }
 
@@ -496,6 +510,7 @@ fn diff_object(
         // An empty object: written anew with its members.
         return replace(text, span, &Value::Object(after.clone()), layout, out);
     }
+    let layout = &layout.local(text, span.start, members[0].0);
     let inline = layout.unit.is_none() || one_line(text, span);
     let indent = line_indent(text, members[0].0).to_string();
     let separator = if inline {
@@ -577,6 +592,7 @@ fn append(
     let Node::Array(existing) = &span.node else {
         return;
     };
+    let layout = &layout.local(text, span.start, existing[0].start);
     let indent = line_indent(text, existing[existing.len() - 1].start).to_string();
     let separator = if inline {
         existing
