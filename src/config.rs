@@ -15,7 +15,7 @@
 //! Severity overrides merge per code. Exclude globs come from the file only and are relative
 //! to its folder.
 
-use crate::diagnostics::{self, FailOn, Settings, Severity};
+use crate::diagnostics::{FailOn, Settings, Severity};
 use globset::{Glob, GlobBuilder, GlobSet, GlobSetBuilder};
 use serde::Deserialize;
 use std::collections::{BTreeMap, BTreeSet, HashMap};
@@ -127,7 +127,7 @@ enum RawSeverity {
 
 /// Checks that `code` is one velvet emits.
 fn known_code(code: &str, key: &str) -> Result<String, String> {
-    match diagnostics::find_code(code) {
+    match crate::rules::find_code(code) {
         Some(c) => Ok(c.name.to_string()),
         None => Err(format!(
             "{key}: no such code {code} (`velvet codes` lists them)"
@@ -401,7 +401,7 @@ impl Config {
         let ignore = match &selection.0 {
             Selection::All => BTreeSet::new(),
             Selection::Ignore(codes) => codes.clone(),
-            Selection::Only(codes) => diagnostics::all_codes()
+            Selection::Only(codes) => crate::rules::all_codes()
                 .into_iter()
                 .map(|c| c.name.to_string())
                 .filter(|n| !codes.contains(n))
@@ -478,7 +478,7 @@ impl Config {
                 let _ = writeln!(
                     out,
                     "# {FILE_NAME} in force: {}",
-                    crate::report::display_path(p)
+                    crate::asset::discover::display_path(p)
                 );
             }
             None => {
@@ -550,30 +550,7 @@ pub struct Resolver {
     by_file: HashMap<PathBuf, Arc<Config>>,
 }
 
-/// `path` made absolute without touching the file system (links are not resolved, so the
-/// folders walked are those the user sees).
-pub fn absolute(path: &Path) -> PathBuf {
-    let path = if path.as_os_str().is_empty() {
-        Path::new(".")
-    } else {
-        path
-    };
-    let abs = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
-    // Drop `.` components and fold `..` where it is lexically safe.
-    let mut out = PathBuf::new();
-    for c in abs.components() {
-        match c {
-            std::path::Component::CurDir => {}
-            std::path::Component::ParentDir => {
-                if !out.pop() {
-                    out.push(c);
-                }
-            }
-            other => out.push(other),
-        }
-    }
-    out
-}
+pub use crate::asset::discover::absolute;
 
 impl Resolver {
     /// A resolver that layers `cli` over the discovered files, or over `config_file` for every
@@ -814,7 +791,7 @@ mod tests {
             ..Layer::default()
         };
         let c = Config::combine(None, &cli);
-        let all = diagnostics::all_codes().len();
+        let all = crate::rules::all_codes().len();
         assert_eq!(c.settings().ignore.len(), all - 1);
         assert!(!c.settings().ignore.contains("TYPE_MISMATCH"));
         assert_eq!(c.settings().max_issues, None);

@@ -9,7 +9,7 @@ use std::process::ExitCode;
 use velvet::asset::discover::{self, Shard};
 use velvet::cli_docs::{self, EXIT_STATUS, EXIT_STATUS_ALL};
 use velvet::config::{self, Layer, Resolver};
-use velvet::diagnostics::{self, FailOn, Settings};
+use velvet::diagnostics::{FailOn, Settings};
 use velvet::migrate;
 use velvet::report::{self, ColorChoice, Format};
 use velvet::rules::schema::Schemas;
@@ -315,7 +315,7 @@ fn man(dir: Option<PathBuf>) -> ExitCode {
 }
 
 fn codes_table(format: CodesFormat) -> String {
-    let codes = diagnostics::all_codes();
+    let codes = velvet::rules::all_codes();
     match format {
         CodesFormat::Text => {
             let width = codes.iter().map(|c| c.name.len()).max().unwrap_or(0);

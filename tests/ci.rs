@@ -132,7 +132,7 @@ fn sarif_meets_github_code_scanning_requirements() {
     let driver = &run["tool"]["driver"];
     assert_eq!(driver["name"], "velvet");
     let rules = driver["rules"].as_array().unwrap();
-    let registry = velvet::diagnostics::all_codes();
+    let registry = velvet::rules::all_codes();
     assert_eq!(rules.len(), registry.len(), "one rule per registered code");
     for (rule, code) in rules.iter().zip(&registry) {
         assert_eq!(rule["id"], code.name);

@@ -7,7 +7,8 @@
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use std::process::Command;
-use velvet::diagnostics::{all_codes, Settings};
+use velvet::diagnostics::Settings;
+use velvet::rules::all_codes;
 use velvet::rules::schema::Schemas;
 use velvet::validate::{FileReport, Validator};
 

@@ -8,6 +8,8 @@
 //! - [`check_inputs`] refuses, before anything is read, a path that does not exist and a folder
 //!   with no asset in it or below: a typo or an emptied folder in a CI command must not pass as
 //!   "0 files checked".
+//! - [`absolute`] and [`display_path`]: how velvet names a file for matching (absolute, without
+//!   resolving links) and in reports (relative to the working folder, forward slashes).
 //! - [`read_list`] reads `--files-from`: paths one per line or NUL-separated (told apart by the
 //!   presence of a NUL byte), so that `git diff --name-only -z` output can be fed as it is.
 //! - [`Shard`] splits the files found into N parts for N independent CI jobs. The split is a
@@ -341,6 +343,41 @@ pub fn assign(items: &[(String, usize, u64)], count: usize) -> Vec<usize> {
         loads.push(Reverse((load + items[i].2, shard)));
     }
     shard_of
+}
+
+/// `path` made absolute without touching the file system (links are not resolved, so the
+/// folders walked are those the user sees).
+pub fn absolute(path: &Path) -> PathBuf {
+    let path = if path.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        path
+    };
+    let abs = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
+    // Drop `.` components and fold `..` where it is lexically safe.
+    let mut out = PathBuf::new();
+    for c in abs.components() {
+        match c {
+            std::path::Component::CurDir => {}
+            std::path::Component::ParentDir => {
+                if !out.pop() {
+                    out.push(c);
+                }
+            }
+            other => out.push(other),
+        }
+    }
+    out
+}
+
+/// A path as reports show it: relative to the working directory when it lies below it, with
+/// forward slashes.
+pub fn display_path(path: &Path) -> String {
+    let shown = std::env::current_dir()
+        .ok()
+        .and_then(|cwd| path.strip_prefix(&cwd).ok().map(Path::to_path_buf))
+        .unwrap_or_else(|| path.to_path_buf());
+    shown.to_string_lossy().replace('\\', "/")
 }
 
 #[cfg(test)]

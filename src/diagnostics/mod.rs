@@ -116,24 +116,3 @@ impl Diagnostic {
         }
     }
 }
-
-/// Every code velvet can emit, loader and schema codes first, then the rules' codes in
-/// registry order. Each name appears once.
-pub fn all_codes() -> Vec<&'static Code> {
-    let mut out: Vec<&'static Code> = Vec::new();
-    for code in codes::LOADER.iter().chain(codes::SCHEMA).copied().chain(
-        crate::rules::REGISTRY
-            .iter()
-            .flat_map(|r| r.codes().iter().copied()),
-    ) {
-        if !out.iter().any(|c| c.name == code.name) {
-            out.push(code);
-        }
-    }
-    out
-}
-
-/// Looks a code up by name.
-pub fn find_code(name: &str) -> Option<&'static Code> {
-    all_codes().into_iter().find(|c| c.name == name)
-}

@@ -11,17 +11,8 @@ pub mod text;
 
 use crate::validate::FileReport;
 use std::io::IsTerminal;
-use std::path::Path;
 
-/// A path as reports show it: relative to the working directory when it lies below it, with
-/// forward slashes.
-pub fn display_path(path: &Path) -> String {
-    let shown = std::env::current_dir()
-        .ok()
-        .and_then(|cwd| path.strip_prefix(&cwd).ok().map(Path::to_path_buf))
-        .unwrap_or_else(|| path.to_path_buf());
-    shown.to_string_lossy().replace('\\', "/")
-}
+pub use crate::asset::discover::display_path;
 
 /// What a report says of the findings a `--max-issues` cap left out of its listing.
 pub fn omitted_note(omitted: usize) -> String {

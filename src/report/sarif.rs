@@ -11,7 +11,7 @@
 //! goes in each result's `properties.pointer`.
 
 use crate::asset::Container;
-use crate::diagnostics::{self, Severity};
+use crate::diagnostics::Severity;
 use crate::validate::FileReport;
 use percent_encoding::{utf8_percent_encode, AsciiSet, NON_ALPHANUMERIC};
 use serde::Serialize;
@@ -40,11 +40,11 @@ pub fn level(severity: Severity) -> &'static str {
 
 /// The artifact URI of `path` and whether it is relative to the working directory.
 pub fn artifact_uri(path: &Path) -> (String, bool) {
-    let abs = crate::config::absolute(path);
+    let abs = crate::asset::discover::absolute(path);
     let encode =
         |c: &std::ffi::OsStr| utf8_percent_encode(&c.to_string_lossy(), SEGMENT).to_string();
     if let Some(rel) = std::env::current_dir().ok().and_then(|cwd| {
-        abs.strip_prefix(crate::config::absolute(&cwd))
+        abs.strip_prefix(crate::asset::discover::absolute(&cwd))
             .ok()
             .map(Path::to_path_buf)
     }) {
@@ -204,7 +204,7 @@ fn artifact_location(path: &Path) -> ArtifactLocation {
 }
 
 fn log<'a>(reports: &'a [FileReport], artifacts: &'a [ArtifactLocation]) -> Log<'a> {
-    let codes = diagnostics::all_codes();
+    let codes = crate::rules::all_codes();
     let index: HashMap<&str, usize> = codes.iter().enumerate().map(|(i, c)| (c.name, i)).collect();
     let rules = codes
         .iter()
