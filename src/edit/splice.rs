@@ -364,8 +364,9 @@ fn visit(span: &Span, f: &mut dyn FnMut(&Span)) {
     }
 }
 
-/// A number as velvet writes it: its own spelling when it has at most [`DECIMALS`] decimals,
-/// otherwise rounded to that many and written as the shortest decimal that reads back.
+/// A number as velvet writes it: its own spelling when it is already at [`DECIMALS`] decimals
+/// or fewer, otherwise rounded to that many and written as the shortest decimal that reads
+/// back.
 pub fn number_text(n: &serde_json::Number) -> String {
     let text = n.to_string();
     let decimals = match text.find(['e', 'E']) {
@@ -378,6 +379,9 @@ pub fn number_text(n: &serde_json::Number) -> String {
     let Some(x) = n.as_f64() else { return text };
     let scale = 10f64.powi(DECIMALS);
     let rounded = (x * scale).round() / scale;
+    if rounded == x {
+        return text; // already at that precision (`5E-1`): the spelling stays
+    }
     if rounded == 0.0 {
         return "0".to_string();
     }
@@ -708,7 +712,9 @@ mod tests {
         assert_eq!(n(0.5), "0.5");
         assert_eq!(n(1.0), "1.0");
         let spelled: serde_json::Number = serde_json::from_str("1E-1").unwrap();
-        assert_eq!(number_text(&spelled), "0.1");
+        assert_eq!(number_text(&spelled), "1e-1"); // serde_json's own spelling of 1E-1
+        let noisy: serde_json::Number = serde_json::from_str("7.5E-8").unwrap();
+        assert_eq!(number_text(&noisy), "0");
     }
 
     #[test]
