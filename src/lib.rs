@@ -12,6 +12,7 @@ pub mod diagnostics;
 pub mod edit;
 pub mod layers;
 pub mod migrate;
+pub mod preview;
 pub mod report;
 pub mod rules;
 pub mod run;

@@ -40,6 +40,9 @@ enum Command {
     /// Add KHR_materials_fuzz to sheen materials (keeping the sheen as the fallback), a fallback
     /// sheen to fuzz materials, and upgrade the pre-ratification sheen draft.
     Migrate(MigrateArgs),
+    /// Render contact sheets (PNG) of each sheen or fuzz material: as authored, as migrated
+    /// and as a loader without fuzz sees it, with the report's figures, plus an index.html.
+    Preview(PreviewArgs),
     /// Print the configuration in force for a file or folder.
     ///
     /// The output is velvet.toml text with the source of each value (default, velvet.toml or
@@ -221,6 +224,21 @@ struct BakeArgs {
     load: LoadArgs,
 }
 
+#[derive(clap::Args)]
+#[command(
+    after_help = "Exit status: 0 done, 1 a file could not be previewed or an output not written (the other sheets are still written), 2 usage error (nothing written)."
+)]
+struct PreviewArgs {
+    /// Files and folders (folders are searched for *.gltf and *.glb, in any letter case).
+    #[arg(required = true)]
+    paths: Vec<PathBuf>,
+    /// The folder the sheets and index.html are written into.
+    #[arg(short, long, value_name = "DIR", default_value = "velvet-preview")]
+    output: PathBuf,
+    #[command(flatten)]
+    load: LoadArgs,
+}
+
 #[derive(Clone, Copy, ValueEnum)]
 enum Compression {
     Fast,
@@ -265,6 +283,7 @@ fn main() -> ExitCode {
         Command::Migrate(args) => migrate(args, cli.quiet),
         Command::Config { path, settings } => show_config(path, settings),
         Command::Bake(args) => bake(args, cli.quiet),
+        Command::Preview(args) => preview(args, cli.quiet),
         Command::Codes { format } => {
             emit(codes_table(format).as_bytes());
             ExitCode::SUCCESS
@@ -592,6 +611,52 @@ fn bake(args: BakeArgs, quiet: bool) -> ExitCode {
         BakeFormat::Json => print!("{}", command::render_json(&results)),
     }
     if results.iter().any(|r| r.failed()) {
+        ExitCode::from(1)
+    } else {
+        ExitCode::SUCCESS
+    }
+}
+
+fn preview(args: PreviewArgs, quiet: bool) -> ExitCode {
+    if let Err(e) = discover::check_inputs(&args.paths) {
+        return usage_error(e);
+    }
+    let previews = velvet::preview::render(&args.paths, &args.load.options());
+    let mut failed = !previews.failures.is_empty();
+    for f in &previews.failures {
+        eprintln!("velvet: {}: {}", f.file.display(), f.message);
+    }
+    match velvet::preview::write(&previews, &args.output) {
+        Ok(written) => {
+            if !quiet {
+                let mut out = String::new();
+                for (sheet, path) in previews.sheets.iter().zip(&written) {
+                    out += &format!(
+                        "{}: {} ({})\n",
+                        path.display(),
+                        sheet.summary.title,
+                        sheet.summary.verdict.text()
+                    );
+                }
+                for f in &previews.without_layers {
+                    out += &format!("{}: no material with a sheen or fuzz layer\n", f.display());
+                }
+                if let Some(index) = written.last() {
+                    out += &format!(
+                        "{} sheet(s); index: {}\n",
+                        previews.sheets.len(),
+                        index.display()
+                    );
+                }
+                emit(out.as_bytes());
+            }
+        }
+        Err(e) => {
+            eprintln!("velvet: {e}");
+            failed = true;
+        }
+    }
+    if failed {
         ExitCode::from(1)
     } else {
         ExitCode::SUCCESS
