@@ -6,9 +6,10 @@
 //! quantised to 8 bits at the end; the PNG encoding is deterministic.
 //!
 //! The figures are the ones `migrate --report` gives, from the same functions, at the
-//! material's factors: `shading::mapping::layer_match` (|max3·E − w·R| over view angles, its
-//! maximum and cosine-weighted rms) and `shading::layering::sheen_to_fuzz_attenuation_difference`
-//! (the largest base-attenuation difference and its view cosine). The verdict reads the
+//! material's factors: `shading::mapping::layer_match_with` (|max3·E − w·R| over view angles,
+//! its maximum and cosine-weighted rms) and `shading::layering::compare_base_attenuation` (the
+//! largest base-attenuation difference and its view cosine), with E and R by quadrature as the
+//! report has them. The verdict reads the
 //! rendered pixels: the largest difference between column 0 and column 1 over both lights and
 //! every swatch, at most [`SAME_CODES`] codes "same to the eye", at most [`CLOSE_CODES`]
 //! "close", else "visible"; a sheen roughness below 0.1 (no fuzz roughness matches it) is
@@ -18,9 +19,55 @@ use super::font::{self, ADVANCE, GLYPH_H, LINE_HEIGHT};
 use super::material::{columns, layer_pair, Column, Kind, Material};
 use super::shade::{render_sphere, Light, Look, Shaded, Sphere};
 use crate::bake::srgb;
-use crate::shading::layering::sheen_to_fuzz_attenuation_difference;
-use crate::shading::mapping::{layer_match, POOR_MATCH_BELOW};
+use crate::shading::layering::{
+    compare_base_attenuation, FuzzReflectance, LayerReflectance, SheenAlbedo,
+};
+use crate::shading::mapping::{layer_match_with, POOR_MATCH_BELOW};
+use crate::shading::{AlbedoMethod, ReflectanceMethod};
 use rayon::prelude::*;
+use std::collections::HashMap;
+use std::sync::Mutex;
+
+/// A layer reflectance that remembers its values: the report's comparisons of one sheet
+/// evaluate the same (μ, roughness) more than once. A value is a function of its inputs alone,
+/// so which task computes it first does not change it.
+struct Memo<R> {
+    inner: R,
+    values: Mutex<HashMap<(u64, u64), f64>>,
+}
+
+impl<R: LayerReflectance> Memo<R> {
+    fn new(inner: R) -> Self {
+        Memo {
+            inner,
+            values: Mutex::new(HashMap::new()),
+        }
+    }
+}
+
+impl<R: LayerReflectance> LayerReflectance for Memo<R> {
+    fn name(&self) -> String {
+        self.inner.name()
+    }
+
+    fn reflectance(&self, mu: f64, roughness: f64) -> f64 {
+        let key = (mu.to_bits(), roughness.to_bits());
+        let known = self
+            .values
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .get(&key)
+            .copied();
+        known.unwrap_or_else(|| {
+            let v = self.inner.reflectance(mu, roughness);
+            self.values
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .insert(key, v);
+            v
+        })
+    }
+}
 
 /// Sphere diameter in pixels.
 pub const SPHERE: usize = 96;
@@ -156,6 +203,9 @@ fn figure_lines(material: &Material) -> (Vec<String>, bool) {
         .skip(1)
         .filter_map(|(j, c)| layer_pair(&cols[0].look.layer, &c.look.layer).map(|p| (j, p)))
         .collect();
+    // The comparisons share the authored layer: its E or R is computed once per view cosine.
+    let sheen_memo = Memo::new(SheenAlbedo(AlbedoMethod::Quadrature));
+    let fuzz_memo = Memo::new(FuzzReflectance(ReflectanceMethod::Quadrature));
     let results: Vec<_> = pairs
         .par_iter()
         .map(|&(j, (sheen, fuzz))| {
@@ -163,8 +213,8 @@ fn figure_lines(material: &Material) -> (Vec<String>, bool) {
                 j,
                 sheen,
                 fuzz,
-                layer_match(sheen, fuzz),
-                sheen_to_fuzz_attenuation_difference(sheen, fuzz),
+                layer_match_with(sheen, fuzz, &sheen_memo, &fuzz_memo),
+                compare_base_attenuation(sheen, fuzz, &sheen_memo, &fuzz_memo),
             )
         })
         .collect();
@@ -213,7 +263,15 @@ pub fn render(file: &str, material: &Material) -> Sheet {
             looks.push(col.look);
         }
     }
-    let shaded: Vec<Shaded> = looks.par_iter().map(|l| Shaded::new(*l)).collect();
+    let ((figures, poor_match), shaded) = rayon::join(
+        || figure_lines(material),
+        || {
+            looks
+                .par_iter()
+                .map(|l| Shaded::new(*l))
+                .collect::<Vec<Shaded>>()
+        },
+    );
     let find = |look: &Look| looks.iter().position(|l| l == look).expect("listed");
     // Rows: per swatch, the furnace and the light.
     let rows: Vec<(usize, Light)> = (0..material.swatches.len())
@@ -249,7 +307,6 @@ pub fn render(file: &str, material: &Material) -> Sheet {
         .collect();
 
     let ncols = per_swatch[0].len();
-    let (figures, poor_match) = figure_lines(material);
     let title = match &material.name {
         Some(n) => format!("{file}: material {} \"{n}\"", material.index),
         None => format!("{file}: material {}", material.index),
@@ -404,7 +461,7 @@ pub fn to_png(sheet: &Sheet) -> Vec<u8> {
     use image::codecs::png::{CompressionType, FilterType, PngEncoder};
     use image::ImageEncoder;
     let mut out = Vec::new();
-    PngEncoder::new_with_quality(&mut out, CompressionType::Default, FilterType::Adaptive)
+    PngEncoder::new_with_quality(&mut out, CompressionType::Fast, FilterType::Adaptive)
         .write_image(
             &sheet.rgb,
             sheet.width as u32,
