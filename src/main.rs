@@ -489,6 +489,10 @@ struct MigrateArgs {
     /// Copy relative resources next to outputs in another folder instead of rewriting URIs.
     #[arg(long)]
     copy_resources: bool,
+    /// Also write contact sheets of the inputs' sheen and fuzz materials (as authored, as
+    /// migrated, without fuzz) and an index.html into DIR, as `velvet preview` does.
+    #[arg(long, value_name = "DIR")]
+    preview: Option<PathBuf>,
     #[command(flatten)]
     load: LoadArgs,
 }
@@ -536,6 +540,19 @@ fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
         dry_run: args.dry_run || args.check,
         progress: !quiet,
     };
+    // The sheets are rendered from the inputs before they are migrated (--in-place overwrites
+    // them), and written after.
+    let previews = args.preview.as_ref().map(|_| {
+        let inputs: Vec<PathBuf> = match args.input.shard {
+            None => request.inputs.clone(),
+            Some(shard) => discover::find(&request.inputs, Some(shard))
+                .0
+                .into_iter()
+                .map(|f| f.path)
+                .collect(),
+        };
+        velvet::preview::render(&inputs, &request.options.load)
+    });
     // A list that names no asset (a change that touched none) is nothing to do, not an error.
     let report = if request.inputs.is_empty() {
         migrate::RunReport {
@@ -556,7 +573,18 @@ fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
             MigrateFormat::Json => migrate::render::json(&report),
         }
     );
-    if report.failed() || (args.check && report.summary.would_change > 0) {
+    let mut preview_failed = false;
+    if let (Some(dir), Some(previews)) = (&args.preview, &previews) {
+        for f in &previews.failures {
+            eprintln!("velvet: preview: {}: {}", f.file.display(), f.message);
+        }
+        preview_failed = !previews.failures.is_empty();
+        if let Err(e) = velvet::preview::write(previews, dir) {
+            eprintln!("velvet: preview: {e}");
+            preview_failed = true;
+        }
+    }
+    if report.failed() || preview_failed || (args.check && report.summary.would_change > 0) {
         ExitCode::from(1)
     } else {
         ExitCode::SUCCESS

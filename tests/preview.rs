@@ -447,3 +447,34 @@ fn bad_inputs_give_an_error_naming_the_file_and_a_non_zero_status() {
     assert_eq!(o.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&o.stderr).contains("cannot create the folder"));
 }
+
+#[test]
+fn migrate_in_place_with_preview_shows_the_materials_as_they_were_before() {
+    let dir = tempfile::tempdir().unwrap();
+    let asset = write(
+        dir.path(),
+        "chair.gltf",
+        &gltf(
+            r#"{"name": "cloth", "extensions": {"KHR_materials_sheen": {"sheenColorFactor": [1, 0.5, 0.5], "sheenRoughnessFactor": 0.4}}}"#,
+        ),
+    );
+    let out = dir.path().join("sheets");
+    let o = Command::new(env!("CARGO_BIN_EXE_velvet"))
+        .args(["migrate", "--in-place", "-q", "--preview"])
+        .arg(&out)
+        .arg(&asset)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // The file now has fuzz …
+    assert!(std::fs::read_to_string(&asset)
+        .unwrap()
+        .contains("KHR_materials_fuzz"));
+    // … and the sheet shows the sheen it had, migrated.
+    assert!(out.join("chair-m0-cloth.png").is_file());
+    let index = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert!(
+        index.contains("sheen -&gt; fuzz: migrate adds KHR_materials_fuzz"),
+        "{index}"
+    );
+}
