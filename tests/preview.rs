@@ -478,3 +478,23 @@ fn migrate_in_place_with_preview_shows_the_materials_as_they_were_before() {
         "{index}"
     );
 }
+
+#[test]
+fn switched_off_layers_alone_get_no_sheet() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = write(
+        dir.path(),
+        "off.gltf",
+        &gltf(
+            r#"{"extensions": {"KHR_materials_fuzz": {"fuzzFactor": 0, "fuzzColorFactor": [1, 1, 1]}}},
+               {"extensions": {"KHR_materials_sheen": {"sheenColorFactor": [0, 0, 0], "sheenRoughnessFactor": 0.5}}},
+               {"extensions": {"KHR_materials_unlit": {}, "KHR_materials_sheen": {"sheenColorFactor": [1, 1, 1]}}},
+               {"extensions": {"KHR_materials_fuzz": {"fuzzFactor": 0.5}}}"#,
+        ),
+    );
+    let materials = material::materials(&load(&path));
+    let indices: Vec<usize> = materials.iter().map(|m| m.index).collect();
+    assert_eq!(indices, [3]);
+    assert!(materials[0].fuzz_roughness_assumed);
+    assert_eq!(materials[0].factors.fuzz.unwrap().roughness, 0.5);
+}

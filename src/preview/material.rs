@@ -100,8 +100,8 @@ pub struct TextureStats {
 
 /// The materials of `asset` that have or get a sheen or fuzz layer, in document order.
 /// Materials that use KHR_materials_unlit or KHR_materials_pbrSpecularGlossiness (which
-/// exclude both layers, so migrate leaves them) and switched-off sheens without fuzz are left
-/// out.
+/// exclude both layers, so migrate leaves them), and a switched-off sheen or fuzz alone (to
+/// which migrate adds nothing), are left out.
 pub fn materials(asset: &Asset) -> Vec<Material> {
     let mut images = ImageCache::default();
     layers::materials(&asset.json)
@@ -133,7 +133,7 @@ fn read(
     let fuzz = fuzz_json.and_then(FuzzView::read);
     let kind = match (&sheen, &fuzz) {
         (Some(_), Some(_)) => Kind::FuzzWithSheen,
-        (None, Some(_)) => Kind::FuzzFallback,
+        (None, Some(f)) if f.is_on() => Kind::FuzzFallback,
         (Some(s), None) if s.is_on() => Kind::SheenToFuzz,
         _ => return None,
     };

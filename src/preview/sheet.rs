@@ -366,7 +366,7 @@ pub fn render(file: &str, material: &Material) -> Sheet {
         .iter()
         .map(|c| (c.title.clone(), c.detail.clone()))
         .chain(std::iter::once((
-            "DIFFERENCE X8".to_string(),
+            format!("DIFFERENCE X{DIFF_GAIN}"),
             "COLUMNS 1 AND 2".to_string(),
         )))
         .collect();
