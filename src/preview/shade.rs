@@ -28,6 +28,7 @@ use crate::shading::fuzz::{
 use crate::shading::layering::{fuzz_base_attenuation, max3, sheen_base_attenuation};
 use crate::shading::{fuzz_reflectance, sheen_albedo, AlbedoMethod};
 use rayon::prelude::*;
+use std::cmp::Ordering;
 use std::f64::consts::PI;
 
 /// View cosines sampled per look: μ_i = (i / (CURVE_NODES − 1))².
@@ -105,8 +106,14 @@ impl Shaded {
         // A switched-off layer is no layer (the specs: sheenColorFactor zero or fuzzFactor zero
         // disables the layer), so it shows the base exactly as a material without one.
         let layer = match look.layer {
-            Layer::Sheen { color, .. } if !(max3(color) > 0.0) => Layer::None,
-            Layer::Fuzz { weight, .. } if !(weight > 0.0) => Layer::None,
+            Layer::Sheen { color, .. }
+                if max3(color).partial_cmp(&0.0) != Some(Ordering::Greater) =>
+            {
+                Layer::None
+            }
+            Layer::Fuzz { weight, .. } if weight.partial_cmp(&0.0) != Some(Ordering::Greater) => {
+                Layer::None
+            }
             other => other,
         };
         let look = Look { layer, ..look };
@@ -342,9 +349,9 @@ mod tests {
         }
         let n = SUN_DIRECTION;
         let got = s.radiance(n, Light::Directional);
-        for k in 0..3 {
-            let want = AMBIENT * s.look.base[k] + 0.8 * s.look.base[k];
-            assert!((got[k] - want).abs() < 1e-12);
+        for (g, b) in got.iter().zip(s.look.base) {
+            let want = AMBIENT * b + 0.8 * b;
+            assert!((g - want).abs() < 1e-12);
         }
     }
 
