@@ -307,7 +307,14 @@ fn a_textured_layer_gives_three_swatches_and_a_missing_texture_leaves_the_factor
         .any(|n| n.starts_with("sheenColorTexture not read")
             && n.ends_with("sheenColorFactor alone is used")));
     let sheet = sheet::render("textured.gltf", m);
-    assert_eq!(sheet.summary.notes, m.notes);
+    // The sheet says what the inputs lacked, and how its rows read the textures.
+    assert_eq!(sheet.summary.notes[..2], m.notes[..]);
+    assert_eq!(sheet.summary.notes.len(), 3);
+    assert!(
+        sheet.summary.notes[2].starts_with("the column headings give the values at the factors")
+    );
+    // The headings and the verdict name the columns at the factors (r = 0.5).
+    assert_eq!(sheet.summary.columns[0], "authored: sheen r 0.500");
     // Two lights for each of the three swatches.
     assert!(sheet.height > 6 * sheet::CELL);
 }

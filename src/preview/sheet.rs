@@ -307,6 +307,17 @@ pub fn render(file: &str, material: &Material) -> Sheet {
         .collect();
 
     let ncols = per_swatch[0].len();
+    // The headings name the values at the factors; textured rows scale them per swatch.
+    let headed = columns(material, &material.factors);
+    let mut notes = material.notes.clone();
+    if material.swatches.len() > 1 {
+        notes.push(
+            "the column headings give the values at the factors; in rows P5, MEAN and P95 each \
+             textured slot's factor is multiplied by its texture's 5th percentile, mean and 95th \
+             percentile"
+                .to_string(),
+        );
+    }
     let title = match &material.name {
         Some(n) => format!("{file}: material {} \"{n}\"", material.index),
         None => format!("{file}: material {}", material.index),
@@ -314,7 +325,7 @@ pub fn render(file: &str, material: &Material) -> Sheet {
     let summary = Summary {
         title,
         kind: kind_text(material.kind),
-        columns: per_swatch[0]
+        columns: headed
             .iter()
             .map(|c| format!("{} {}", c.title.to_lowercase(), c.detail.to_lowercase()))
             .collect(),
@@ -322,7 +333,7 @@ pub fn render(file: &str, material: &Material) -> Sheet {
         max_codes,
         verdict: Verdict::from_codes(max_codes[0].max(max_codes[1])),
         poor_match,
-        notes: material.notes.clone(),
+        notes,
     };
 
     // Layout.
@@ -362,7 +373,7 @@ pub fn render(file: &str, material: &Material) -> Sheet {
     }
     let col_x = |j: usize| LABEL_W + CELL * j;
     let label_chars = CELL / ADVANCE;
-    let headings: Vec<(String, String)> = per_swatch[0]
+    let headings: Vec<(String, String)> = headed
         .iter()
         .map(|c| (c.title.clone(), c.detail.clone()))
         .chain(std::iter::once((
