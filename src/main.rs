@@ -41,6 +41,9 @@ enum Command {
     /// Add KHR_materials_fuzz to sheen materials (keeping the sheen as the fallback), a fallback
     /// sheen to fuzz materials, and upgrade the pre-ratification sheen draft.
     Migrate(MigrateArgs),
+    /// Render contact sheets (PNG) of each sheen or fuzz material: as authored, as migrated
+    /// and as a loader without fuzz sees it, with the report's figures, plus an index.html.
+    Preview(PreviewArgs),
     /// Print the configuration in force for a file or folder.
     ///
     /// The output is velvet.toml text with the source of each value (default, velvet.toml or
@@ -231,6 +234,21 @@ struct BakeArgs {
     load: LoadArgs,
 }
 
+#[derive(clap::Args)]
+#[command(
+    after_help = "Exit status: 0 done, 1 a file could not be previewed or an output not written (the other sheets are still written), 2 usage error (nothing written)."
+)]
+struct PreviewArgs {
+    /// Files and folders (folders are searched for *.gltf and *.glb, in any letter case).
+    #[arg(required = true)]
+    paths: Vec<PathBuf>,
+    /// The folder the sheets and index.html are written into.
+    #[arg(short, long, value_name = "DIR", default_value = "velvet-preview")]
+    output: PathBuf,
+    #[command(flatten)]
+    load: LoadArgs,
+}
+
 #[derive(Clone, Copy, ValueEnum)]
 enum Compression {
     Fast,
@@ -275,6 +293,7 @@ fn main() -> ExitCode {
         Command::Migrate(args) => migrate(args, cli.quiet),
         Command::Config { path, settings } => show_config(path, settings),
         Command::Bake(args) => bake(args, cli.quiet),
+        Command::Preview(args) => preview(args, cli.quiet),
         Command::Codes { format } => {
             emit(codes_table(format).as_bytes());
             ExitCode::SUCCESS
@@ -493,6 +512,10 @@ struct MigrateArgs {
     /// that existing scripts run.
     #[arg(long, hide = true, conflicts_with = "rewrite_uris")]
     copy_resources: bool,
+    /// Also write contact sheets of the inputs' sheen and fuzz materials (as authored, as
+    /// migrated, without fuzz) and an index.html into DIR, as `velvet preview` does.
+    #[arg(long, value_name = "DIR")]
+    preview: Option<PathBuf>,
     #[command(flatten)]
     load: LoadArgs,
 }
@@ -541,6 +564,19 @@ fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
         dry_run: args.dry_run || args.check,
         progress: !quiet,
     };
+    // The sheets are rendered from the inputs before they are migrated (--in-place overwrites
+    // them), and written after.
+    let previews = args.preview.as_ref().map(|_| {
+        let inputs: Vec<PathBuf> = match args.input.shard {
+            None => request.inputs.clone(),
+            Some(shard) => discover::find(&request.inputs, Some(shard))
+                .0
+                .into_iter()
+                .map(|f| f.path)
+                .collect(),
+        };
+        velvet::preview::render(&inputs, &request.options.load)
+    });
     // A list that names no asset (a change that touched none) is nothing to do, not an error.
     let report = if request.inputs.is_empty() {
         migrate::RunReport {
@@ -570,7 +606,18 @@ fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
             MigrateFormat::Json => migrate::render::json(&report),
         }
     );
-    if report.failed() || (args.check && report.summary.would_change > 0) {
+    let mut preview_failed = false;
+    if let (Some(dir), Some(previews)) = (&args.preview, &previews) {
+        for f in &previews.failures {
+            eprintln!("velvet: preview: {}: {}", f.file.display(), f.message);
+        }
+        preview_failed = !previews.failures.is_empty();
+        if let Err(e) = velvet::preview::write(previews, dir) {
+            eprintln!("velvet: preview: {e}");
+            preview_failed = true;
+        }
+    }
+    if report.failed() || preview_failed || (args.check && report.summary.would_change > 0) {
         ExitCode::from(1)
     } else {
         ExitCode::SUCCESS
@@ -638,6 +685,52 @@ fn bake(args: BakeArgs, quiet: bool) -> ExitCode {
         BakeFormat::Json => print!("{}", command::render_json(&results)),
     }
     if results.iter().any(|r| r.failed()) {
+        ExitCode::from(1)
+    } else {
+        ExitCode::SUCCESS
+    }
+}
+
+fn preview(args: PreviewArgs, quiet: bool) -> ExitCode {
+    if let Err(e) = discover::check_inputs(&args.paths) {
+        return usage_error(e);
+    }
+    let previews = velvet::preview::render(&args.paths, &args.load.options());
+    let mut failed = !previews.failures.is_empty();
+    for f in &previews.failures {
+        eprintln!("velvet: {}: {}", f.file.display(), f.message);
+    }
+    match velvet::preview::write(&previews, &args.output) {
+        Ok(written) => {
+            if !quiet {
+                let mut out = String::new();
+                for (sheet, path) in previews.sheets.iter().zip(&written) {
+                    out += &format!(
+                        "{}: {} ({})\n",
+                        path.display(),
+                        sheet.summary.title,
+                        sheet.summary.verdict.text()
+                    );
+                }
+                for f in &previews.without_layers {
+                    out += &format!("{}: no material with a sheen or fuzz layer\n", f.display());
+                }
+                if let Some(index) = written.last() {
+                    out += &format!(
+                        "{} sheet(s); index: {}\n",
+                        previews.sheets.len(),
+                        index.display()
+                    );
+                }
+                emit(out.as_bytes());
+            }
+        }
+        Err(e) => {
+            eprintln!("velvet: {e}");
+            failed = true;
+        }
+    }
+    if failed {
         ExitCode::from(1)
     } else {
         ExitCode::SUCCESS

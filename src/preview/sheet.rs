@@ -1,0 +1,484 @@
+//! One material's contact sheet: the spheres of its columns (see `material.rs`) under the
+//! white furnace and the directional light, one row pair per swatch, the difference between
+//! the authored column and column 1 (|codes| per channel, times [`DIFF_GAIN`]), and the
+//! report's figures with a verdict, printed in the built-in font. Values are composited over
+//! the background in linear light, clamped into [0, 1], sRGB-encoded (`bake::srgb`) and
+//! quantised to 8 bits at the end; the PNG encoding is deterministic.
+//!
+//! The figures are the ones `migrate --report` gives, from the same functions, at the
+//! material's factors: `shading::mapping::layer_match_with` (|max3·E − w·R| over view angles,
+//! its maximum and cosine-weighted rms) and `shading::layering::compare_base_attenuation` (the
+//! largest base-attenuation difference and its view cosine), with E and R by quadrature as the
+//! report has them. The verdict reads the
+//! rendered pixels: the largest difference between column 0 and column 1 over both lights and
+//! every swatch, at most [`SAME_CODES`] codes "same to the eye", at most [`CLOSE_CODES`]
+//! "close", else "visible"; a sheen roughness below 0.1 (no fuzz roughness matches it) is
+//! flagged beside it.
+
+use super::font::{self, ADVANCE, GLYPH_H, LINE_HEIGHT};
+use super::material::{columns, layer_pair, Column, Kind, Material};
+use super::shade::{render_sphere, Light, Look, Shaded, Sphere};
+use crate::bake::srgb;
+use crate::shading::layering::{
+    compare_base_attenuation, FuzzReflectance, LayerReflectance, SheenAlbedo,
+};
+use crate::shading::mapping::{layer_match_with, POOR_MATCH_BELOW};
+use crate::shading::{AlbedoMethod, ReflectanceMethod};
+use rayon::prelude::*;
+use std::collections::HashMap;
+use std::sync::Mutex;
+
+/// A layer reflectance that remembers its values: the report's comparisons of one sheet
+/// evaluate the same (μ, roughness) more than once. A value is a function of its inputs alone,
+/// so which task computes it first does not change it.
+struct Memo<R> {
+    inner: R,
+    values: Mutex<HashMap<(u64, u64), f64>>,
+}
+
+impl<R: LayerReflectance> Memo<R> {
+    fn new(inner: R) -> Self {
+        Memo {
+            inner,
+            values: Mutex::new(HashMap::new()),
+        }
+    }
+}
+
+impl<R: LayerReflectance> LayerReflectance for Memo<R> {
+    fn name(&self) -> String {
+        self.inner.name()
+    }
+
+    fn reflectance(&self, mu: f64, roughness: f64) -> f64 {
+        let key = (mu.to_bits(), roughness.to_bits());
+        let known = self
+            .values
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .get(&key)
+            .copied();
+        known.unwrap_or_else(|| {
+            let v = self.inner.reflectance(mu, roughness);
+            self.values
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .insert(key, v);
+            v
+        })
+    }
+}
+
+/// Sphere diameter in pixels.
+pub const SPHERE: usize = 96;
+/// Width and height of one cell (a sphere and its padding).
+pub const CELL: usize = 112;
+/// Width of the row labels on the left.
+pub const LABEL_W: usize = 60;
+const MARGIN: usize = 8;
+/// Gain of the difference image: a difference of one code shows as DIFF_GAIN codes.
+pub const DIFF_GAIN: u32 = 8;
+/// At most this many codes between column 0 and column 1: "same to the eye".
+pub const SAME_CODES: u8 = 2;
+/// At most this many codes: "close".
+pub const CLOSE_CODES: u8 = 10;
+/// Background behind the spheres, linear.
+const BACKGROUND: f64 = 0.03;
+const TEXT: [u8; 3] = [235, 235, 235];
+const DIM_TEXT: [u8; 3] = [170, 170, 170];
+
+/// What the picture says, in words.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Verdict {
+    Same,
+    Close,
+    Visible,
+}
+
+impl Verdict {
+    pub fn from_codes(codes: u8) -> Verdict {
+        if codes <= SAME_CODES {
+            Verdict::Same
+        } else if codes <= CLOSE_CODES {
+            Verdict::Close
+        } else {
+            Verdict::Visible
+        }
+    }
+
+    pub fn text(self) -> &'static str {
+        match self {
+            Verdict::Same => "same to the eye",
+            Verdict::Close => "close",
+            Verdict::Visible => "visible difference: look before trusting it",
+        }
+    }
+}
+
+/// The words of a sheet, for its index entry.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Summary {
+    pub title: String,
+    pub kind: &'static str,
+    pub columns: Vec<String>,
+    /// The report's figures, one line per comparison.
+    pub figures: Vec<String>,
+    /// Largest difference between columns 0 and 1, in codes: furnace, directional light.
+    pub max_codes: [u8; 2],
+    pub verdict: Verdict,
+    /// The sheen roughness lies below 0.1, where no fuzz roughness matches it.
+    pub poor_match: bool,
+    pub notes: Vec<String>,
+}
+
+impl Summary {
+    /// The verdict line as printed.
+    pub fn verdict_line(&self) -> String {
+        let mut line = format!(
+            "verdict: {} ({} vs {}: at most {} codes in the furnace, {} under the light)",
+            self.verdict.text(),
+            self.columns[0],
+            self.columns.get(1).map_or("", String::as_str),
+            self.max_codes[0],
+            self.max_codes[1]
+        );
+        if self.poor_match {
+            line += &format!(
+                "; sheen roughness below {POOR_MATCH_BELOW}: no fuzz roughness matches it well"
+            );
+        }
+        line
+    }
+}
+
+/// A rendered sheet: 8-bit sRGB pixels, row by row, and its words.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Sheet {
+    pub width: usize,
+    pub height: usize,
+    pub rgb: Vec<u8>,
+    pub summary: Summary,
+}
+
+fn kind_text(kind: Kind) -> &'static str {
+    match kind {
+        Kind::SheenToFuzz => {
+            "sheen -> fuzz: migrate adds KHR_materials_fuzz and keeps the sheen as the fallback"
+        }
+        Kind::FuzzFallback => "fuzz: migrate adds a fallback sheen for loaders without fuzz",
+        Kind::FuzzWithSheen => {
+            "fuzz and sheen: migrate leaves both; --refresh-fallback would write the refreshed sheen"
+        }
+    }
+}
+
+/// 8-bit sRGB codes of a sphere composited over the background.
+pub fn sphere_codes(sphere: &Sphere) -> Vec<[u8; 3]> {
+    sphere
+        .radiance
+        .iter()
+        .zip(&sphere.coverage)
+        .map(|(rad, &c)| rad.map(|v| encode(c * clamp01(v) + (1.0 - c) * BACKGROUND)))
+        .collect()
+}
+
+fn clamp01(x: f64) -> f64 {
+    if x.is_nan() {
+        0.0
+    } else {
+        x.clamp(0.0, 1.0)
+    }
+}
+
+/// Linear light in [0, 1] to an 8-bit sRGB code.
+pub fn encode(linear: f64) -> u8 {
+    srgb::quantise(srgb::encode(clamp01(linear)), 255) as u8
+}
+
+fn figure_lines(material: &Material) -> (Vec<String>, bool) {
+    let cols = columns(material, &material.factors);
+    let pairs: Vec<(usize, _)> = cols
+        .iter()
+        .enumerate()
+        .skip(1)
+        .filter_map(|(j, c)| layer_pair(&cols[0].look.layer, &c.look.layer).map(|p| (j, p)))
+        .collect();
+    // The comparisons share the authored layer: its E or R is computed once per view cosine.
+    let sheen_memo = Memo::new(SheenAlbedo(AlbedoMethod::Quadrature));
+    let fuzz_memo = Memo::new(FuzzReflectance(ReflectanceMethod::Quadrature));
+    let results: Vec<_> = pairs
+        .par_iter()
+        .map(|&(j, (sheen, fuzz))| {
+            (
+                j,
+                sheen,
+                fuzz,
+                layer_match_with(sheen, fuzz, &sheen_memo, &fuzz_memo),
+                compare_base_attenuation(sheen, fuzz, &sheen_memo, &fuzz_memo),
+            )
+        })
+        .collect();
+    let mut poor = false;
+    let lines = results
+        .into_iter()
+        .map(|(j, sheen, fuzz, m, a)| {
+            poor |= m.poor_match;
+            let mut line = format!(
+                "{} {} (sheen r {:.3}, max3 {:.3} / fuzz a {:.3}, w {:.3}): |max3*E - w*R| max {:.4} at mu {:.3}, rms {:.4}; base attenuation differs by at most {:.4} at mu {:.3}",
+                cols[j].title,
+                cols[j].detail,
+                sheen.roughness,
+                sheen.color_max3,
+                fuzz.roughness,
+                fuzz.weight,
+                m.max,
+                m.at_mu,
+                m.rms,
+                a.max_difference,
+                a.at_mu,
+            );
+            if a.clamps.clamped > 0 {
+                line += &format!(
+                    " ({} attenuations clamped at 0 where E exceeds 1)",
+                    a.clamps.clamped
+                );
+            }
+            line
+        })
+        .collect();
+    (lines, poor)
+}
+
+/// Renders `material`'s sheet; `file` names the asset in the title.
+pub fn render(file: &str, material: &Material) -> Sheet {
+    // Every distinct look once, in parallel; the order of the list is fixed by the columns.
+    let per_swatch: Vec<Vec<Column>> = material
+        .swatches
+        .iter()
+        .map(|s| columns(material, s))
+        .collect();
+    let mut looks: Vec<Look> = Vec::new();
+    for col in per_swatch.iter().flatten() {
+        if !looks.contains(&col.look) {
+            looks.push(col.look);
+        }
+    }
+    let ((figures, poor_match), shaded) = rayon::join(
+        || figure_lines(material),
+        || {
+            looks
+                .par_iter()
+                .map(|l| Shaded::new(*l))
+                .collect::<Vec<Shaded>>()
+        },
+    );
+    let find = |look: &Look| looks.iter().position(|l| l == look).expect("listed");
+    // Rows: per swatch, the furnace and the light.
+    let rows: Vec<(usize, Light)> = (0..material.swatches.len())
+        .flat_map(|s| [(s, Light::Furnace), (s, Light::Directional)])
+        .collect();
+    let spheres: Vec<Vec<Vec<[u8; 3]>>> = rows
+        .par_iter()
+        .map(|&(s, light)| {
+            per_swatch[s]
+                .par_iter()
+                .map(|c| sphere_codes(&render_sphere(&shaded[find(&c.look)], light, SPHERE)))
+                .collect()
+        })
+        .collect();
+    let mut max_codes = [0u8; 2];
+    let diffs: Vec<Vec<[u8; 3]>> = rows
+        .iter()
+        .zip(&spheres)
+        .map(|(&(_, light), row)| {
+            let slot = usize::from(light == Light::Directional);
+            row[0]
+                .iter()
+                .zip(&row[1])
+                .map(|(a, b)| {
+                    std::array::from_fn(|k| {
+                        let d = a[k].abs_diff(b[k]);
+                        max_codes[slot] = max_codes[slot].max(d);
+                        (u32::from(d) * DIFF_GAIN).min(255) as u8
+                    })
+                })
+                .collect()
+        })
+        .collect();
+
+    let ncols = per_swatch[0].len();
+    // The headings name the values at the factors; textured rows scale them per swatch.
+    let headed = columns(material, &material.factors);
+    let mut notes = material.notes.clone();
+    if material.swatches.len() > 1 {
+        notes.push(
+            "the column headings give the values at the factors; in rows P5, MEAN and P95 each \
+             textured slot's factor is multiplied by its texture's 5th percentile, mean and 95th \
+             percentile"
+                .to_string(),
+        );
+    }
+    let title = match &material.name {
+        Some(n) => format!("{file}: material {} \"{n}\"", material.index),
+        None => format!("{file}: material {}", material.index),
+    };
+    let summary = Summary {
+        title,
+        kind: kind_text(material.kind),
+        columns: headed
+            .iter()
+            .map(|c| format!("{} {}", c.title.to_lowercase(), c.detail.to_lowercase()))
+            .collect(),
+        figures,
+        max_codes,
+        verdict: Verdict::from_codes(max_codes[0].max(max_codes[1])),
+        poor_match,
+        notes,
+    };
+
+    // Layout.
+    let width = LABEL_W + CELL * (ncols + 1) + MARGIN;
+    let chars = (width - 2 * MARGIN) / ADVANCE;
+    let mut text: Vec<(String, [u8; 3])> = Vec::new();
+    for f in &summary.figures {
+        for l in font::wrap(f, chars) {
+            text.push((l, TEXT));
+        }
+    }
+    for l in font::wrap(&summary.verdict_line(), chars) {
+        text.push((l, TEXT));
+    }
+    for n in &summary.notes {
+        for l in font::wrap(&format!("note: {n}"), chars) {
+            text.push((l, DIM_TEXT));
+        }
+    }
+    let title_lines = font::wrap(&summary.title, chars);
+    let kind_lines = font::wrap(summary.kind, chars);
+    let header = MARGIN + LINE_HEIGHT * (title_lines.len() + kind_lines.len()) + 4;
+    let grid_top = header + 2 * LINE_HEIGHT;
+    let height = grid_top + CELL * rows.len() + MARGIN + LINE_HEIGHT * text.len() + MARGIN;
+    let mut canvas = Canvas::new(width, height, [0; 3]);
+    let bg = encode(BACKGROUND);
+    canvas.fill(0, 0, width, height, [bg / 2, bg / 2, bg / 2]);
+
+    let mut y = MARGIN;
+    for l in &title_lines {
+        canvas.text(MARGIN, y, l, TEXT);
+        y += LINE_HEIGHT;
+    }
+    for l in &kind_lines {
+        canvas.text(MARGIN, y, l, DIM_TEXT);
+        y += LINE_HEIGHT;
+    }
+    let col_x = |j: usize| LABEL_W + CELL * j;
+    let label_chars = CELL / ADVANCE;
+    let headings: Vec<(String, String)> = headed
+        .iter()
+        .map(|c| (c.title.clone(), c.detail.clone()))
+        .chain(std::iter::once((
+            format!("DIFFERENCE X{DIFF_GAIN}"),
+            "COLUMNS 1 AND 2".to_string(),
+        )))
+        .collect();
+    for (j, (a, b)) in headings.iter().enumerate() {
+        for (k, t) in [a, b].into_iter().enumerate() {
+            let t: String = t.chars().take(label_chars).collect();
+            let x = col_x(j) + (CELL - t.chars().count() * ADVANCE) / 2;
+            canvas.text(x, header + k * LINE_HEIGHT, &t, TEXT);
+        }
+    }
+    let pad = (CELL - SPHERE) / 2;
+    for (r, &(s, light)) in rows.iter().enumerate() {
+        let top = grid_top + CELL * r;
+        let name = match light {
+            Light::Furnace => "FURNACE",
+            Light::Directional => "LIGHT",
+        };
+        canvas.text(MARGIN, top + CELL / 2 - LINE_HEIGHT, name, TEXT);
+        canvas.text(MARGIN, top + CELL / 2, material.swatches[s].label, DIM_TEXT);
+        for (j, codes) in spheres[r].iter().enumerate() {
+            canvas.fill(col_x(j) + 2, top + 2, CELL - 4, CELL - 4, [bg; 3]);
+            canvas.blit(col_x(j) + pad, top + pad, SPHERE, codes);
+        }
+        canvas.blit(col_x(ncols) + pad, top + pad, SPHERE, &diffs[r]);
+    }
+    let mut y = grid_top + CELL * rows.len() + MARGIN;
+    for (l, color) in &text {
+        canvas.text(MARGIN, y, l, *color);
+        y += LINE_HEIGHT;
+    }
+    Sheet {
+        width,
+        height,
+        rgb: canvas.rgb,
+        summary,
+    }
+}
+
+/// An 8-bit RGB image being drawn.
+struct Canvas {
+    width: usize,
+    height: usize,
+    rgb: Vec<u8>,
+}
+
+impl Canvas {
+    fn new(width: usize, height: usize, color: [u8; 3]) -> Canvas {
+        Canvas {
+            width,
+            height,
+            rgb: color.repeat(width * height),
+        }
+    }
+
+    fn set(&mut self, x: usize, y: usize, c: [u8; 3]) {
+        if x < self.width && y < self.height {
+            let i = 3 * (y * self.width + x);
+            self.rgb[i..i + 3].copy_from_slice(&c);
+        }
+    }
+
+    fn fill(&mut self, x: usize, y: usize, w: usize, h: usize, c: [u8; 3]) {
+        for yy in y..y + h {
+            for xx in x..x + w {
+                self.set(xx, yy, c);
+            }
+        }
+    }
+
+    fn blit(&mut self, x: usize, y: usize, size: usize, codes: &[[u8; 3]]) {
+        for (i, c) in codes.iter().enumerate() {
+            self.set(x + i % size, y + i / size, *c);
+        }
+    }
+
+    fn text(&mut self, x: usize, y: usize, text: &str, c: [u8; 3]) {
+        for (k, ch) in text.chars().enumerate() {
+            let rows = font::glyph(ch);
+            for (dy, row) in rows.iter().enumerate().take(GLYPH_H) {
+                for dx in 0..font::GLYPH_W {
+                    if row & (0x10 >> dx) != 0 {
+                        self.set(x + k * ADVANCE + dx, y + dy, c);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The sheet as PNG bytes (deterministic: fixed filter and compression).
+pub fn to_png(sheet: &Sheet) -> Vec<u8> {
+    use image::codecs::png::{CompressionType, FilterType, PngEncoder};
+    use image::ImageEncoder;
+    let mut out = Vec::new();
+    PngEncoder::new_with_quality(&mut out, CompressionType::Fast, FilterType::Adaptive)
+        .write_image(
+            &sheet.rgb,
+            sheet.width as u32,
+            sheet.height as u32,
+            image::ExtendedColorType::Rgb8,
+        )
+        .expect("encoding an in-memory RGB8 image of matching size cannot fail");
+    out
+}

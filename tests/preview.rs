@@ -1,0 +1,507 @@
+//! `velvet preview`: the shading of the spheres against the specs' formulas integrated here,
+//! the conversions a sheet shows, textures, determinism, and the command's outcomes. Inputs are
+//! generated in temporary folders.
+
+use std::f64::consts::PI;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use velvet::preview::material::{self, columns, Kind};
+use velvet::preview::shade::{pixel_normal, render_sphere, Layer, Light, Look, Shaded};
+use velvet::preview::sheet::{self, encode, sphere_codes};
+use velvet::shading::charlie::{charlie_d, charlie_lambda};
+
+fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+fn gltf(materials: &str) -> String {
+    format!(
+        r#"{{"asset": {{"version": "2.0"}}, "extensionsUsed": ["KHR_materials_sheen", "KHR_materials_fuzz"], "materials": [{materials}]}}"#
+    )
+}
+
+fn load(path: &Path) -> velvet::asset::Asset {
+    velvet::asset::load(path)
+        .asset
+        .expect("the test asset loads")
+}
+
+/// Interior pixels (whole pixel on the sphere) of a sphere of `size`.
+fn interior(size: usize) -> Vec<(usize, usize)> {
+    let mut v = Vec::new();
+    for y in 0..size {
+        for x in 0..size {
+            let s = size as f64;
+            let corner_inside = |dx: f64, dy: f64| {
+                let px = (x as f64 + dx) / s * 2.0 - 1.0;
+                let py = 1.0 - (y as f64 + dy) / s * 2.0;
+                px * px + py * py < 1.0
+            };
+            if corner_inside(0.0, 0.0)
+                && corner_inside(1.0, 0.0)
+                && corner_inside(0.0, 1.0)
+                && corner_inside(1.0, 1.0)
+            {
+                v.push((x, y));
+            }
+        }
+    }
+    v
+}
+
+#[test]
+fn a_furnace_sphere_without_a_layer_is_uniform_at_the_base_colour() {
+    let base = [0.8, 0.35, 0.05];
+    let size = 64;
+    let sphere = render_sphere(
+        &Shaded::new(Look {
+            base,
+            layer: Layer::None,
+        }),
+        Light::Furnace,
+        size,
+    );
+    let codes = sphere_codes(&sphere);
+    let want = base.map(encode);
+    let inside = interior(size);
+    assert!(inside.len() > 2500);
+    for (x, y) in inside {
+        assert_eq!(codes[y * size + x], want, "pixel ({x}, {y})");
+    }
+    // A switched-off sheen (sheenColorFactor zero) is the same picture.
+    let off = render_sphere(
+        &Shaded::new(Look {
+            base,
+            layer: Layer::Sheen {
+                color: [0.0; 3],
+                roughness: 0.5,
+            },
+        }),
+        Light::Furnace,
+        size,
+    );
+    assert_eq!(sphere_codes(&off), codes);
+}
+
+/// E(μ, r) = ∫ D·V·NdotL dω over the light hemisphere, by the midpoint rule in (t, φ) with
+/// NdotL = t² (dNdotL = 2t dt) and φ over [0, π] doubled; D and λ are the spec's Charlie terms.
+fn albedo_by_midpoints(mu: f64, r: f64) -> f64 {
+    let (nt, nphi) = (200, 96);
+    let sv = (1.0 - mu * mu).max(0.0).sqrt();
+    let lambda_v = charlie_lambda(mu, r);
+    let mut sum = 0.0;
+    for i in 0..nt {
+        let t = (i as f64 + 0.5) / nt as f64;
+        let ml = t * t;
+        let sl = (1.0 - ml * ml).max(0.0).sqrt();
+        // V·NdotL with NdotL cancelled: 1 / ((1 + λv + λl)·4·μ).
+        let vis = 1.0 / ((1.0 + lambda_v + charlie_lambda(ml, r)) * 4.0 * mu);
+        let mut inner = 0.0;
+        for j in 0..nphi {
+            let phi = (j as f64 + 0.5) / nphi as f64 * PI;
+            let h = [sv + sl * phi.cos(), sl * phi.sin(), mu + ml];
+            let n_dot_h = h[2] / (h[0] * h[0] + h[1] * h[1] + h[2] * h[2]).sqrt();
+            inner += charlie_d(n_dot_h, r);
+        }
+        sum += inner * (PI / nphi as f64) * 2.0 * vis * 2.0 * t / nt as f64;
+    }
+    sum
+}
+
+#[test]
+fn a_sheen_sphere_in_the_furnace_matches_the_layering_formula_integrated_here() {
+    // Outgoing radiance in a white furnace of radiance 1 for a Lambertian base ρ under a sheen
+    // (albedo scaling with both terms):
+    //   L(μ) = sheenColor·E(μ) + ρ/π ∫ min(1 − m·E(μ), 1 − m·E(μl)) μl dω
+    //        = sheenColor·E(μ) + ρ·2∫₀¹ min(a(μ), a(μl)) μl dμl,   m = max3(sheenColor).
+    let base = [0.45, 0.3, 0.2];
+    let size = 128;
+    for (color, r) in [([0.9f64, 0.6, 0.3], 0.5f64), ([0.3, 0.8, 1.0], 0.3)] {
+        let m = color[0].max(color[1]).max(color[2]);
+        let shaded = Shaded::new(Look {
+            base,
+            layer: Layer::Sheen {
+                color,
+                roughness: r,
+            },
+        });
+        let codes = sphere_codes(&render_sphere(&shaded, Light::Furnace, size));
+        // The outer integral over μl = s², 2∫ min(..) s² 2s ds, midpoint rule.
+        let ns = 160;
+        let light_terms: Vec<(f64, f64)> = (0..ns)
+            .map(|k| {
+                let s = (k as f64 + 0.5) / ns as f64;
+                let a = (1.0 - m * albedo_by_midpoints(s * s, r)).clamp(0.0, 1.0);
+                (a, 4.0 * s * s * s / ns as f64)
+            })
+            .collect();
+        // Pixels along the row through the centre: view cosines from about 0.25 to 1.
+        let y = size / 2;
+        let mut checked = 0;
+        for x in (size / 2..size).step_by(7) {
+            let n = pixel_normal(size, x, y).unwrap();
+            let mu = n[2];
+            if mu < 0.25 {
+                continue;
+            }
+            let e = albedo_by_midpoints(mu, r);
+            let av = (1.0 - m * e).clamp(0.0, 1.0);
+            let b: f64 = light_terms.iter().map(|&(al, w)| av.min(al) * w).sum();
+            for k in 0..3 {
+                let want = encode(color[k] * e + base[k] * b);
+                let got = codes[y * size + x][k];
+                assert!(
+                    got.abs_diff(want) <= 1,
+                    "r={r}, μ={mu:.3}, channel {k}: rendered {got}, integrated {want}"
+                );
+            }
+            checked += 1;
+        }
+        assert!(checked >= 6, "{checked} view cosines checked");
+    }
+}
+
+#[test]
+fn the_fallback_of_a_black_fuzz_shows_no_layer() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = write(
+        dir.path(),
+        "black.gltf",
+        &gltf(
+            r#"{"name": "black fuzz", "pbrMetallicRoughness": {"baseColorFactor": [0.6, 0.5, 0.4, 1]},
+               "extensions": {"KHR_materials_fuzz": {"fuzzFactor": 1, "fuzzColorFactor": [0, 0, 0], "fuzzRoughnessFactor": 0.5}}}"#,
+        ),
+    );
+    let materials = material::materials(&load(&path));
+    assert_eq!(materials.len(), 1);
+    let m = &materials[0];
+    assert_eq!(m.kind, Kind::FuzzFallback);
+    let cols = columns(m, &m.factors);
+    assert_eq!(cols.len(), 3);
+    let bare = Shaded::new(Look {
+        base: m.base,
+        layer: Layer::None,
+    });
+    for light in [Light::Furnace, Light::Directional] {
+        let want = sphere_codes(&render_sphere(&bare, light, 64));
+        for c in &cols[1..] {
+            let got = sphere_codes(&render_sphere(&Shaded::new(c.look), light, 64));
+            assert_eq!(got, want, "{} {} under {light:?}", c.title, c.detail);
+        }
+        // The authored black fuzz does darken the base: it is not the bare base.
+        let authored = sphere_codes(&render_sphere(&Shaded::new(cols[0].look), light, 64));
+        assert_ne!(authored, want);
+    }
+}
+
+#[test]
+fn sheen_migrates_to_fuzz_with_the_fitted_and_the_copied_roughness() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = write(
+        dir.path(),
+        "sheen.gltf",
+        &gltf(
+            r#"{"name": "cloth", "pbrMetallicRoughness": {"baseColorFactor": [0.1, 0.0, 0.2, 1]},
+               "extensions": {"KHR_materials_sheen": {"sheenColorFactor": [1.0, 0.0, 0.75], "sheenRoughnessFactor": 0.5}}}"#,
+        ),
+    );
+    let m = &material::materials(&load(&path))[0];
+    assert_eq!(m.kind, Kind::SheenToFuzz);
+    let cols = columns(m, &m.factors);
+    let alpha = velvet::shading::mapping::fuzz_roughness_for_sheen(0.5);
+    assert!((alpha - 0.556).abs() < 1e-3, "α(0.5) = {alpha}");
+    let fuzz = |roughness| Layer::Fuzz {
+        color: [1.0, 0.0, 0.75],
+        weight: 1.0,
+        roughness,
+    };
+    assert_eq!(cols[1].look.layer, fuzz(alpha));
+    assert_eq!(cols[2].look.layer, fuzz(0.5));
+    // What a loader without fuzz sees: the sheen, kept.
+    assert_eq!(cols[3].look, cols[0].look);
+    let sheet = sheet::render("sheen.gltf", m);
+    assert_eq!(sheet.rgb.len(), sheet.width * sheet.height * 3);
+    // The report's figures for both mappings, with the values migrate --report gives.
+    assert_eq!(sheet.summary.figures.len(), 2);
+    let fitted = velvet::shading::mapping::layer_match(
+        velvet::shading::layering::SheenParams {
+            color_max3: 1.0,
+            roughness: 0.5,
+        },
+        velvet::shading::layering::FuzzParams {
+            weight: 1.0,
+            roughness: alpha,
+        },
+    );
+    assert!(
+        sheet.summary.figures[0].contains(&format!("rms {:.4}", fitted.rms)),
+        "{}",
+        sheet.summary.figures[0]
+    );
+    assert!(sheet.summary.verdict_line().starts_with("verdict: "));
+}
+
+/// A 4×1 RGBA PNG as a data: URI.
+fn png_data_uri(pixels: &[[u8; 4]]) -> String {
+    use base64::Engine;
+    let mut img = image::RgbaImage::new(pixels.len() as u32, 1);
+    for (i, p) in pixels.iter().enumerate() {
+        img.put_pixel(i as u32, 0, image::Rgba(*p));
+    }
+    let mut bytes = Vec::new();
+    img.write_to(
+        &mut std::io::Cursor::new(&mut bytes),
+        image::ImageFormat::Png,
+    )
+    .unwrap();
+    format!(
+        "data:image/png;base64,{}",
+        base64::engine::general_purpose::STANDARD.encode(bytes)
+    )
+}
+
+#[test]
+fn a_textured_layer_gives_three_swatches_and_a_missing_texture_leaves_the_factor() {
+    let dir = tempfile::tempdir().unwrap();
+    // Roughness (alpha) 0, 51, 102, …: 20 texels; nearest rank p5 = 0, p95 = the 19th.
+    let rough: Vec<[u8; 4]> = (0..20).map(|i| [255, 255, 255, (i * 12) as u8]).collect();
+    let text = format!(
+        r#"{{"asset": {{"version": "2.0"}},
+            "images": [{{"uri": "{}"}}, {{"uri": "missing.png"}}],
+            "textures": [{{"source": 0}}, {{"source": 1}}],
+            "materials": [{{"name": "textured",
+              "pbrMetallicRoughness": {{"baseColorFactor": [0.5, 0.5, 0.5, 1], "baseColorTexture": {{"index": 1}}}},
+              "extensions": {{"KHR_materials_sheen": {{"sheenColorFactor": [1, 1, 1], "sheenRoughnessFactor": 0.5,
+                  "sheenRoughnessTexture": {{"index": 0}}, "sheenColorTexture": {{"index": 1}}}}}}}}]}}"#,
+        png_data_uri(&rough)
+    );
+    let path = write(dir.path(), "textured.gltf", &text);
+    let m = &material::materials(&load(&path))[0];
+    let labels: Vec<&str> = m.swatches.iter().map(|s| s.label).collect();
+    assert_eq!(labels, ["P5", "MEAN", "P95"]);
+    let r: Vec<f64> = m
+        .swatches
+        .iter()
+        .map(|s| s.sheen.unwrap().roughness)
+        .collect();
+    assert_eq!(r[0], 0.0);
+    assert!((r[1] - 0.5 * 114.0 / 255.0).abs() < 1e-12, "{}", r[1]);
+    assert_eq!(r[2], 0.5 * 216.0 / 255.0);
+    // The missing image: the colour and the base keep their factors, and the notes say so.
+    for s in &m.swatches {
+        assert_eq!(s.sheen.unwrap().color, [1.0; 3]);
+    }
+    assert_eq!(m.base, [0.5; 3]);
+    assert_eq!(m.notes.len(), 2, "{:?}", m.notes);
+    assert!(m
+        .notes
+        .iter()
+        .any(|n| n.starts_with("baseColorTexture not read")
+            && n.contains("missing.png")
+            && n.ends_with("the base is baseColorFactor alone")));
+    assert!(m
+        .notes
+        .iter()
+        .any(|n| n.starts_with("sheenColorTexture not read")
+            && n.ends_with("sheenColorFactor alone is used")));
+    let sheet = sheet::render("textured.gltf", m);
+    // The sheet says what the inputs lacked, and how its rows read the textures.
+    assert_eq!(sheet.summary.notes[..2], m.notes[..]);
+    assert_eq!(sheet.summary.notes.len(), 3);
+    assert!(
+        sheet.summary.notes[2].starts_with("the column headings give the values at the factors")
+    );
+    // The headings and the verdict name the columns at the factors (r = 0.5).
+    assert_eq!(sheet.summary.columns[0], "authored: sheen r 0.500");
+    // Two lights for each of the three swatches.
+    assert!(sheet.height > 6 * sheet::CELL);
+}
+
+fn library(dir: &Path) {
+    write(
+        dir,
+        "a.gltf",
+        &gltf(
+            r#"{"name": "sheen", "pbrMetallicRoughness": {"baseColorFactor": [0.2, 0.3, 0.4, 1]},
+                "extensions": {"KHR_materials_sheen": {"sheenColorFactor": [0.9, 0.8, 0.7], "sheenRoughnessFactor": 0.35}}},
+               {"name": "plain"},
+               {"name": "fuzz", "extensions": {"KHR_materials_fuzz": {"fuzzFactor": 0.7, "fuzzColorFactor": [0.2, 0.9, 0.4], "fuzzRoughnessFactor": 0.6}}}"#,
+        ),
+    );
+    std::fs::create_dir(dir.join("sub")).unwrap();
+    write(
+        &dir.join("sub"),
+        "b.gltf",
+        &gltf(
+            r#"{"extensions": {"KHR_materials_fuzz": {"fuzzFactor": 1, "fuzzColorFactor": [1, 1, 1]},
+                               "KHR_materials_sheen": {"sheenColorFactor": [1, 1, 1], "sheenRoughnessFactor": 0.8}}}"#,
+        ),
+    );
+    write(dir, "none.gltf", &gltf(r#"{"name": "no layer"}"#));
+}
+
+fn run(args: &[&Path], threads: &str) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_velvet"))
+        .arg("preview")
+        .args(args)
+        .env("RAYON_NUM_THREADS", threads)
+        .output()
+        .unwrap()
+}
+
+fn folder_bytes(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut files: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| {
+            let e = e.unwrap();
+            (
+                e.file_name().to_string_lossy().into_owned(),
+                std::fs::read(e.path()).unwrap(),
+            )
+        })
+        .collect();
+    files.sort();
+    files
+}
+
+#[test]
+fn identical_inputs_give_identical_bytes_at_one_and_two_threads() {
+    let dir = tempfile::tempdir().unwrap();
+    let lib = dir.path().join("lib");
+    std::fs::create_dir(&lib).unwrap();
+    library(&lib);
+    let outs: Vec<PathBuf> = ["1", "2", "2"]
+        .iter()
+        .enumerate()
+        .map(|(k, threads)| {
+            let out = dir.path().join(format!("out{k}"));
+            let o = run(&[&lib, Path::new("-o"), &out], threads);
+            assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+            out
+        })
+        .collect();
+    let first = folder_bytes(&outs[0]);
+    let names: Vec<&str> = first.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "a-m0-sheen.png",
+            "a-m2-fuzz.png",
+            "index.html",
+            "sub_b-m0.png"
+        ]
+    );
+    for out in &outs[1..] {
+        assert_eq!(folder_bytes(out), first);
+    }
+    // The index links every sheet and lists the file without layers.
+    let index = String::from_utf8(first[2].1.clone()).unwrap();
+    for png in ["a-m0-sheen.png", "a-m2-fuzz.png", "sub_b-m0.png"] {
+        assert!(index.contains(&format!("<img src=\"{png}\"")), "{png}");
+    }
+    assert!(index.contains("none.gltf"));
+    // Each sheet is a PNG of the size the layout gives: 4 columns + the difference for the
+    // sheen and for the fuzz with a sheen, 3 + 1 for the fuzz alone; one furnace and one light
+    // row.
+    for (name, columns) in [
+        ("a-m0-sheen.png", 4),
+        ("a-m2-fuzz.png", 3),
+        ("sub_b-m0.png", 4),
+    ] {
+        let bytes = &first.iter().find(|(n, _)| n == name).unwrap().1;
+        let img = image::load_from_memory(bytes).unwrap();
+        assert_eq!(
+            img.width() as usize,
+            sheet::LABEL_W + sheet::CELL * (columns + 1) + 8,
+            "{name}"
+        );
+        assert!(img.height() as usize > 2 * sheet::CELL);
+    }
+}
+
+#[test]
+fn bad_inputs_give_an_error_naming_the_file_and_a_non_zero_status() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let missing = dir.path().join("nope.gltf");
+    let o = run(&[&missing, Path::new("-o"), &out], "1");
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("nope.gltf: no such file or folder"));
+    assert!(!out.exists());
+
+    let broken = write(dir.path(), "broken.gltf", "{\"asset\": ");
+    let good = write(
+        dir.path(),
+        "good.gltf",
+        &gltf(
+            r#"{"extensions": {"KHR_materials_sheen": {"sheenColorFactor": [1, 1, 1], "sheenRoughnessFactor": 0.5}}}"#,
+        ),
+    );
+    let o = run(&[&broken, &good, Path::new("-o"), &out], "1");
+    assert_eq!(o.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(stderr.contains("broken.gltf"), "{stderr}");
+    // The good file's sheet is still written, and the index lists the failure.
+    assert!(out.join("good-m0.png").is_file());
+    let index = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert!(index.contains("broken.gltf"));
+
+    // An output folder that cannot be made: status 1, the path named.
+    let blocker = write(dir.path(), "file", "x");
+    let o = run(&[&good, Path::new("-o"), &blocker.join("out")], "1");
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("cannot create the folder"));
+}
+
+#[test]
+fn migrate_in_place_with_preview_shows_the_materials_as_they_were_before() {
+    let dir = tempfile::tempdir().unwrap();
+    let asset = write(
+        dir.path(),
+        "chair.gltf",
+        &gltf(
+            r#"{"name": "cloth", "extensions": {"KHR_materials_sheen": {"sheenColorFactor": [1, 0.5, 0.5], "sheenRoughnessFactor": 0.4}}}"#,
+        ),
+    );
+    let out = dir.path().join("sheets");
+    let o = Command::new(env!("CARGO_BIN_EXE_velvet"))
+        .args(["migrate", "--in-place", "-q", "--preview"])
+        .arg(&out)
+        .arg(&asset)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // The file now has fuzz …
+    assert!(std::fs::read_to_string(&asset)
+        .unwrap()
+        .contains("KHR_materials_fuzz"));
+    // … and the sheet shows the sheen it had, migrated.
+    assert!(out.join("chair-m0-cloth.png").is_file());
+    let index = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert!(
+        index.contains("sheen -&gt; fuzz: migrate adds KHR_materials_fuzz"),
+        "{index}"
+    );
+}
+
+#[test]
+fn switched_off_layers_alone_get_no_sheet() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = write(
+        dir.path(),
+        "off.gltf",
+        &gltf(
+            r#"{"extensions": {"KHR_materials_fuzz": {"fuzzFactor": 0, "fuzzColorFactor": [1, 1, 1]}}},
+               {"extensions": {"KHR_materials_sheen": {"sheenColorFactor": [0, 0, 0], "sheenRoughnessFactor": 0.5}}},
+               {"extensions": {"KHR_materials_unlit": {}, "KHR_materials_sheen": {"sheenColorFactor": [1, 1, 1]}}},
+               {"extensions": {"KHR_materials_fuzz": {"fuzzFactor": 0.5}}}"#,
+        ),
+    );
+    let materials = material::materials(&load(&path));
+    let indices: Vec<usize> = materials.iter().map(|m| m.index).collect();
+    assert_eq!(indices, [3]);
+    assert!(materials[0].fuzz_roughness_assumed);
+    assert_eq!(materials[0].factors.fuzz.unwrap().roughness, 0.5);
+}
