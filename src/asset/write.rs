@@ -107,24 +107,19 @@ impl JsonStyle {
 /// see [`unchanged`].
 ///
 /// The JSON is written as splices into the loaded text (see [`crate::edit::splice`]): every
-/// byte of the input that the edit did not change is kept. The document as loaded is read
-/// again from that text for the comparison (callers apply their edits to `asset.json` itself;
-/// writing is the rare step where a second read costs little), and the result is read once more
-/// to check it. A GLB's chunk padding belongs to the container and is set anew.
+/// byte of the input that the edit did not change is kept. The document as loaded is read off
+/// that text as the comparison goes (callers apply their edits to `asset.json` itself), and the
+/// result is read once more to check it, neither time building a second document. A GLB's
+/// chunk padding belongs to the container and is set anew.
 pub fn to_bytes(asset: &Asset, json: &Value, bin: Option<&[u8]>) -> Vec<u8> {
     let source = match asset.container {
         Container::Gltf => asset.json_text.as_str(),
         Container::Glb => asset.json_text.trim_end_matches(['\0', ' ']),
     };
-    let spliced = serde_json::from_str::<Value>(source)
-        .ok()
-        .and_then(|before| crate::edit::splice::rewrite(source, &before, json))
+    let spliced = crate::edit::splice::rewrite(source, json)
         // The spliced text must read back as the document meant, numbers as velvet writes
         // them; if it ever did not, the document is written afresh rather than corrupted.
-        .filter(|text| {
-            serde_json::from_str::<Value>(text).ok()
-                == Some(crate::edit::splice::written(json.clone()))
-        });
+        .filter(|text| crate::edit::splice::reads_as_written(text, json));
     let text = match spliced {
         Some(text) => text.into_bytes(),
         None => JsonStyle::detect(&asset.json_text).render(json),

@@ -28,13 +28,14 @@ use serde_json::{Map, Value};
 /// Decimal places of the numbers velvet writes.
 pub const DECIMALS: i32 = 6;
 
-/// The text of `after` written as splices into `text`, which holds `before`; `None` when the
-/// text cannot be scanned (the caller then writes the document afresh).
-pub fn rewrite(text: &str, before: &Value, after: &Value) -> Option<String> {
+/// The text of `after` written as splices into `text` (which holds the document as loaded);
+/// `None` when the text cannot be scanned (the caller then writes the document afresh). The
+/// loaded document is read off the text as the comparison goes, never held as a whole.
+pub fn rewrite(text: &str, after: &Value) -> Option<String> {
     let root = Scanner { text, at: 0 }.value()?;
     let layout = Layout::detect(text, &root);
     let mut splices = Vec::new();
-    diff(text, &root, before, after, &layout, &mut splices);
+    diff(text, &root, after, &layout, &mut splices);
     splices.sort_by_key(|s| (s.start, s.end));
     let mut out =
         String::with_capacity(text.len() + splices.iter().map(|s| s.text.len()).sum::<usize>());
@@ -421,33 +422,24 @@ fn one_line(text: &str, span: &Span) -> bool {
     !text[span.start..span.end].contains('\n')
 }
 
-fn diff(
-    text: &str,
-    span: &Span,
-    before: &Value,
-    after: &Value,
-    layout: &Layout,
-    out: &mut Vec<Splice>,
-) {
-    if before == after {
+fn diff(text: &str, span: &Span, after: &Value, layout: &Layout, out: &mut Vec<Splice>) {
+    if matches(text, span, after, Compare::Exact) {
         return;
     }
-    match (&span.node, before, after) {
-        (Node::Object(members), Value::Object(b), Value::Object(a)) if members.len() == b.len() => {
-            diff_object(text, span, members, b, a, layout, out)
+    match (&span.node, after) {
+        (Node::Object(members), Value::Object(a)) => {
+            diff_object(text, span, members, a, layout, out)
         }
-        (Node::Array(items), Value::Array(b), Value::Array(a))
-            if items.len() == b.len() && a.len() >= b.len() =>
-        {
-            for ((item, old), new) in items.iter().zip(b).zip(a) {
-                diff(text, item, old, new, layout, out);
+        (Node::Array(items), Value::Array(a)) if a.len() >= items.len() => {
+            for (item, new) in items.iter().zip(a) {
+                diff(text, item, new, layout, out);
             }
-            if a.len() > b.len() {
+            if a.len() > items.len() {
                 append(
                     text,
                     span,
                     items.last().map(|i| i.end),
-                    &a[b.len()..],
+                    &a[items.len()..],
                     layout,
                     out,
                 );
@@ -455,6 +447,75 @@ fn diff(
         }
         _ => replace(text, span, after, layout, out),
     }
+}
+
+/// How [`matches`] compares numbers.
+#[derive(Clone, Copy, PartialEq)]
+enum Compare {
+    /// As values: the text holds exactly this document.
+    Exact,
+    /// As velvet writes them: numbers rounded as [`number_text`] rounds.
+    Written,
+}
+
+/// The key whose opening quote stands at `at`, decoded (borrowed when it has no escapes).
+fn key_at(text: &str, at: usize) -> Option<std::borrow::Cow<'_, str>> {
+    let mut scanner = Scanner { text, at };
+    scanner.string()?;
+    let raw = &text[at..scanner.at];
+    if !raw.contains('\\') {
+        return Some(std::borrow::Cow::Borrowed(&raw[1..raw.len() - 1]));
+    }
+    serde_json::from_str::<String>(raw)
+        .ok()
+        .map(std::borrow::Cow::Owned)
+}
+
+/// True when the value at `span` in `text` is `value`.
+fn matches(text: &str, span: &Span, value: &Value, compare: Compare) -> bool {
+    match (&span.node, value) {
+        (Node::Scalar, _) => match serde_json::from_str::<Value>(&text[span.start..span.end]) {
+            Ok(Value::Number(a)) if compare == Compare::Written => {
+                matches!(value, Value::Number(b) if a.to_string() == number_text(b))
+            }
+            Ok(v) => v == *value,
+            Err(_) => false,
+        },
+        (Node::Object(members), Value::Object(map)) => {
+            if members.len() != map.len() {
+                return false;
+            }
+            let mut seen = std::collections::HashSet::with_capacity(members.len());
+            members.iter().all(|(key_start, member)| {
+                key_at(text, *key_start).is_some_and(|key| {
+                    let found = map.get(key.as_ref());
+                    seen.insert(key) && found.is_some_and(|v| matches(text, member, v, compare))
+                })
+            })
+        }
+        (Node::Array(items), Value::Array(values)) => {
+            items.len() == values.len()
+                && items
+                    .iter()
+                    .zip(values)
+                    .all(|(item, v)| matches(text, item, v, compare))
+        }
+        _ => false,
+    }
+}
+
+/// True when `text` holds `value` with its numbers as velvet writes them: the check a spliced
+/// text passes before it is written. It reads the text without building a document.
+pub fn reads_as_written(text: &str, value: &Value) -> bool {
+    let mut scanner = Scanner { text, at: 0 };
+    let Some(root) = scanner.value() else {
+        return false;
+    };
+    scanner.skip_ws();
+    let rest = text[scanner.at..].trim_end_matches(['\0', ' ', '\t', '\n', '\r']);
+    rest.is_empty()
+        && serde_json::from_str::<serde::de::IgnoredAny>(text).is_ok()
+        && matches(text, &root, value, Compare::Written)
 }
 
 /// Writes `after` over `span`: on one line where the old value was a one-line container, laid
@@ -469,27 +530,38 @@ fn replace(text: &str, span: &Span, after: &Value, layout: &Layout, out: &mut Ve
     });
 }
 
-#[allow(clippy::too_many_arguments)]
 fn diff_object(
     text: &str,
     span: &Span,
     members: &[(usize, Span)],
-    before: &Map<String, Value>,
     after: &Map<String, Value>,
     layout: &Layout,
     out: &mut Vec<Splice>,
 ) {
-    let removed: Vec<bool> = before.keys().map(|k| !after.contains_key(k)).collect();
+    let keys: Option<Vec<std::borrow::Cow<str>>> =
+        members.iter().map(|(k, _)| key_at(text, *k)).collect();
+    let distinct = keys.as_ref().is_some_and(|keys| {
+        let set: std::collections::HashSet<&str> = keys.iter().map(|k| k.as_ref()).collect();
+        set.len() == keys.len()
+    });
+    let (Some(keys), true) = (keys, distinct) else {
+        // Keys that do not decode, or a key twice: the object is written anew, in place.
+        return replace(text, span, &Value::Object(after.clone()), layout, out);
+    };
+    let removed: Vec<bool> = keys
+        .iter()
+        .map(|k| !after.contains_key(k.as_ref()))
+        .collect();
     let added: Vec<(&String, &Value)> = after
         .iter()
-        .filter(|(k, _)| !before.contains_key(*k))
+        .filter(|(k, _)| !keys.iter().any(|have| have == *k))
         .collect();
     let any_removed = removed.iter().any(|r| *r);
     if any_removed && (!added.is_empty() || removed.iter().all(|r| *r)) {
         // Members both leave and arrive, or all leave: the object is written anew, in place.
         return replace(text, span, &Value::Object(after.clone()), layout, out);
     }
-    for (i, ((key_start, value), (key, old))) in members.iter().zip(before).enumerate() {
+    for (i, ((key_start, value), key)) in members.iter().zip(&keys).enumerate() {
         if removed[i] {
             let (start, end) = match (i, members.get(i + 1)) {
                 // A member after the first takes the separator before it.
@@ -504,7 +576,7 @@ fn diff_object(
                 text: String::new(),
             });
         } else {
-            diff(text, value, old, &after[key], layout, out);
+            diff(text, value, &after[key.as_ref()], layout, out);
         }
     }
     if added.is_empty() {
@@ -535,10 +607,10 @@ fn diff_object(
     };
     // A new key goes after the member that precedes it in the edited document (the edit
     // applier puts `extensionsUsed` after `asset`, say), or first when none does.
-    let position: std::collections::HashMap<&str, usize> = before
-        .keys()
+    let position: std::collections::HashMap<&str, usize> = keys
+        .iter()
         .enumerate()
-        .map(|(i, k)| (k.as_str(), i))
+        .map(|(i, k)| (k.as_ref(), i))
         .collect();
     let mut anchor: Option<usize> = None;
     let mut leading = String::new();
@@ -627,12 +699,13 @@ mod tests {
         let before: Value = serde_json::from_str(text).unwrap();
         let mut after = before.clone();
         edit(&mut after);
-        let out = rewrite(text, &before, &after).unwrap();
+        let out = rewrite(text, &after).unwrap();
         let reread: Value = serde_json::from_str(&out).unwrap();
         assert_eq!(
             reread, after,
             "the spliced text reads back as the edited document"
         );
+        assert!(reads_as_written(&out, &after));
         out
     }
 
@@ -694,7 +767,7 @@ mod tests {
         let mut after = before.clone();
         after["a"] = serde_json::json!(0.7499999999999999);
         assert_eq!(
-            rewrite(text, &before, &after).unwrap(),
+            rewrite(text, &after).unwrap(),
             "{\n  \"a\": 0.75,\n  \"b\": [1, 2],\n  \"c\": true\n}\n"
         );
         let out = edited(text, |d| {
@@ -730,7 +803,7 @@ mod tests {
         );
         after.insert("materials".into(), serde_json::json!([]));
         assert_eq!(
-            rewrite(text, &before, &Value::Object(after)).unwrap(),
+            rewrite(text, &Value::Object(after)).unwrap(),
             "{\n  \"first\": 1,\n  \"asset\": {\"version\": \"2.0\"},\n  \"extensionsUsed\": [\n    \"KHR_materials_fuzz\"\n  ],\n  \"materials\": []\n}\n"
         );
     }
@@ -739,6 +812,22 @@ mod tests {
     fn written_values_hold_what_the_file_will_hold() {
         let value = written(serde_json::json!({"a": [0.30000000000000004, 1.0, 2], "b": "x"}));
         assert_eq!(value.to_string(), r#"{"a":[0.3,1.0,2],"b":"x"}"#);
+    }
+
+    #[test]
+    fn the_read_back_check_refuses_a_text_that_holds_something_else() {
+        let value = serde_json::json!({"a": [1, 0.7499999999999999], "b": "x"});
+        assert!(reads_as_written(r#"{"a": [1, 0.75], "b": "x"}"#, &value));
+        for wrong in [
+            r#"{"a": [1, 0.75], "b": "y"}"#,
+            r#"{"a": [1, 0.75]}"#,
+            r#"{"a": [1, 0.75], "b": "x", "b": "x"}"#,
+            r#"{"a": [1, 0.75], "b": "x"} {"#,
+            r#"{"a": [1, 0.75] "b": "x"}"#,
+            r#"{"a": [1, tru], "b": "x"}"#,
+        ] {
+            assert!(!reads_as_written(wrong, &value), "{wrong}");
+        }
     }
 
     #[test]
