@@ -208,14 +208,9 @@ impl Layout {
         let newline = if text.contains("\r\n") { "\r\n" } else { "\n" };
         let pretty = text.trim_end().contains('\n');
         let unit = pretty.then(|| {
-            let unit = text.lines().skip(1).find_map(|line| {
-                let unit: String = line
-                    .chars()
-                    .take_while(|c| *c == ' ' || *c == '\t')
-                    .collect();
-                (!unit.is_empty()).then_some(unit)
-            });
-            unit.unwrap_or_else(|| "  ".to_string())
+            crate::asset::write::JsonStyle::detect(text)
+                .indent
+                .unwrap_or_else(|| "  ".to_string())
         });
         let mut layout = Layout {
             unit,
