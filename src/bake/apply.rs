@@ -311,13 +311,7 @@ pub fn apply(
                     // Already written next to the output as it was encoded.
                     let stored = baked[id.0].stored.clone().expect("checked");
                     let report = &mut outputs[id.0];
-                    let images = json
-                        .as_object_mut()
-                        .expect("the document is an object")
-                        .entry("images")
-                        .or_insert_with(|| json!([]))
-                        .as_array_mut()
-                        .expect("images is an array");
+                    let images = images_mut(&mut json);
                     images.push(json!({"name": report.name, "uri": file_uri(&stored.name)}));
                     let index = images.len() - 1;
                     report.stored = stored.name;
@@ -495,13 +489,7 @@ pub fn add_image(
         });
         (json!({"name": name, "uri": uri}), file)
     };
-    let images = json
-        .as_object_mut()
-        .expect("the document is an object")
-        .entry("images")
-        .or_insert_with(|| json!([]))
-        .as_array_mut()
-        .expect("images is an array");
+    let images = images_mut(json);
     images.push(entry);
     (images.len() - 1, stored)
 }
@@ -537,4 +525,14 @@ fn drop_empty_bin(json: &mut Value) {
             root.shift_remove("buffers");
         }
     }
+}
+/// The document's `images` array, created when absent (the plan has checked that the document
+/// is an object whose `images`, if any, is an array).
+fn images_mut(json: &mut Value) -> &mut Vec<Value> {
+    json.as_object_mut()
+        .expect("the document is an object")
+        .entry("images")
+        .or_insert_with(|| json!([]))
+        .as_array_mut()
+        .expect("images is an array")
 }
