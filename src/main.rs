@@ -82,7 +82,8 @@ struct SettingsArgs {
     /// Use FILE for every input instead of the velvet.toml found above each one.
     #[arg(long, value_name = "FILE")]
     config: Option<PathBuf>,
-    /// Report at most N issues per file (the report then says truncated); 0: no limit.
+    /// List at most N issues per file, the most severe first (the report says how many it left
+    /// out; the exit status and counts still come from every finding); 0: no limit.
     #[arg(long, value_name = "N")]
     max_issues: Option<usize>,
     /// Leave out issues with this code (repeatable); adds to the codes velvet.toml ignores.

@@ -60,14 +60,18 @@ pub struct FileReport {
     pub json_offset: usize,
     pub findings: Vec<Finding>,
     pub counts: Counts,
-    /// True when `--max-issues` left findings out of the listing (`omitted` of them).
-    pub truncated: bool,
+    /// How many findings `--max-issues` left out of the listing (they are counted all the same).
     pub omitted: usize,
     pub info: Option<AssetInfo>,
 }
 
 impl FileReport {
     /// True when a finding is at or above the run's fail-on severity.
+    /// True when `--max-issues` left findings out of the listing.
+    pub fn truncated(&self) -> bool {
+        self.omitted > 0
+    }
+
     /// Judged on every finding, also those a `--max-issues` cap left out of the listing.
     pub fn fails(&self, settings: &Settings) -> bool {
         let c = self.counts;
@@ -231,7 +235,6 @@ impl Validator {
                 })
                 .collect(),
             counts,
-            truncated: omitted > 0,
             omitted,
             info,
         }

@@ -67,7 +67,7 @@ pub fn render(reports: &[FileReport]) -> String {
                 escape_data(&message)
             );
         }
-        if report.truncated {
+        if report.truncated() {
             let _ = writeln!(
                 out,
                 "::notice file={file},title=velvet::{}",

@@ -27,7 +27,7 @@ pub fn report_value(report: &FileReport) -> Value {
             "numInfos": c.infos,
             "numHints": c.hints,
             "messages": messages,
-            "truncated": report.truncated,
+            "truncated": report.truncated(),
         },
     });
     if let Some(info) = &report.info {

@@ -248,7 +248,7 @@ fn log<'a>(reports: &'a [FileReport], artifacts: &'a [ArtifactLocation]) -> Log<
                 },
             });
         }
-        if report.truncated {
+        if report.truncated() {
             notifications.push(Notification {
                 level: "note",
                 message: OwnedText {

@@ -81,7 +81,7 @@ pub fn render_with(reports: &[FileReport], options: &Options) -> String {
                 let _ = writeln!(out, "    {}", paint(Style::new().dimmed(), &line));
             }
         }
-        if report.truncated {
+        if report.truncated() {
             let _ = writeln!(out, "{file}: {}", super::omitted_note(report.omitted));
         }
         let c = report.counts;
@@ -177,7 +177,6 @@ mod tests {
                 ..Counts::default()
             },
             findings,
-            truncated: false,
             omitted: 0,
             info: None,
         }

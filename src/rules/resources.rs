@@ -89,11 +89,7 @@ fn array<'a>(json: &'a Value, key: &str) -> impl Iterator<Item = (usize, &'a Val
 }
 
 fn byte_length(buffer: &Value) -> Option<u64> {
-    buffer
-        .get("byteLength")
-        .and_then(Value::as_f64)
-        .filter(|n| *n >= 0.0 && n.fract() == 0.0)
-        .map(|n| n as u64)
+    buffer.get("byteLength").and_then(super::as_index)
 }
 
 fn short_buffer(index: usize, declared: u64, actual: u64, what: &str) -> Diagnostic {
