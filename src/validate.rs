@@ -10,6 +10,10 @@ use rayon::prelude::*;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
+/// Documents from this size (bytes of JSON text) up run their rules in parallel; below it the
+/// files of a run are the parallel unit and splitting a small file only adds overhead.
+const PARALLEL_RULES_FROM: usize = 1 << 20;
+
 /// A finding with where it stands in the file.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Finding {
@@ -170,9 +174,7 @@ impl Validator {
             asset: &asset,
             schemas: &self.schemas,
         };
-        for rule in rules::REGISTRY {
-            rule.check(&cx, &mut diagnostics);
-        }
+        diagnostics.extend(run_rules(&cx, asset.json_text.len() >= PARALLEL_RULES_FROM));
         let info = asset_info(&asset.json);
         let mut report = self.finish(
             settings,
@@ -190,11 +192,16 @@ impl Validator {
                     .iter()
                     .map(|f| f.diagnostic.pointer.as_str()),
             );
-            for f in &mut report.findings {
+            for (f, position) in report.findings.iter_mut().zip(positions) {
                 if !f.diagnostic.pointer.is_empty() && f.position.is_none() {
-                    f.position = positions.get(&f.diagnostic.pointer).copied();
+                    f.position = position;
                 }
             }
+        }
+        if asset.json_text.len() >= PARALLEL_RULES_FROM {
+            // Freeing a big document tree takes as long as a rule; it is left to the pool while
+            // the report is written.
+            rayon::spawn(move || drop(asset));
         }
         report
     }
@@ -241,6 +248,29 @@ impl Validator {
     }
 }
 
+/// Every registered rule's findings, in registry order. In parallel, each rule keeps its own
+/// list and the lists are joined in registry order, so the report does not depend on which
+/// rule finished first.
+fn run_rules(cx: &Context, parallel: bool) -> Vec<Diagnostic> {
+    if parallel {
+        let found: Vec<Vec<Diagnostic>> = rules::REGISTRY
+            .par_iter()
+            .map(|rule| {
+                let mut out = Vec::new();
+                rule.check(cx, &mut out);
+                out
+            })
+            .collect();
+        found.into_iter().flatten().collect()
+    } else {
+        let mut out = Vec::new();
+        for rule in rules::REGISTRY {
+            rule.check(cx, &mut out);
+        }
+        out
+    }
+}
+
 fn strings(json: &Value, key: &str) -> Vec<String> {
     json.get(key)
         .and_then(Value::as_array)
@@ -270,5 +300,50 @@ fn asset_info(json: &Value) -> AssetInfo {
         material_count: materials.len(),
         sheen_material_count: with(layers::SHEEN),
         fuzz_material_count: with(layers::FUZZ),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A document whose materials trip many rules at once: schema errors, a dangling texture,
+    /// legacy draft keys, fuzz without fallback, a switched-off layer with a texture.
+    fn many_faults(materials: usize) -> String {
+        let mut list = Vec::new();
+        for i in 0..materials {
+            list.push(match i % 5 {
+                0 => r#"{"extensions":{"KHR_materials_sheen":{"sheenColorFactor":[1.5,0.0],"sheenRoughnessFactor":"rough"}}}"#.to_string(),
+                1 => r#"{"extensions":{"KHR_materials_sheen":{"sheenColorFactor":[0,0,0],"sheenColorTexture":{"index":7}}}}"#.to_string(),
+                2 => r#"{"extensions":{"KHR_materials_sheen":{"sheenFactor":0.5,"sheenColor":[1,1,1]}}}"#.to_string(),
+                3 => r#"{"extensions":{"KHR_materials_fuzz":{"fuzzColorFactor":[0.2,0.2,0.2]}}}"#.to_string(),
+                _ => format!(r#"{{"name":"m{i}","extensions":{{"KHR_materials_sheen":{{"sheenColorFactor":[1,1,1],"sheenRoughnessFactor":0.5}}}}}}"#),
+            });
+        }
+        format!(
+            r#"{{"asset":{{"version":"2.0"}},"extensionsUsed":["KHR_materials_sheen","KHR_materials_fuzz"],"materials":[{}]}}"#,
+            list.join(",")
+        )
+    }
+
+    #[test]
+    fn rules_run_in_parallel_report_exactly_what_they_report_one_after_another() {
+        let text = many_faults(400);
+        let loaded = asset::load_bytes_with(
+            Path::new("faults.gltf"),
+            text.as_bytes(),
+            &asset::LoadOptions::default(),
+        );
+        let asset = loaded.asset.expect("the document parses");
+        let schemas = Schemas::builtin();
+        let cx = Context {
+            asset: &asset,
+            schemas: &schemas,
+        };
+        let sequential = run_rules(&cx, false);
+        assert!(sequential.len() > 500, "{} findings", sequential.len());
+        for _ in 0..4 {
+            assert_eq!(run_rules(&cx, true), sequential);
+        }
     }
 }

@@ -104,8 +104,7 @@ pub struct Stream<W: std::io::Write> {
 
 /// A JSON report as an element of the pretty-printed array of several: every line indented.
 fn json_element(report: &FileReport) -> String {
-    let text =
-        serde_json::to_string_pretty(&json::report_value(report)).expect("a report serialises");
+    let text = json::report_pretty(report);
     let mut out = String::with_capacity(text.len() + 64);
     for (i, line) in text.lines().enumerate() {
         if i > 0 {
