@@ -14,6 +14,7 @@ pub mod diagnostics;
 pub mod edit;
 pub mod layers;
 pub mod migrate;
+pub mod output;
 pub mod preview;
 pub mod report;
 pub mod rules;
