@@ -9,7 +9,8 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use std::time::Duration;
-use velvet::migrate::{self, Destination, Options, Request};
+use velvet::migrate::{self, Options, Request};
+use velvet::output::paths::Destination;
 
 /// Material `i` of a generated asset: the kind cycles so that every conversion is exercised.
 fn material(i: usize) -> Value {

@@ -2,9 +2,9 @@
 //! KHR_materials_fuzz.
 //!
 //! The flow is one way: load ([`asset`]) → validate ([`validate`], [`rules`]) → report
-//! ([`report`]); [`migrate`] and [`bake`] plan and apply edits; [`preview`] draws contact
-//! sheets of what a migration does to each material. The binary in `main.rs` only parses
-//! arguments and maps outcomes to exit codes.
+//! ([`report`]); [`migrate`] and [`bake`] plan and apply edits, and share [`output`] for
+//! where their outputs go; [`preview`] draws contact sheets of what a migration does to each
+//! material. The binary in `main.rs` only parses arguments and maps outcomes to exit codes.
 
 pub mod asset;
 pub mod bake;
@@ -14,6 +14,7 @@ pub mod diagnostics;
 pub mod edit;
 pub mod layers;
 pub mod migrate;
+pub mod output;
 pub mod preview;
 pub mod report;
 pub mod rules;

@@ -534,7 +534,8 @@ enum MigrateFormat {
 }
 
 fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
-    use velvet::migrate::{self, Destination};
+    use velvet::migrate;
+    use velvet::output::{paths::Destination, summary::Detail};
     let paths = match args.input.resolve() {
         Ok(p) => p,
         Err(e) => return usage_error(e),
@@ -597,11 +598,11 @@ fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
             MigrateFormat::Text => migrate::render::text(
                 &report,
                 if quiet {
-                    migrate::render::Detail::Quiet
+                    Detail::Quiet
                 } else if args.verbose || args.report {
-                    migrate::render::Detail::Verbose
+                    Detail::Verbose
                 } else {
-                    migrate::render::Detail::Normal
+                    Detail::Normal
                 }
             ),
             MigrateFormat::Json => migrate::render::json(&report),
@@ -626,7 +627,8 @@ fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
 }
 
 fn bake(args: BakeArgs, quiet: bool) -> ExitCode {
-    use velvet::bake::command::{self, Destination, Options, Request};
+    use velvet::bake::command::{self, Options, Request};
+    use velvet::output::{paths::Destination, summary::Detail};
     let paths = match args.input.resolve() {
         Ok(p) => p,
         Err(e) => return usage_error(e),
@@ -675,11 +677,11 @@ fn bake(args: BakeArgs, quiet: bool) -> ExitCode {
                 &results,
                 args.dry_run,
                 if quiet {
-                    migrate::render::Detail::Quiet
+                    Detail::Quiet
                 } else if args.verbose || args.report || args.dry_run {
-                    migrate::render::Detail::Verbose
+                    Detail::Verbose
                 } else {
-                    migrate::render::Detail::Normal
+                    Detail::Normal
                 }
             )
         ),

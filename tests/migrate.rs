@@ -9,9 +9,10 @@ use std::process::Command;
 use velvet::asset::glb;
 use velvet::diagnostics::Severity;
 use velvet::migrate::roughness::{self, Direction, RoughnessMapping};
-use velvet::migrate::{
-    self, render, Conversion, Destination, FileOutcome, Note, Options, Request, Skip, UsageError,
-};
+use velvet::migrate::{self, render, Conversion, FileOutcome, Note, Options, Request, Skip};
+use velvet::output::paths::Destination;
+use velvet::output::summary::Detail;
+use velvet::output::UsageError;
 use velvet::rules::schema::Schemas;
 use velvet::validate::Validator;
 
@@ -836,7 +837,7 @@ fn dry_run_prints_the_plan_and_writes_nothing() {
         report.files[0].outcome,
         FileOutcome::Planned { changes: true }
     );
-    let text = render::text(&report, render::Detail::Verbose);
+    let text = render::text(&report, Detail::Verbose);
     assert!(
         text.contains("  material 0 \"champagne\": sheen → fuzz\n"),
         "{text}"
@@ -1639,7 +1640,7 @@ fn an_out_dir_tree_moved_elsewhere_validates_clean() {
     assert!(
         !report.failed(),
         "{}",
-        render::text(&report, render::Detail::Verbose)
+        render::text(&report, Detail::Verbose)
     );
     let moved = dir.path().join("far/away/moved");
     std::fs::create_dir_all(moved.parent().unwrap()).unwrap();
@@ -1724,7 +1725,7 @@ fn a_link_to_a_file_outside_the_input_folder_is_refused_and_nothing_of_it_is_wri
             report.summary.failed,
             6,
             "{}",
-            render::text(&report, render::Detail::Verbose)
+            render::text(&report, Detail::Verbose)
         );
         for file in report
             .files

@@ -15,7 +15,8 @@ use serde_json::{json, Map, Value};
 use std::path::{Path, PathBuf};
 use velvet::bake::command as bake;
 use velvet::diagnostics::{Settings, Severity};
-use velvet::migrate::{self, Destination, FileOutcome, Options};
+use velvet::migrate::{self, FileOutcome, Options};
+use velvet::output::paths::Destination;
 use velvet::rules::schema::Schemas;
 use velvet::validate::Validator;
 
@@ -314,7 +315,7 @@ fn migrate_file(input: &Path, output: &Path) -> FileOutcome {
 fn bake_file(input: &Path, output: &Path) -> bake::Outcome {
     let results = bake::run(&bake::Request {
         inputs: vec![input.to_path_buf()],
-        destination: bake::Destination::File(output.to_path_buf()),
+        destination: Destination::File(output.to_path_buf()),
         dry_run: false,
         options: bake::Options::default(),
         progress: false,

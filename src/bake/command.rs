@@ -1,13 +1,13 @@
-//! `velvet bake` over many files, with the output rules of `velvet migrate` (its
-//! [`paths`](crate::migrate::paths) module pairs inputs with outputs and refuses a bad request
-//! before anything is read, and relocates the relative URIs of an output written to another
-//! folder): each file is loaded, planned, baked, applied and written independently and in
-//! parallel. One failing file does not stop the others; nothing is written for a file that
-//! fails, and every write is atomic (a temporary file renamed into place). An input is never
-//! written unless `--in-place` is asked, and a file with nothing to bake is copied byte for
-//! byte (or, in place, not written at all). A file the loader reports errors for is not baked.
+//! `velvet bake` over many files, with the output rules it shares with `velvet migrate`
+//! ([`crate::output::paths`] pairs inputs with outputs and refuses a bad request before
+//! anything is read, and relocates the relative URIs of an output written to another folder):
+//! each file is loaded, planned, baked, applied and written independently and in parallel.
+//! One failing file does not stop the others; nothing is written for a file that fails, and
+//! every write is atomic (a temporary file renamed into place). An input is never written
+//! unless `--in-place` is asked, and a file with nothing to bake is copied byte for byte (or,
+//! in place, not written at all). A file the loader reports errors for is not baked.
 
-use std::collections::{HashMap, HashSet};
+use std::collections::HashSet;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
@@ -16,21 +16,20 @@ use rayon::prelude::*;
 use serde::Serialize;
 use serde_json::Value;
 
-use super::apply::{apply, ApplyOptions, Names, OutputReport};
+use super::apply::{apply, ApplyOptions, OutputReport};
 use super::codec::{EncodeOptions, PngCompression};
 use super::engine::{bake_into, BakeOptions, MaxImagePixels};
 use super::kernel::KernelOptions;
 use super::plan::{plan, BakePlan, Note, PlanOptions};
 use super::prune::Dropped;
 use crate::asset::discover::Shard;
-use crate::asset::{self, resource, write};
+use crate::asset::{self, write};
 use crate::diagnostics::Severity;
-use crate::migrate::apply::{copy_resources, create_parent};
-use crate::migrate::paths::{identity, jobs, relocate, Job, Relocation};
-use crate::migrate::render::{added, bytes, files_line, plural, Detail};
-
-pub use crate::migrate::paths::Destination;
-pub use crate::migrate::UsageError;
+use crate::output::files::{copy_resources, create_parent, file_sink, write_new_files};
+use crate::output::files::{Claims, FileNames};
+use crate::output::paths::{check_links, jobs, relocate, Destination, Job, Relocation};
+use crate::output::summary::{added, bytes, files_line, plural, Detail};
+use crate::output::UsageError;
 
 /// What a run does besides where it writes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -146,94 +145,6 @@ impl FileResult {
     }
 }
 
-/// File names claimed in one run, across files (several assets may write into one folder),
-/// each with the hash and length of what it holds. Names carry a hash of their content, so two
-/// files claiming one name mean the same bytes, whichever claims first.
-#[derive(Default)]
-pub struct Claims {
-    claimed: Mutex<HashMap<PathBuf, (String, usize)>>,
-}
-
-/// The names one output may use: not a file the document references, not the document
-/// itself, and either new or already holding exactly the bytes to be written.
-pub(crate) struct FileNames<'a> {
-    claims: &'a Claims,
-    dir: PathBuf,
-    taken: HashSet<PathBuf>,
-}
-
-impl<'a> FileNames<'a> {
-    /// The names free next to `output` for new images of `asset` (read from `input`, its
-    /// resources relocated by `relocation`).
-    pub(crate) fn next_to(
-        claims: &'a Claims,
-        asset: &asset::Asset,
-        input: &Path,
-        output: &Path,
-        relocation: &Relocation,
-    ) -> FileNames<'a> {
-        let taken: HashSet<PathBuf> = ["buffers", "images"]
-            .iter()
-            .flat_map(|kind| {
-                asset
-                    .json
-                    .get(*kind)
-                    .and_then(Value::as_array)
-                    .into_iter()
-                    .flatten()
-            })
-            .filter_map(|item| item.get("uri").and_then(Value::as_str))
-            .filter_map(|uri| match resource::resolve(uri, asset.base_dir(), "") {
-                Ok(resource::Location::File(p)) => Some(identity(&p)),
-                _ => None,
-            })
-            .chain(relocation.copies.iter().map(|c| identity(&c.to)))
-            .chain([identity(output), identity(input)])
-            .collect();
-        FileNames {
-            claims,
-            dir: folder_of(output),
-            taken,
-        }
-    }
-
-    /// The folder new files go to.
-    pub(crate) fn dir(&self) -> &Path {
-        &self.dir
-    }
-}
-
-impl Names for FileNames<'_> {
-    fn claim(&mut self, name: &str, bytes: &[u8]) -> bool {
-        let path = identity(&self.dir.join(name));
-        if self.taken.contains(&path) {
-            return false;
-        }
-        let mut claimed = self
-            .claims
-            .claimed
-            .lock()
-            .unwrap_or_else(|e| e.into_inner());
-        let held = (super::apply::content_hash(bytes), bytes.len());
-        if let Some(existing) = claimed.get(&path) {
-            return *existing == held;
-        }
-        if path.exists() && std::fs::read(&path).map_or(true, |b| b != bytes) {
-            return false;
-        }
-        claimed.insert(path.clone(), held);
-        self.taken.insert(path);
-        true
-    }
-}
-
-fn folder_of(path: &Path) -> PathBuf {
-    match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => PathBuf::from("."),
-    }
-}
-
 fn slot_reports(plan: &BakePlan, names: &[String]) -> Vec<SlotReport> {
     plan.slots
         .iter()
@@ -248,59 +159,6 @@ fn slot_reports(plan: &BakePlan, names: &[String]) -> Vec<SlotReport> {
                 .collect(),
         })
         .collect()
-}
-
-/// What [`file_sink`] returns: a [`Sink`](super::Sink) it owns.
-pub(crate) type FileSink<'s> =
-    Box<dyn Fn(super::OutputId, &mut super::Baked) -> Result<(), String> + Sync + 's>;
-
-/// A [`Sink`](super::Sink) that writes each output as a file into `dir` as soon as it is encoded
-/// (named from the source image, the slots and a hash of the bytes, claimed through `names`)
-/// and drops its bytes. Only for a .gltf whose new images are files.
-pub(crate) fn file_sink<'s, 'c: 's>(
-    names: &'s Mutex<FileNames<'c>>,
-    images: &'s Value,
-    plan: &'s BakePlan,
-) -> FileSink<'s> {
-    Box::new(move |id, baked| {
-        let Some((format, bytes)) = baked.encoded.take() else {
-            return Ok(());
-        };
-        let name = super::apply::output_name(images, &plan.outputs[id.0]);
-        let (dir, file) = {
-            let mut names = names.lock().unwrap_or_else(|e| e.into_inner());
-            let file = super::apply::file_candidates(&name, format, &bytes)
-                .find(|candidate| names.claim(candidate, &bytes))
-                .expect("some name is free");
-            (names.dir().to_path_buf(), file)
-        };
-        write_new_file(&dir, &file, &bytes)?;
-        baked.stored = Some(super::StoredFile {
-            name: file,
-            format,
-            bytes: bytes.len(),
-        });
-        Ok(())
-    })
-}
-
-/// Writes new image files into `dir` (each atomically; one already holding the bytes is left).
-pub(crate) fn write_new_files(dir: &Path, files: &[super::apply::NewFile]) -> Result<(), String> {
-    for file in files {
-        write_new_file(dir, &file.name, &file.bytes)?;
-    }
-    Ok(())
-}
-
-/// Writes one new file into `dir` atomically, unless it already holds `bytes`.
-pub(crate) fn write_new_file(dir: &Path, name: &str, bytes: &[u8]) -> Result<(), String> {
-    std::fs::create_dir_all(dir)
-        .map_err(|e| format!("cannot create folder {}: {e}", dir.display()))?;
-    let path = dir.join(name);
-    if std::fs::read(&path).is_ok_and(|b| b == bytes) {
-        return Ok(());
-    }
-    write::write_atomic(&path, bytes).map_err(|e| format!("cannot write {}: {e}", path.display()))
 }
 
 /// Bakes one file; errors name what is wrong (the caller adds the file).
@@ -320,7 +178,7 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
         Some(asset) if errors.is_empty() => asset,
         _ => return Err(format!("cannot be baked: {}", errors.join("; "))),
     };
-    crate::migrate::paths::check_links(&asset)?;
+    check_links(&asset)?;
     let plan = plan(&asset, options.plan);
     let planned_names: Vec<String> = plan
         .outputs

@@ -6,17 +6,18 @@
 //! in place, not written at all). A file the loader could not read cleanly is not migrated:
 //! rewriting it would hide the fault (a truncated BIN chunk would come out "fixed").
 
-use super::paths::{relocate, Job, Relocation};
 use super::plan::{plan_document, DocumentPlan};
 use super::textures;
 use super::Options;
 use crate::asset::{self, write, Asset};
 use crate::bake::apply::{apply as bake_apply, ApplyOptions, OutputReport};
-use crate::bake::command::{file_sink, write_new_files, Claims, FileNames};
 use crate::bake::{bake_into, BakeOptions, KernelOptions};
 use crate::diagnostics::Severity;
 use crate::edit;
-use std::path::{Path, PathBuf};
+use crate::output::files::{copy_resources, create_parent, file_sink, write_new_files};
+use crate::output::files::{Claims, FileNames};
+use crate::output::paths::{check_links, relocate, Job, Relocation};
+use std::path::PathBuf;
 use std::sync::Mutex;
 
 /// Everything known about one file before anything is written.
@@ -84,7 +85,7 @@ pub fn plan_file(job: &Job, options: &Options) -> Result<FilePlan, String> {
             ))
         }
     };
-    super::paths::check_links(&asset).map_err(|e| format!("{}: {e}", job.input.display()))?;
+    check_links(&asset).map_err(|e| format!("{}: {e}", job.input.display()))?;
     let document = plan_document(&asset, options);
     let relocation = match &job.output {
         Some(output) if output != &job.input => relocate(&asset, output, options.rewrite_uris)
@@ -108,39 +109,6 @@ pub fn plan_file(job: &Job, options: &Options) -> Result<FilePlan, String> {
         embed: options.embed,
         baked: Vec::new(),
     })
-}
-
-/// Creates the folder `path` goes in, if it has one.
-pub(crate) fn create_parent(path: &Path) -> Result<(), String> {
-    match path.parent() {
-        Some(dir) if !dir.as_os_str().is_empty() => std::fs::create_dir_all(dir)
-            .map_err(|e| format!("cannot create folder {}: {e}", dir.display())),
-        _ => Ok(()),
-    }
-}
-
-/// Places a relocation's resource copies that the written document `json` still names (each a
-/// regular file, hard-linked or copied atomically from the resolved source), for migrate and
-/// bake alike.
-pub(crate) fn copy_resources(
-    relocation: &Relocation,
-    json: &serde_json::Value,
-) -> Result<(), String> {
-    let used = super::paths::relative_uris(json);
-    for copy in relocation
-        .copies
-        .iter()
-        .filter(|c| used.contains(&c.uri.as_str()))
-    {
-        let from = copy
-            .from
-            .canonicalize()
-            .map_err(|e| format!("cannot read resource {}: {e}", copy.from.display()))?;
-        create_parent(&copy.to)?;
-        write::copy_atomic(&from, &copy.to)
-            .map_err(|e| format!("cannot write resource {}: {e}", copy.to.display()))?;
-    }
-    Ok(())
 }
 
 /// Applies a file's plan and writes its output (and resource copies). On failure the output

@@ -4,12 +4,13 @@
 
 use super::apply::{execute, plan_file, Written};
 use super::note::{Conversion, Level, Note, Skip};
-use super::paths::{jobs, Destination, Job, ResourceCopy};
 use super::plan::MaterialPlan;
-use super::{Options, UsageError};
+use super::Options;
 use crate::asset::discover::Shard;
-use crate::bake::command::Claims;
 use crate::edit::Edit;
+use crate::output::files::Claims;
+use crate::output::paths::{jobs, Destination, Job, ResourceCopy};
+use crate::output::UsageError;
 use rayon::prelude::*;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -137,7 +138,13 @@ fn migrate_one(job: &Job, options: &Options, dry_run: bool, claims: &Claims) -> 
     } else {
         (written.len(), written.iter().map(|o| o.bytes).sum())
     };
-    let mut notes = plan.relocation.notes.clone();
+    let mut notes: Vec<Note> = plan
+        .relocation
+        .notes
+        .iter()
+        .cloned()
+        .map(Note::from)
+        .collect();
     for output in &plan.baked {
         notes.push(Note::BakeError {
             pointer: output

@@ -3,11 +3,12 @@
 //!
 //! The flow is one way. [`plan`] decides, per material, which conversion applies and turns it
 //! into [`Edit`]s and [`Note`]s (plain values: a dry run prints them, tests compare them);
-//! [`paths`] decides where each output goes and which relative URIs or resources must follow
-//! it; [`apply`] executes a file's plan and writes it atomically; [`batch`] runs many files in
-//! parallel and sums up. Each conversion rule is one file: [`sheen_to_fuzz`], [`fallback`],
-//! [`legacy`]. The roughness choice between the layers lives in [`roughness`] alone. Textures
-//! that a conversion must bake are planned in [`textures`] and made by the bake engine.
+//! [`crate::output::paths`] decides where each output goes and which relative URIs or resources
+//! must follow it; [`apply`] executes a file's plan and writes it atomically; [`batch`] runs
+//! many files in parallel and sums up. Each conversion rule is one file: [`sheen_to_fuzz`],
+//! [`fallback`], [`legacy`]. The roughness choice between the layers lives in [`roughness`]
+//! alone. Textures that a conversion must bake are planned in [`textures`] and made by the bake
+//! engine.
 
 pub mod apply;
 pub mod batch;
@@ -16,7 +17,6 @@ pub mod fallback;
 pub mod legacy;
 pub mod measure;
 pub mod note;
-pub mod paths;
 pub mod plan;
 pub mod render;
 pub mod roughness;
@@ -25,7 +25,6 @@ pub mod textures;
 
 pub use batch::{run, run_shard, FileOutcome, FileResult, Request, RunReport, Summary};
 pub use note::{Conversion, Level, Note, Skip};
-pub use paths::Destination;
 pub use plan::{plan_document, DocumentPlan, MaterialPlan};
 
 pub use crate::edit::Edit;
@@ -53,32 +52,4 @@ pub struct Options {
     pub budget: budget::Budget,
     /// Limits and URI policy for reading inputs and their resources.
     pub load: crate::asset::LoadOptions,
-}
-
-/// A request velvet cannot carry out as given (exit status 2): nothing is read or written.
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-pub enum UsageError {
-    #[error("say where the output goes: -o FILE (one input), --out-dir DIR or --in-place (or use --dry-run)")]
-    NoDestination,
-    #[error("-o names one output file, but {0} inputs were given; use --out-dir DIR for several")]
-    OutputForMany(usize),
-    #[error("-o names one output file, but {0} is a folder; use --out-dir DIR")]
-    OutputForFolder(String),
-    #[error("-o {output}: the input {input} is a {container} file and the output keeps its container; name the output *.{extension}")]
-    ContainerMismatch {
-        input: String,
-        output: String,
-        container: &'static str,
-        extension: &'static str,
-    },
-    #[error("the output {output} is the input {input}; use --in-place to overwrite inputs")]
-    OutputIsInput { output: String, input: String },
-    #[error("{first} and {second} would both be written to {output}")]
-    OutputCollision {
-        output: String,
-        first: String,
-        second: String,
-    },
-    #[error("no inputs given")]
-    NoInputs,
 }

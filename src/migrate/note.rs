@@ -4,6 +4,7 @@
 //! Notes are values with their data (numbers, names), so tests compare them exactly and the
 //! JSON output carries the numbers; [`Note::message`] words them for people, in one place.
 
+use crate::output::paths::RelocationNote;
 use serde::Serialize;
 use serde_json::Value;
 
@@ -194,6 +195,22 @@ pub enum Note {
         best: f64,
         written: f64,
     },
+}
+
+impl From<RelocationNote> for Note {
+    fn from(note: RelocationNote) -> Note {
+        match note {
+            RelocationNote::UrisRewritten {
+                count,
+                leaves_folder,
+            } => Note::UrisRewritten {
+                count,
+                leaves_folder,
+            },
+            RelocationNote::ResourcesCopied { count } => Note::ResourcesCopied { count },
+            RelocationNote::ResourceMissing { uri } => Note::ResourceMissing { uri },
+        }
+    }
 }
 
 fn rgb(c: [f64; 3]) -> String {

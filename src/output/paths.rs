@@ -1,4 +1,4 @@
-//! Where outputs go, and what must follow them.
+//! Where outputs go, and what must follow them, for `velvet migrate` and `velvet bake` alike.
 //!
 //! [`jobs`] pairs every input file with its output: `-o` for one input, `--out-dir` mirroring
 //! each input folder's tree, or `--in-place`. It refuses, before anything is read or written,
@@ -16,8 +16,10 @@
 //! [`check_links`] refuses, before anything of the asset is read, a resource that reaches
 //! outside the input's folder through a symbolic link: it would otherwise be read, baked or
 //! copied into the output.
+//!
+//! A relocation says what it did as [`RelocationNote`]s, plain facts that each command words
+//! its own way.
 
-use super::note::Note;
 use super::UsageError;
 use crate::asset::{discover, resource, Asset};
 use crate::edit::Edit;
@@ -28,7 +30,7 @@ use std::collections::HashMap;
 use std::io;
 use std::path::{Component, Path, PathBuf};
 
-/// Where migrated files are written.
+/// Where migrated or baked files are written.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Destination {
     /// Nowhere (a dry run only).
@@ -165,12 +167,23 @@ pub struct ResourceCopy {
     pub to: PathBuf,
 }
 
+/// What a relocation has to say about an output's resources.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum RelocationNote {
+    /// Relative URIs rewritten so that the output finds the input's resources.
+    UrisRewritten { count: usize, leaves_folder: bool },
+    /// Resources copied next to the output.
+    ResourcesCopied { count: usize },
+    /// A resource to copy is missing; its URI is left as it was.
+    ResourceMissing { uri: String },
+}
+
 /// What an output in another folder needs: URI rewrites (as edits), copies, and notes.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Relocation {
     pub edits: Vec<Edit>,
     pub copies: Vec<ResourceCopy>,
-    pub notes: Vec<Note>,
+    pub notes: Vec<RelocationNote>,
 }
 
 /// Characters a path segment of a URI keeps as they are (RFC 3986 unreserved and sub-delims,
@@ -326,7 +339,7 @@ pub fn relocate(asset: &Asset, output: &Path, rewrite_uris: bool) -> Result<Relo
                     }
                 };
                 if !from.is_file() {
-                    relocation.notes.push(Note::ResourceMissing {
+                    relocation.notes.push(RelocationNote::ResourceMissing {
                         uri: uri.to_string(),
                     });
                 } else if !relocation.copies.iter().any(|c| c.uri == uri) {
@@ -361,13 +374,13 @@ pub fn relocate(asset: &Asset, output: &Path, rewrite_uris: bool) -> Result<Relo
         let leaves_folder = relocation.edits.iter().any(
             |e| matches!(e, Edit::Set { value: Value::String(u), .. } if u.starts_with("../")),
         );
-        relocation.notes.push(Note::UrisRewritten {
+        relocation.notes.push(RelocationNote::UrisRewritten {
             count: rewritten,
             leaves_folder,
         });
     }
     if !relocation.copies.is_empty() {
-        relocation.notes.push(Note::ResourcesCopied {
+        relocation.notes.push(RelocationNote::ResourcesCopied {
             count: relocation.copies.len(),
         });
     }

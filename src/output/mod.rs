@@ -1,0 +1,41 @@
+//! Where the outputs of `velvet migrate` and `velvet bake` go and what is written besides them:
+//! both commands take the same destinations and refuse the same requests, keep an output in
+//! another folder loadable the same way, and word their reports alike, so these rules live here
+//! once, owned by neither command.
+//!
+//! [`paths`] pairs inputs with outputs and says what must follow an output (relative URIs,
+//! resource copies, link checks); [`files`] writes new image files and resource copies next to
+//! an output; [`summary`] holds the wording the two text reports share. [`UsageError`] is a
+//! request either command refuses before anything is read or written.
+
+pub mod files;
+pub mod paths;
+pub mod summary;
+
+/// A request velvet cannot carry out as given (exit status 2): nothing is read or written.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum UsageError {
+    #[error("say where the output goes: -o FILE (one input), --out-dir DIR or --in-place (or use --dry-run)")]
+    NoDestination,
+    #[error("-o names one output file, but {0} inputs were given; use --out-dir DIR for several")]
+    OutputForMany(usize),
+    #[error("-o names one output file, but {0} is a folder; use --out-dir DIR")]
+    OutputForFolder(String),
+    #[error("-o {output}: the input {input} is a {container} file and the output keeps its container; name the output *.{extension}")]
+    ContainerMismatch {
+        input: String,
+        output: String,
+        container: &'static str,
+        extension: &'static str,
+    },
+    #[error("the output {output} is the input {input}; use --in-place to overwrite inputs")]
+    OutputIsInput { output: String, input: String },
+    #[error("{first} and {second} would both be written to {output}")]
+    OutputCollision {
+        output: String,
+        first: String,
+        second: String,
+    },
+    #[error("no inputs given")]
+    NoInputs,
+}
