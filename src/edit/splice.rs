@@ -72,8 +72,8 @@ struct Span {
 enum Node {
     Scalar,
     /// Members as (where the key's opening quote stands, the value).
-    Object(Vec<(usize, Span)>),
-    Array(Vec<Span>),
+    Object(Box<[(usize, Span)]>),
+    Array(Box<[Span]>),
 }
 
 struct Scanner<'a> {
@@ -111,6 +111,85 @@ impl Scanner<'_> {
         }
     }
 
+    /// Scans the value at the cursor and tells whether it is `value` as velvet writes it
+    /// (numbers compared as [`Compare::Written`]); `None` where the text is not JSON. It stops
+    /// at the first difference.
+    fn holds(&mut self, value: &Value) -> Option<bool> {
+        self.skip_ws();
+        match (self.peek()?, value) {
+            (b'{', Value::Object(map)) => {
+                self.at += 1;
+                self.skip_ws();
+                if self.peek()? == b'}' {
+                    self.at += 1;
+                    return Some(map.is_empty());
+                }
+                let mut seen = std::collections::HashSet::with_capacity(map.len());
+                loop {
+                    self.skip_ws();
+                    let key_start = self.at;
+                    if self.peek()? != b'"' {
+                        return None;
+                    }
+                    self.string()?;
+                    let key = key_at(self.text, key_start)?;
+                    self.eat(b':')?;
+                    let Some(member) = map.get(key.as_ref()) else {
+                        return Some(false);
+                    };
+                    if !seen.insert(key) || !self.holds(member)? {
+                        return Some(false);
+                    }
+                    self.skip_ws();
+                    match self.peek()? {
+                        b',' => self.at += 1,
+                        b'}' => {
+                            self.at += 1;
+                            return Some(seen.len() == map.len());
+                        }
+                        _ => return None,
+                    }
+                }
+            }
+            (b'[', Value::Array(items)) => {
+                self.at += 1;
+                self.skip_ws();
+                if self.peek()? == b']' {
+                    self.at += 1;
+                    return Some(items.is_empty());
+                }
+                let mut count = 0;
+                loop {
+                    let Some(item) = items.get(count) else {
+                        return Some(false);
+                    };
+                    if !self.holds(item)? {
+                        return Some(false);
+                    }
+                    count += 1;
+                    self.skip_ws();
+                    match self.peek()? {
+                        b',' => self.at += 1,
+                        b']' => {
+                            self.at += 1;
+                            return Some(count == items.len());
+                        }
+                        _ => return None,
+                    }
+                }
+            }
+            (b'{' | b'[', _) => Some(false),
+            _ => {
+                let span = self.value()?;
+                Some(scalar_matches(
+                    &self.text[span.start..span.end],
+                    value,
+                    Compare::Written,
+                ))
+            }
+        }
+    }
+
     fn value(&mut self) -> Option<Span> {
         self.skip_ws();
         let start = self.at;
@@ -142,7 +221,7 @@ impl Scanner<'_> {
                         }
                     }
                 }
-                Node::Object(members)
+                Node::Object(members.into_boxed_slice())
             }
             b'[' => {
                 self.at += 1;
@@ -164,7 +243,7 @@ impl Scanner<'_> {
                         }
                     }
                 }
-                Node::Array(items)
+                Node::Array(items.into_boxed_slice())
             }
             b'"' => {
                 self.string()?;
@@ -469,13 +548,7 @@ fn key_at(text: &str, at: usize) -> Option<std::borrow::Cow<'_, str>> {
 /// True when the value at `span` in `text` is `value`.
 fn matches(text: &str, span: &Span, value: &Value, compare: Compare) -> bool {
     match (&span.node, value) {
-        (Node::Scalar, _) => match serde_json::from_str::<Value>(&text[span.start..span.end]) {
-            Ok(Value::Number(a)) if compare == Compare::Written => {
-                matches!(value, Value::Number(b) if a.to_string() == number_text(b))
-            }
-            Ok(v) => v == *value,
-            Err(_) => false,
-        },
+        (Node::Scalar, _) => scalar_matches(&text[span.start..span.end], value, compare),
         (Node::Object(members), Value::Object(map)) => {
             if members.len() != map.len() {
                 return false;
@@ -499,18 +572,28 @@ fn matches(text: &str, span: &Span, value: &Value, compare: Compare) -> bool {
     }
 }
 
+/// True when the scalar written `raw` is `value`.
+fn scalar_matches(raw: &str, value: &Value, compare: Compare) -> bool {
+    match serde_json::from_str::<Value>(raw) {
+        Ok(Value::Number(a)) if compare == Compare::Written => {
+            matches!(value, Value::Number(b) if a.to_string() == number_text(b))
+        }
+        Ok(v) => v == *value,
+        Err(_) => false,
+    }
+}
+
 /// True when `text` holds `value` with its numbers as velvet writes them: the check a spliced
-/// text passes before it is written. It reads the text without building a document.
+/// text passes before it is written. It reads the text as it compares, holding neither a
+/// document nor a tree of spans.
 pub fn reads_as_written(text: &str, value: &Value) -> bool {
     let mut scanner = Scanner { text, at: 0 };
-    let Some(root) = scanner.value() else {
+    if scanner.holds(value) != Some(true) {
         return false;
-    };
+    }
     scanner.skip_ws();
     let rest = text[scanner.at..].trim_end_matches(['\0', ' ', '\t', '\n', '\r']);
-    rest.is_empty()
-        && serde_json::from_str::<serde::de::IgnoredAny>(text).is_ok()
-        && matches(text, &root, value, Compare::Written)
+    rest.is_empty() && serde_json::from_str::<serde::de::IgnoredAny>(text).is_ok()
 }
 
 /// Writes `after` over `span`: on one line where the old value was a one-line container, laid
@@ -820,6 +903,14 @@ mod tests {
             r#"{"a": [1, 0.75], "b": "x"} {"#,
             r#"{"a": [1, 0.75] "b": "x"}"#,
             r#"{"a": [1, tru], "b": "x"}"#,
+            r#"{"a": [1], "b": "x"}"#,
+            r#"{"a": [1, 0.75, 2], "b": "x"}"#,
+            r#"{"a": {"0": 1}, "b": "x"}"#,
+            r#"{"a": [1, 0.75], "c": "x"}"#,
+            r#"{"a": [1, 0.75], "b": "x", "c": 1}"#,
+            r#"{"a": [1, 0.7499999999999999], "b": "x"}"#,
+            r#"["a"]"#,
+            "",
         ] {
             assert!(!reads_as_written(wrong, &value), "{wrong}");
         }
