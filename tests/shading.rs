@@ -123,3 +123,32 @@ fn points_and_plot_together_are_a_usage_error() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("cannot be used with"));
 }
+
+/// The default roughness budget, measured by appearance: moving the fuzz roughness by the
+/// budget from the mapping's α(r) adds little to the cosine-weighted rms difference in
+/// reflectance that the mapping itself leaves, while three times the budget would add more
+/// than the smallest difference the mapping leaves anywhere (docs/shading.md, "The roughness
+/// budget").
+#[test]
+fn the_default_roughness_budget_adds_little_to_the_mappings_own_appearance_difference() {
+    use velvet::migrate::budget::DEFAULT_BUDGET;
+    use velvet::shading::mapping::{fuzz_roughness_for_sheen, mapping_rms};
+    let mut least_own = f64::INFINITY;
+    let mut most_added_at_budget: f64 = 0.0;
+    let mut most_added_at_triple: f64 = 0.0;
+    for i in 1..=20 {
+        let r = f64::from(i) / 20.0;
+        let alpha = fuzz_roughness_for_sheen(r);
+        let own = mapping_rms(r, alpha);
+        let added = |d: f64| {
+            mapping_rms(r, (alpha + d).min(1.0)).max(mapping_rms(r, (alpha - d).max(0.0))) - own
+        };
+        least_own = least_own.min(own);
+        most_added_at_budget = most_added_at_budget.max(added(DEFAULT_BUDGET));
+        most_added_at_triple = most_added_at_triple.max(added(3.0 * DEFAULT_BUDGET));
+    }
+    assert!((0.0085..0.0095).contains(&least_own), "{least_own}");
+    assert!(most_added_at_budget < 0.0025, "{most_added_at_budget}");
+    assert!(most_added_at_budget < least_own / 3.0);
+    assert!(most_added_at_triple > least_own, "{most_added_at_triple}");
+}

@@ -35,10 +35,10 @@ use serde::Serialize;
 use std::collections::BTreeMap;
 
 /// The default budget: the largest roughness difference a plan may leave, in roughness units.
-/// 0.01 is 2.5 codes of an 8-bit roughness texture, below the mapping's own stated deviation
-/// from the optimum in the fuzz → sheen direction (1.5e-2), and well below the roughness steps
-/// a viewer tells apart in a sheen or fuzz lobe (the lobe's reflectance moves by less than 0.3%
-/// of its albedo per 0.01 of roughness above r = 0.1).
+/// 0.01 is 2.5 codes of an 8-bit roughness texture. Measured by appearance, moving the fuzz
+/// roughness 0.01 from the mapping's α(r) adds at most 0.0023 to the cosine-weighted rms
+/// reflectance difference the mapping itself leaves (never below 0.0091), a quarter of it;
+/// 0.03 would add up to 0.013 (docs/shading.md, "The roughness budget").
 pub const DEFAULT_BUDGET: f64 = 0.01;
 
 /// How far a planned texture may be from the exact target.
