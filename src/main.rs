@@ -410,8 +410,9 @@ fn validate(args: ValidateArgs, color: ColorChoice, quiet: bool) -> ExitCode {
         },
         None => Schemas::builtin(),
     };
-    let validator =
-        Validator::new(schemas, Settings::default()).with_load_options(args.load.options());
+    let validator = Validator::new(schemas, Settings::default())
+        .with_load_options(args.load.options())
+        .with_positions(args.format.shows_positions());
     let progress = report::progress_bar(quiet);
     let options = report::Options {
         color: args.format == Format::Text && color.for_stdout(),

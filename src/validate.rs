@@ -96,6 +96,9 @@ pub struct Validator {
     pub schemas: Schemas,
     pub settings: Settings,
     pub load: asset::LoadOptions,
+    /// Whether findings are placed in the source text (line and column); a report format that
+    /// does not show them skips the scan.
+    pub positions: bool,
 }
 
 impl Validator {
@@ -104,7 +107,13 @@ impl Validator {
             schemas,
             settings,
             load: asset::LoadOptions::default(),
+            positions: true,
         }
+    }
+
+    /// The same validator, placing findings in the source text or not.
+    pub fn with_positions(self, positions: bool) -> Validator {
+        Validator { positions, ..self }
     }
 
     /// The same validator loading files under `load`.
@@ -184,7 +193,7 @@ impl Validator {
             diagnostics,
             Some(info),
         );
-        if !report.findings.is_empty() {
+        if self.positions && !report.findings.is_empty() {
             let positions = asset::position::locate(
                 &asset.json_text,
                 report

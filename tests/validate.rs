@@ -528,6 +528,32 @@ fn a_link_inside_the_folder_that_leads_out_of_it_is_not_followed() {
 }
 
 #[test]
+fn links_are_judged_by_where_they_lead_a_linked_folder_on_the_way_included() {
+    let dir = tempfile::tempdir().unwrap();
+    let outside = dir.path().join("secret");
+    std::fs::create_dir(&outside).unwrap();
+    write_images(&outside);
+    let assets = dir.path().join("assets");
+    std::fs::create_dir_all(assets.join("own")).unwrap();
+    write_images(&assets.join("own"));
+    // A folder on the way out, a link that stays inside, and the asset's folder itself
+    // reached through a link.
+    std::os::unix::fs::symlink(&outside, assets.join("tex")).unwrap();
+    std::os::unix::fs::symlink(assets.join("own/a.png"), assets.join("alias.png")).unwrap();
+    std::os::unix::fs::symlink(&assets, dir.path().join("via")).unwrap();
+    let doc = json!({"asset": {"version": "2.0"}, "images": [
+        {"uri": "tex/a.png"}, {"uri": "alias.png"}, {"uri": "own/a.png"}
+    ]});
+    std::fs::write(assets.join("links.gltf"), doc.to_string()).unwrap();
+    let expected = ["URI_NOT_FOLLOWED /images/0/uri"];
+    assert_eq!(all_findings(&assets.join("links.gltf")), expected);
+    assert_eq!(
+        all_findings(&dir.path().join("via").join("links.gltf")),
+        expected
+    );
+}
+
+#[test]
 fn a_git_lfs_pointer_is_named_with_the_command_that_fetches_it() {
     let (status, out, _) = velvet(&[
         "validate",

@@ -21,7 +21,7 @@ use std::borrow::Cow;
 use std::collections::HashMap;
 use std::io::{BufReader, Cursor};
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
+use std::sync::{Mutex, OnceLock};
 
 /// The file format an asset came in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -54,6 +54,8 @@ pub struct Asset {
     /// The limits and URI policy it was loaded with; resources are read under them too.
     pub options: LoadOptions,
     image_headers: Mutex<HashMap<usize, Result<ImageHeader, Diagnostic>>>,
+    /// The folder with its links resolved, found once on the first resource read.
+    real_base: OnceLock<Option<PathBuf>>,
 }
 
 /// The outcome of loading one file: the asset when its JSON could be read, and every fault
@@ -280,6 +282,7 @@ pub fn load_bytes_with(path: &Path, bytes: &[u8], options: &LoadOptions) -> Load
             bin,
             options: *options,
             image_headers: Mutex::new(HashMap::new()),
+            real_base: OnceLock::new(),
         }),
         diagnostics,
     }
@@ -454,7 +457,10 @@ impl Asset {
         )?;
         if let Location::File(path) = &location {
             if !self.options.allow_outside_uris {
-                resource::check_inside(path, self.base_dir(), uri, pointer)?;
+                let real_base = self
+                    .real_base
+                    .get_or_init(|| resource::real_folder(self.base_dir()));
+                resource::check_inside(path, self.base_dir(), real_base.as_deref(), uri, pointer)?;
             }
         }
         Ok(location)

@@ -136,23 +136,47 @@ pub fn is_remote(uri: &str) -> bool {
 }
 
 /// Refuses a path that lies in `base_dir` by its text but leads out of it through a symbolic
-/// link. A path that does not exist (yet) is left to whoever opens it.
+/// link. A path that does not exist (yet) is left to whoever opens it. `real_base` is
+/// `base_dir` with every link resolved (see [`real_folder`]).
+///
+/// A path below the folder whose every component is a plain name and none a link is inside
+/// without resolving anything: one `lstat` per component, where resolving the whole path
+/// would read every directory above the folder too. Anything else is resolved in full.
 pub fn check_inside(
     path: &Path,
     base_dir: &Path,
+    real_base: Option<&Path>,
     uri: &str,
     pointer: &str,
 ) -> Result<(), Diagnostic> {
+    if let Ok(below) = path.strip_prefix(base_dir) {
+        if below
+            .components()
+            .all(|c| matches!(c, std::path::Component::Normal(_)))
+        {
+            let mut at = base_dir.to_path_buf();
+            let mut plain = true;
+            for part in below.components() {
+                at.push(part);
+                match std::fs::symlink_metadata(&at) {
+                    Ok(meta) if meta.file_type().is_symlink() => {
+                        plain = false;
+                        break;
+                    }
+                    Ok(_) => {}
+                    Err(_) => return Ok(()), // not there (yet): left to whoever opens it
+                }
+            }
+            if plain {
+                return Ok(());
+            }
+        }
+    }
     let Ok(real) = std::fs::canonicalize(path) else {
         return Ok(());
     };
-    let base = if base_dir.as_os_str().is_empty() {
-        Path::new(".")
-    } else {
-        base_dir
-    };
-    match std::fs::canonicalize(base) {
-        Ok(base) if real.starts_with(&base) => Ok(()),
+    match real_base {
+        Some(base) if real.starts_with(base) => Ok(()),
         _ => Err(Diagnostic::new(
             &codes::URI_NOT_FOLLOWED,
             pointer,
@@ -162,6 +186,16 @@ pub fn check_inside(
             ),
         )),
     }
+}
+
+/// `base_dir` with every link resolved (`.` for the empty path); `None` when it cannot be.
+pub fn real_folder(base_dir: &Path) -> Option<PathBuf> {
+    let base = if base_dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        base_dir
+    };
+    std::fs::canonicalize(base).ok()
 }
 
 /// The path of a local `file:` URI (`file:///p`, `file://localhost/p` or `file:/p`), still

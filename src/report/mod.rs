@@ -37,6 +37,14 @@ pub enum Format {
     Github,
 }
 
+impl Format {
+    /// Whether reports in this format show where in the file each finding stands (line and
+    /// column). The Khronos-shaped JSON reports name values by pointer only.
+    pub fn shows_positions(self) -> bool {
+        !matches!(self, Format::Json | Format::Jsonl)
+    }
+}
+
 /// When to colour text output.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
 pub enum ColorChoice {

@@ -271,12 +271,8 @@ fn locate(cx: &Context, uri: &str, pointer: &str, out: &mut Vec<Diagnostic>) -> 
     };
     let fault = |code: &Code, detail: String| Diagnostic::new(code, pointer, detail);
     // Asset::resolve has refused links that lead out of the folder. A stat, not a read.
-    let found = std::fs::canonicalize(&path).and_then(|real| {
-        let meta = std::fs::metadata(&real)?;
-        Ok((real, meta))
-    });
-    let (real, meta) = match found {
-        Ok((real, meta)) if meta.is_file() => (real, meta),
+    let meta = match std::fs::metadata(&path) {
+        Ok(meta) if meta.is_file() => meta,
         Ok(_) => {
             out.push(fault(
                 &codes::IO_ERROR,
@@ -299,7 +295,7 @@ fn locate(cx: &Context, uri: &str, pointer: &str, out: &mut Vec<Diagnostic>) -> 
             return None;
         }
     };
-    if meta.len() <= LFS_POINTER_MAX_LEN && is_lfs_pointer(&real) {
+    if meta.len() <= LFS_POINTER_MAX_LEN && is_lfs_pointer(&path) {
         out.push(fault(
             &GIT_LFS_POINTER,
             format!(
