@@ -279,6 +279,28 @@ impl<'a> Scanner<'a> {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn digit_tokens_name_array_elements_and_object_keys_alike() {
+        let text = "{\"a\": {\"5\": 1, \"05\": 2}, \"b\": [10, 20, 30]}";
+        let at = |found: Option<Position>| found.map(|p| &text[p.offset..p.offset + 2]);
+        let found = locate(
+            text,
+            ["/a/5", "/a/05", "/b/2", "/b/02", "/b/1", "/a/x", "/b/3"],
+        );
+        let found: Vec<_> = found.into_iter().map(at).collect();
+        assert_eq!(
+            found,
+            [
+                Some("1,"),
+                Some("2}"),
+                Some("30"),
+                None,
+                Some("20"),
+                None,
+                None
+            ]
+        );
+    }
 
     #[test]
     fn truncated_text_with_a_multibyte_key_is_scanned_without_panic() {
