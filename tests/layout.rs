@@ -58,10 +58,13 @@ fn migrate(dir: &Path, name: &str, text: &str) -> (Vec<u8>, Vec<u8>) {
 
 const SHEEN: &str = r#""KHR_materials_sheen": {"sheenColorFactor": [1.0, 0.5, 0.25], "sheenRoughnessFactor": 5E-1}"#;
 
+/// A layout case: the file's name, its text, and what every inserted line must satisfy.
+type LayoutCase = (&'static str, String, fn(&str) -> bool);
+
 #[test]
 fn migrate_keeps_every_byte_and_follows_each_layout() {
     let dir = tempfile::tempdir().unwrap();
-    let cases: Vec<(&str, String, fn(&str) -> bool)> = vec![
+    let cases: Vec<LayoutCase> = vec![
         (
             "tabs.gltf",
             format!("{{\n\t\"asset\": {{\n\t\t\"version\": \"2.0\"\n\t}},\n\t\"extensionsUsed\": [\n\t\t\"KHR_materials_sheen\"\n\t],\n\t\"materials\": [\n\t\t{{\n\t\t\t\"name\": \"caf\\u00e9\",\n\t\t\t\"extensions\": {{\n\t\t\t\t{SHEEN}\n\t\t\t}}\n\t\t}}\n\t]\n}}\n"),

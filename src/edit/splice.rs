@@ -314,11 +314,13 @@ impl Layout {
                 }
             }
             match &span.node {
-                Node::Object(members) if members.len() >= 2 => {
-                    if !seen_comma && !text[span.start..span.end].contains('\n') {
-                        layout.inline_comma = text[members[0].1.end..members[1].0].to_string();
-                        seen_comma = true;
-                    }
+                Node::Object(members)
+                    if members.len() >= 2
+                        && !seen_comma
+                        && !text[span.start..span.end].contains('\n') =>
+                {
+                    layout.inline_comma = text[members[0].1.end..members[1].0].to_string();
+                    seen_comma = true;
                 }
                 Node::Array(items) if items.len() >= 2 => {
                     let one_line = !text[span.start..span.end].contains('\n');

@@ -1,7 +1,7 @@
 //! The texture plan of mapped roughness textures, chosen within an error budget.
 //!
 //! A roughness texture read through the fitted mapping holds, per texel t, the target α(f·t)
-//! for the material's factor f (see [`roughness`](super::roughness)); the layer reads
+//! for the material's factor f (see [`roughness`]); the layer reads
 //! factor × texel. Three plans can give it, from cheapest to dearest:
 //!
 //! - [`TexturePlan::Shared`]: one mapped texture per source texture, g(t) = α(t), read by every

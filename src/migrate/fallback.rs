@@ -74,7 +74,7 @@ fn incompatible(a: &Value, b: &Value) -> Option<String> {
 const SAME_VALUE_TOLERANCE: f64 = 1e-12;
 
 /// JSON equality where numbers compare by value (1 equals 1.0, and values within
-/// [`SAME_VALUE_TOLERANCE`] of each other are equal), so that refreshing a fallback made by
+/// `SAME_VALUE_TOLERANCE` of each other are equal), so that refreshing a fallback made by
 /// velvet itself finds it up to date.
 pub fn same_json(a: &Value, b: &Value) -> bool {
     match (a, b) {

@@ -49,7 +49,7 @@ pub fn added(textures: usize, size: usize, dry_run: bool) -> String {
     }
 }
 
-/// The summary's first line, alike for migrate and bake: "N files: X <done>, Y unchanged,
+/// The summary's first line, alike for migrate and bake: "N files: X `<done>`, Y unchanged,
 /// Z failed".
 pub fn files_line(
     files: usize,

@@ -1,4 +1,4 @@
-//! Switched-off layers with textures: sheen is off when sheenColorFactor is [0,0,0] (its
+//! Switched-off layers with textures: sheen is off when sheenColorFactor is `[0, 0, 0]` (its
 //! default) and fuzz when fuzzFactor is 0 (its default). Textures on such a layer have no
 //! effect, which usually means a forgotten factor: exporters often write the texture and rely
 //! on a default that turns the layer off.

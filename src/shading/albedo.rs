@@ -10,10 +10,10 @@
 //! sin²θh is formed from the unnormalised half vector v + l as |horizontal|² / |v + l|², which
 //! lies in [0, 1] by construction (no 1 − NdotH² to go negative).
 //!
-//! Limits: μ is floored at [`MU_MIN`]. Below it the Charlie albedo grows without bound, because the
+//! Limits: μ is floored at [`MU_MIN`](super::charlie::MU_MIN). Below it the Charlie albedo grows without bound, because the
 //! fitted λ stays finite at cosθ = 0 (λ(0) = exp(a + e)) while a masking term that balanced the
 //! 1/(4μ) would have to grow like 1/μ: E(μ) ~ 1/(4 μ λ(μ)) → ∞. Renderers floor NdotV for the
-//! same reason. For r → 0 and μ ≥ [`MU_MIN`], NdotH ≥ μ/2 keeps the half vector off the horizon, so
+//! same reason. For r → 0 and μ ≥ [`MU_MIN`](super::charlie::MU_MIN), NdotH ≥ μ/2 keeps the half vector off the horizon, so
 //! E → 0; the lobe only reaches the view directions near grazing, where for small r the albedo
 //! exceeds 1 (the fitted visibility is not energy conserving there). That excess is why the base
 //! attenuation 1 − max3(sheenColor)·E needs a clamp (see `layering.rs`).

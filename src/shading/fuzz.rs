@@ -358,7 +358,7 @@ pub fn table_node(k: usize) -> f64 {
     k as f64 / (TABLE_SIZE - 1) as f64
 }
 
-/// R at (μ, α) from table values laid out as [`fuzz_table::VALUES`] (R at μ_i = (i/32)²,
+/// R at (μ, α) from table values laid out as `fuzz_table::VALUES` (R at μ_i = (i/32)²,
 /// α_j = j/32 in values[j·33 + i]): Catmull–Rom in √μ and in α, with the samples extended
 /// linearly past the edges, and negative results (an overshoot where R ≈ 0) raised to 0. μ and
 /// α are clamped into [0, 1]; at the nodes the lookup returns the stored value exactly.

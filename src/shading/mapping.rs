@@ -280,9 +280,9 @@ pub fn node(j: usize) -> f64 {
 /// misses in its first cell. R is sampled at α_j = j/32.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ObjectiveSamples {
-    /// E(μ_k, r_j) in sheen[j][k], r_j = (j/32)².
+    /// E(μ_k, r_j) in `sheen[j][k]`, r_j = (j/32)².
     pub sheen: Vec<[f64; MU_NODES]>,
-    /// R(μ_k, α_j) in fuzz[j][k], α_j = j/32.
+    /// R(μ_k, α_j) in `fuzz[j][k]`, α_j = j/32.
     pub fuzz: Vec<[f64; MU_NODES]>,
 }
 

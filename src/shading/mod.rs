@@ -2,7 +2,7 @@
 //! ([`charlie`]), its directional albedo E(μ, r) by three methods behind one function
 //! ([`sheen_albedo`]: quadrature in [`albedo`], tables in [`table`], a closed-form fit in [`fit`]),
 //! the layering of sheen and fuzz over a base ([`layering`]), and the speed-against-error report
-//! ([`accuracy`], drawn by [`plot`], run by `velvet bench` through [`bench`]).
+//! ([`accuracy`], drawn by [`plot`], run by `velvet bench` through [`bench`](mod@bench)).
 
 pub mod accuracy;
 pub mod albedo;

@@ -129,7 +129,7 @@ impl Cell {
 /// The most cells one integration may create before it gives up (and says so).
 pub const MAX_CELLS: usize = 4000;
 
-/// ∫∫ f over [xb[0], xb[last]] × [yb[0], yb[last]] to absolute tolerance `tol`, starting from the
+/// ∫∫ f over `[xb[0], xb[last]] × [yb[0], yb[last]]` to absolute tolerance `tol`, starting from the
 /// cells between consecutive break values (put them at the integrand's kinks).
 pub fn integrate_2d<S: Separable>(f: &S, xb: &[f64], yb: &[f64], tol: f64) -> Estimate {
     assert!(
