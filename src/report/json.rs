@@ -93,6 +93,13 @@ pub fn report_pretty(report: &FileReport) -> String {
     serde_json::to_string_pretty(&shape(report)).expect("a report serialises")
 }
 
+/// One report as an object, pretty-printed and followed by a newline, written straight to
+/// `out` (a report of tens of thousands of findings is never held as text).
+pub fn write_pretty(out: &mut impl std::io::Write, report: &FileReport) -> std::io::Result<()> {
+    serde_json::to_writer_pretty(&mut *out, &shape(report))?;
+    out.write_all(b"\n")
+}
+
 /// One report as an object; several as an array.
 pub fn render(reports: &[FileReport]) -> String {
     let mut text = match reports {

@@ -186,6 +186,11 @@ impl<W: std::io::Write> Stream<W> {
 
     /// Writes what ends the output: the summary line, or the whole-run document.
     pub fn finish(mut self) {
+        if let (Format::Json, false, [one]) = (self.format, self.json_array, self.kept.as_slice()) {
+            let _ = json::write_pretty(&mut self.out, one);
+            let _ = self.out.flush();
+            return;
+        }
         let text = match self.format {
             Format::Text if !self.options.quiet => text::summary(self.files, self.totals),
             Format::Json if self.json_array && self.files == 0 => "[]\n".to_string(),
