@@ -111,6 +111,46 @@ impl Scanner<'_> {
         }
     }
 
+    /// Steps over the opening `{` or `[` at the cursor; true when `close` follows at once (an
+    /// empty container, stepped over too).
+    fn open(&mut self, close: u8) -> Option<bool> {
+        self.at += 1;
+        self.skip_ws();
+        let empty = self.peek()? == close;
+        if empty {
+            self.at += 1;
+        }
+        Some(empty)
+    }
+
+    /// Reads a member's key and its colon; the key's opening quote stands at the offset given.
+    fn key(&mut self) -> Option<usize> {
+        self.skip_ws();
+        let key_start = self.at;
+        if self.peek()? != b'"' {
+            return None;
+        }
+        self.string()?;
+        self.eat(b':')?;
+        Some(key_start)
+    }
+
+    /// After a member or element: true past a `,` (another follows), false past `close`.
+    fn next(&mut self, close: u8) -> Option<bool> {
+        self.skip_ws();
+        match self.peek()? {
+            b',' => {
+                self.at += 1;
+                Some(true)
+            }
+            b if b == close => {
+                self.at += 1;
+                Some(false)
+            }
+            _ => None,
+        }
+    }
+
     /// Scans the value at the cursor and tells whether it is `value` as velvet writes it
     /// (numbers compared as [`Compare::Written`]); `None` where the text is not JSON. It stops
     /// at the first difference.
@@ -118,44 +158,25 @@ impl Scanner<'_> {
         self.skip_ws();
         match (self.peek()?, value) {
             (b'{', Value::Object(map)) => {
-                self.at += 1;
-                self.skip_ws();
-                if self.peek()? == b'}' {
-                    self.at += 1;
+                if self.open(b'}')? {
                     return Some(map.is_empty());
                 }
                 let mut seen = std::collections::HashSet::with_capacity(map.len());
                 loop {
-                    self.skip_ws();
-                    let key_start = self.at;
-                    if self.peek()? != b'"' {
-                        return None;
-                    }
-                    self.string()?;
-                    let key = key_at(self.text, key_start)?;
-                    self.eat(b':')?;
+                    let key = key_at(self.text, self.key()?)?;
                     let Some(member) = map.get(key.as_ref()) else {
                         return Some(false);
                     };
                     if !seen.insert(key) || !self.holds(member)? {
                         return Some(false);
                     }
-                    self.skip_ws();
-                    match self.peek()? {
-                        b',' => self.at += 1,
-                        b'}' => {
-                            self.at += 1;
-                            return Some(seen.len() == map.len());
-                        }
-                        _ => return None,
+                    if !self.next(b'}')? {
+                        return Some(seen.len() == map.len());
                     }
                 }
             }
             (b'[', Value::Array(items)) => {
-                self.at += 1;
-                self.skip_ws();
-                if self.peek()? == b']' {
-                    self.at += 1;
+                if self.open(b']')? {
                     return Some(items.is_empty());
                 }
                 let mut count = 0;
@@ -167,14 +188,8 @@ impl Scanner<'_> {
                         return Some(false);
                     }
                     count += 1;
-                    self.skip_ws();
-                    match self.peek()? {
-                        b',' => self.at += 1,
-                        b']' => {
-                            self.at += 1;
-                            return Some(count == items.len());
-                        }
-                        _ => return None,
+                    if !self.next(b']')? {
+                        return Some(count == items.len());
                     }
                 }
             }
@@ -195,51 +210,25 @@ impl Scanner<'_> {
         let start = self.at;
         let node = match self.peek()? {
             b'{' => {
-                self.at += 1;
                 let mut members = Vec::new();
-                self.skip_ws();
-                if self.peek()? == b'}' {
-                    self.at += 1;
-                } else {
+                if !self.open(b'}')? {
                     loop {
-                        self.skip_ws();
-                        let key_start = self.at;
-                        if self.peek()? != b'"' {
-                            return None;
-                        }
-                        self.string()?;
-                        self.eat(b':')?;
+                        let key_start = self.key()?;
                         members.push((key_start, self.value()?));
-                        self.skip_ws();
-                        match self.peek()? {
-                            b',' => self.at += 1,
-                            b'}' => {
-                                self.at += 1;
-                                break;
-                            }
-                            _ => return None,
+                        if !self.next(b'}')? {
+                            break;
                         }
                     }
                 }
                 Node::Object(members.into_boxed_slice())
             }
             b'[' => {
-                self.at += 1;
                 let mut items = Vec::new();
-                self.skip_ws();
-                if self.peek()? == b']' {
-                    self.at += 1;
-                } else {
+                if !self.open(b']')? {
                     loop {
                         items.push(self.value()?);
-                        self.skip_ws();
-                        match self.peek()? {
-                            b',' => self.at += 1,
-                            b']' => {
-                                self.at += 1;
-                                break;
-                            }
-                            _ => return None,
+                        if !self.next(b']')? {
+                            break;
                         }
                     }
                 }
