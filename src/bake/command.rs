@@ -8,7 +8,6 @@
 //! in place, not written at all). A file the loader reports errors for is not baked.
 
 use std::collections::HashSet;
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
@@ -310,8 +309,7 @@ pub fn run_shard(request: &Request, shard: Option<Shard>) -> Result<Vec<FileResu
         shard,
     )?;
     let claims = Claims::default();
-    let bar = (request.progress && jobs.len() > 1 && std::io::stderr().is_terminal())
-        .then(|| indicatif::ProgressBar::new(jobs.len() as u64));
+    let bar = crate::output::progress_bar(request.progress, jobs.len());
     let mut results: Vec<FileResult> = walk_errors
         .into_iter()
         .map(|(path, e)| {

@@ -14,7 +14,6 @@ use crate::output::UsageError;
 use rayon::prelude::*;
 use serde::Serialize;
 use std::collections::BTreeMap;
-use std::io::IsTerminal;
 use std::path::PathBuf;
 
 /// One `velvet migrate` invocation.
@@ -197,15 +196,7 @@ pub fn run_shard(request: &Request, shard: Option<Shard>) -> Result<RunReport, U
         shard,
     )?;
     let claims = Claims::default();
-    let bar = (request.progress && std::io::stderr().is_terminal() && jobs.len() > 1).then(|| {
-        let bar = indicatif::ProgressBar::new(jobs.len() as u64);
-        if let Ok(style) =
-            indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} files {msg}")
-        {
-            bar.set_style(style);
-        }
-        bar
-    });
+    let bar = crate::output::progress_bar(request.progress, jobs.len());
     let mut files: Vec<FileResult> = walk_errors
         .into_iter()
         .map(|(path, e)| {

@@ -12,6 +12,21 @@ pub mod files;
 pub mod paths;
 pub mod summary;
 
+/// The progress bar of a run over `files` files, when `wanted`: on a terminal only (logs and
+/// pipes never see one), and only for more than one file.
+pub fn progress_bar(wanted: bool, files: usize) -> Option<indicatif::ProgressBar> {
+    use std::io::IsTerminal;
+    (wanted && files > 1 && std::io::stderr().is_terminal()).then(|| {
+        let bar = indicatif::ProgressBar::new(files as u64);
+        if let Ok(style) =
+            indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} files {msg}")
+        {
+            bar.set_style(style);
+        }
+        bar
+    })
+}
+
 /// A request velvet cannot carry out as given (exit status 2): nothing is read or written.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum UsageError {
