@@ -11,7 +11,6 @@ use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
-use rayon::prelude::*;
 use serde::Serialize;
 use serde_json::Value;
 
@@ -26,9 +25,9 @@ use crate::asset::{self, write};
 use crate::diagnostics::Severity;
 use crate::output::files::{copy_resources, create_parent, file_sink, write_new_files};
 use crate::output::files::{Claims, FileNames};
-use crate::output::paths::{check_links, jobs, relocate, Destination, Job, Relocation};
+use crate::output::paths::{check_links, relocate, Destination, Job, Relocation};
 use crate::output::summary::{added, bytes, files_line, plural, Detail};
-use crate::output::UsageError;
+use crate::output::{run_each, Scope, UsageError};
 
 /// What a run does besides where it writes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -302,17 +301,16 @@ pub fn run(request: &Request) -> Result<Vec<FileResult>, UsageError> {
 
 /// Runs like [`run`] over the files of one shard only (see [`Shard`]).
 pub fn run_shard(request: &Request, shard: Option<Shard>) -> Result<Vec<FileResult>, UsageError> {
-    let (jobs, walk_errors) = jobs(
-        &request.inputs,
-        &request.destination,
-        request.dry_run,
+    let scope = Scope {
+        inputs: &request.inputs,
+        destination: &request.destination,
+        dry_run: request.dry_run,
         shard,
-    )?;
-    let claims = Claims::default();
-    let bar = crate::output::progress_bar(request.progress, jobs.len());
-    let mut results: Vec<FileResult> = walk_errors
-        .into_iter()
-        .map(|(path, e)| {
+        progress: request.progress,
+    };
+    run_each(
+        &scope,
+        |path, e| {
             FileResult::new(
                 &path,
                 None,
@@ -320,25 +318,13 @@ pub fn run_shard(request: &Request, shard: Option<Shard>) -> Result<Vec<FileResu
                     error: format!("cannot read folder: {e}"),
                 },
             )
-        })
-        .collect();
-    results.extend(
-        jobs.par_iter()
-            .map(|job| {
-                let result = bake_file(job, request, &claims).unwrap_or_else(|error| {
-                    FileResult::new(&job.input, job.output.as_deref(), Outcome::Failed { error })
-                });
-                if let Some(bar) = &bar {
-                    bar.inc(1);
-                }
-                result
+        },
+        |job, claims| {
+            bake_file(job, request, claims).unwrap_or_else(|error| {
+                FileResult::new(&job.input, job.output.as_deref(), Outcome::Failed { error })
             })
-            .collect::<Vec<_>>(),
-    );
-    if let Some(bar) = bar {
-        bar.finish_and_clear();
-    }
-    Ok(results)
+        },
+    )
 }
 
 /// Totals over a run.

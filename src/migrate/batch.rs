@@ -9,9 +9,8 @@ use super::Options;
 use crate::asset::discover::Shard;
 use crate::edit::Edit;
 use crate::output::files::Claims;
-use crate::output::paths::{jobs, Destination, Job, ResourceCopy};
-use crate::output::UsageError;
-use rayon::prelude::*;
+use crate::output::paths::{Destination, Job, ResourceCopy};
+use crate::output::{run_each, Scope, UsageError};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -189,17 +188,16 @@ pub fn run(request: &Request) -> Result<RunReport, UsageError> {
 
 /// Runs like [`run`] over the files of one shard only (see [`Shard`]).
 pub fn run_shard(request: &Request, shard: Option<Shard>) -> Result<RunReport, UsageError> {
-    let (jobs, walk_errors) = jobs(
-        &request.inputs,
-        &request.destination,
-        request.dry_run,
+    let scope = Scope {
+        inputs: &request.inputs,
+        destination: &request.destination,
+        dry_run: request.dry_run,
         shard,
-    )?;
-    let claims = Claims::default();
-    let bar = crate::output::progress_bar(request.progress, jobs.len());
-    let mut files: Vec<FileResult> = walk_errors
-        .into_iter()
-        .map(|(path, e)| {
+        progress: request.progress,
+    };
+    let files = run_each(
+        &scope,
+        |path, e| {
             FileResult::failed(
                 &Job {
                     input: path.clone(),
@@ -207,18 +205,9 @@ pub fn run_shard(request: &Request, shard: Option<Shard>) -> Result<RunReport, U
                 },
                 format!("cannot read folder {}: {e}", path.display()),
             )
-        })
-        .collect();
-    files.par_extend(jobs.par_iter().map(|job| {
-        let result = migrate_one(job, &request.options, request.dry_run, &claims);
-        if let Some(bar) = &bar {
-            bar.inc(1);
-        }
-        result
-    }));
-    if let Some(bar) = bar {
-        bar.finish_and_clear();
-    }
+        },
+        |job, claims| migrate_one(job, &request.options, request.dry_run, claims),
+    )?;
     let summary = summarise(&files);
     Ok(RunReport {
         dry_run: request.dry_run,

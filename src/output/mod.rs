@@ -5,16 +5,60 @@
 //!
 //! [`paths`] pairs inputs with outputs and says what must follow an output (relative URIs,
 //! resource copies, link checks); [`files`] writes new image files and resource copies next to
-//! an output; [`summary`] holds the wording the two text reports share. [`UsageError`] is a
-//! request either command refuses before anything is read or written.
+//! an output; [`summary`] holds the wording the two text reports share. [`run_each`] runs a
+//! command's files in parallel under one set of name claims and one progress bar.
+//! [`UsageError`] is a request either command refuses before anything is read or written.
 
 pub mod files;
 pub mod paths;
 pub mod summary;
 
+use crate::asset::discover::Shard;
+use rayon::prelude::*;
+use std::path::PathBuf;
+
+/// The files of a migrate or bake request, and how a run over them shows its progress.
+pub struct Scope<'a> {
+    pub inputs: &'a [PathBuf],
+    pub destination: &'a paths::Destination,
+    pub dry_run: bool,
+    pub shard: Option<Shard>,
+    /// A progress bar on a terminal, for runs over more than one file.
+    pub progress: bool,
+}
+
+/// Runs `each` over every file of `scope` in parallel, under one set of name claims, after one
+/// `unreadable` result per folder that could not be read; results come in that order, files in
+/// input order. `Err` is a usage error: nothing was read or written.
+pub fn run_each<R: Send>(
+    scope: &Scope,
+    unreadable: impl Fn(PathBuf, std::io::Error) -> R,
+    each: impl Fn(&paths::Job, &files::Claims) -> R + Sync,
+) -> Result<Vec<R>, UsageError> {
+    let (jobs, walk_errors) =
+        paths::jobs(scope.inputs, scope.destination, scope.dry_run, scope.shard)?;
+    let claims = files::Claims::default();
+    let bar = progress_bar(scope.progress, jobs.len());
+    let mut results: Vec<R> = walk_errors
+        .into_iter()
+        .map(|(path, e)| unreadable(path, e))
+        .collect();
+    results.par_extend(jobs.par_iter().map(|job| {
+        let result = each(job, &claims);
+        if let Some(bar) = &bar {
+            bar.inc(1);
+        }
+        result
+    }));
+    if let Some(bar) = bar {
+        bar.finish_and_clear();
+    }
+    Ok(results)
+}
+
 /// The progress bar of a run over `files` files, when `wanted`: on a terminal only (logs and
 /// pipes never see one), and only for more than one file.
-pub fn progress_bar(wanted: bool, files: usize) -> Option<indicatif::ProgressBar> {
+fn progress_bar(wanted: bool, files: usize) -> Option<indicatif::ProgressBar> {
     use std::io::IsTerminal;
     (wanted && files > 1 && std::io::stderr().is_terminal()).then(|| {
         let bar = indicatif::ProgressBar::new(files as u64);
