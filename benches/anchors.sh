@@ -29,7 +29,15 @@ measure() {
     : > "$work/times"
     while [ $i -lt "$runs" ]; do
         rm -rf "$work/out" && mkdir -p "$work/out"
-        /usr/bin/time -f "%e %M" -o "$work/time1" "$@" > /dev/null 2>&1 || true
+        # velvet validate exits 1 when it finds errors (the generated files have some); any
+        # other failure means the figure would not measure the job, so the run stops.
+        status=0
+        /usr/bin/time -f "%e %M" -o "$work/time1" "$@" > /dev/null 2> "$work/stderr" || status=$?
+        if [ "$status" -gt 1 ]; then
+            echo "$label: exit status $status" >&2
+            cat "$work/stderr" >&2
+            exit 1
+        fi
         tail -n 1 "$work/time1" >> "$work/times"
         i=$((i + 1))
     done
