@@ -3,7 +3,7 @@
 //! material's sheen and fuzz objects (lenient: a schema-invalid value reads as absent, the
 //! schema check reports it).
 
-use serde_json::{Map, Value};
+use crate::asset::tape::JsonView;
 
 pub const SHEEN: &str = "KHR_materials_sheen";
 pub const FUZZ: &str = "KHR_materials_fuzz";
@@ -111,35 +111,38 @@ pub struct TextureRef {
 
 /// A glTF index: a non-negative integer, also when written with a zero fraction (`1.0`), which
 /// JSON Schema counts as an integer.
-pub fn as_index(value: &Value) -> Option<u64> {
-    value.as_u64().or_else(|| {
+pub fn as_index<'a>(value: impl JsonView<'a>) -> Option<u64> {
+    value.unsigned().or_else(|| {
         value
-            .as_f64()
+            .number()
             .filter(|n| *n >= 0.0 && n.fract() == 0.0 && *n < u64::MAX as f64)
             .map(|n| n as u64)
     })
 }
 
 impl TextureRef {
-    pub fn read(value: &Value) -> Option<TextureRef> {
-        let obj = value.as_object()?;
+    pub fn read<'a>(value: impl JsonView<'a>) -> Option<TextureRef> {
+        if !value.object() {
+            return None;
+        }
         Some(TextureRef {
-            index: obj.get("index").and_then(as_index),
-            tex_coord: obj.get("texCoord").and_then(as_index).unwrap_or(0),
+            index: value.member("index").and_then(as_index),
+            tex_coord: value.member("texCoord").and_then(as_index).unwrap_or(0),
         })
     }
 }
 
-fn number(obj: &Map<String, Value>, key: &str) -> Option<f64> {
-    obj.get(key).and_then(Value::as_f64)
+fn number<'a>(obj: impl JsonView<'a>, key: &str) -> Option<f64> {
+    obj.member(key)?.number()
 }
 
-fn rgb(obj: &Map<String, Value>, key: &str) -> Option<[f64; 3]> {
-    let arr = obj.get(key)?.as_array()?;
-    match arr.as_slice() {
-        [r, g, b] => Some([r.as_f64()?, g.as_f64()?, b.as_f64()?]),
-        _ => None,
+fn rgb<'a>(obj: impl JsonView<'a>, key: &str) -> Option<[f64; 3]> {
+    let arr = obj.member(key)?;
+    if arr.length()? != 3 {
+        return None;
     }
+    let c = |i| arr.element(i).and_then(JsonView::number);
+    Some([c(0)?, c(1)?, c(2)?])
 }
 
 /// The largest of three components.
@@ -157,14 +160,16 @@ pub struct SheenView {
 }
 
 impl SheenView {
-    pub fn read(ext: &Value) -> Option<SheenView> {
-        let obj = ext.as_object()?;
+    pub fn read<'a>(obj: impl JsonView<'a>) -> Option<SheenView> {
+        if !obj.object() {
+            return None;
+        }
         Some(SheenView {
             color_factor: rgb(obj, "sheenColorFactor").unwrap_or(SHEEN_COLOR_DEFAULT),
             roughness_factor: number(obj, "sheenRoughnessFactor")
                 .unwrap_or(SHEEN_ROUGHNESS_DEFAULT),
-            color_texture: obj.get("sheenColorTexture").and_then(TextureRef::read),
-            roughness_texture: obj.get("sheenRoughnessTexture").and_then(TextureRef::read),
+            color_texture: obj.member("sheenColorTexture").and_then(TextureRef::read),
+            roughness_texture: obj.member("sheenRoughnessTexture").and_then(TextureRef::read),
         })
     }
 
@@ -187,15 +192,17 @@ pub struct FuzzView {
 }
 
 impl FuzzView {
-    pub fn read(ext: &Value) -> Option<FuzzView> {
-        let obj = ext.as_object()?;
+    pub fn read<'a>(obj: impl JsonView<'a>) -> Option<FuzzView> {
+        if !obj.object() {
+            return None;
+        }
         Some(FuzzView {
             factor: number(obj, "fuzzFactor").unwrap_or(FUZZ_FACTOR_DEFAULT),
             color_factor: rgb(obj, "fuzzColorFactor").unwrap_or(FUZZ_COLOR_DEFAULT),
             roughness_factor: number(obj, "fuzzRoughnessFactor"),
-            texture: obj.get("fuzzTexture").and_then(TextureRef::read),
-            color_texture: obj.get("fuzzColorTexture").and_then(TextureRef::read),
-            roughness_texture: obj.get("fuzzRoughnessTexture").and_then(TextureRef::read),
+            texture: obj.member("fuzzTexture").and_then(TextureRef::read),
+            color_texture: obj.member("fuzzColorTexture").and_then(TextureRef::read),
+            roughness_texture: obj.member("fuzzRoughnessTexture").and_then(TextureRef::read),
         })
     }
 
@@ -212,14 +219,14 @@ impl FuzzView {
 }
 
 /// A material's `extensions` object, if any.
-pub fn extensions(material: &Value) -> Option<&Map<String, Value>> {
+pub fn extensions(material: &serde_json::Value) -> Option<&serde_json::Map<String, serde_json::Value>> {
     material.get("extensions")?.as_object()
 }
 
 /// The materials array (empty when absent or not an array).
-pub fn materials(json: &Value) -> &[Value] {
+pub fn materials(json: &serde_json::Value) -> &[serde_json::Value] {
     json.get("materials")
-        .and_then(Value::as_array)
+        .and_then(serde_json::Value::as_array)
         .map_or(&[], Vec::as_slice)
 }
 

@@ -11,6 +11,8 @@ pub mod limits;
 pub mod pointer;
 pub mod position;
 pub mod resource;
+pub mod tape;
+pub mod tape_schema;
 pub mod write;
 
 use crate::diagnostics::{codes, Diagnostic};
@@ -47,6 +49,8 @@ pub struct Asset {
     pub container: Container,
     pub json: Value,
     pub json_text: String,
+    /// The index of `json_text` that the rules read.
+    pub tape: tape::Tape,
     /// Byte offset of `json_text` in the file (20 in a GLB, 3 after a byte-order mark).
     pub json_offset: usize,
     /// The GLB BIN chunk, if any.
@@ -232,7 +236,15 @@ pub fn load_bytes_with(path: &Path, bytes: &[u8], options: &LoadOptions) -> Load
             diagnostics,
         };
     }
-    let json: Value = match serde_json::from_str(parse_text) {
+    let index = tape::Tape::build(parse_text);
+    let parsed = match &index {
+        Ok(_) => serde_json::from_str(parse_text),
+        Err(_) => serde_json::from_str::<Value>(parse_text).and_then(|_| {
+            // serde_json accepts what the index refused: only a text over 4 GiB gets here.
+            Err(serde::de::Error::custom("the JSON text is too large to index"))
+        }),
+    };
+    let json: Value = match parsed {
         Ok(v) => v,
         Err(e) => {
             diagnostics.push(
@@ -277,6 +289,7 @@ pub fn load_bytes_with(path: &Path, bytes: &[u8], options: &LoadOptions) -> Load
             path: path.to_path_buf(),
             container,
             json,
+            tape: index.expect("the index was built when the JSON parsed"),
             json_text,
             json_offset,
             bin,
@@ -322,12 +335,12 @@ fn check_bin_length(json: &Value, bin: Option<&[u8]>, out: &mut Vec<Diagnostic>)
 
 /// Checks that a buffer's data holds its declared byteLength.
 fn check_buffer_length(
-    buffer: &Value,
+    buffer: tape::Node,
     index: usize,
     actual: usize,
     pointer: &str,
 ) -> Result<(), Diagnostic> {
-    match buffer.get("byteLength").and_then(Value::as_u64) {
+    match buffer.get("byteLength").and_then(|v| v.as_u64()) {
         Some(declared) if (actual as u64) < declared => Err(Diagnostic::new(
             &codes::BUFFER_BYTE_LENGTH_MISMATCH,
             format!("{pointer}/byteLength"),
@@ -343,6 +356,11 @@ fn strip_position(message: &str) -> &str {
 }
 
 impl Asset {
+    /// The document as read from the file, through its index.
+    pub fn root(&self) -> tape::Node<'_> {
+        self.tape.root(&self.json_text)
+    }
+
     /// The folder relative URIs are resolved against.
     pub fn base_dir(&self) -> &Path {
         self.path.parent().unwrap_or(Path::new("."))
@@ -351,16 +369,16 @@ impl Asset {
     /// The bytes of buffer `index`: the GLB BIN chunk, a `data:` URI or a file.
     pub fn buffer_bytes(&self, index: usize) -> Result<Cow<'_, [u8]>, Diagnostic> {
         let pointer = format!("/buffers/{index}");
-        let buffer = self.json.pointer(&pointer).ok_or_else(|| {
+        let buffer = self.root().pointer(&pointer).ok_or_else(|| {
             Diagnostic::new(
                 &codes::UNRESOLVED_REFERENCE,
                 &pointer,
                 format!("buffer {index} does not exist"),
             )
         })?;
-        match buffer.get("uri").and_then(Value::as_str) {
+        match buffer.get("uri").and_then(|u| u.as_str()) {
             Some(uri) => {
-                let bytes = self.read_uri(uri, &format!("{pointer}/uri"))?;
+                let bytes = self.read_uri(&uri, &format!("{pointer}/uri"))?;
                 check_buffer_length(buffer, index, bytes.len(), &pointer)?;
                 Ok(Cow::Owned(bytes))
             }
@@ -381,21 +399,21 @@ impl Asset {
     /// The encoded bytes of image `index`, from its URI or its bufferView.
     pub fn image_bytes(&self, index: usize) -> Result<Cow<'_, [u8]>, Diagnostic> {
         let pointer = format!("/images/{index}");
-        let image = self.json.pointer(&pointer).ok_or_else(|| {
+        let image = self.root().pointer(&pointer).ok_or_else(|| {
             Diagnostic::new(
                 &codes::UNRESOLVED_REFERENCE,
                 &pointer,
                 format!("image {index} does not exist"),
             )
         })?;
-        if let Some(uri) = image.get("uri").and_then(Value::as_str) {
+        if let Some(uri) = image.get("uri").and_then(|u| u.as_str()) {
             return self
-                .read_uri(uri, &format!("{pointer}/uri"))
+                .read_uri(&uri, &format!("{pointer}/uri"))
                 .map(Cow::Owned);
         }
         let view_index = image
             .get("bufferView")
-            .and_then(Value::as_u64)
+            .and_then(|v| v.as_u64())
             .ok_or_else(|| {
                 Diagnostic::new(
                     &codes::IO_ERROR,
@@ -412,7 +430,7 @@ impl Asset {
         pointer: &str,
     ) -> Result<Cow<'_, [u8]>, Diagnostic> {
         let view = self
-            .json
+            .root()
             .pointer(&format!("/bufferViews/{view_index}"))
             .ok_or_else(|| {
                 Diagnostic::new(
@@ -423,10 +441,10 @@ impl Asset {
             })?;
         let buffer = view
             .get("buffer")
-            .and_then(Value::as_u64)
+            .and_then(|v| v.as_u64())
             .unwrap_or(u64::MAX) as usize;
-        let offset = view.get("byteOffset").and_then(Value::as_u64).unwrap_or(0) as usize;
-        let length = view.get("byteLength").and_then(Value::as_u64).unwrap_or(0) as usize;
+        let offset = view.get("byteOffset").and_then(|v| v.as_u64()).unwrap_or(0) as usize;
+        let length = view.get("byteLength").and_then(|v| v.as_u64()).unwrap_or(0) as usize;
         let bytes = self.buffer_bytes(buffer)?;
         let end = offset.checked_add(length).filter(|end| *end <= bytes.len()).ok_or_else(|| {
             Diagnostic::new(
@@ -531,13 +549,13 @@ impl Asset {
         let what = format!("image {index}");
         let pointer = format!("/images/{index}");
         let uri = self
-            .json
+            .root()
             .pointer(&format!("{pointer}/uri"))
-            .and_then(Value::as_str);
+            .and_then(|u| u.as_str());
         if let Some(uri) = uri {
             let uri_pointer = format!("{pointer}/uri");
-            if let Location::File(path) = self.resolve(uri, &uri_pointer)? {
-                let file = resource::open_file(&path, uri, &uri_pointer)?;
+            if let Location::File(path) = self.resolve(&uri, &uri_pointer)? {
+                let file = resource::open_file(&path, &uri, &uri_pointer)?;
                 return resource::read_header(BufReader::new(file), &pointer, &what);
             }
         }

@@ -284,7 +284,7 @@ pub fn plan(asset: &Asset, options: PlanOptions) -> BakePlan {
         if !layer_is_on(layer.extension, layer.value) {
             out.notes.push(Note::new(
                 Level::Info,
-                &layer.pointer,
+                &layer.pointer(),
                 format!(
                     "{} is switched off; its textures are left as they are",
                     layer.extension
@@ -294,13 +294,13 @@ pub fn plan(asset: &Asset, options: PlanOptions) -> BakePlan {
         }
         'slots: for slot_use in uses {
             let slot = slot_use.slot;
-            let pointer = slot_use.pointer.clone();
+            let pointer = slot_use.pointer().clone();
             let (factor, assumed) = match read_factor(layer.value, slot) {
                 Ok(f) => f,
                 Err(message) => {
                     out.notes.push(Note::new(
                         Level::Warning,
-                        format!("{}/{}", layer.pointer, slot.factor),
+                        format!("{}/{}", layer.pointer(), slot.factor),
                         message,
                     ));
                     continue;
@@ -312,7 +312,7 @@ pub fn plan(asset: &Asset, options: PlanOptions) -> BakePlan {
             if let Some(message) = assumed {
                 out.notes.push(Note::new(
                     Level::Warning,
-                    format!("{}/{}", layer.pointer, slot.factor),
+                    format!("{}/{}", layer.pointer(), slot.factor),
                     message,
                 ));
             }
@@ -320,7 +320,7 @@ pub fn plan(asset: &Asset, options: PlanOptions) -> BakePlan {
                 if options.allow_out_of_range {
                     out.notes.push(Note::new(
                         Level::Warning,
-                        format!("{}/{}", layer.pointer, slot.factor),
+                        format!("{}/{}", layer.pointer(), slot.factor),
                         format!(
                             "{} {factor:?} is outside [0, 1]; baked as asked, results clamped",
                             slot.factor
@@ -329,7 +329,7 @@ pub fn plan(asset: &Asset, options: PlanOptions) -> BakePlan {
                 } else {
                     out.notes.push(Note::new(
                         Level::Warning,
-                        format!("{}/{}", layer.pointer, slot.factor),
+                        format!("{}/{}", layer.pointer(), slot.factor),
                         format!(
                             "{} {factor:?} is outside [0, 1] (the schema forbids it); the slot is \
                              left as it was (--allow-out-of-range bakes it, clamped)",
@@ -407,7 +407,7 @@ pub fn plan(asset: &Asset, options: PlanOptions) -> BakePlan {
                 extension: layer.extension,
                 texture_key: slot.texture,
                 factor_key: slot.factor,
-                layer_pointer: layer.pointer.clone(),
+                layer_pointer: layer.pointer().clone(),
                 texture: texture_index as usize,
                 factor: factor.clone(),
                 written_factor: None,

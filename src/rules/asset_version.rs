@@ -4,7 +4,6 @@
 
 use super::{Context, Rule};
 use crate::diagnostics::{Code, Diagnostic, Severity};
-use serde_json::Value;
 
 pub const UNKNOWN_ASSET_MAJOR_VERSION: Code = Code::new(
     "UNKNOWN_ASSET_MAJOR_VERSION",
@@ -45,8 +44,8 @@ impl Rule for AssetVersion {
     }
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
-        let text = |key: &str| cx.json().get("asset")?.get(key).and_then(Value::as_str);
-        let Some((major, minor)) = text("version").and_then(parse) else {
+        let text = |key: &str| cx.json().get("asset")?.get(key)?.as_str();
+        let Some((major, minor)) = text("version").as_deref().and_then(parse) else {
             return;
         };
         if major != 2 {
@@ -64,7 +63,7 @@ impl Rule for AssetVersion {
                 format!("asset version 2.{minor} is newer than glTF 2.0"),
             ));
         }
-        if let Some((min_major, min_minor)) = text("minVersion").and_then(parse) {
+        if let Some((min_major, min_minor)) = text("minVersion").as_deref().and_then(parse) {
             if (min_major, min_minor) > (major, minor) {
                 out.push(Diagnostic::new(
                     &ASSET_MIN_VERSION_GREATER_THAN_VERSION,

@@ -6,7 +6,6 @@
 use super::{Context, Rule};
 use crate::asset::pointer;
 use crate::diagnostics::{Code, Diagnostic, Severity};
-use serde_json::Value;
 
 pub const MESH_PRIMITIVE_INVALID_ATTRIBUTE: Code = Code::new(
     "MESH_PRIMITIVE_INVALID_ATTRIBUTE",
@@ -37,18 +36,18 @@ impl Rule for Attributes {
     }
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
-        let meshes = cx.json().get("meshes").and_then(Value::as_array);
-        for (m, mesh) in meshes.into_iter().flatten().enumerate() {
-            let primitives = mesh.get("primitives").and_then(Value::as_array);
-            for (p, primitive) in primitives.into_iter().flatten().enumerate() {
-                let attributes = primitive.get("attributes").and_then(Value::as_object);
+        let meshes = cx.json().get("meshes").and_then(|m| m.as_array());
+        for (m, mesh) in meshes.iter().flat_map(|a| a.iter()).enumerate() {
+            let primitives = mesh.get("primitives").and_then(|p| p.as_array());
+            for (p, primitive) in primitives.iter().flat_map(|a| a.iter()).enumerate() {
+                let attributes = primitive.get("attributes").and_then(|a| a.as_object());
                 for name in attributes.into_iter().flat_map(|a| a.keys()) {
-                    if !is_valid_semantic(name) {
+                    if !is_valid_semantic(&name) {
                         out.push(Diagnostic::new(
                             &MESH_PRIMITIVE_INVALID_ATTRIBUTE,
                             format!(
                                 "/meshes/{m}/primitives/{p}/attributes/{}",
-                                pointer::escape(name)
+                                pointer::escape(&name)
                             ),
                             format!(
                                 "'{name}' is not a glTF attribute semantic; application-specific ones start with '_'"

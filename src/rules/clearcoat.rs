@@ -24,11 +24,8 @@ impl Rule for Clearcoat {
     }
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
-        let materials = layers::materials(cx.json());
         for layer in layer_objects(cx.json()) {
-            if !layers::extensions(&materials[layer.material])
-                .is_some_and(|e| e.contains_key(layers::CLEARCOAT))
-            {
+            if layer.extensions.get(layers::CLEARCOAT).is_none() {
                 continue;
             }
             let (code, message) = if layer.extension == layers::SHEEN {
@@ -42,7 +39,7 @@ impl Rule for Clearcoat {
                     "this fuzz layer lies over the clear coat (a sheen layer would lie under it)",
                 )
             };
-            out.push(Diagnostic::new(code, &layer.pointer, message));
+            out.push(Diagnostic::new(code, &layer.pointer(), message));
         }
     }
 }

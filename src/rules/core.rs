@@ -11,6 +11,8 @@
 use super::{Context, Rule};
 use crate::diagnostics::{codes, Code, Diagnostic, Severity};
 use jsonschema::error::ValidationErrorKind;
+use crate::asset::tape::Node;
+use crate::asset::tape_schema::TapeJson;
 use serde_json::Value;
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -91,7 +93,7 @@ pub const NODE_MATRIX_TRS: Code = Code::new(
 
 /// The core schema compiled for one run.
 pub struct CoreSchema {
-    validator: jsonschema::Validator,
+    validator: jsonschema::Validator<TapeJson>,
 }
 
 impl CoreSchema {
@@ -107,7 +109,7 @@ impl CoreSchema {
             })
             .collect();
         let root = files["glTF.schema.json"].clone();
-        let validator = jsonschema::options()
+        let validator = jsonschema::options_for::<TapeJson>()
             .with_draft(jsonschema::Draft::Draft202012)
             // URIs are judged by the resources rule, which knows what a glTF URI may be.
             .should_validate_formats(false)
@@ -118,7 +120,7 @@ impl CoreSchema {
     }
 
     /// Validates `json`, pushing one diagnostic per schema error.
-    pub fn check(&self, json: &Value, out: &mut Vec<Diagnostic>) {
+    pub fn check(&self, json: Node, out: &mut Vec<Diagnostic>) {
         for error in self.validator.iter_errors(json) {
             let at = error.instance_path().as_str().to_string();
             let schema_path = error.schema_path().as_str().to_string();
@@ -283,7 +285,9 @@ mod tests {
 
     fn codes_and_pointers(json: Value) -> Vec<(&'static str, String)> {
         let mut out = Vec::new();
-        CoreSchema::builtin().check(&json, &mut out);
+        let text = json.to_string();
+        let tape = crate::asset::tape::Tape::build(&text).unwrap();
+        CoreSchema::builtin().check(tape.root(&text), &mut out);
         out.into_iter().map(|d| (d.code, d.pointer)).collect()
     }
 

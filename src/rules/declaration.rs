@@ -8,7 +8,7 @@ use super::{layer_objects, Context, Rule};
 use crate::asset::pointer;
 use crate::diagnostics::{Code, Diagnostic, Severity};
 use crate::layers;
-use serde_json::Value;
+use crate::asset::tape::{Kind, Node};
 use std::collections::BTreeSet;
 
 pub const UNDECLARED_EXTENSION: Code = Code::new(
@@ -34,9 +34,9 @@ pub const FUZZ_DECLARED_UNUSED: Code = Code::new(
 
 pub struct Declaration;
 
-fn names(json: &Value, key: &str) -> Vec<(usize, String)> {
+fn names(json: Node, key: &str) -> Vec<(usize, String)> {
     json.get(key)
-        .and_then(Value::as_array)
+        .and_then(|a| a.as_array())
         .map(|a| {
             a.iter()
                 .enumerate()
@@ -113,25 +113,24 @@ impl Rule for Declaration {
 /// properties, and are not searched. The path is kept as tokens (array indices as text) and
 /// made a pointer only for what is reported.
 fn extension_objects<'a>(
-    value: &'a Value,
+    value: Node<'a>,
     path: &mut Vec<std::borrow::Cow<'a, str>>,
     found: &mut dyn FnMut(&[std::borrow::Cow<'a, str>], &str),
 ) {
-    match value {
-        Value::Object(map) => {
-            for (key, child) in map {
+    match value.kind() {
+        Kind::Object => {
+            for (key, child) in value.as_object().into_iter().flat_map(|o| o.iter()) {
                 if key == "extras" {
                     continue;
                 }
-                path.push(key.as_str().into());
-                if key == "extensions" {
-                    if let Value::Object(exts) = child {
-                        for (name, ext) in exts {
-                            path.push(name.as_str().into());
-                            found(path, name);
-                            extension_objects(ext, path, found);
-                            path.pop();
-                        }
+                let is_extensions = key == "extensions";
+                path.push(key);
+                if is_extensions {
+                    for (name, ext) in child.as_object().into_iter().flat_map(|o| o.iter()) {
+                        path.push(name.clone());
+                        found(path.as_slice(), &name);
+                        extension_objects(ext, path, found);
+                        path.pop();
                     }
                 } else if child.is_object() || child.is_array() {
                     extension_objects(child, path, found);
@@ -139,8 +138,8 @@ fn extension_objects<'a>(
                 path.pop();
             }
         }
-        Value::Array(items) => {
-            for (i, child) in items.iter().enumerate() {
+        Kind::Array => {
+            for (i, child) in value.as_array().into_iter().flat_map(|a| a.iter()).enumerate() {
                 if child.is_object() || child.is_array() {
                     path.push(i.to_string().into());
                     extension_objects(child, path, found);

@@ -26,13 +26,9 @@ impl Rule for Exclusions {
     }
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
-        let materials = layers::materials(cx.json());
         for layer in layer_objects(cx.json()) {
-            let Some(exts) = layers::extensions(&materials[layer.material]) else {
-                continue;
-            };
             for excluded in [layers::SPEC_GLOSS, layers::UNLIT] {
-                if exts.contains_key(excluded) {
+                if layer.extensions.get(excluded).is_some() {
                     let code = if layer.extension == layers::SHEEN {
                         &SHEEN_EXCLUDED
                     } else {
@@ -40,7 +36,7 @@ impl Rule for Exclusions {
                     };
                     out.push(Diagnostic::new(
                         code,
-                        &layer.pointer,
+                        &layer.pointer(),
                         format!(
                             "{} must not be used together with {excluded} on one material",
                             layer.extension

@@ -7,7 +7,6 @@
 use super::{Context, Rule};
 use crate::diagnostics::{Code, Diagnostic, Severity};
 use crate::layers::{self, FuzzView, SheenView};
-use serde_json::Value;
 
 pub const FUZZ_WITHOUT_FALLBACK: Code = Code::new(
     "KHR_MATERIALS_FUZZ_WITHOUT_FALLBACK",
@@ -40,10 +39,10 @@ impl Rule for Fallback {
         let json = cx.json();
         let fuzz_required = json
             .get("extensionsRequired")
-            .and_then(Value::as_array)
-            .is_some_and(|a| a.iter().any(|e| e.as_str() == Some(layers::FUZZ)));
-        for (i, material) in layers::materials(json).iter().enumerate() {
-            let Some(exts) = layers::extensions(material) else {
+            .and_then(|r| r.as_array())
+            .is_some_and(|a| a.iter().any(|e| e.is_str(layers::FUZZ)));
+        for (i, material) in super::materials(json).enumerate() {
+            let Some(exts) = material.get("extensions") else {
                 continue;
             };
             let Some(fuzz) = exts.get(layers::FUZZ).and_then(FuzzView::read) else {

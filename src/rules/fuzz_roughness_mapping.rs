@@ -45,8 +45,8 @@ impl Rule for FuzzRoughnessMapping {
     }
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
-        for (i, material) in layers::materials(cx.json()).iter().enumerate() {
-            let Some(exts) = layers::extensions(material) else {
+        for (i, material) in super::materials(cx.json()).enumerate() {
+            let Some(exts) = material.get("extensions") else {
                 continue;
             };
             let (Some(fuzz), Some(sheen)) = (

@@ -34,8 +34,8 @@ impl Rule for ImageSize {
         }
         let count = json
             .get("images")
-            .and_then(serde_json::Value::as_array)
-            .map_or(0, Vec::len);
+            .and_then(|i| i.as_array())
+            .map_or(0, |a| a.len());
         for image in images.into_iter().filter(|&i| (i as usize) < count) {
             let Ok(header) = cx.asset.image_header(image as usize) else {
                 continue;

@@ -28,7 +28,7 @@ impl Rule for LegacySheen {
                 if layer.value.get(name).is_some() {
                     out.push(Diagnostic::new(
                         &SHEEN_LEGACY_DRAFT,
-                        pointer::join(&layer.pointer, name),
+                        pointer::join(&layer.pointer(), name),
                         format!(
                             "{name} belongs to the pre-ratification KHR_materials_sheen draft and is ignored by ratified loaders; `velvet migrate` upgrades it"
                         ),

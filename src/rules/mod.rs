@@ -24,10 +24,10 @@ pub mod roughness_alpha;
 pub mod schema;
 pub mod texcoord;
 
+use crate::asset::tape::{JsonView, Node};
 use crate::asset::{pointer, Asset};
 use crate::diagnostics::{Code, Diagnostic};
 use crate::layers::{self, Slot, TextureRef};
-use serde_json::Value;
 
 /// What a rule sees: the asset and the schemas compiled for this run.
 pub struct Context<'a> {
@@ -35,12 +35,12 @@ pub struct Context<'a> {
     pub schemas: &'a schema::Schemas,
 }
 
-impl Context<'_> {
-    pub fn json(&self) -> &Value {
-        &self.asset.json
+impl<'a> Context<'a> {
+    /// The document, read through the asset's index.
+    pub fn json(&self) -> Node<'a> {
+        self.asset.root()
     }
 }
-
 /// A validation rule.
 pub trait Rule: Sync {
     /// The codes this rule may emit.
@@ -94,84 +94,123 @@ pub fn find_code(name: &str) -> Option<&'static Code> {
 }
 
 /// One sheen or fuzz object on a material.
-pub struct LayerObject<'a> {
+#[derive(Clone, Copy)]
+pub struct LayerObject<J> {
     pub material: usize,
     pub extension: &'static str,
-    pub value: &'a Value,
+    pub value: J,
+    /// The material's `extensions` object, which holds `value`.
+    pub extensions: J,
+}
+
+impl<J> LayerObject<J> {
     /// Pointer to the extension object.
-    pub pointer: String,
+    pub fn pointer(&self) -> String {
+        format!("/materials/{}/extensions/{}", self.material, self.extension)
+    }
 }
 
 /// Every KHR_materials_sheen and KHR_materials_fuzz object in `materials[*].extensions`.
-pub fn layer_objects(json: &Value) -> impl Iterator<Item = LayerObject<'_>> {
-    layers::materials(json)
-        .iter()
-        .enumerate()
-        .flat_map(|(i, material)| {
-            [layers::SHEEN, layers::FUZZ]
-                .into_iter()
-                .filter_map(move |ext| {
-                    let value = layers::extensions(material)?.get(ext)?;
-                    Some(LayerObject {
-                        material: i,
-                        extension: ext,
-                        value,
-                        pointer: format!("/materials/{i}/extensions/{ext}"),
-                    })
+pub fn layer_objects<'a, J: JsonView<'a>>(json: J) -> impl Iterator<Item = LayerObject<J>> + 'a {
+    let materials = json.member("materials");
+    let count = materials.and_then(JsonView::length).unwrap_or(0);
+    (0..count).flat_map(move |i| {
+        let extensions = materials
+            .and_then(|m| m.element(i))
+            .and_then(|m| m.member("extensions"));
+        [layers::SHEEN, layers::FUZZ]
+            .into_iter()
+            .filter_map(move |ext| {
+                let extensions = extensions?;
+                let value = extensions.member(ext)?;
+                Some(LayerObject {
+                    material: i,
+                    extension: ext,
+                    value,
+                    extensions,
                 })
-        })
+            })
+    })
 }
 
 /// A texture slot that is present on a layer object.
-pub struct SlotUse<'a> {
+pub struct SlotUse<J> {
     pub slot: &'static Slot,
     pub texture: TextureRef,
-    pub value: &'a Value,
-    pub pointer: String,
+    pub value: J,
+    material: usize,
+}
+
+impl<J> SlotUse<J> {
+    /// Pointer to the textureInfo.
+    pub fn pointer(&self) -> String {
+        format!(
+            "/materials/{}/extensions/{}/{}",
+            self.material, self.slot.extension, self.slot.texture
+        )
+    }
 }
 
 /// The texture slots a layer object fills.
-pub fn slot_uses<'a>(layer: &'a LayerObject<'a>) -> impl Iterator<Item = SlotUse<'a>> + 'a {
+pub fn slot_uses<'a, J: JsonView<'a>>(
+    layer: &LayerObject<J>,
+) -> impl Iterator<Item = SlotUse<J>> + 'a {
+    let (value, material) = (layer.value, layer.material);
     layers::slots_of(layer.extension).filter_map(move |slot| {
-        let value = layer.value.get(slot.texture)?;
+        let info = value.member(slot.texture)?;
         Some(SlotUse {
             slot,
-            texture: TextureRef::read(value)?,
-            value,
-            pointer: pointer::join(&layer.pointer, slot.texture),
+            texture: TextureRef::read(info)?,
+            value: info,
+            material,
         })
     })
 }
 
 pub use crate::layers::as_index;
 
+/// The elements of an array that may be absent or not an array (then there are none).
+pub fn elements(array: Option<Node<'_>>) -> impl Iterator<Item = Node<'_>> {
+    array
+        .and_then(|a| a.as_array())
+        .into_iter()
+        .flat_map(|a| a.iter())
+}
+
+/// The materials array's elements.
+pub fn materials(json: Node<'_>) -> impl Iterator<Item = Node<'_>> {
+    elements(json.get("materials"))
+}
+
 /// The texCoord set a textureInfo really uses: KHR_texture_transform may override it.
-pub fn effective_tex_coord(texture_info: &Value) -> u64 {
+pub fn effective_tex_coord<'a>(texture_info: impl JsonView<'a>) -> u64 {
     texture_info
-        .pointer(&format!(
-            "/extensions/{}/texCoord",
-            layers::TEXTURE_TRANSFORM
-        ))
-        .and_then(Value::as_u64)
-        .or_else(|| texture_info.get("texCoord").and_then(Value::as_u64))
+        .member("extensions")
+        .and_then(|e| e.member(layers::TEXTURE_TRANSFORM))
+        .and_then(|t| t.member("texCoord"))
+        .and_then(JsonView::unsigned)
+        .or_else(|| texture_info.member("texCoord").and_then(JsonView::unsigned))
         .unwrap_or(0)
 }
 
 /// The images a texture may be drawn from: `source` and the sources of image-format extensions
 /// (EXT_texture_webp, KHR_texture_basisu, …), each with its pointer.
-pub fn texture_sources(texture: &Value, texture_pointer: &str) -> Vec<(Option<u64>, String)> {
+pub fn texture_sources<'a>(
+    texture: impl JsonView<'a>,
+    texture_pointer: &str,
+) -> Vec<(Option<u64>, String)> {
     let mut out = Vec::new();
-    if let Some(source) = texture.get("source") {
-        out.push((source.as_u64(), format!("{texture_pointer}/source")));
+    if let Some(source) = texture.member("source") {
+        out.push((source.unsigned(), format!("{texture_pointer}/source")));
     }
-    if let Some(exts) = texture.get("extensions").and_then(Value::as_object) {
+    if let Some(exts) = texture.member("extensions").and_then(JsonView::members) {
         for (name, ext) in exts {
-            if let Some(source) = ext.get("source") {
+            if let Some(source) = ext.member("source") {
                 out.push((
-                    source.as_u64(),
+                    source.unsigned(),
                     format!(
                         "{texture_pointer}/extensions/{}/source",
-                        pointer::escape(name)
+                        pointer::escape(&name)
                     ),
                 ));
             }

@@ -6,7 +6,8 @@ use super::{Context, Rule};
 use crate::asset::pointer;
 use crate::diagnostics::{Code, Diagnostic, Severity};
 use crate::layers;
-use serde_json::Value;
+use crate::asset::tape::{Kind, Node};
+use std::fmt::Write;
 
 pub const UNEXPECTED_EXTENSION_OBJECT: Code = Code::new(
     "UNEXPECTED_EXTENSION_OBJECT",
@@ -33,15 +34,16 @@ fn is_material(path: &str) -> bool {
         .is_some_and(|rest| !rest.is_empty() && rest.bytes().all(|b| b.is_ascii_digit()))
 }
 
-fn walk(value: &Value, path: &mut String, depth: usize, out: &mut Vec<Diagnostic>) {
+fn walk(value: Node, path: &mut String, depth: usize, out: &mut Vec<Diagnostic>) {
     // Extension objects are never deeper than this in any real asset; stop rather than recurse
     // without bound on hostile input.
     if depth > 64 {
         return;
     }
-    match value {
-        Value::Object(map) => {
-            if let Some(Value::Object(exts)) = map.get("extensions") {
+    match value.kind() {
+        Kind::Object => {
+            let Some(map) = value.as_object() else { return };
+            if let Some(exts) = map.get("extensions").and_then(|e| e.as_object()) {
                 for name in [layers::SHEEN, layers::FUZZ] {
                     if exts.contains_key(name) && !is_material(path) {
                         out.push(Diagnostic::new(
@@ -52,22 +54,22 @@ fn walk(value: &Value, path: &mut String, depth: usize, out: &mut Vec<Diagnostic
                     }
                 }
             }
-            for (key, child) in map {
-                if matches!(child, Value::Object(_) | Value::Array(_)) {
+            for (key, child) in map.iter() {
+                if child.is_object() || child.is_array() {
                     let len = path.len();
                     path.push('/');
-                    path.push_str(&pointer::escape(key));
+                    path.push_str(&pointer::escape(&key));
                     walk(child, path, depth + 1, out);
                     path.truncate(len);
                 }
             }
         }
-        Value::Array(items) => {
+        Kind::Array => {
+            let Some(items) = value.as_array() else { return };
             for (i, child) in items.iter().enumerate() {
-                if matches!(child, Value::Object(_) | Value::Array(_)) {
+                if child.is_object() || child.is_array() {
                     let len = path.len();
-                    path.push('/');
-                    path.push_str(&i.to_string());
+                    let _ = write!(path, "/{i}");
                     walk(child, path, depth + 1, out);
                     path.truncate(len);
                 }

@@ -12,7 +12,8 @@
 use super::{as_index, Context, Rule};
 use crate::asset::pointer;
 use crate::diagnostics::{codes, Code, Diagnostic};
-use serde_json::Value;
+use crate::asset::tape::{Kind, Node};
+use std::borrow::Cow;
 
 pub use codes::UNRESOLVED_REFERENCE;
 
@@ -101,8 +102,8 @@ impl Rule for References {
         let json = cx.json();
         let array_len = |target: &str| {
             json.pointer(target)
-                .and_then(Value::as_array)
-                .map_or(0, Vec::len)
+                .and_then(|a| a.as_array())
+                .map_or(0, |a| a.len())
         };
         for (pattern, target) in LINKS {
             let segments: Vec<&str> = pattern.split('/').skip(1).collect();
@@ -162,10 +163,10 @@ fn unresolved_message(at: &str, index: u64, target: &str, len: usize) -> String 
 }
 
 /// One step of a path into the document.
-#[derive(Clone, Copy)]
+#[derive(Clone)]
 enum Token<'a> {
     Index(usize),
-    Key(&'a str),
+    Key(Cow<'a, str>),
 }
 
 impl Token<'_> {
@@ -180,40 +181,45 @@ impl Token<'_> {
 /// Calls `found` with the path and value of every match of `segments` under `value`. The
 /// path is kept as tokens and turned into a pointer only for what is reported.
 fn walk<'a>(
-    value: &'a Value,
-    segments: &[&str],
+    value: Node<'a>,
+    segments: &[&'static str],
     path: &mut Vec<Token<'a>>,
-    found: &mut dyn FnMut(&[Token<'a>], &'a Value),
+    found: &mut dyn FnMut(&[Token<'a>], Node<'a>),
 ) {
     let Some((first, rest)) = segments.split_first() else {
         found(path, value);
         return;
     };
-    let mut visit = |token: Token<'a>, child: &'a Value, path: &mut Vec<Token<'a>>| {
+    let mut visit = |token: Token<'a>, child: Node<'a>, path: &mut Vec<Token<'a>>| {
         path.push(token);
         walk(child, rest, path, found);
         path.pop();
     };
-    match (*first, value) {
-        ("*", Value::Array(items)) => {
-            for (i, child) in items.iter().enumerate() {
+    match (*first, value.kind()) {
+        ("*", Kind::Array) => {
+            for (i, child) in value.as_array().into_iter().flat_map(|a| a.iter()).enumerate() {
                 visit(Token::Index(i), child, path);
             }
         }
-        ("*", Value::Object(map)) => {
-            for (key, child) in map {
+        ("*", Kind::Object) => {
+            for (key, child) in value.as_object().into_iter().flat_map(|o| o.iter()) {
                 visit(Token::Key(key), child, path);
             }
         }
-        (pattern, Value::Object(map)) if pattern.starts_with('*') => {
+        (pattern, Kind::Object) if pattern.starts_with('*') => {
             let suffix = &pattern[1..];
-            for (key, child) in map.iter().filter(|(k, _)| k.ends_with(suffix)) {
+            for (key, child) in value
+                .as_object()
+                .into_iter()
+                .flat_map(|o| o.iter())
+                .filter(|(k, _)| k.ends_with(suffix))
+            {
                 visit(Token::Key(key), child, path);
             }
         }
-        (key, Value::Object(map)) => {
-            if let Some((key, child)) = map.get_key_value(key) {
-                visit(Token::Key(key), child, path);
+        (key, Kind::Object) => {
+            if let Some(child) = value.get(key) {
+                visit(Token::Key(Cow::Borrowed(key)), child, path);
             }
         }
         _ => {}
@@ -223,7 +229,7 @@ fn walk<'a>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use serde_json::json;
+    use serde_json::{json, Value};
 
     fn unresolved(doc: Value) -> Vec<String> {
         let asset =

@@ -16,7 +16,7 @@ use super::{Context, Rule};
 use crate::asset::resource::{self, ImageFormat, Location};
 use crate::asset::Container;
 use crate::diagnostics::{codes, Code, Diagnostic, Severity};
-use serde_json::Value;
+use crate::asset::tape::Node;
 use std::path::Path;
 
 pub const FILE_NOT_FOUND: Code = Code::new(
@@ -79,16 +79,13 @@ impl Rule for Resources {
     }
 }
 
-fn array<'a>(json: &'a Value, key: &str) -> impl Iterator<Item = (usize, &'a Value)> {
-    json.get(key)
-        .and_then(Value::as_array)
-        .into_iter()
-        .flatten()
+fn array<'a>(json: Node<'a>, key: &str) -> impl Iterator<Item = (usize, Node<'a>)> {
+    super::elements(json.get(key))
         .enumerate()
         .filter(|(_, v)| v.is_object())
 }
 
-fn byte_length(buffer: &Value) -> Option<u64> {
+fn byte_length(buffer: Node) -> Option<u64> {
     buffer.get("byteLength").and_then(super::as_index)
 }
 
@@ -100,7 +97,7 @@ fn short_buffer(index: usize, declared: u64, actual: u64, what: &str) -> Diagnos
     )
 }
 
-fn check_buffer(cx: &Context, index: usize, buffer: &Value, out: &mut Vec<Diagnostic>) {
+fn check_buffer(cx: &Context, index: usize, buffer: Node, out: &mut Vec<Diagnostic>) {
     let declared = byte_length(buffer);
     let Some(uri) = buffer.get("uri") else {
         // The GLB's own buffer is checked against its BIN chunk on load; a buffer that an
@@ -119,7 +116,7 @@ fn check_buffer(cx: &Context, index: usize, buffer: &Value, out: &mut Vec<Diagno
     };
     let Some(uri) = uri.as_str() else { return }; // TYPE_MISMATCH from the schema
     let pointer = format!("/buffers/{index}/uri");
-    match locate(cx, uri, &pointer, out) {
+    match locate(cx, &uri, &pointer, out) {
         Some(Located::Data { media_type, len }) => {
             if !matches!(
                 media_type.as_str(),
@@ -146,15 +143,15 @@ fn check_buffer(cx: &Context, index: usize, buffer: &Value, out: &mut Vec<Diagno
     }
 }
 
-fn check_image(cx: &Context, index: usize, image: &Value, out: &mut Vec<Diagnostic>) {
+fn check_image(cx: &Context, index: usize, image: Node, out: &mut Vec<Diagnostic>) {
     let mut declared = image
         .get("mimeType")
-        .and_then(Value::as_str)
+        .and_then(|m| m.as_str())
         .map(|m| (m.to_string(), format!("/images/{index}/mimeType")));
     if let Some(uri) = image.get("uri") {
         let Some(uri) = uri.as_str() else { return };
         let pointer = format!("/images/{index}/uri");
-        match locate(cx, uri, &pointer, out) {
+        match locate(cx, &uri, &pointer, out) {
             Some(Located::Data { media_type, .. }) => {
                 if declared.is_none() && KNOWN_MIME_TYPES.contains(&media_type.as_str()) {
                     declared = Some((media_type, pointer));
@@ -173,8 +170,8 @@ fn check_image(cx: &Context, index: usize, image: &Value, out: &mut Vec<Diagnost
         .is_some_and(|(mime, _)| !KNOWN_MIME_TYPES.contains(&mime.as_str()))
         || image
             .get("uri")
-            .and_then(Value::as_str)
-            .is_some_and(|uri| !uri.starts_with("data:") && other_format_extension(uri))
+            .and_then(|u| u.as_str())
+            .is_some_and(|uri| !uri.starts_with("data:") && other_format_extension(&uri))
     {
         return;
     }
@@ -221,7 +218,7 @@ fn mime_of(format: ImageFormat) -> &'static str {
 }
 
 /// True when an image's bufferView lies in a buffer already in memory.
-fn view_in_memory(cx: &Context, image: &Value) -> bool {
+fn view_in_memory(cx: &Context, image: Node) -> bool {
     let json = cx.json();
     let Some(buffer) = image
         .get("bufferView")
@@ -233,7 +230,7 @@ fn view_in_memory(cx: &Context, image: &Value) -> bool {
     else {
         return false; // a dangling index is reported by the indices rule
     };
-    match buffer.get("uri").and_then(Value::as_str) {
+    match buffer.get("uri").and_then(|u| u.as_str()) {
         Some(uri) => uri.starts_with("data:"),
         None => cx.asset.bin.is_some(),
     }

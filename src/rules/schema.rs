@@ -9,6 +9,8 @@ use crate::asset::pointer;
 use crate::diagnostics::{codes, Code, Diagnostic};
 use crate::layers;
 use jsonschema::error::ValidationErrorKind;
+use crate::asset::tape::Node;
+use crate::asset::tape_schema::TapeJson;
 use serde_json::Value;
 use std::collections::{BTreeSet, HashMap};
 use std::path::Path;
@@ -71,7 +73,7 @@ struct PropertyTree {
 }
 
 struct LayerSchema {
-    validator: jsonschema::Validator,
+    validator: jsonschema::Validator<TapeJson>,
     properties: PropertyTree,
 }
 
@@ -149,7 +151,7 @@ impl Schemas {
         let files = Arc::new(files);
         let layer = |name: &str| -> Result<LayerSchema, SchemaError> {
             let schema = &files[name];
-            let validator = jsonschema::options()
+            let validator = jsonschema::options_for::<TapeJson>()
                 .with_draft(jsonschema::Draft::Draft4)
                 .with_retriever(FileRetriever(files.clone()))
                 .build(schema)
@@ -217,9 +219,13 @@ fn property_tree(schema: &Value, files: &HashMap<String, Value>, depth: usize) -
     tree
 }
 
-fn unexpected(value: &Value, tree: &PropertyTree, at: &str, out: &mut Vec<Diagnostic>) {
+fn unexpected(value: Node, tree: &PropertyTree, at: &str, out: &mut Vec<Diagnostic>) {
     let Some(obj) = value.as_object() else { return };
-    for (key, child) in obj {
+    for (key, child) in obj.iter() {
+        let key = key.as_ref();
+        if tree.known.contains(key) && !tree.children.contains_key(key) {
+            continue;
+        }
         let here = pointer::join(at, key);
         if !tree.known.contains(key) {
             out.push(Diagnostic::new(
@@ -268,17 +274,17 @@ impl Rule for SchemaCheck {
             };
             for error in schema.validator.iter_errors(layer.value) {
                 let code = code_for(error.kind());
-                let at = format!("{}{}", layer.pointer, error.instance_path().as_str());
+                let at = format!("{}{}", layer.pointer(), error.instance_path().as_str());
                 out.push(Diagnostic::new(code, at, error.to_string()));
             }
             let before = out.len();
-            unexpected(layer.value, &schema.properties, &layer.pointer, out);
+            unexpected(layer.value, &schema.properties, &layer.pointer(), out);
             if layer.extension == layers::SHEEN {
                 // A property of the sheen draft is one fault, reported by the legacy rule under
                 // its more specific code, not here as well.
                 let legacy: Vec<String> = super::legacy_sheen::LEGACY_PROPERTIES
                     .iter()
-                    .map(|name| pointer::join(&layer.pointer, name))
+                    .map(|name| pointer::join(&layer.pointer(), name))
                     .collect();
                 let found = out.split_off(before);
                 out.extend(found.into_iter().filter(|d| {

@@ -2,9 +2,9 @@
 //! KHR_texture_transform substitutes) needs every mesh primitive drawn with that material to
 //! carry TEXCOORD_N, or loaders sample garbage or refuse the mesh.
 
-use super::{effective_tex_coord, layer_objects, slot_uses, Context, Rule};
+use super::{effective_tex_coord, layer_objects, slot_uses, Context, Rule, SlotUse};
+use crate::asset::tape::Node;
 use crate::diagnostics::{Code, Diagnostic, Severity};
-use serde_json::Value;
 use std::collections::HashMap;
 
 pub const MESH_PRIMITIVE_TOO_FEW_TEXCOORDS: Code = Code::new(
@@ -23,36 +23,29 @@ impl Rule for TexCoords {
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
         let json = cx.json();
         // material index -> texCoord sets its sheen/fuzz textures read, with the slot pointer.
-        let mut needs: HashMap<u64, Vec<(u64, String)>> = HashMap::new();
+        let mut needs: HashMap<u64, Vec<(u64, SlotUse<Node>)>> = HashMap::new();
         for layer in layer_objects(json) {
             for slot in slot_uses(&layer) {
                 needs
                     .entry(layer.material as u64)
                     .or_default()
-                    .push((effective_tex_coord(slot.value), slot.pointer));
+                    .push((effective_tex_coord(slot.value), slot));
             }
         }
         if needs.is_empty() {
             return;
         }
-        let meshes = json
-            .get("meshes")
-            .and_then(Value::as_array)
-            .map_or(&[][..], Vec::as_slice);
-        for (m, mesh) in meshes.iter().enumerate() {
-            let primitives = mesh
-                .get("primitives")
-                .and_then(Value::as_array)
-                .map_or(&[][..], Vec::as_slice);
-            for (p, primitive) in primitives.iter().enumerate() {
-                let Some(material) = primitive.get("material").and_then(Value::as_u64) else {
+        for (m, mesh) in super::elements(json.get("meshes")).enumerate() {
+            for (p, primitive) in super::elements(mesh.get("primitives")).enumerate() {
+                let Some(material) = primitive.get("material").and_then(|v| v.as_u64()) else {
                     continue;
                 };
                 let Some(slots) = needs.get(&material) else {
                     continue;
                 };
-                let attributes = primitive.get("attributes").and_then(Value::as_object);
-                for (set, slot_pointer) in slots {
+                let attributes = primitive.get("attributes").and_then(|a| a.as_object());
+                for (set, slot) in slots {
+                    let slot_pointer = slot.pointer();
                     let attribute = format!("TEXCOORD_{set}");
                     if !attributes.is_some_and(|a| a.contains_key(&attribute)) {
                         out.push(Diagnostic::new(

@@ -1,0 +1,1087 @@
+//! The read model: a compact index of the JSON text. One pass over the text records every
+//! value's kind and byte span in a flat array (20 bytes a value, no allocation per value);
+//! [`Node`] reads values from it on demand: a string is borrowed from the text unless it holds
+//! escapes, a number is parsed from its span when asked. Validation reads the document through
+//! this index and never builds a `serde_json::Value` of the whole document, which took about
+//! eight times the text in memory and most of a run's time to build and free.
+//!
+//! Written by hand because the JSON crates at hand either build a tree of owned values
+//! (serde_json's `Value`) or hand out borrowed events without random access (its `RawValue`
+//! keeps a span but no index of what is inside it). The grammar accepted is serde_json's,
+//! RFC 8259 without extensions: a text serde_json refuses is refused here, and the loader then
+//! asks serde_json for its exact message. A unit test and a property test hold the two parsers
+//! to the same verdict and the same values.
+//!
+//! Object members keep their order and their duplicates; lookups give the last duplicate and
+//! iteration gives each key once at its first place with its last value, as serde_json's
+//! order-preserving map does.
+
+use serde_json::Value;
+use std::borrow::Cow;
+
+/// What a value is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kind {
+    Null,
+    Bool,
+    Number,
+    String,
+    Array,
+    Object,
+}
+
+const KIND_BITS: u32 = 3;
+const ESCAPED: u32 = 1 << KIND_BITS;
+const COUNT_SHIFT: u32 = KIND_BITS + 1;
+/// Most members or elements one container may hold (the count shares a word with the kind).
+const MAX_COUNT: u32 = (1 << (32 - COUNT_SHIFT)) - 1;
+
+/// One value (or one object key) in the index.
+#[derive(Debug, Clone, Copy)]
+struct Entry {
+    /// Byte span of the value in the text; for a string, quotes included.
+    start: u32,
+    end: u32,
+    /// Index of the entry after this value and everything inside it.
+    next: u32,
+    /// Kind (3 bits), whether a string holds escapes (1 bit), member or element count.
+    meta: u32,
+    /// For an array: where its element indices start in `Tape::elements`.
+    elements: u32,
+}
+
+impl Entry {
+    fn kind(&self) -> Kind {
+        match self.meta & ((1 << KIND_BITS) - 1) {
+            0 => Kind::Null,
+            1 => Kind::Bool,
+            2 => Kind::Number,
+            3 => Kind::String,
+            4 => Kind::Array,
+            _ => Kind::Object,
+        }
+    }
+
+    fn count(&self) -> usize {
+        (self.meta >> COUNT_SHIFT) as usize
+    }
+}
+
+fn kind_bits(kind: Kind) -> u32 {
+    match kind {
+        Kind::Null => 0,
+        Kind::Bool => 1,
+        Kind::Number => 2,
+        Kind::String => 3,
+        Kind::Array => 4,
+        Kind::Object => 5,
+    }
+}
+
+/// The index of one JSON text. It holds no text: [`Tape::root`] pairs it with the text it was
+/// built from.
+#[derive(Debug, Default)]
+pub struct Tape {
+    entries: Vec<Entry>,
+    /// Entry indices of every array's elements, one run per array.
+    elements: Vec<u32>,
+}
+
+/// Why a text has no index: it is not JSON as serde_json reads it, or it is too large to index.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum TapeError {
+    /// Not JSON at this byte offset; serde_json gives the message.
+    Syntax(usize),
+    /// A text over 4 GiB, or a container with more than 2^28 entries.
+    TooLarge,
+}
+
+/// An open container while the index is built.
+struct Open {
+    entry: u32,
+    count: u32,
+    /// For an array: where its elements start in the scratch stack.
+    scratch: usize,
+    is_object: bool,
+}
+
+struct Builder<'t> {
+    bytes: &'t [u8],
+    at: usize,
+    entries: Vec<Entry>,
+    elements: Vec<u32>,
+    /// Element indices of the arrays still open, innermost last.
+    scratch: Vec<u32>,
+}
+
+impl Tape {
+    /// Indexes `text`, which must be one JSON value with optional whitespace around it.
+    /// Nesting is not limited here (the builder does not recurse); the loader limits it first.
+    pub fn build(text: &str) -> Result<Tape, TapeError> {
+        if text.len() >= u32::MAX as usize {
+            return Err(TapeError::TooLarge);
+        }
+        let mut builder = Builder {
+            bytes: text.as_bytes(),
+            at: 0,
+            // A value takes at least two bytes of pretty-printed text on average.
+            entries: Vec::with_capacity(text.len() / 16),
+            elements: Vec::new(),
+            scratch: Vec::new(),
+        };
+        builder.document()?;
+        Ok(Tape {
+            entries: builder.entries,
+            elements: builder.elements,
+        })
+    }
+
+    /// The root value of `text`, which must be the text this index was built from.
+    pub fn root<'a>(&'a self, text: &'a str) -> Node<'a> {
+        Node {
+            text,
+            tape: self,
+            at: 0,
+        }
+    }
+
+    /// Bytes held by the index (for memory figures).
+    pub fn heap_bytes(&self) -> usize {
+        self.entries.capacity() * std::mem::size_of::<Entry>() + self.elements.capacity() * 4
+    }
+}
+
+impl Builder<'_> {
+    fn skip_whitespace(&mut self) {
+        while let Some(b' ' | b'\n' | b'\r' | b'\t') = self.bytes.get(self.at) {
+            self.at += 1;
+        }
+    }
+
+    fn fail<T>(&self) -> Result<T, TapeError> {
+        Err(TapeError::Syntax(self.at))
+    }
+
+    fn push(&mut self, kind: Kind, start: usize, meta_extra: u32) -> u32 {
+        let index = self.entries.len() as u32;
+        self.entries.push(Entry {
+            start: start as u32,
+            end: self.at as u32,
+            next: index + 1,
+            meta: kind_bits(kind) | meta_extra,
+            elements: 0,
+        });
+        index
+    }
+
+    /// The whole text: one value, whitespace around it, nothing else.
+    fn document(&mut self) -> Result<(), TapeError> {
+        let mut stack: Vec<Open> = Vec::new();
+        self.skip_whitespace();
+        loop {
+            // A value starts here.
+            self.value_start(&mut stack)?;
+            // Close what ends here, then find where the next value starts.
+            loop {
+                self.skip_whitespace();
+                let Some(open) = stack.last_mut() else {
+                    return if self.at == self.bytes.len() {
+                        Ok(())
+                    } else {
+                        self.fail()
+                    };
+                };
+                match self.bytes.get(self.at) {
+                    Some(b',') => {
+                        self.at += 1;
+                        self.skip_whitespace();
+                        if open.is_object {
+                            self.key()?;
+                        }
+                        break;
+                    }
+                    Some(b']') if !open.is_object => {
+                        self.at += 1;
+                        let open = stack.pop().expect("an open array");
+                        self.close(open);
+                    }
+                    Some(b'}') if open.is_object => {
+                        self.at += 1;
+                        let open = stack.pop().expect("an open object");
+                        self.close(open);
+                    }
+                    _ => return self.fail(),
+                }
+            }
+        }
+    }
+
+    /// Reads the value starting here. A scalar is read whole; a container is opened, and so is
+    /// the first value inside it, down to the first scalar or empty container.
+    fn value_start(&mut self, stack: &mut Vec<Open>) -> Result<(), TapeError> {
+        loop {
+            let start = self.at;
+            // A value that is an array element is recorded for its array.
+            if let Some(open) = stack.last_mut() {
+                if open.count == MAX_COUNT {
+                    return Err(TapeError::TooLarge);
+                }
+                open.count += 1;
+                if !open.is_object {
+                    self.scratch.push(self.entries.len() as u32);
+                }
+            }
+            match self.bytes.get(self.at) {
+                Some(b'{') | Some(b'[') => {
+                    let is_object = self.bytes[self.at] == b'{';
+                    self.at += 1;
+                    let kind = if is_object { Kind::Object } else { Kind::Array };
+                    let entry = self.push(kind, start, 0);
+                    let open = Open {
+                        entry,
+                        count: 0,
+                        scratch: self.scratch.len(),
+                        is_object,
+                    };
+                    self.skip_whitespace();
+                    let closer = if is_object { b'}' } else { b']' };
+                    if self.bytes.get(self.at) == Some(&closer) {
+                        self.at += 1;
+                        self.close(open);
+                        return Ok(());
+                    }
+                    stack.push(open);
+                    if is_object {
+                        self.key()?;
+                    }
+                }
+                Some(b'"') => {
+                    let escaped = self.string()?;
+                    self.push(Kind::String, start, if escaped { ESCAPED } else { 0 });
+                    return Ok(());
+                }
+                Some(b'-' | b'0'..=b'9') => {
+                    self.number()?;
+                    self.push(Kind::Number, start, 0);
+                    return Ok(());
+                }
+                Some(b't') => return self.literal(b"true", Kind::Bool, start),
+                Some(b'f') => return self.literal(b"false", Kind::Bool, start),
+                Some(b'n') => return self.literal(b"null", Kind::Null, start),
+                _ => return self.fail(),
+            }
+        }
+    }
+
+    /// Records the end of a container: its span, its count and (for an array) its elements.
+    fn close(&mut self, open: Open) {
+        let next = self.entries.len() as u32;
+        let elements = self.elements.len() as u32;
+        if !open.is_object {
+            self.elements.extend(self.scratch.drain(open.scratch..));
+        }
+        let entry = &mut self.entries[open.entry as usize];
+        entry.end = self.at as u32;
+        entry.next = next;
+        entry.meta |= open.count << COUNT_SHIFT;
+        entry.elements = elements;
+    }
+
+    /// An object key and its colon; leaves `at` on the value.
+    fn key(&mut self) -> Result<(), TapeError> {
+        if self.bytes.get(self.at) != Some(&b'"') {
+            return self.fail();
+        }
+        let start = self.at;
+        let escaped = self.string()?;
+        self.push(Kind::String, start, if escaped { ESCAPED } else { 0 });
+        self.skip_whitespace();
+        if self.bytes.get(self.at) != Some(&b':') {
+            return self.fail();
+        }
+        self.at += 1;
+        self.skip_whitespace();
+        Ok(())
+    }
+
+    fn literal(&mut self, word: &[u8], kind: Kind, start: usize) -> Result<(), TapeError> {
+        for &expected in word {
+            if self.bytes.get(self.at) != Some(&expected) {
+                return self.fail();
+            }
+            self.at += 1;
+        }
+        self.push(kind, start, 0);
+        Ok(())
+    }
+
+    /// A string from its opening quote; says whether it holds escapes. Escapes are checked as
+    /// serde_json checks them, lone surrogates included.
+    fn string(&mut self) -> Result<bool, TapeError> {
+        let start = self.at;
+        self.at += 1;
+        let mut escaped = false;
+        loop {
+            // The text is UTF-8 already: only quotes, backslashes and control characters matter.
+            let rest = &self.bytes[self.at..];
+            match rest
+                .iter()
+                .position(|&b| b == b'"' || b == b'\\' || b < 0x20)
+            {
+                None => {
+                    self.at = self.bytes.len();
+                    return self.fail();
+                }
+                Some(i) => {
+                    self.at += i;
+                    match self.bytes[self.at] {
+                        b'"' => {
+                            self.at += 1;
+                            break;
+                        }
+                        b'\\' => {
+                            escaped = true;
+                            self.at += 1;
+                            match self.bytes.get(self.at) {
+                                Some(b'"' | b'\\' | b'/' | b'b' | b'f' | b'n' | b'r' | b't') => {
+                                    self.at += 1
+                                }
+                                Some(b'u') => {
+                                    self.at += 1;
+                                    for _ in 0..4 {
+                                        match self.bytes.get(self.at) {
+                                            Some(b) if b.is_ascii_hexdigit() => self.at += 1,
+                                            _ => return self.fail(),
+                                        }
+                                    }
+                                }
+                                _ => return self.fail(),
+                            }
+                        }
+                        _ => return self.fail(),
+                    }
+                }
+            }
+        }
+        if escaped {
+            // Surrogate pairing is serde_json's to judge; escapes are rare in glTF.
+            let text = std::str::from_utf8(&self.bytes[start..self.at]).map_err(|_| TapeError::Syntax(start))?;
+            if serde_json::from_str::<String>(text).is_err() {
+                return Err(TapeError::Syntax(start));
+            }
+        }
+        Ok(escaped)
+    }
+
+    /// `-? (0 | [1-9][0-9]*) (. [0-9]+)? ([eE] [+-]? [0-9]+)?`
+    fn number(&mut self) -> Result<(), TapeError> {
+        let digits = |b: &mut Self| {
+            let from = b.at;
+            while let Some(b'0'..=b'9') = b.bytes.get(b.at) {
+                b.at += 1;
+            }
+            b.at > from
+        };
+        if self.bytes.get(self.at) == Some(&b'-') {
+            self.at += 1;
+        }
+        match self.bytes.get(self.at) {
+            Some(b'0') => self.at += 1,
+            Some(b'1'..=b'9') => {
+                digits(self);
+            }
+            _ => return self.fail(),
+        }
+        if self.bytes.get(self.at) == Some(&b'.') {
+            self.at += 1;
+            if !digits(self) {
+                return self.fail();
+            }
+        }
+        if let Some(b'e' | b'E') = self.bytes.get(self.at) {
+            self.at += 1;
+            if let Some(b'+' | b'-') = self.bytes.get(self.at) {
+                self.at += 1;
+            }
+            if !digits(self) {
+                return self.fail();
+            }
+        }
+        Ok(())
+    }
+}
+
+/// One value of an indexed text. Cheap to copy.
+#[derive(Clone, Copy)]
+pub struct Node<'a> {
+    text: &'a str,
+    tape: &'a Tape,
+    at: u32,
+}
+
+impl std::fmt::Debug for Node<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.raw())
+    }
+}
+
+impl<'a> Node<'a> {
+    fn entry(&self) -> &'a Entry {
+        &self.tape.entries[self.at as usize]
+    }
+
+    fn node(&self, at: u32) -> Node<'a> {
+        Node {
+            text: self.text,
+            tape: self.tape,
+            at,
+        }
+    }
+
+    pub fn kind(&self) -> Kind {
+        self.entry().kind()
+    }
+
+    /// The value's text, as written.
+    pub fn raw(&self) -> &'a str {
+        let e = self.entry();
+        &self.text[e.start as usize..e.end as usize]
+    }
+
+    /// Byte span of the value in the text.
+    pub fn span(&self) -> std::ops::Range<usize> {
+        let e = self.entry();
+        e.start as usize..e.end as usize
+    }
+
+    /// A number unique to this value within its document.
+    pub fn id(&self) -> u32 {
+        self.at
+    }
+
+    /// The address of the index this value belongs to: with [`Node::id`], a value's identity.
+    pub fn document_address(&self) -> usize {
+        std::ptr::from_ref(self.tape) as usize
+    }
+
+    pub fn is_object(&self) -> bool {
+        self.kind() == Kind::Object
+    }
+    pub fn is_array(&self) -> bool {
+        self.kind() == Kind::Array
+    }
+    pub fn is_string(&self) -> bool {
+        self.kind() == Kind::String
+    }
+    pub fn is_number(&self) -> bool {
+        self.kind() == Kind::Number
+    }
+    pub fn is_null(&self) -> bool {
+        self.kind() == Kind::Null
+    }
+
+    pub fn as_bool(&self) -> Option<bool> {
+        (self.kind() == Kind::Bool).then(|| self.raw() == "true")
+    }
+
+    /// A string's value: borrowed from the text when it holds no escapes.
+    pub fn as_str(&self) -> Option<Cow<'a, str>> {
+        let e = self.entry();
+        if e.kind() != Kind::String {
+            return None;
+        }
+        let raw = self.raw();
+        if e.meta & ESCAPED == 0 {
+            Some(Cow::Borrowed(&raw[1..raw.len() - 1]))
+        } else {
+            // Checked when the index was built.
+            Some(Cow::Owned(serde_json::from_str(raw).unwrap_or_default()))
+        }
+    }
+
+    /// Whether this is the string `s`.
+    pub fn is_str(&self, s: &str) -> bool {
+        self.as_str().is_some_and(|v| v == s)
+    }
+
+    /// A number as the nearest f64; `None` past its range (`1e400`), as serde_json reads it.
+    pub fn as_f64(&self) -> Option<f64> {
+        if self.kind() != Kind::Number {
+            return None;
+        }
+        self.raw().parse().ok().filter(|f: &f64| f.is_finite())
+    }
+
+    /// A number written as a non-negative integer that fits in 64 bits (`1.0` is not).
+    pub fn as_u64(&self) -> Option<u64> {
+        if self.kind() != Kind::Number {
+            return None;
+        }
+        self.raw().parse().ok()
+    }
+
+    /// A number written as an integer that fits in 64 bits.
+    pub fn as_i64(&self) -> Option<i64> {
+        if self.kind() != Kind::Number {
+            return None;
+        }
+        self.raw().parse().ok()
+    }
+
+    pub fn as_object(&self) -> Option<Object<'a>> {
+        self.is_object().then_some(Object { node: *self })
+    }
+
+    pub fn as_array(&self) -> Option<Array<'a>> {
+        self.is_array().then_some(Array { node: *self })
+    }
+
+    /// An object's member (the last, if the key is duplicated) or an array's element, as
+    /// `serde_json::Value::get` reads them.
+    pub fn get<I: Index>(&self, index: I) -> Option<Node<'a>> {
+        index.index_into(*self)
+    }
+
+    /// The value an RFC 6901 pointer names, as `serde_json::Value::pointer` finds it.
+    pub fn pointer(&self, pointer: &str) -> Option<Node<'a>> {
+        if pointer.is_empty() {
+            return Some(*self);
+        }
+        let rest = pointer.strip_prefix('/')?;
+        let mut node = *self;
+        for token in rest.split('/') {
+            let token = if token.contains('~') {
+                Cow::Owned(token.replace("~1", "/").replace("~0", "~"))
+            } else {
+                Cow::Borrowed(token)
+            };
+            node = match node.kind() {
+                Kind::Object => node.as_object()?.get(&token)?,
+                Kind::Array => {
+                    // As serde_json: decimal digits without a leading zero (but "0").
+                    if token.starts_with('+') || (token.len() > 1 && token.starts_with('0')) {
+                        return None;
+                    }
+                    node.as_array()?.get(token.parse().ok()?)?
+                }
+                _ => return None,
+            };
+        }
+        Some(node)
+    }
+
+    /// The value as a `serde_json::Value`, for the few places that need one (error reports,
+    /// comparisons of whole values).
+    pub fn to_value(&self) -> Value {
+        serde_json::from_str(self.raw()).unwrap_or(Value::Null)
+    }
+}
+
+/// What [`Node::get`] takes: a key or an array index.
+pub trait Index {
+    fn index_into<'a>(&self, node: Node<'a>) -> Option<Node<'a>>;
+}
+
+impl Index for &str {
+    fn index_into<'a>(&self, node: Node<'a>) -> Option<Node<'a>> {
+        node.as_object()?.get(self)
+    }
+}
+
+impl Index for usize {
+    fn index_into<'a>(&self, node: Node<'a>) -> Option<Node<'a>> {
+        node.as_array()?.get(*self)
+    }
+}
+
+impl Index for &String {
+    fn index_into<'a>(&self, node: Node<'a>) -> Option<Node<'a>> {
+        node.as_object()?.get(self)
+    }
+}
+
+/// An object's members.
+#[derive(Clone, Copy)]
+pub struct Object<'a> {
+    node: Node<'a>,
+}
+
+impl<'a> Object<'a> {
+    /// Members as written, duplicates included: (key entry, value entry).
+    fn raw_members(&self) -> RawMembers<'a> {
+        let e = self.node.entry();
+        RawMembers {
+            node: self.node,
+            at: self.node.at + 1,
+            end: e.next,
+        }
+    }
+
+    /// Whether a key entry spells `key`.
+    fn key_is(&self, key_at: u32, key: &str) -> bool {
+        let k = self.node.node(key_at);
+        let e = k.entry();
+        if e.meta & ESCAPED == 0 {
+            let raw = k.raw();
+            &raw[1..raw.len() - 1] == key
+        } else {
+            k.as_str().is_some_and(|s| s == key)
+        }
+    }
+
+    /// The value of `key`: the last one, if the key is written more than once.
+    pub fn get(&self, key: &str) -> Option<Node<'a>> {
+        let mut found = None;
+        for (k, v) in self.raw_members() {
+            if self.key_is(k, key) {
+                found = Some(v);
+            }
+        }
+        found.map(|at| self.node.node(at))
+    }
+
+    pub fn contains_key(&self, key: &str) -> bool {
+        self.raw_members().any(|(k, _)| self.key_is(k, key))
+    }
+
+    /// Distinct keys.
+    pub fn len(&self) -> usize {
+        let count = self.node.entry().count();
+        if self.has_duplicates() {
+            self.iter().count()
+        } else {
+            count
+        }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.node.entry().count() == 0
+    }
+
+    fn has_duplicates(&self) -> bool {
+        let count = self.node.entry().count();
+        if count < 2 {
+            return false;
+        }
+        let keys: Vec<Cow<'a, str>> = self
+            .raw_members()
+            .map(|(k, _)| self.node.node(k).as_str().unwrap_or_default())
+            .collect();
+        if count <= 16 {
+            return (1..keys.len()).any(|i| keys[..i].contains(&keys[i]));
+        }
+        let mut seen = std::collections::HashSet::with_capacity(keys.len());
+        !keys.iter().all(|k| seen.insert(k))
+    }
+
+    /// Members in order: each key once, at its first place, with its last value.
+    pub fn iter(&self) -> Members<'a> {
+        let duplicates = self.has_duplicates();
+        Members {
+            object: *self,
+            raw: self.raw_members(),
+            duplicates,
+        }
+    }
+
+    pub fn keys(&self) -> impl Iterator<Item = Cow<'a, str>> + 'a {
+        self.iter().map(|(k, _)| k)
+    }
+
+    pub fn values(&self) -> impl Iterator<Item = Node<'a>> + 'a {
+        self.iter().map(|(_, v)| v)
+    }
+}
+
+#[derive(Clone)]
+struct RawMembers<'a> {
+    node: Node<'a>,
+    at: u32,
+    end: u32,
+}
+
+impl Iterator for RawMembers<'_> {
+    /// (key entry, value entry)
+    type Item = (u32, u32);
+    fn next(&mut self) -> Option<(u32, u32)> {
+        if self.at >= self.end {
+            return None;
+        }
+        let key = self.at;
+        let value = key + 1;
+        self.at = self.node.tape.entries[value as usize].next;
+        Some((key, value))
+    }
+}
+
+/// The members of an object, as [`Object::iter`] gives them.
+pub struct Members<'a> {
+    object: Object<'a>,
+    raw: RawMembers<'a>,
+    duplicates: bool,
+}
+
+impl<'a> Iterator for Members<'a> {
+    type Item = (Cow<'a, str>, Node<'a>);
+    fn next(&mut self) -> Option<Self::Item> {
+        loop {
+            let (k, v) = self.raw.next()?;
+            let node = self.object.node;
+            let key = node.node(k).as_str().unwrap_or_default();
+            if !self.duplicates {
+                return Some((key, node.node(v)));
+            }
+            // A key seen before was given at its first place; a first one takes its last value.
+            let earlier = RawMembers {
+                node,
+                at: node.at + 1,
+                end: k,
+            };
+            if earlier
+                .clone()
+                .any(|(e, _)| node.node(e).as_str().unwrap_or_default() == key)
+            {
+                continue;
+            }
+            let value = self.object.get(&key).unwrap_or(node.node(v));
+            return Some((key, value));
+        }
+    }
+}
+
+/// An array's elements.
+#[derive(Clone, Copy)]
+pub struct Array<'a> {
+    node: Node<'a>,
+}
+
+impl<'a> Array<'a> {
+    fn indices(&self) -> &'a [u32] {
+        let e = self.node.entry();
+        let from = e.elements as usize;
+        &self.node.tape.elements[from..from + e.count()]
+    }
+
+    pub fn len(&self) -> usize {
+        self.node.entry().count()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    pub fn get(&self, index: usize) -> Option<Node<'a>> {
+        self.indices().get(index).map(|&at| self.node.node(at))
+    }
+
+    pub fn iter(&self) -> Elements<'a> {
+        Elements {
+            node: self.node,
+            indices: self.indices().iter(),
+        }
+    }
+}
+
+/// The elements of an array, in order.
+pub struct Elements<'a> {
+    node: Node<'a>,
+    indices: std::slice::Iter<'a, u32>,
+}
+
+impl<'a> Iterator for Elements<'a> {
+    type Item = Node<'a>;
+    fn next(&mut self) -> Option<Node<'a>> {
+        self.indices.next().map(|&at| self.node.node(at))
+    }
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        self.indices.size_hint()
+    }
+}
+
+impl ExactSizeIterator for Elements<'_> {}
+
+impl<'a> DoubleEndedIterator for Elements<'a> {
+    fn next_back(&mut self) -> Option<Node<'a>> {
+        self.indices.next_back().map(|&at| self.node.node(at))
+    }
+}
+
+/// Read access that the index's [`Node`] and `&serde_json::Value` share, for the helpers that
+/// both the rules (which read the index) and the editors (which read and change a `Value`) use.
+/// The names differ from the inherent methods so that a call always says which it means.
+pub trait JsonView<'a>: Copy + 'a {
+    /// An object's member (the last, if duplicated).
+    fn member(self, key: &str) -> Option<Self>;
+    /// An array's element.
+    fn element(self, index: usize) -> Option<Self>;
+    /// An array's length.
+    fn length(self) -> Option<usize>;
+    /// An object's members in order, each key once.
+    fn members(self) -> Option<Vec<(Cow<'a, str>, Self)>>;
+    fn number(self) -> Option<f64>;
+    fn unsigned(self) -> Option<u64>;
+    fn text(self) -> Option<Cow<'a, str>>;
+    fn object(self) -> bool;
+}
+
+impl<'a> JsonView<'a> for Node<'a> {
+    fn member(self, key: &str) -> Option<Self> {
+        self.as_object()?.get(key)
+    }
+    fn element(self, index: usize) -> Option<Self> {
+        self.as_array()?.get(index)
+    }
+    fn length(self) -> Option<usize> {
+        Some(self.as_array()?.len())
+    }
+    fn members(self) -> Option<Vec<(Cow<'a, str>, Self)>> {
+        Some(self.as_object()?.iter().collect())
+    }
+    fn number(self) -> Option<f64> {
+        self.as_f64()
+    }
+    fn unsigned(self) -> Option<u64> {
+        self.as_u64()
+    }
+    fn text(self) -> Option<Cow<'a, str>> {
+        self.as_str()
+    }
+    fn object(self) -> bool {
+        self.is_object()
+    }
+}
+
+impl<'a> JsonView<'a> for &'a Value {
+    fn member(self, key: &str) -> Option<Self> {
+        self.as_object()?.get(key)
+    }
+    fn element(self, index: usize) -> Option<Self> {
+        self.as_array()?.get(index)
+    }
+    fn length(self) -> Option<usize> {
+        Some(self.as_array()?.len())
+    }
+    fn members(self) -> Option<Vec<(Cow<'a, str>, Self)>> {
+        Some(
+            self.as_object()?
+                .iter()
+                .map(|(k, v)| (Cow::Borrowed(k.as_str()), v))
+                .collect(),
+        )
+    }
+    fn number(self) -> Option<f64> {
+        self.as_f64()
+    }
+    fn unsigned(self) -> Option<u64> {
+        self.as_u64()
+    }
+    fn text(self) -> Option<Cow<'a, str>> {
+        self.as_str().map(Cow::Borrowed)
+    }
+    fn object(self) -> bool {
+        self.is_object()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Rebuilds a `Value` through the index's own accessors (not `to_value`).
+    pub(super) fn rebuild(node: Node) -> Value {
+        match node.kind() {
+            Kind::Null => Value::Null,
+            Kind::Bool => Value::Bool(node.as_bool().unwrap()),
+            Kind::Number => serde_json::from_str(node.raw()).unwrap(),
+            Kind::String => Value::String(node.as_str().unwrap().into_owned()),
+            Kind::Array => Value::Array(node.as_array().unwrap().iter().map(rebuild).collect()),
+            Kind::Object => Value::Object(
+                node.as_object()
+                    .unwrap()
+                    .iter()
+                    .map(|(k, v)| (k.into_owned(), rebuild(v)))
+                    .collect(),
+            ),
+        }
+    }
+
+    fn agrees(text: &str) {
+        let ours = Tape::build(text);
+        let theirs = serde_json::from_str::<Value>(text);
+        match (&ours, &theirs) {
+            (Ok(tape), Ok(value)) => {
+                assert_eq!(&rebuild(tape.root(text)), value, "{text:?}");
+                // Key order too.
+                assert_eq!(
+                    serde_json::to_string(&rebuild(tape.root(text))).unwrap(),
+                    serde_json::to_string(value).unwrap()
+                );
+            }
+            (Err(_), Err(_)) => {}
+            _ => panic!(
+                "{text:?}: index says {:?}, serde_json says {:?}",
+                ours.is_ok(),
+                theirs.is_ok()
+            ),
+        }
+    }
+
+    #[test]
+    fn accepts_and_refuses_what_serde_json_does() {
+        for text in [
+            "{}",
+            "[]",
+            " { \"a\" : [1, -0, 0.5, 1e3, 1E-3, -1.5e+2, true, false, null, \"x\"] } ",
+            "{\"a\":{\"b\":[[],[{}],[[1]]]}}",
+            "\"\\u00e9\\n\\\"\\\\\\/\"",
+            "\"\\ud83d\\ude00\"",
+            "123",
+            "[1,]",
+            "{\"a\":1,}",
+            "[01]",
+            "[1.]",
+            "[.5]",
+            "[1e]",
+            "[-]",
+            "[+1]",
+            "{\"a\" 1}",
+            "{1:2}",
+            "[tru]",
+            "[nul]",
+            "\"a\tb\"",
+            "\"\\x\"",
+            "\"\\u12\"",
+            "\"\\ud800\"",
+            "\"\\udc00\"",
+            "{} {}",
+            "[1] x",
+            "",
+            "   ",
+            "[",
+            "{\"a\":",
+            "\"open",
+            "[1 2]",
+            "{\"a\":1 \"b\":2}",
+            "\u{feff}{}",
+            "[1e400, -1e400, 123456789012345678901234567890]",
+            "{\"a\":1,\"b\":2,\"a\":3}",
+        ] {
+            agrees(text);
+        }
+    }
+
+    #[test]
+    fn duplicate_keys_read_as_serde_json_reads_them() {
+        let text = r#"{"a":1,"b":2,"a":3}"#;
+        let tape = Tape::build(text).unwrap();
+        let obj = tape.root(text).as_object().unwrap();
+        assert_eq!(obj.get("a").unwrap().as_u64(), Some(3));
+        assert_eq!(obj.len(), 2);
+        let keys: Vec<_> = obj.keys().collect();
+        assert_eq!(keys, ["a", "b"]);
+    }
+
+    #[test]
+    fn numbers_read_as_serde_json_reads_them() {
+        let text = "[1, 1.0, -0, 18446744073709551615, 18446744073709551616, -3, 1e2, 0.1, 1e400, -1e400, 5e-400]";
+        let tape = Tape::build(text).unwrap();
+        let value: Value = serde_json::from_str(text).unwrap();
+        for (i, node) in tape.root(text).as_array().unwrap().iter().enumerate() {
+            assert_eq!(node.as_u64(), value[i].as_u64(), "{i}");
+            assert_eq!(node.as_i64(), value[i].as_i64(), "{i}");
+            assert_eq!(node.as_f64(), value[i].as_f64(), "{i}");
+        }
+    }
+
+    #[test]
+    fn pointers_resolve_as_serde_json_resolves_them() {
+        let text = r#"{"a/b":{"~k":[10,[20,21]]},"":{"":5},"n":[1,2]}"#;
+        let tape = Tape::build(text).unwrap();
+        let value: Value = serde_json::from_str(text).unwrap();
+        for p in [
+            "", "/a~1b", "/a~1b/~0k/1/0", "/a~1b/~0k/01", "/a~1b/~0k/+1", "/", "//", "/n/2",
+            "/n/-", "x", "/n/1/x",
+        ] {
+            assert_eq!(
+                tape.root(text).pointer(p).map(|n| n.to_value()),
+                value.pointer(p).cloned(),
+                "{p}"
+            );
+        }
+    }
+
+    #[test]
+    fn spans_cover_values_as_written() {
+        let text = "{ \"k\" : [ 1 , \"s\\u0041\" ] }";
+        let tape = Tape::build(text).unwrap();
+        let k = tape.root(text).get("k").unwrap();
+        assert_eq!(k.raw(), "[ 1 , \"s\\u0041\" ]");
+        assert_eq!(k.get(1).unwrap().as_str().unwrap(), "sA");
+        assert_eq!(k.get(0).unwrap().span(), 10..11);
+        assert!(tape.root(text).get("s").is_none() && k.get(2).is_none());
+    }
+
+    #[test]
+    fn errors_name_the_byte_where_reading_stopped() {
+        assert_eq!(Tape::build("[1, x]").unwrap_err(), TapeError::Syntax(4));
+        assert_eq!(Tape::build("{\"a\":1}  ,").unwrap_err(), TapeError::Syntax(9));
+    }
+}
+
+#[cfg(test)]
+mod properties {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn json_value() -> impl Strategy<Value = Value> {
+        let leaf = prop_oneof![
+            Just(Value::Null),
+            any::<bool>().prop_map(Value::Bool),
+            any::<i64>().prop_map(Value::from),
+            (-1e6f64..1e6).prop_map(Value::from),
+            "[a-z\\\\\"é\u{1F600}\n]{0,6}".prop_map(Value::String),
+        ];
+        leaf.prop_recursive(4, 40, 6, |inner| {
+            prop_oneof![
+                prop::collection::vec(inner.clone(), 0..6).prop_map(Value::Array),
+                prop::collection::vec(("[ab~/]{0,3}", inner), 0..6)
+                    .prop_map(|m| Value::Object(m.into_iter().collect())),
+            ]
+        })
+    }
+
+    proptest! {
+        /// Any JSON text, and any cut or one-byte change of it, gets the same verdict from the
+        /// index as from serde_json, and the same values when both read it.
+        #[test]
+        fn the_index_reads_what_serde_json_reads(
+            value in json_value(),
+            pretty in any::<bool>(),
+            cut in any::<prop::sample::Index>(),
+            at in any::<prop::sample::Index>(),
+            byte in prop::sample::select(b"{}[]\",:0-.eE+ tfn\\x1".to_vec()),
+        ) {
+            let text = if pretty {
+                serde_json::to_string_pretty(&value).unwrap()
+            } else {
+                serde_json::to_string(&value).unwrap()
+            };
+            let tape = Tape::build(&text).unwrap();
+            prop_assert_eq!(&super::tests::rebuild(tape.root(&text)), &value);
+            let mut bytes = text.clone().into_bytes();
+            let cut_at = cut.index(bytes.len() + 1);
+            let cut_text = String::from_utf8_lossy(&bytes[..cut_at]).into_owned();
+            prop_assert_eq!(Tape::build(&cut_text).is_ok(), serde_json::from_str::<Value>(&cut_text).is_ok());
+            let i = at.index(bytes.len());
+            bytes[i] = byte;
+            if let Ok(changed) = String::from_utf8(bytes) {
+                let ours = Tape::build(&changed);
+                let theirs = serde_json::from_str::<Value>(&changed);
+                prop_assert_eq!(ours.is_ok(), theirs.is_ok(), "{:?}", changed);
+                if let (Ok(tape), Ok(value)) = (ours, theirs) {
+                    prop_assert_eq!(super::tests::rebuild(tape.root(&changed)), value);
+                }
+            }
+        }
+    }
+}
