@@ -7,7 +7,8 @@ use crate::diagnostics::{Diagnostic, Settings, Severity};
 use crate::layers;
 use crate::rules::{self, schema::Schemas, Context};
 use rayon::prelude::*;
-use serde_json::Value;
+use crate::asset::tape::Node;
+use std::borrow::Cow;
 use std::path::{Path, PathBuf};
 
 /// Documents from this size (bytes of JSON text) up run their rules in parallel; below it the
@@ -184,7 +185,7 @@ impl Validator {
             schemas: &self.schemas,
         };
         diagnostics.extend(run_rules(&cx, asset.json_text.len() >= PARALLEL_RULES_FROM));
-        let info = asset_info(&asset.json);
+        let info = asset_info(asset.root());
         let mut report = self.finish(
             settings,
             path.to_path_buf(),
@@ -280,33 +281,26 @@ fn run_rules(cx: &Context, parallel: bool) -> Vec<Diagnostic> {
     }
 }
 
-fn strings(json: &Value, key: &str) -> Vec<String> {
-    json.get(key)
-        .and_then(Value::as_array)
-        .map(|a| {
-            a.iter()
-                .filter_map(Value::as_str)
-                .map(str::to_string)
-                .collect()
-        })
-        .unwrap_or_default()
+fn strings(json: Node, key: &str) -> Vec<String> {
+    crate::rules::elements(json.get(key))
+        .filter_map(|s| s.as_str())
+        .map(Cow::into_owned)
+        .collect()
 }
 
-fn asset_info(json: &Value) -> AssetInfo {
-    let materials = layers::materials(json);
+fn asset_info(json: Node) -> AssetInfo {
     let with = |ext: &str| {
-        materials
-            .iter()
-            .filter(|m| layers::extensions(m).is_some_and(|e| e.contains_key(ext)))
+        crate::rules::materials(json)
+            .filter(|m| m.get("extensions").is_some_and(|e| e.get(ext).is_some()))
             .count()
     };
-    let text = |p: &str| json.pointer(p).and_then(Value::as_str).map(str::to_string);
+    let text = |p: &str| json.pointer(p).and_then(|s| s.as_str()).map(Cow::into_owned);
     AssetInfo {
         version: text("/asset/version"),
         generator: text("/asset/generator"),
         extensions_used: strings(json, "extensionsUsed"),
         extensions_required: strings(json, "extensionsRequired"),
-        material_count: materials.len(),
+        material_count: crate::rules::materials(json).count(),
         sheen_material_count: with(layers::SHEEN),
         fuzz_material_count: with(layers::FUZZ),
     }

@@ -439,7 +439,7 @@ fn glb_images_go_to_aligned_buffer_views_and_a_dropped_source_leaves_the_bin() {
     let loaded = asset::load(&output);
     assert!(loaded.diagnostics.is_empty(), "{:?}", loaded.diagnostics);
     let asset = loaded.asset.unwrap();
-    let out = &asset.json;
+    let out = asset.json();
     let ext = &out["materials"][0]["extensions"];
     // Texture 0 stays for the base colour; the old texture 1 is replaced by one new texture
     // (index 1) that sheen colour and fuzz roughness share, and fuzzTexture gets its own (2).
@@ -517,11 +517,11 @@ fn glb_uniform_output_collapses_into_a_factor_and_its_source_is_dropped() {
     // Written rounded to six decimals (velvet's stated precision for the numbers it writes).
     let expected = (srgb_decode(f64::from(colour(255, 0.5)) / 255.0) * 1e6).round() / 1e6;
     assert_eq!(
-        asset.json["materials"][0]["extensions"]["KHR_materials_sheen"],
+        asset.json()["materials"][0]["extensions"]["KHR_materials_sheen"],
         json!({"sheenColorFactor": [expected, expected, expected], "sheenRoughnessFactor": 0.25})
     );
     for key in ["textures", "images", "bufferViews", "buffers"] {
-        assert!(asset.json.get(key).is_none(), "{key} is gone");
+        assert!(asset.json().get(key).is_none(), "{key} is gone");
     }
     assert!(asset.bin.is_none(), "an empty BIN chunk is not written");
     assert_eq!(validation_errors(&output), Vec::<String>::new());

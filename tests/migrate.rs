@@ -1353,12 +1353,12 @@ fn a_glb_keeps_baked_textures_in_its_bin_chunk() {
     let bytes = std::fs::read(&output).unwrap();
     let loaded = velvet::asset::load_bytes(&output, &bytes);
     let asset = loaded.asset.unwrap();
-    let views = asset.json["bufferViews"].as_array().unwrap();
+    let views = asset.json()["bufferViews"].as_array().unwrap();
     assert_eq!(views.len(), 3, "the source and the two baked images");
     for view in views {
         assert_eq!(view["byteOffset"].as_u64().unwrap_or(0) % 4, 0);
     }
-    let images = asset.json["images"].as_array().unwrap();
+    let images = asset.json()["images"].as_array().unwrap();
     assert!(images.iter().all(|i| i.get("uri").is_none()));
     assert!(errors(&output).is_empty(), "{:?}", errors(&output));
 }

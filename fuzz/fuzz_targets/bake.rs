@@ -58,7 +58,7 @@ fuzz_target!(|data: &[u8]| {
         }
     }
     let bin = asset.bin.take();
-    let json = asset.json.clone();
+    let json = asset.json().clone();
     let applied = apply(
         json,
         bin,

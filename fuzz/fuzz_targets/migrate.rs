@@ -22,10 +22,10 @@ fuzz_target!(|data: &[u8]| {
     };
     let plan = plan_document(&asset, &options);
     let edits: Vec<_> = plan.edits().cloned().collect();
-    let Ok(true) = velvet::edit::apply(&mut asset.json, &edits) else {
+    let Ok(true) = velvet::edit::apply(asset.json_mut(), &edits) else {
         return;
     };
-    let bytes = write::to_bytes(&asset, &asset.json, asset.bin.as_deref());
+    let bytes = write::to_bytes(&asset, asset.json(), asset.bin.as_deref());
     let again = velvet::asset::load_bytes_with(Path::new(path), &bytes, &options.load);
     let migrated = again.asset.unwrap_or_else(|| {
         panic!(

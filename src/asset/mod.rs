@@ -41,13 +41,14 @@ impl Container {
     }
 }
 
-/// A loaded asset. `json` is what velvet reads and edits; `json_text` is the JSON as it was in
-/// the file, kept for source positions and for byte-identical output when nothing changes.
+/// A loaded asset. `json_text` is the JSON as it was in the file and `tape` its index, which
+/// validation reads; [`Asset::json`] is the document as a `serde_json::Value`, built on first
+/// use, which the editors read and change.
 #[derive(Debug)]
 pub struct Asset {
     pub path: PathBuf,
     pub container: Container,
-    pub json: Value,
+    json: OnceLock<Value>,
     pub json_text: String,
     /// The index of `json_text` that the rules read.
     pub tape: tape::Tape,
@@ -236,17 +237,18 @@ pub fn load_bytes_with(path: &Path, bytes: &[u8], options: &LoadOptions) -> Load
             diagnostics,
         };
     }
-    let index = tape::Tape::build(parse_text);
-    let parsed = match &index {
-        Ok(_) => serde_json::from_str(parse_text),
-        Err(_) => serde_json::from_str::<Value>(parse_text).and_then(|_| {
-            // serde_json accepts what the index refused: only a text over 4 GiB gets here.
-            Err(serde::de::Error::custom("the JSON text is too large to index"))
-        }),
-    };
-    let json: Value = match parsed {
-        Ok(v) => v,
-        Err(e) => {
+    let index = match tape::Tape::build(parse_text) {
+        Ok(index) => index,
+        Err(refused) => {
+            // serde_json words the fault; it refuses what the index refuses (tested), but for
+            // a text too large to index.
+            let e = match serde_json::from_str::<serde::de::IgnoredAny>(parse_text) {
+                Err(e) => e,
+                Ok(_) => serde::de::Error::custom(match refused {
+                    tape::TapeError::TooLarge => "the JSON text is too large to index",
+                    tape::TapeError::Syntax(_) => "the JSON text could not be indexed",
+                }),
+            };
             diagnostics.push(
                 Diagnostic::new(
                     &codes::INVALID_JSON,
@@ -270,7 +272,7 @@ pub fn load_bytes_with(path: &Path, bytes: &[u8], options: &LoadOptions) -> Load
             };
         }
     };
-    if !json.is_object() {
+    if !index.root(parse_text).is_object() {
         diagnostics.push(Diagnostic::new(
             &codes::INVALID_JSON_ROOT_OBJECT,
             "",
@@ -282,14 +284,14 @@ pub fn load_bytes_with(path: &Path, bytes: &[u8], options: &LoadOptions) -> Load
         };
     }
     if container == Container::Glb {
-        check_bin_length(&json, bin.as_deref(), &mut diagnostics);
+        check_bin_length(index.root(parse_text), bin.as_deref(), &mut diagnostics);
     }
     Loaded {
         asset: Some(Asset {
             path: path.to_path_buf(),
             container,
-            json,
-            tape: index.expect("the index was built when the JSON parsed"),
+            json: OnceLock::new(),
+            tape: index,
             json_text,
             json_offset,
             bin,
@@ -303,14 +305,14 @@ pub fn load_bytes_with(path: &Path, bytes: &[u8], options: &LoadOptions) -> Load
 
 /// A GLB's buffer 0 without a URI is its BIN chunk: the chunk must hold the declared
 /// byteLength (it may be up to 3 bytes longer, for padding).
-fn check_bin_length(json: &Value, bin: Option<&[u8]>, out: &mut Vec<Diagnostic>) {
+fn check_bin_length(json: tape::Node, bin: Option<&[u8]>, out: &mut Vec<Diagnostic>) {
     let Some(buffer) = json.pointer("/buffers/0") else {
         return;
     };
     if buffer.get("uri").is_some() {
         return;
     }
-    let Some(declared) = buffer.get("byteLength").and_then(Value::as_u64) else {
+    let Some(declared) = buffer.get("byteLength").and_then(|v| v.as_u64()) else {
         return;
     };
     match bin {
@@ -359,6 +361,30 @@ impl Asset {
     /// The document as read from the file, through its index.
     pub fn root(&self) -> tape::Node<'_> {
         self.tape.root(&self.json_text)
+    }
+
+    /// The document as a `serde_json::Value`, parsed from the text on first use.
+    pub fn json(&self) -> &Value {
+        self.json.get_or_init(|| {
+            // The index accepted this text, and serde_json accepts what the index accepts
+            // (tested), so the fallback is never taken.
+            serde_json::from_str(self.json_text.trim_end_matches(['\0', ' '])).unwrap_or_default()
+        })
+    }
+
+    /// The document for editing.
+    pub fn json_mut(&mut self) -> &mut Value {
+        self.json();
+        self.json.get_mut().expect("set just above")
+    }
+
+    /// Takes the document out, leaving an empty one; [`Asset::set_json`] puts one back.
+    pub fn take_json(&mut self) -> Value {
+        std::mem::take(self.json_mut())
+    }
+
+    pub fn set_json(&mut self, json: Value) {
+        *self.json_mut() = json;
     }
 
     /// The folder relative URIs are resolved against.

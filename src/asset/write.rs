@@ -132,7 +132,7 @@ pub fn to_bytes(asset: &Asset, json: &Value, bin: Option<&[u8]>) -> Vec<u8> {
 
 /// True when an edit left the document as loaded, so the input's bytes can stand as they are.
 pub fn unchanged(asset: &Asset, json: &Value, bin: Option<&[u8]>) -> bool {
-    &asset.json == json && asset.bin.as_deref() == bin
+    asset.json() == json && asset.bin.as_deref() == bin
 }
 
 /// Writes `bytes` to `path` atomically: into a temporary file in the same folder, flushed to

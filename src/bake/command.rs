@@ -206,12 +206,12 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
         if output == input {
             return Ok(result);
         }
-        copy_resources(&relocation, &asset.json)?;
+        copy_resources(&relocation, asset.json())?;
         create_parent(output)?;
         let out_bytes = if relocation.edits.is_empty() {
             bytes
         } else {
-            let mut json = std::mem::take(&mut asset.json);
+            let mut json = asset.take_json();
             crate::edit::apply(&mut json, &relocation.edits).map_err(|e| e.to_string())?;
             write::to_bytes(&asset, &json, asset.bin.as_deref())
         };
@@ -244,7 +244,7 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
         output,
         &relocation,
     ));
-    let images = asset.json.get("images").cloned().unwrap_or(Value::Null);
+    let images = asset.json().get("images").cloned().unwrap_or(Value::Null);
     let streamed = asset.container == asset::Container::Gltf && !options.embed;
     let mut baked = Vec::with_capacity(plan.recipes.len());
     let results = {
@@ -262,7 +262,7 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
     let mut names = names.into_inner().unwrap_or_else(|e| e.into_inner());
     let out_dir = names.dir().to_path_buf();
     // The document as it will stand next to the output.
-    let mut json = std::mem::take(&mut asset.json);
+    let mut json = asset.take_json();
     crate::edit::apply(&mut json, &relocation.edits).map_err(|e| e.to_string())?;
     let bin = asset.bin.take();
     let applied = apply(

@@ -248,7 +248,7 @@ const EDITED_ARRAYS: [&str; 4] = ["buffers", "bufferViews", "images", "textures"
 
 /// Plans the bake of one asset.
 pub fn plan(asset: &Asset, options: PlanOptions) -> BakePlan {
-    let json = &asset.json;
+    let json = asset.json();
     let mut out = BakePlan::default();
     for key in EDITED_ARRAYS {
         let Some(value) = json.get(key) else { continue };

@@ -146,7 +146,7 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
         };
         let images = plan
             .asset
-            .json
+            .json()
             .get("images")
             .cloned()
             .unwrap_or(serde_json::Value::Null);
@@ -185,7 +185,7 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
             plan.relocation.edits.as_slice(),
         ]);
     for edits in groups {
-        changed |= edit::apply(&mut plan.asset.json, edits)
+        changed |= edit::apply(plan.asset.json_mut(), edits)
             .map_err(|e| format!("{}: {e}", plan.input.display()))?;
     }
     if !changed && plan.in_place() {
@@ -197,9 +197,9 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
     }
     create_parent(&output)?;
     let bytes = if bake_plan.is_empty() {
-        copy_resources(&plan.relocation, &plan.asset.json)?;
+        copy_resources(&plan.relocation, plan.asset.json())?;
         if changed {
-            write::to_bytes(&plan.asset, &plan.asset.json, plan.asset.bin.as_deref())
+            write::to_bytes(&plan.asset, plan.asset.json(), plan.asset.bin.as_deref())
         } else if plan.bytes.is_empty() {
             // Edits that set what was there already: the input's own bytes, read again.
             asset::read(&plan.input, &plan.asset.options)
@@ -208,7 +208,7 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
             std::mem::take(&mut plan.bytes)
         }
     } else {
-        let json = std::mem::take(&mut plan.asset.json);
+        let json = plan.asset.take_json();
         let applied = bake_apply(
             json,
             plan.asset.bin.take(),
@@ -221,7 +221,7 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
         copy_resources(&plan.relocation, &applied.json)?;
         write_new_files(&names_dir, &applied.files)?;
         let bytes = write::to_bytes(&plan.asset, &applied.json, applied.bin.as_deref());
-        plan.asset.json = applied.json;
+        plan.asset.set_json(applied.json);
         plan.asset.bin = applied.bin;
         plan.baked = applied.outputs;
         bytes

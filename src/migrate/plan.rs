@@ -76,7 +76,7 @@ pub struct MaterialCx<'a> {
 
 impl MaterialCx<'_> {
     pub fn json(&self) -> &Value {
-        &self.asset.json
+        self.asset.json()
     }
 
     /// Pointer to `extension` on this material.
@@ -143,12 +143,12 @@ impl DocumentPlan {
 
 /// Plans the migration of every material of `asset`.
 pub fn plan_document(asset: &Asset, options: &Options) -> DocumentPlan {
-    let mut materials: Vec<MaterialPlan> = (0..layers::materials(&asset.json).len())
+    let mut materials: Vec<MaterialPlan> = (0..layers::materials(asset.json()).len())
         .filter_map(|i| plan_material(asset, i, options))
         .collect();
     super::budget::plan(asset, &mut materials, options.budget);
     let declared: Vec<&str> = asset
-        .json
+        .json()
         .get("extensionsUsed")
         .and_then(Value::as_array)
         .map(|a| a.iter().filter_map(Value::as_str).collect())
@@ -179,7 +179,7 @@ pub fn plan_document(asset: &Asset, options: &Options) -> DocumentPlan {
 
 /// The plan of material `index`, or `None` when it has neither sheen nor fuzz.
 pub fn plan_material(asset: &Asset, index: usize, options: &Options) -> Option<MaterialPlan> {
-    let material = layers::materials(&asset.json).get(index)?;
+    let material = layers::materials(asset.json()).get(index)?;
     let exts = layers::extensions(material)?;
     let (sheen, fuzz) = (exts.get(layers::SHEEN), exts.get(layers::FUZZ));
     if sheen.is_none() && fuzz.is_none() {

@@ -247,7 +247,7 @@ impl std::fmt::Display for TextureBake {
 /// texture cannot be baked (no such texture or image, an image that cannot be read, no
 /// source, a KTX2 source).
 pub fn sources(asset: &Asset, index: usize) -> Result<Vec<(String, usize)>, String> {
-    let json = &asset.json;
+    let json = asset.json();
     let texture = json
         .get("textures")
         .and_then(Value::as_array)

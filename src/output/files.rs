@@ -44,7 +44,7 @@ impl<'a> FileNames<'a> {
             .iter()
             .flat_map(|kind| {
                 asset
-                    .json
+                    .json()
                     .get(*kind)
                     .and_then(Value::as_array)
                     .into_iter()

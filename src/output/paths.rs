@@ -281,7 +281,7 @@ pub fn check_links(asset: &Asset) -> Result<(), String> {
     }
     let base = folder_of(&asset.path);
     let mut real_base: Option<PathBuf> = None;
-    for uri in relative_uris(&asset.json) {
+    for uri in relative_uris(asset.json()) {
         let Ok(resource::Location::File(path)) = resource::resolve(uri, base, "") else {
             continue;
         };
@@ -317,7 +317,7 @@ pub fn relocate(asset: &Asset, output: &Path, rewrite_uris: bool) -> Result<Relo
     let mut prefix: Option<String> = None;
     let mut rewritten = 0;
     for kind in ["buffers", "images"] {
-        let Some(items) = asset.json.get(kind).and_then(Value::as_array) else {
+        let Some(items) = asset.json().get(kind).and_then(Value::as_array) else {
             continue;
         };
         for (i, item) in items.iter().enumerate() {

@@ -104,7 +104,7 @@ pub struct TextureStats {
 /// which migrate adds nothing), are left out.
 pub fn materials(asset: &Asset) -> Vec<Material> {
     let mut images = ImageCache::default();
-    layers::materials(&asset.json)
+    layers::materials(asset.json())
         .iter()
         .enumerate()
         .filter_map(|(index, m)| read(asset, index, m, &mut images))
@@ -258,7 +258,7 @@ fn image_index(asset: &Asset, info: &Value) -> Result<usize, String> {
         .and_then(layers::as_index)
         .ok_or("no texture index")?;
     let source = asset
-        .json
+        .json()
         .pointer(&format!("/textures/{texture}/source"))
         .and_then(layers::as_index)
         .ok_or_else(|| format!("texture {texture} has no source image"))?;
