@@ -169,7 +169,9 @@ impl SheenView {
             roughness_factor: number(obj, "sheenRoughnessFactor")
                 .unwrap_or(SHEEN_ROUGHNESS_DEFAULT),
             color_texture: obj.member("sheenColorTexture").and_then(TextureRef::read),
-            roughness_texture: obj.member("sheenRoughnessTexture").and_then(TextureRef::read),
+            roughness_texture: obj
+                .member("sheenRoughnessTexture")
+                .and_then(TextureRef::read),
         })
     }
 
@@ -202,7 +204,9 @@ impl FuzzView {
             roughness_factor: number(obj, "fuzzRoughnessFactor"),
             texture: obj.member("fuzzTexture").and_then(TextureRef::read),
             color_texture: obj.member("fuzzColorTexture").and_then(TextureRef::read),
-            roughness_texture: obj.member("fuzzRoughnessTexture").and_then(TextureRef::read),
+            roughness_texture: obj
+                .member("fuzzRoughnessTexture")
+                .and_then(TextureRef::read),
         })
     }
 
@@ -219,7 +223,9 @@ impl FuzzView {
 }
 
 /// A material's `extensions` object, if any.
-pub fn extensions(material: &serde_json::Value) -> Option<&serde_json::Map<String, serde_json::Value>> {
+pub fn extensions(
+    material: &serde_json::Value,
+) -> Option<&serde_json::Map<String, serde_json::Value>> {
     material.get("extensions")?.as_object()
 }
 

@@ -2,12 +2,12 @@
 //! settings, and place each finding in the source text. Files run in parallel; each file's
 //! report is independent of the others.
 
+use crate::asset::tape::Node;
 use crate::asset::{self, discover, position::Position, Container};
 use crate::diagnostics::{Diagnostic, Settings, Severity};
 use crate::layers;
 use crate::rules::{self, schema::Schemas, Context};
 use rayon::prelude::*;
-use crate::asset::tape::Node;
 use std::borrow::Cow;
 use std::path::{Path, PathBuf};
 
@@ -208,11 +208,6 @@ impl Validator {
                 }
             }
         }
-        if asset.json_text.len() >= PARALLEL_RULES_FROM {
-            // Freeing a big document tree takes as long as a rule; it is left to the pool while
-            // the report is written.
-            rayon::spawn(move || drop(asset));
-        }
         report
     }
 
@@ -294,7 +289,11 @@ fn asset_info(json: Node) -> AssetInfo {
             .filter(|m| m.get("extensions").is_some_and(|e| e.get(ext).is_some()))
             .count()
     };
-    let text = |p: &str| json.pointer(p).and_then(|s| s.as_str()).map(Cow::into_owned);
+    let text = |p: &str| {
+        json.pointer(p)
+            .and_then(|s| s.as_str())
+            .map(Cow::into_owned)
+    };
     AssetInfo {
         version: text("/asset/version"),
         generator: text("/asset/generator"),

@@ -80,7 +80,7 @@ pub fn load(path: &Path) -> Loaded {
 /// Reads and parses one file under `options`. Never fails: faults become diagnostics.
 pub fn load_with(path: &Path, options: &LoadOptions) -> Loaded {
     match read(path, options) {
-        Ok(bytes) => load_bytes_with(path, &bytes, options),
+        Ok(bytes) => load_owned(path, bytes, options),
         Err(d) => Loaded {
             asset: None,
             diagnostics: vec![d],
@@ -122,6 +122,24 @@ pub fn read(path: &Path, options: &LoadOptions) -> Result<Vec<u8>, Diagnostic> {
 /// Parses the bytes of a file that lives (or would live) at `path` under the default limits.
 pub fn load_bytes(path: &Path, bytes: &[u8]) -> Loaded {
     load_bytes_with(path, bytes, &LoadOptions::default())
+}
+
+/// Parses bytes read from `path`, keeping them as the JSON text without a copy when the file is
+/// a .gltf in plain UTF-8 (a copy of a large document costs as much as indexing it).
+fn load_owned(path: &Path, bytes: Vec<u8>, options: &LoadOptions) -> Loaded {
+    let plain = !bytes.starts_with(b"glTF")
+        && !bytes.starts_with(b"\xEF\xBB\xBF")
+        && !path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("glb"))
+        && bytes.len() as u64 <= options.max_document_bytes;
+    if !plain {
+        return load_bytes_with(path, &bytes, options);
+    }
+    match String::from_utf8(bytes) {
+        Ok(text) => load_text(path, text, Container::Gltf, 0, None, Vec::new(), options),
+        Err(e) => load_bytes_with(path, e.as_bytes(), options),
+    }
 }
 
 /// Parses the bytes of a file that lives (or would live) at `path`; `path` is used for the
@@ -210,10 +228,37 @@ pub fn load_bytes_with(path: &Path, bytes: &[u8], options: &LoadOptions) -> Load
             };
         }
     };
+    load_text(
+        path,
+        json_text,
+        container,
+        json_offset,
+        bin,
+        diagnostics,
+        options,
+    )
+}
+
+/// Indexes a document's JSON text and makes the asset.
+fn load_text(
+    path: &Path,
+    json_text: String,
+    container: Container,
+    json_offset: usize,
+    bin: Option<Vec<u8>>,
+    mut diagnostics: Vec<Diagnostic>,
+    options: &LoadOptions,
+) -> Loaded {
     // A GLB's JSON chunk may carry NUL padding (reported by glb::split); parse past it.
     let parse_text = json_text.trim_end_matches(['\0', ' ']);
     let max_depth = options.max_json_depth.min(limits::JSON_DEPTH_CEILING);
-    if let Some(at) = limits::find_too_deep(parse_text, max_depth) {
+    let built = tape::Tape::build_within(parse_text, max_depth);
+    // A text that nests too deep is refused for its depth, whatever else is wrong with it.
+    let too_deep = match &built {
+        Ok(_) => None,
+        Err(_) => limits::find_too_deep(parse_text, max_depth),
+    };
+    if let Some(at) = too_deep {
         diagnostics.push(
             Diagnostic::new(
                 &codes::JSON_TOO_DEEP,
@@ -237,7 +282,7 @@ pub fn load_bytes_with(path: &Path, bytes: &[u8], options: &LoadOptions) -> Load
             diagnostics,
         };
     }
-    let index = match tape::Tape::build(parse_text) {
+    let index = match built {
         Ok(index) => index,
         Err(refused) => {
             // serde_json words the fault; it refuses what the index refuses (tested), but for
@@ -246,7 +291,9 @@ pub fn load_bytes_with(path: &Path, bytes: &[u8], options: &LoadOptions) -> Load
                 Err(e) => e,
                 Ok(_) => serde::de::Error::custom(match refused {
                     tape::TapeError::TooLarge => "the JSON text is too large to index",
-                    tape::TapeError::Syntax(_) => "the JSON text could not be indexed",
+                    tape::TapeError::Syntax(_) | tape::TapeError::TooDeep(_) => {
+                        "the JSON text could not be indexed"
+                    }
                 }),
             };
             diagnostics.push(

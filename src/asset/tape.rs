@@ -31,8 +31,13 @@ pub enum Kind {
 }
 
 const KIND_BITS: u32 = 3;
+/// A string that holds escapes.
 const ESCAPED: u32 = 1 << KIND_BITS;
-const COUNT_SHIFT: u32 = KIND_BITS + 1;
+/// A string that is an object key.
+const KEY: u32 = 1 << (KIND_BITS + 1);
+/// An object that writes a key more than once.
+const DUPLICATES: u32 = 1 << (KIND_BITS + 2);
+const COUNT_SHIFT: u32 = KIND_BITS + 3;
 /// Most members or elements one container may hold (the count shares a word with the kind).
 const MAX_COUNT: u32 = (1 << (32 - COUNT_SHIFT)) - 1;
 
@@ -44,7 +49,7 @@ struct Entry {
     end: u32,
     /// Index of the entry after this value and everything inside it.
     next: u32,
-    /// Kind (3 bits), whether a string holds escapes (1 bit), member or element count.
+    /// Kind (3 bits), the flags above (3 bits), member or element count.
     meta: u32,
     /// For an array: where its element indices start in `Tape::elements`.
     elements: u32,
@@ -92,8 +97,10 @@ pub struct Tape {
 pub enum TapeError {
     /// Not JSON at this byte offset; serde_json gives the message.
     Syntax(usize),
-    /// A text over 4 GiB, or a container with more than 2^28 entries.
+    /// A text over 4 GiB, or a container with more than 2^26 entries.
     TooLarge,
+    /// An array or object at this byte offset nests deeper than the limit.
+    TooDeep(usize),
 }
 
 /// An open container while the index is built.
@@ -108,26 +115,36 @@ struct Open {
 struct Builder<'t> {
     bytes: &'t [u8],
     at: usize,
+    max_depth: usize,
     entries: Vec<Entry>,
     elements: Vec<u32>,
     /// Element indices of the arrays still open, innermost last.
     scratch: Vec<u32>,
+    /// Key entries of the object being closed.
+    keys: Vec<u32>,
 }
 
 impl Tape {
     /// Indexes `text`, which must be one JSON value with optional whitespace around it.
-    /// Nesting is not limited here (the builder does not recurse); the loader limits it first.
     pub fn build(text: &str) -> Result<Tape, TapeError> {
+        Tape::build_within(text, usize::MAX)
+    }
+
+    /// Indexes `text`, refusing arrays and objects nested deeper than `max_depth` (the root is
+    /// depth 1). The builder does not recurse; the limit protects what reads the index.
+    pub fn build_within(text: &str, max_depth: usize) -> Result<Tape, TapeError> {
         if text.len() >= u32::MAX as usize {
             return Err(TapeError::TooLarge);
         }
         let mut builder = Builder {
             bytes: text.as_bytes(),
             at: 0,
+            max_depth,
             // A value takes at least two bytes of pretty-printed text on average.
             entries: Vec::with_capacity(text.len() / 16),
             elements: Vec::new(),
             scratch: Vec::new(),
+            keys: Vec::new(),
         };
         builder.document()?;
         Ok(Tape {
@@ -233,6 +250,9 @@ impl Builder<'_> {
             }
             match self.bytes.get(self.at) {
                 Some(b'{') | Some(b'[') => {
+                    if stack.len() >= self.max_depth {
+                        return Err(TapeError::TooDeep(self.at));
+                    }
                     let is_object = self.bytes[self.at] == b'{';
                     self.at += 1;
                     let kind = if is_object { Kind::Object } else { Kind::Array };
@@ -280,11 +300,50 @@ impl Builder<'_> {
         if !open.is_object {
             self.elements.extend(self.scratch.drain(open.scratch..));
         }
+        let duplicates = open.is_object && open.count > 1 && self.has_duplicate_keys(open.entry);
         let entry = &mut self.entries[open.entry as usize];
         entry.end = self.at as u32;
         entry.next = next;
         entry.meta |= open.count << COUNT_SHIFT;
+        if duplicates {
+            entry.meta |= DUPLICATES;
+        }
         entry.elements = elements;
+    }
+
+    /// Whether the object just closed at `object` writes a key twice. Checked once here so
+    /// that reading its members needs no check.
+    fn has_duplicate_keys(&mut self, object: u32) -> bool {
+        let end = self.entries.len() as u32;
+        let mut keys = std::mem::take(&mut self.keys);
+        keys.clear();
+        let mut at = object + 1;
+        while at < end {
+            keys.push(at);
+            at = self.entries[at as usize + 1].next;
+        }
+        let text = |k: u32| -> Cow<'_, [u8]> {
+            let e = &self.entries[k as usize];
+            let raw = &self.bytes[e.start as usize..e.end as usize];
+            if e.meta & ESCAPED == 0 {
+                Cow::Borrowed(&raw[1..raw.len() - 1])
+            } else {
+                let raw = std::str::from_utf8(raw).unwrap_or_default();
+                Cow::Owned(
+                    serde_json::from_str::<String>(raw)
+                        .unwrap_or_default()
+                        .into_bytes(),
+                )
+            }
+        };
+        let found = if keys.len() <= 16 {
+            (1..keys.len()).any(|i| (0..i).any(|j| text(keys[i]) == text(keys[j])))
+        } else {
+            let mut seen = std::collections::HashSet::with_capacity(keys.len());
+            !keys.iter().all(|&k| seen.insert(text(k)))
+        };
+        self.keys = keys;
+        found
     }
 
     /// An object key and its colon; leaves `at` on the value.
@@ -294,7 +353,7 @@ impl Builder<'_> {
         }
         let start = self.at;
         let escaped = self.string()?;
-        self.push(Kind::String, start, if escaped { ESCAPED } else { 0 });
+        self.push(Kind::String, start, KEY | if escaped { ESCAPED } else { 0 });
         self.skip_whitespace();
         if self.bytes.get(self.at) != Some(&b':') {
             return self.fail();
@@ -365,7 +424,8 @@ impl Builder<'_> {
         }
         if escaped {
             // Surrogate pairing is serde_json's to judge; escapes are rare in glTF.
-            let text = std::str::from_utf8(&self.bytes[start..self.at]).map_err(|_| TapeError::Syntax(start))?;
+            let text = std::str::from_utf8(&self.bytes[start..self.at])
+                .map_err(|_| TapeError::Syntax(start))?;
             if serde_json::from_str::<String>(text).is_err() {
                 return Err(TapeError::Syntax(start));
             }
@@ -570,6 +630,32 @@ impl<'a> Node<'a> {
         Some(node)
     }
 
+    /// The value of every object member named `key` anywhere inside this value, in text order,
+    /// found by one scan of the index rather than a walk. Rules use it to rule out a finding
+    /// cheaply before walking for its path.
+    pub fn members_named<'k>(&self, key: &'k str) -> impl Iterator<Item = Node<'a>> + 'k
+    where
+        'a: 'k,
+    {
+        let node = *self;
+        let entries = &self.tape.entries[self.at as usize + 1..self.entry().next as usize];
+        let first = self.at + 1;
+        entries.iter().enumerate().filter_map(move |(i, e)| {
+            if e.meta & KEY == 0 {
+                return None;
+            }
+            let at = first + i as u32;
+            let k = node.node(at);
+            let raw = k.raw();
+            let matches = if e.meta & ESCAPED == 0 {
+                &raw[1..raw.len() - 1] == key
+            } else {
+                k.as_str().is_some_and(|s| s == key)
+            };
+            matches.then(|| node.node(at + 1))
+        })
+    }
+
     /// The value as a `serde_json::Value`, for the few places that need one (error reports,
     /// comparisons of whole values).
     pub fn to_value(&self) -> Value {
@@ -635,6 +721,9 @@ impl<'a> Object<'a> {
         for (k, v) in self.raw_members() {
             if self.key_is(k, key) {
                 found = Some(v);
+                if !self.has_duplicates() {
+                    break;
+                }
             }
         }
         found.map(|at| self.node.node(at))
@@ -659,19 +748,7 @@ impl<'a> Object<'a> {
     }
 
     fn has_duplicates(&self) -> bool {
-        let count = self.node.entry().count();
-        if count < 2 {
-            return false;
-        }
-        let keys: Vec<Cow<'a, str>> = self
-            .raw_members()
-            .map(|(k, _)| self.node.node(k).as_str().unwrap_or_default())
-            .collect();
-        if count <= 16 {
-            return (1..keys.len()).any(|i| keys[..i].contains(&keys[i]));
-        }
-        let mut seen = std::collections::HashSet::with_capacity(keys.len());
-        !keys.iter().all(|k| seen.insert(k))
+        self.node.entry().meta & DUPLICATES != 0
     }
 
     /// Members in order: each key once, at its first place, with its last value.
@@ -999,8 +1076,17 @@ mod tests {
         let tape = Tape::build(text).unwrap();
         let value: Value = serde_json::from_str(text).unwrap();
         for p in [
-            "", "/a~1b", "/a~1b/~0k/1/0", "/a~1b/~0k/01", "/a~1b/~0k/+1", "/", "//", "/n/2",
-            "/n/-", "x", "/n/1/x",
+            "",
+            "/a~1b",
+            "/a~1b/~0k/1/0",
+            "/a~1b/~0k/01",
+            "/a~1b/~0k/+1",
+            "/",
+            "//",
+            "/n/2",
+            "/n/-",
+            "x",
+            "/n/1/x",
         ] {
             assert_eq!(
                 tape.root(text).pointer(p).map(|n| n.to_value()),
@@ -1022,9 +1108,38 @@ mod tests {
     }
 
     #[test]
+    fn nesting_past_the_limit_is_refused_at_its_bracket() {
+        assert!(Tape::build_within("{\"a\":[[1]]}", 3).is_ok());
+        assert_eq!(
+            Tape::build_within("{\"a\":[[[1]]]}", 3).unwrap_err(),
+            TapeError::TooDeep(7)
+        );
+        // Brackets inside strings do not nest.
+        assert!(Tape::build_within("[\"[[[[\"]", 1).is_ok());
+    }
+
+    #[test]
+    fn members_named_finds_every_member_of_that_name_in_text_order() {
+        let text = r#"{"x":1,"a":{"x":2,"b":[{"x":3},{"\u0078":4}]},"y":{"xx":5}}"#;
+        let tape = Tape::build(text).unwrap();
+        let found: Vec<u64> = tape
+            .root(text)
+            .members_named("x")
+            .filter_map(|n| n.as_u64())
+            .collect();
+        assert_eq!(found, [1, 2, 3, 4]);
+        let inner = tape.root(text).get("a").unwrap();
+        assert_eq!(inner.members_named("x").count(), 3);
+        assert_eq!(tape.root(text).members_named("z").count(), 0);
+    }
+
+    #[test]
     fn errors_name_the_byte_where_reading_stopped() {
         assert_eq!(Tape::build("[1, x]").unwrap_err(), TapeError::Syntax(4));
-        assert_eq!(Tape::build("{\"a\":1}  ,").unwrap_err(), TapeError::Syntax(9));
+        assert_eq!(
+            Tape::build("{\"a\":1}  ,").unwrap_err(),
+            TapeError::Syntax(9)
+        );
     }
 }
 

@@ -284,7 +284,7 @@ pub fn plan(asset: &Asset, options: PlanOptions) -> BakePlan {
         if !layer_is_on(layer.extension, layer.value) {
             out.notes.push(Note::new(
                 Level::Info,
-                &layer.pointer(),
+                layer.pointer(),
                 format!(
                     "{} is switched off; its textures are left as they are",
                     layer.extension

@@ -39,7 +39,7 @@ impl Rule for Clearcoat {
                     "this fuzz layer lies over the clear coat (a sheen layer would lie under it)",
                 )
             };
-            out.push(Diagnostic::new(code, &layer.pointer(), message));
+            out.push(Diagnostic::new(code, layer.pointer(), message));
         }
     }
 }

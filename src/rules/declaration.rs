@@ -6,9 +6,9 @@
 
 use super::{layer_objects, Context, Rule};
 use crate::asset::pointer;
+use crate::asset::tape::{Kind, Node};
 use crate::diagnostics::{Code, Diagnostic, Severity};
 use crate::layers;
-use crate::asset::tape::{Kind, Node};
 use std::collections::BTreeSet;
 
 pub const UNDECLARED_EXTENSION: Code = Code::new(
@@ -62,47 +62,66 @@ impl Rule for Declaration {
             .into_iter()
             .map(|(_, n)| n)
             .collect();
-        let mut reported = BTreeSet::new();
-        extension_objects(json, &mut Vec::new(), &mut |path, name| {
-            // One finding per extension: the first place it is used.
-            if !declared.contains(name) && reported.insert(name.to_string()) {
-                let at: String = path
-                    .iter()
-                    .map(|t| format!("/{}", pointer::escape(t)))
-                    .collect();
-                out.push(Diagnostic::new(
-                    &UNDECLARED_EXTENSION,
-                    at,
-                    format!("{name} is used but not declared in extensionsUsed"),
-                ));
-            }
-        });
-        for (k, name) in names(json, "extensionsRequired") {
-            if !declared.contains(&name) {
-                out.push(Diagnostic::new(
-                    &UNUSED_EXTENSION_REQUIRED,
-                    format!("/extensionsRequired/{k}"),
-                    format!("{name} is required but not in extensionsUsed"),
-                ));
-            }
+        undeclared(json, &declared, out);
+        check_lists(json, &declared, out);
+    }
+}
+
+/// One finding per extension used but not declared, at the first place it is used.
+fn undeclared(json: Node, declared: &BTreeSet<String>, out: &mut Vec<Diagnostic>) {
+    // Every name in every `extensions` object (extras included, so a superset of what the walk
+    // visits): when all are declared there is nothing to report, and no walk to do.
+    let all_declared = json.members_named("extensions").all(|exts| {
+        exts.as_object().map_or(true, |o| {
+            o.keys().all(|name| declared.contains(name.as_ref()))
+        })
+    });
+    if all_declared {
+        return;
+    }
+    let mut reported = BTreeSet::new();
+    extension_objects(json, &mut Vec::new(), &mut |path, name| {
+        if !declared.contains(name) && reported.insert(name.to_string()) {
+            let at: String = path
+                .iter()
+                .map(|t| format!("/{}", pointer::escape(t)))
+                .collect();
+            out.push(Diagnostic::new(
+                &UNDECLARED_EXTENSION,
+                at,
+                format!("{name} is used but not declared in extensionsUsed"),
+            ));
         }
-        let mut used = [false, false];
-        for layer in layer_objects(json) {
-            used[usize::from(layer.extension == layers::FUZZ)] = true;
+    });
+}
+
+/// The findings about extensionsUsed and extensionsRequired themselves.
+fn check_lists(json: Node, declared: &BTreeSet<String>, out: &mut Vec<Diagnostic>) {
+    for (k, name) in names(json, "extensionsRequired") {
+        if !declared.contains(&name) {
+            out.push(Diagnostic::new(
+                &UNUSED_EXTENSION_REQUIRED,
+                format!("/extensionsRequired/{k}"),
+                format!("{name} is required but not in extensionsUsed"),
+            ));
         }
-        for (k, name) in names(json, "extensionsUsed") {
-            let (is_used, code) = match name.as_str() {
-                layers::SHEEN => (used[0], &SHEEN_DECLARED_UNUSED),
-                layers::FUZZ => (used[1], &FUZZ_DECLARED_UNUSED),
-                _ => continue,
-            };
-            if !is_used {
-                out.push(Diagnostic::new(
-                    code,
-                    format!("/extensionsUsed/{k}"),
-                    format!("{name} is declared in extensionsUsed but no material uses it"),
-                ));
-            }
+    }
+    let mut used = [false, false];
+    for layer in layer_objects(json) {
+        used[usize::from(layer.extension == layers::FUZZ)] = true;
+    }
+    for (k, name) in names(json, "extensionsUsed") {
+        let (is_used, code) = match name.as_str() {
+            layers::SHEEN => (used[0], &SHEEN_DECLARED_UNUSED),
+            layers::FUZZ => (used[1], &FUZZ_DECLARED_UNUSED),
+            _ => continue,
+        };
+        if !is_used {
+            out.push(Diagnostic::new(
+                code,
+                format!("/extensionsUsed/{k}"),
+                format!("{name} is declared in extensionsUsed but no material uses it"),
+            ));
         }
     }
 }
@@ -139,7 +158,12 @@ fn extension_objects<'a>(
             }
         }
         Kind::Array => {
-            for (i, child) in value.as_array().into_iter().flat_map(|a| a.iter()).enumerate() {
+            for (i, child) in value
+                .as_array()
+                .into_iter()
+                .flat_map(|a| a.iter())
+                .enumerate()
+            {
                 if child.is_object() || child.is_array() {
                     path.push(i.to_string().into());
                     extension_objects(child, path, found);

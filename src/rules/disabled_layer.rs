@@ -53,7 +53,7 @@ impl Rule for DisabledLayer {
                 let stated = layer.value.get(slot.slot.factor).is_some();
                 out.push(Diagnostic::new(
                     code,
-                    &slot.pointer(),
+                    slot.pointer(),
                     format!(
                         "{} has no effect: {why}{}, which switches the layer off",
                         slot.slot.texture,

@@ -36,7 +36,7 @@ impl Rule for Exclusions {
                     };
                     out.push(Diagnostic::new(
                         code,
-                        &layer.pointer(),
+                        layer.pointer(),
                         format!(
                             "{} must not be used together with {excluded} on one material",
                             layer.extension

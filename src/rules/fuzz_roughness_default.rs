@@ -27,7 +27,7 @@ impl Rule for FuzzRoughnessDefault {
             if fuzz.is_on() && layer.value.get("fuzzRoughnessFactor").is_none() {
                 out.push(Diagnostic::new(
                     &FUZZ_ROUGHNESS_DEFAULT_AMBIGUOUS,
-                    &layer.pointer(),
+                    layer.pointer(),
                     format!(
                         "fuzzRoughnessFactor is omitted: the draft's table gives {} and its schema {}; loaders may differ, so write it explicitly (velvet assumes {})",
                         layers::FUZZ_ROUGHNESS_DEFAULT_TABLE,

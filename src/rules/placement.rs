@@ -4,9 +4,9 @@
 
 use super::{Context, Rule};
 use crate::asset::pointer;
+use crate::asset::tape::{Kind, Node};
 use crate::diagnostics::{Code, Diagnostic, Severity};
 use crate::layers;
-use crate::asset::tape::{Kind, Node};
 use std::fmt::Write;
 
 pub const UNEXPECTED_EXTENSION_OBJECT: Code = Code::new(
@@ -23,8 +23,18 @@ impl Rule for Placement {
     }
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
+        // When every sheen and fuzz key in the document is a material's layer, none is out of
+        // place; the walk, which finds where one is, is needed only otherwise.
+        let json = cx.json();
+        let keys = [layers::SHEEN, layers::FUZZ]
+            .iter()
+            .map(|name| json.members_named(name).count())
+            .sum::<usize>();
+        if keys == super::layer_objects(json).count() {
+            return;
+        }
         let mut path = String::new();
-        walk(cx.json(), &mut path, 0, out);
+        walk(json, &mut path, 0, out);
     }
 }
 
@@ -65,7 +75,9 @@ fn walk(value: Node, path: &mut String, depth: usize, out: &mut Vec<Diagnostic>)
             }
         }
         Kind::Array => {
-            let Some(items) = value.as_array() else { return };
+            let Some(items) = value.as_array() else {
+                return;
+            };
             for (i, child) in items.iter().enumerate() {
                 if child.is_object() || child.is_array() {
                     let len = path.len();

@@ -11,8 +11,8 @@
 
 use super::{as_index, Context, Rule};
 use crate::asset::pointer;
-use crate::diagnostics::{codes, Code, Diagnostic};
 use crate::asset::tape::{Kind, Node};
+use crate::diagnostics::{codes, Code, Diagnostic};
 use std::borrow::Cow;
 
 pub use codes::UNRESOLVED_REFERENCE;
@@ -105,35 +105,40 @@ impl Rule for References {
                 .and_then(|a| a.as_array())
                 .map_or(0, |a| a.len())
         };
-        for (pattern, target) in LINKS {
-            let segments: Vec<&str> = pattern.split('/').skip(1).collect();
-            // Most targets are fixed: their length is read once per pattern.
-            let fixed_len = (!target.contains("{0}")).then(|| array_len(target));
-            walk(json, &segments, &mut Vec::new(), &mut |path, value| {
-                let Some(index) = as_index(value) else {
-                    return; // not an index: the schema check reports the type
-                };
-                let (target, len) = match fixed_len {
-                    Some(len) if index < len as u64 => return,
-                    Some(len) => (target.to_string(), len),
-                    None => {
-                        // `{0}` is the array index the pattern's first `*` matched.
-                        let first = path.get(1).map_or(String::new(), Token::text);
-                        let target = target.replace("{0}", &first);
-                        let len = array_len(&target);
-                        (target, len)
-                    }
-                };
-                if index >= len as u64 {
-                    let at: String = path
-                        .iter()
-                        .map(|t| format!("/{}", pointer::escape(&t.text())))
-                        .collect();
-                    let message = unresolved_message(&at, index, &target, len);
-                    out.push(Diagnostic::new(&UNRESOLVED_REFERENCE, at, message));
+        // Most targets are fixed: their length is read once.
+        let fixed_len: Vec<Option<usize>> = LINKS
+            .iter()
+            .map(|(_, target)| (!target.contains("{0}")).then(|| array_len(target)))
+            .collect();
+        let mut found: Vec<(usize, Diagnostic)> = Vec::new();
+        walk(json, steps(), &mut Vec::new(), &mut |link, path, value| {
+            let Some(index) = as_index(value) else {
+                return; // not an index: the schema check reports the type
+            };
+            let target = LINKS[link].1;
+            let (target, len) = match fixed_len[link] {
+                Some(len) if index < len as u64 => return,
+                Some(len) => (target.to_string(), len),
+                None => {
+                    // `{0}` is the array index the pattern's first `*` matched.
+                    let first = path.get(1).map_or(String::new(), Token::text);
+                    let target = target.replace("{0}", &first);
+                    let len = array_len(&target);
+                    (target, len)
                 }
-            });
-        }
+            };
+            if index >= len as u64 {
+                let at: String = path
+                    .iter()
+                    .map(|t| format!("/{}", pointer::escape(&t.text())))
+                    .collect();
+                let message = unresolved_message(&at, index, &target, len);
+                found.push((link, Diagnostic::new(&UNRESOLVED_REFERENCE, at, message)));
+            }
+        });
+        // Reported link by link, in the table's order, each in document order.
+        found.sort_by_key(|(link, _)| *link);
+        out.extend(found.into_iter().map(|(_, d)| d));
     }
 }
 
@@ -178,48 +183,91 @@ impl Token<'_> {
     }
 }
 
-/// Calls `found` with the path and value of every match of `segments` under `value`. The
-/// path is kept as tokens and turned into a pointer only for what is reported.
+/// One segment of the patterns in [`LINKS`], with the patterns that continue from it: the
+/// table as a tree, so that one walk of the document serves every pattern.
+struct Step {
+    segment: &'static str,
+    /// The pattern that ends here, by its place in [`LINKS`].
+    link: Option<usize>,
+    next: Vec<Step>,
+}
+
+impl Step {
+    fn matches(&self, key: &str) -> bool {
+        match self.segment.strip_prefix('*') {
+            Some(suffix) => key.ends_with(suffix),
+            None => self.segment == key,
+        }
+    }
+}
+
+/// [`LINKS`] as a tree of steps, built once.
+fn steps() -> &'static [Step] {
+    static STEPS: std::sync::OnceLock<Vec<Step>> = std::sync::OnceLock::new();
+    STEPS.get_or_init(|| {
+        let mut root: Vec<Step> = Vec::new();
+        for (link, (pattern, _)) in LINKS.iter().enumerate() {
+            let mut level = &mut root;
+            let segments: Vec<&'static str> = pattern.split('/').skip(1).collect();
+            for (i, segment) in segments.iter().enumerate() {
+                let at = match level.iter().position(|s| s.segment == *segment) {
+                    Some(at) => at,
+                    None => {
+                        level.push(Step {
+                            segment,
+                            link: None,
+                            next: Vec::new(),
+                        });
+                        level.len() - 1
+                    }
+                };
+                if i + 1 == segments.len() {
+                    level[at].link = Some(link);
+                }
+                level = &mut level[at].next;
+            }
+        }
+        root
+    })
+}
+
+/// Calls `found` with the pattern, path and value of every match of `steps` under `value`.
+/// The path is kept as tokens and turned into a pointer only for what is reported.
 fn walk<'a>(
     value: Node<'a>,
-    segments: &[&'static str],
+    steps: &'static [Step],
     path: &mut Vec<Token<'a>>,
-    found: &mut dyn FnMut(&[Token<'a>], Node<'a>),
+    found: &mut dyn FnMut(usize, &[Token<'a>], Node<'a>),
 ) {
-    let Some((first, rest)) = segments.split_first() else {
-        found(path, value);
-        return;
-    };
-    let mut visit = |token: Token<'a>, child: Node<'a>, path: &mut Vec<Token<'a>>| {
-        path.push(token);
-        walk(child, rest, path, found);
-        path.pop();
-    };
-    match (*first, value.kind()) {
-        ("*", Kind::Array) => {
-            for (i, child) in value.as_array().into_iter().flat_map(|a| a.iter()).enumerate() {
-                visit(Token::Index(i), child, path);
+    let mut visit =
+        |step: &'static Step, token: Token<'a>, child: Node<'a>, path: &mut Vec<Token<'a>>| {
+            path.push(token);
+            if let Some(link) = step.link {
+                found(link, path, child);
+            }
+            if !step.next.is_empty() {
+                walk(child, &step.next, path, found);
+            }
+            path.pop();
+        };
+    match value.kind() {
+        Kind::Array => {
+            for step in steps.iter().filter(|s| s.segment == "*") {
+                for (i, child) in value
+                    .as_array()
+                    .into_iter()
+                    .flat_map(|a| a.iter())
+                    .enumerate()
+                {
+                    visit(step, Token::Index(i), child, path);
+                }
             }
         }
-        ("*", Kind::Object) => {
+        Kind::Object => {
             for (key, child) in value.as_object().into_iter().flat_map(|o| o.iter()) {
-                visit(Token::Key(key), child, path);
-            }
-        }
-        (pattern, Kind::Object) if pattern.starts_with('*') => {
-            let suffix = &pattern[1..];
-            for (key, child) in value
-                .as_object()
-                .into_iter()
-                .flat_map(|o| o.iter())
-                .filter(|(k, _)| k.ends_with(suffix))
-            {
-                visit(Token::Key(key), child, path);
-            }
-        }
-        (key, Kind::Object) => {
-            if let Some(child) = value.get(key) {
-                visit(Token::Key(Cow::Borrowed(key)), child, path);
+                for step in steps.iter().filter(|s| s.matches(&key)) {
+                    visit(step, Token::Key(key.clone()), child, path);
+                }
             }
         }
         _ => {}

@@ -14,9 +14,9 @@
 
 use super::{Context, Rule};
 use crate::asset::resource::{self, ImageFormat, Location};
+use crate::asset::tape::Node;
 use crate::asset::Container;
 use crate::diagnostics::{codes, Code, Diagnostic, Severity};
-use crate::asset::tape::Node;
 use std::path::Path;
 
 pub const FILE_NOT_FOUND: Code = Code::new(

@@ -66,7 +66,7 @@ impl Rule for RoughnessAlpha {
                             };
                             out.push(Diagnostic::new(
                                 code,
-                                &slot.pointer(),
+                                slot.pointer(),
                                 format!(
                                     "{} reads alpha, but image {image} ({:?}, {} channel{}) has none: roughness will equal the factor everywhere",
                                     slot.slot.texture,

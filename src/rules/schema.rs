@@ -6,11 +6,11 @@
 
 use super::{layer_objects, Context, Rule};
 use crate::asset::pointer;
+use crate::asset::tape::Node;
+use crate::asset::tape_schema::TapeJson;
 use crate::diagnostics::{codes, Code, Diagnostic};
 use crate::layers;
 use jsonschema::error::ValidationErrorKind;
-use crate::asset::tape::Node;
-use crate::asset::tape_schema::TapeJson;
 use serde_json::Value;
 use std::collections::{BTreeSet, HashMap};
 use std::path::Path;
@@ -272,7 +272,10 @@ impl Rule for SchemaCheck {
             } else {
                 &cx.schemas.fuzz
             };
-            for error in schema.validator.iter_errors(layer.value) {
+            // Most objects are valid, and the yes-or-no check is the cheaper walk.
+            let errors = (!schema.validator.is_valid(layer.value))
+                .then(|| schema.validator.iter_errors(layer.value));
+            for error in errors.into_iter().flatten() {
                 let code = code_for(error.kind());
                 let at = format!("{}{}", layer.pointer(), error.instance_path().as_str());
                 out.push(Diagnostic::new(code, at, error.to_string()));
