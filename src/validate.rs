@@ -197,6 +197,7 @@ impl Validator {
         if self.positions && !report.findings.is_empty() {
             let positions = asset::position::locate(
                 &asset.json_text,
+                asset.root(),
                 report
                     .findings
                     .iter()
