@@ -729,6 +729,18 @@ impl<'a> Object<'a> {
         found.map(|at| self.node.node(at))
     }
 
+    /// Members as written, a duplicated key at each of its places: (key, value).
+    pub fn entries(&self) -> Vec<(Node<'a>, Node<'a>)> {
+        self.raw_members()
+            .map(|(k, v)| (self.node.node(k), self.node.node(v)))
+            .collect()
+    }
+
+    /// Whether the object writes a key more than once.
+    pub fn has_duplicate_keys(&self) -> bool {
+        self.has_duplicates()
+    }
+
     pub fn contains_key(&self, key: &str) -> bool {
         self.raw_members().any(|(k, _)| self.key_is(k, key))
     }

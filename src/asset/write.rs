@@ -116,7 +116,7 @@ pub fn to_bytes(asset: &Asset, json: &Value, bin: Option<&[u8]>) -> Vec<u8> {
         Container::Gltf => asset.json_text.as_str(),
         Container::Glb => asset.json_text.trim_end_matches(['\0', ' ']),
     };
-    let spliced = crate::edit::splice::rewrite(source, json)
+    let spliced = crate::edit::splice::rewrite(source, asset.root(), json)
         // The spliced text must read back as the document meant, numbers as velvet writes
         // them; if it ever did not, the document is written afresh rather than corrupted.
         .filter(|text| crate::edit::splice::reads_as_written(text, json));
