@@ -462,7 +462,7 @@ fn one_line(text: &str, node: Node) -> bool {
 }
 
 fn diff(text: &str, node: Node, after: &Value, layout: &Layout, out: &mut Vec<Splice>) {
-    if matches(text, node, after, Compare::Exact) {
+    if matches(node, after, Compare::Exact) {
         return;
     }
     match (node.kind(), after) {
@@ -478,7 +478,7 @@ fn diff(text: &str, node: Node, after: &Value, layout: &Layout, out: &mut Vec<Sp
                 append(
                     text,
                     node,
-                    items.iter().last().map(|i| i.span().end),
+                    items.iter().next_back().map(|i| i.span().end),
                     &a[items.len()..],
                     layout,
                     out,
@@ -511,8 +511,8 @@ fn key_at(text: &str, at: usize) -> Option<std::borrow::Cow<'_, str>> {
         .map(std::borrow::Cow::Owned)
 }
 
-/// True when the value `node` in `text` is `value`.
-fn matches(text: &str, node: Node, value: &Value, compare: Compare) -> bool {
+/// True when the value `node` is `value`.
+fn matches(node: Node, value: &Value, compare: Compare) -> bool {
     match (node.kind(), value) {
         (Kind::Object, Value::Object(map)) => {
             let Some(object) = node.as_object() else {
@@ -523,7 +523,7 @@ fn matches(text: &str, node: Node, value: &Value, compare: Compare) -> bool {
                 && object.len() == map.len()
                 && object.iter().all(|(key, member)| {
                     map.get(key.as_ref())
-                        .is_some_and(|v| matches(text, member, v, compare))
+                        .is_some_and(|v| matches(member, v, compare))
                 })
         }
         (Kind::Array, Value::Array(values)) => node.as_array().is_some_and(|items| {
@@ -531,7 +531,7 @@ fn matches(text: &str, node: Node, value: &Value, compare: Compare) -> bool {
                 && items
                     .iter()
                     .zip(values)
-                    .all(|(item, v)| matches(text, item, v, compare))
+                    .all(|(item, v)| matches(item, v, compare))
         }),
         (Kind::Object | Kind::Array, _) => false,
         _ => scalar_matches(node.raw(), value, compare),
@@ -719,7 +719,7 @@ fn append(
     let Some(existing) = span.as_array() else {
         return;
     };
-    let (Some(first), Some(last)) = (existing.get(0), existing.iter().last()) else {
+    let (Some(first), Some(last)) = (existing.get(0), existing.iter().next_back()) else {
         return;
     };
     let layout = &layout.local(text, span.span().start, first.span().start);
