@@ -1,5 +1,5 @@
 //! The read model: a compact index of the JSON text. One pass over the text records every
-//! value's kind and byte span in a flat array (20 bytes a value, no allocation per value);
+//! value's kind and byte span in a flat array (16 bytes a value, no allocation per value);
 //! [`Node`] reads values from it on demand: a string is borrowed from the text unless it holds
 //! escapes, a number is parsed from its span when asked. Validation reads the document through
 //! this index and never builds a `serde_json::Value` of the whole document, which took about
@@ -38,8 +38,9 @@ const KEY: u32 = 1 << (KIND_BITS + 1);
 /// An object that writes a key more than once.
 const DUPLICATES: u32 = 1 << (KIND_BITS + 2);
 const COUNT_SHIFT: u32 = KIND_BITS + 3;
-/// Most members or elements one container may hold (the count shares a word with the kind).
-const MAX_COUNT: u32 = (1 << (32 - COUNT_SHIFT)) - 1;
+/// The largest number the word shared with the kind holds: an object's member count, or where
+/// an array's run starts in `Tape::elements`.
+const MAX_AUX: u32 = (1 << (32 - COUNT_SHIFT)) - 1;
 
 /// One value (or one object key) in the index.
 #[derive(Debug, Clone, Copy)]
@@ -49,10 +50,9 @@ struct Entry {
     end: u32,
     /// Index of the entry after this value and everything inside it.
     next: u32,
-    /// Kind (3 bits), the flags above (3 bits), member or element count.
+    /// Kind (3 bits), the flags above (3 bits), and for an object its member count, for an
+    /// array where its run starts in `Tape::elements`.
     meta: u32,
-    /// For an array: where its element indices start in `Tape::elements`.
-    elements: u32,
 }
 
 impl Entry {
@@ -67,7 +67,7 @@ impl Entry {
         }
     }
 
-    fn count(&self) -> usize {
+    fn aux(&self) -> usize {
         (self.meta >> COUNT_SHIFT) as usize
     }
 }
@@ -88,7 +88,7 @@ fn kind_bits(kind: Kind) -> u32 {
 #[derive(Debug, Default)]
 pub struct Tape {
     entries: Vec<Entry>,
-    /// Entry indices of every array's elements, one run per array.
+    /// One run per array: its element count, then its elements' entry indices.
     elements: Vec<u32>,
 }
 
@@ -97,7 +97,7 @@ pub struct Tape {
 pub enum TapeError {
     /// Not JSON at this byte offset; serde_json gives the message.
     Syntax(usize),
-    /// A text over 4 GiB, or a container with more than 2^26 entries.
+    /// A text over 4 GiB, or more than 2^26 members in an object or elements in all arrays.
     TooLarge,
     /// An array or object at this byte offset nests deeper than the limit.
     TooDeep(usize),
@@ -186,7 +186,6 @@ impl Builder<'_> {
             end: self.at as u32,
             next: index + 1,
             meta: kind_bits(kind) | meta_extra,
-            elements: 0,
         });
         index
     }
@@ -220,12 +219,12 @@ impl Builder<'_> {
                     Some(b']') if !open.is_object => {
                         self.at += 1;
                         let open = stack.pop().expect("an open array");
-                        self.close(open);
+                        self.close(open)?;
                     }
                     Some(b'}') if open.is_object => {
                         self.at += 1;
                         let open = stack.pop().expect("an open object");
-                        self.close(open);
+                        self.close(open)?;
                     }
                     _ => return self.fail(),
                 }
@@ -240,7 +239,7 @@ impl Builder<'_> {
             let start = self.at;
             // A value that is an array element is recorded for its array.
             if let Some(open) = stack.last_mut() {
-                if open.count == MAX_COUNT {
+                if open.count == MAX_AUX {
                     return Err(TapeError::TooLarge);
                 }
                 open.count += 1;
@@ -267,8 +266,7 @@ impl Builder<'_> {
                     let closer = if is_object { b'}' } else { b']' };
                     if self.bytes.get(self.at) == Some(&closer) {
                         self.at += 1;
-                        self.close(open);
-                        return Ok(());
+                        return self.close(open);
                     }
                     stack.push(open);
                     if is_object {
@@ -293,22 +291,30 @@ impl Builder<'_> {
         }
     }
 
-    /// Records the end of a container: its span, its count and (for an array) its elements.
-    fn close(&mut self, open: Open) {
+    /// Records the end of a container: its span, and its count or (for an array) its run of
+    /// elements.
+    fn close(&mut self, open: Open) -> Result<(), TapeError> {
         let next = self.entries.len() as u32;
-        let elements = self.elements.len() as u32;
-        if !open.is_object {
+        let aux = if open.is_object {
+            open.count
+        } else {
+            let run = self.elements.len();
+            if run > MAX_AUX as usize {
+                return Err(TapeError::TooLarge);
+            }
+            self.elements.push(open.count);
             self.elements.extend(self.scratch.drain(open.scratch..));
-        }
+            run as u32
+        };
         let duplicates = open.is_object && open.count > 1 && self.has_duplicate_keys(open.entry);
         let entry = &mut self.entries[open.entry as usize];
         entry.end = self.at as u32;
         entry.next = next;
-        entry.meta |= open.count << COUNT_SHIFT;
+        entry.meta |= aux << COUNT_SHIFT;
         if duplicates {
             entry.meta |= DUPLICATES;
         }
-        entry.elements = elements;
+        Ok(())
     }
 
     /// Whether the object just closed at `object` writes a key twice. Checked once here so
@@ -747,7 +753,7 @@ impl<'a> Object<'a> {
 
     /// Distinct keys.
     pub fn len(&self) -> usize {
-        let count = self.node.entry().count();
+        let count = self.node.entry().aux();
         if self.has_duplicates() {
             self.iter().count()
         } else {
@@ -756,7 +762,7 @@ impl<'a> Object<'a> {
     }
 
     pub fn is_empty(&self) -> bool {
-        self.node.entry().count() == 0
+        self.node.entry().aux() == 0
     }
 
     fn has_duplicates(&self) -> bool {
@@ -847,12 +853,14 @@ pub struct Array<'a> {
 impl<'a> Array<'a> {
     fn indices(&self) -> &'a [u32] {
         let e = self.node.entry();
-        let from = e.elements as usize;
-        &self.node.tape.elements[from..from + e.count()]
+        let run = e.aux();
+        let elements = &self.node.tape.elements;
+        let count = elements[run] as usize;
+        &elements[run + 1..run + 1 + count]
     }
 
     pub fn len(&self) -> usize {
-        self.node.entry().count()
+        self.node.tape.elements[self.node.entry().aux()] as usize
     }
 
     pub fn is_empty(&self) -> bool {
