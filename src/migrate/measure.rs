@@ -34,7 +34,7 @@ pub fn attenuation(
         .and_then(Value::as_u64)
         .ok_or("the texture has no valid index")?;
     let texture = asset
-        .json()
+        .root()
         .get("textures")
         .and_then(|t| t.get(index as usize))
         .ok_or_else(|| format!("texture {index} does not exist"))?;

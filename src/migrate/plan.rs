@@ -5,6 +5,7 @@
 use super::note::{Conversion, Note, Skip};
 use super::textures::{self, TextureBake};
 use super::{fallback, legacy, sheen_to_fuzz, Options};
+use crate::asset::tape::Node;
 use crate::asset::Asset;
 use crate::edit::Edit;
 use crate::layers;
@@ -74,9 +75,10 @@ pub struct MaterialCx<'a> {
     pub options: &'a Options,
 }
 
-impl MaterialCx<'_> {
-    pub fn json(&self) -> &Value {
-        self.asset.json()
+impl<'a> MaterialCx<'a> {
+    /// The document as loaded, through its index.
+    pub fn json(&self) -> Node<'a> {
+        self.asset.root()
     }
 
     /// Pointer to `extension` on this material.
@@ -143,16 +145,19 @@ impl DocumentPlan {
 
 /// Plans the migration of every material of `asset`.
 pub fn plan_document(asset: &Asset, options: &Options) -> DocumentPlan {
-    let mut materials: Vec<MaterialPlan> = (0..layers::materials(asset.json()).len())
+    let count = asset
+        .root()
+        .get("materials")
+        .and_then(|m| m.as_array())
+        .map_or(0, |m| m.len());
+    let mut materials: Vec<MaterialPlan> = (0..count)
         .filter_map(|i| plan_material(asset, i, options))
         .collect();
     super::budget::plan(asset, &mut materials, options.budget);
-    let declared: Vec<&str> = asset
-        .json()
-        .get("extensionsUsed")
-        .and_then(Value::as_array)
-        .map(|a| a.iter().filter_map(Value::as_str).collect())
-        .unwrap_or_default();
+    let declared: Vec<std::borrow::Cow<str>> =
+        crate::rules::elements(asset.root().get("extensionsUsed"))
+            .filter_map(|e| e.as_str())
+            .collect();
     let any = |wanted: &[Conversion]| {
         materials
             .iter()
@@ -160,14 +165,15 @@ pub fn plan_document(asset: &Asset, options: &Options) -> DocumentPlan {
     };
     let mut declarations = Vec::new();
     // extensionsRequired is never touched: fuzz is optional, sheen is its fallback.
-    if any(&[Conversion::SheenToFuzz]) && !declared.contains(&layers::FUZZ) {
+    let declares = |name: &str| declared.iter().any(|d| d == name);
+    if any(&[Conversion::SheenToFuzz]) && !declares(layers::FUZZ) {
         declarations.push(Edit::declare_used(layers::FUZZ));
     }
     if any(&[
         Conversion::FallbackSheen,
         Conversion::RefreshedFallback,
         Conversion::LegacyUpgrade,
-    ]) && !declared.contains(&layers::SHEEN)
+    ]) && !declares(layers::SHEEN)
     {
         declarations.push(Edit::declare_used(layers::SHEEN));
     }
@@ -179,7 +185,13 @@ pub fn plan_document(asset: &Asset, options: &Options) -> DocumentPlan {
 
 /// The plan of material `index`, or `None` when it has neither sheen nor fuzz.
 pub fn plan_material(asset: &Asset, index: usize, options: &Options) -> Option<MaterialPlan> {
-    let material = layers::materials(asset.json()).get(index)?;
+    // The material alone is read into a value: the document is never built as one.
+    let node = asset.root().get("materials")?.get(index)?;
+    let layer_nodes = node.get("extensions")?;
+    if layer_nodes.get(layers::SHEEN).is_none() && layer_nodes.get(layers::FUZZ).is_none() {
+        return None;
+    }
+    let material = &node.to_value();
     let exts = layers::extensions(material)?;
     let (sheen, fuzz) = (exts.get(layers::SHEEN), exts.get(layers::FUZZ));
     if sheen.is_none() && fuzz.is_none() {
@@ -247,23 +259,23 @@ pub(crate) fn number_like(original: Option<&Value>, value: f64) -> Value {
 /// The texCoord set a textureInfo reads, and the first primitive drawn with `material` that
 /// lacks it, if any (carrying such a texture into a slot velvet checks would add an error).
 pub(crate) fn primitive_lacking_tex_coord(
-    json: &Value,
+    json: Node,
     material: usize,
     texture_info: &Value,
 ) -> Option<String> {
     let set = crate::rules::effective_tex_coord(texture_info);
     let attribute = format!("TEXCOORD_{set}");
-    let meshes = json.get("meshes").and_then(Value::as_array)?;
+    let meshes = json.get("meshes").and_then(|m| m.as_array())?;
     for (m, mesh) in meshes.iter().enumerate() {
-        let Some(primitives) = mesh.get("primitives").and_then(Value::as_array) else {
+        let Some(primitives) = mesh.get("primitives").and_then(|p| p.as_array()) else {
             continue;
         };
         for (p, primitive) in primitives.iter().enumerate() {
-            if primitive.get("material").and_then(Value::as_u64) != Some(material as u64) {
+            if primitive.get("material").and_then(|v| v.as_u64()) != Some(material as u64) {
                 continue;
             }
             let attributes = primitive.get("attributes");
-            if attributes.and_then(|a| a.get(&attribute)).is_none() {
+            if attributes.and_then(|a| a.get(attribute.as_str())).is_none() {
                 return Some(format!("mesh {m} primitive {p} has no {attribute}"));
             }
         }
@@ -274,14 +286,14 @@ pub(crate) fn primitive_lacking_tex_coord(
 /// Why a textureInfo cannot be carried into a checked slot, if it cannot: its index names no
 /// texture, or a primitive lacks its texCoord set.
 pub(crate) fn texture_unusable(
-    json: &Value,
+    json: Node,
     material: usize,
     texture_info: &Value,
 ) -> Option<String> {
     let textures = json
         .get("textures")
-        .and_then(Value::as_array)
-        .map_or(0, Vec::len);
+        .and_then(|t| t.as_array())
+        .map_or(0, |t| t.len());
     match texture_info.get("index").and_then(Value::as_u64) {
         Some(i) if (i as usize) < textures => {
             primitive_lacking_tex_coord(json, material, texture_info)

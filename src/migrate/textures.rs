@@ -247,16 +247,15 @@ impl std::fmt::Display for TextureBake {
 /// texture cannot be baked (no such texture or image, an image that cannot be read, no
 /// source, a KTX2 source).
 pub fn sources(asset: &Asset, index: usize) -> Result<Vec<(String, usize)>, String> {
-    let json = asset.json();
+    let json = asset.root();
     let texture = json
         .get("textures")
-        .and_then(Value::as_array)
         .and_then(|t| t.get(index))
         .ok_or_else(|| format!("texture {index} does not exist"))?;
     let image_count = json
         .get("images")
-        .and_then(Value::as_array)
-        .map_or(0, Vec::len);
+        .and_then(|i| i.as_array())
+        .map_or(0, |i| i.len());
     let texture_pointer = format!("/textures/{index}");
     let mut out = Vec::new();
     for (image, pointer) in crate::rules::texture_sources(texture, &texture_pointer) {
@@ -275,8 +274,7 @@ pub fn sources(asset: &Asset, index: usize) -> Result<Vec<(String, usize)>, Stri
         let ktx2 = header.format == ImageFormat::Ktx2
             || json
                 .pointer(&format!("/images/{image}/mimeType"))
-                .and_then(Value::as_str)
-                == Some("image/ktx2");
+                .is_some_and(|m| m.is_str("image/ktx2"));
         if ktx2 {
             return Err(format!(
                 "texture {index} has a KTX2 source (image {image}); {KTX2_REASON}"

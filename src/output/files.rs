@@ -42,16 +42,9 @@ impl<'a> FileNames<'a> {
     ) -> FileNames<'a> {
         let taken: HashSet<PathBuf> = ["buffers", "images"]
             .iter()
-            .flat_map(|kind| {
-                asset
-                    .json()
-                    .get(*kind)
-                    .and_then(Value::as_array)
-                    .into_iter()
-                    .flatten()
-            })
-            .filter_map(|item| item.get("uri").and_then(Value::as_str))
-            .filter_map(|uri| match resource::resolve(uri, asset.base_dir(), "") {
+            .flat_map(|kind| crate::rules::elements(asset.root().get(*kind)))
+            .filter_map(|item| item.get("uri").and_then(|u| u.as_str()))
+            .filter_map(|uri| match resource::resolve(&uri, asset.base_dir(), "") {
                 Ok(resource::Location::File(p)) => Some(identity(&p)),
                 _ => None,
             })
@@ -164,7 +157,7 @@ pub(crate) fn copy_resources(relocation: &Relocation, json: &Value) -> Result<()
     for copy in relocation
         .copies
         .iter()
-        .filter(|c| used.contains(&c.uri.as_str()))
+        .filter(|c| used.iter().any(|u| u.as_ref() == c.uri.as_str()))
     {
         let from = copy
             .from

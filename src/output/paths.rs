@@ -21,11 +21,13 @@
 //! its own way.
 
 use super::UsageError;
+use crate::asset::tape::JsonView;
 use crate::asset::{discover, resource, Asset};
 use crate::edit::Edit;
 use percent_encoding::{utf8_percent_encode, AsciiSet, NON_ALPHANUMERIC};
 use serde::Serialize;
 use serde_json::Value;
+use std::borrow::Cow;
 use std::collections::HashMap;
 use std::io;
 use std::path::{Component, Path, PathBuf};
@@ -249,18 +251,15 @@ pub fn folder_of(path: &Path) -> &Path {
 }
 
 /// The relative URIs (buffers and images) of a document, each once, in document order.
-pub fn relative_uris(json: &Value) -> Vec<&str> {
-    let mut out: Vec<&str> = Vec::new();
+pub fn relative_uris<'a>(json: impl JsonView<'a>) -> Vec<Cow<'a, str>> {
+    let mut out: Vec<Cow<'a, str>> = Vec::new();
     for kind in ["buffers", "images"] {
-        for item in json
-            .get(kind)
-            .and_then(Value::as_array)
-            .into_iter()
-            .flatten()
-        {
-            if let Some(uri) = item
-                .get("uri")
-                .and_then(Value::as_str)
+        let items = json.member(kind);
+        for i in 0..items.and_then(JsonView::length).unwrap_or(0) {
+            if let Some(uri) = items
+                .and_then(|a| a.element(i))
+                .and_then(|item| item.member("uri"))
+                .and_then(JsonView::text)
                 .filter(|u| is_relative_path(u))
             {
                 if !out.contains(&uri) {
@@ -281,8 +280,8 @@ pub fn check_links(asset: &Asset) -> Result<(), String> {
     }
     let base = folder_of(&asset.path);
     let mut real_base: Option<PathBuf> = None;
-    for uri in relative_uris(asset.json()) {
-        let Ok(resource::Location::File(path)) = resource::resolve(uri, base, "") else {
+    for uri in relative_uris(asset.root()) {
+        let Ok(resource::Location::File(path)) = resource::resolve(&uri, base, "") else {
             continue;
         };
         let Ok(real) = path.canonicalize() else {
@@ -317,17 +316,18 @@ pub fn relocate(asset: &Asset, output: &Path, rewrite_uris: bool) -> Result<Relo
     let mut prefix: Option<String> = None;
     let mut rewritten = 0;
     for kind in ["buffers", "images"] {
-        let Some(items) = asset.json().get(kind).and_then(Value::as_array) else {
+        let Some(items) = asset.root().get(kind).and_then(|a| a.as_array()) else {
             continue;
         };
         for (i, item) in items.iter().enumerate() {
             let Some(uri) = item
                 .get("uri")
-                .and_then(Value::as_str)
+                .and_then(|u| u.as_str())
                 .filter(|u| is_relative_path(u))
             else {
                 continue;
             };
+            let uri: &str = &uri;
             let pointer = format!("/{kind}/{i}/uri");
             if !rewrite_uris {
                 let from = match resource::resolve(uri, from_dir, &pointer) {
