@@ -130,6 +130,29 @@ pub fn to_bytes(asset: &Asset, json: &Value, bin: Option<&[u8]>) -> Vec<u8> {
     }
 }
 
+/// The bytes of `asset` with `edits` applied as splices into its loaded text (see
+/// [`crate::edit::splice::splice_edits`]), and whether they changed anything; `Ok(None)` for a
+/// plan the splicer does not take or a text that does not read back as meant, which the caller
+/// then applies to the whole document.
+pub fn spliced_bytes<'e>(
+    asset: &Asset,
+    edits: impl IntoIterator<Item = &'e crate::edit::Edit>,
+) -> Result<Option<(Vec<u8>, bool)>, crate::edit::EditError> {
+    let source = match asset.container {
+        Container::Gltf => asset.json_text.as_str(),
+        Container::Glb => asset.json_text.trim_end_matches(['\0', ' ']),
+    };
+    let Some((text, changed)) = crate::edit::splice::splice_edits(source, asset.root(), edits)?
+    else {
+        return Ok(None);
+    };
+    let bytes = match asset.container {
+        Container::Gltf => text.into_bytes(),
+        Container::Glb => glb::join(text.as_bytes(), asset.bin.as_deref()),
+    };
+    Ok(Some((bytes, changed)))
+}
+
 /// True when an edit left the document as loaded, so the input's bytes can stand as they are.
 pub fn unchanged(asset: &Asset, json: &Value, bin: Option<&[u8]>) -> bool {
     asset.json() == json && asset.bin.as_deref() == bin

@@ -25,7 +25,9 @@
 //! before it is written reads that new text with a small streaming scanner, written here for the
 //! same reason.
 
+use super::{Edit, EditError};
 use crate::asset::tape::{Kind, Node};
+use rayon::prelude::*;
 use serde_json::{Map, Value};
 
 /// Decimal places of the numbers velvet writes.
@@ -38,13 +40,257 @@ pub fn rewrite(text: &str, root: Node, after: &Value) -> Option<String> {
     let layout = Layout::detect(text, root);
     let mut splices = Vec::new();
     diff(text, root, after, &layout, &mut splices);
+    assemble(text, splices)
+}
+
+/// A part of the document an edit plan changes: a top-level member, or one element of a
+/// top-level array (a material, an image).
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+struct Unit {
+    member: String,
+    element: Option<usize>,
+}
+
+/// The text of `text` (indexed by `root`) with `edits` applied, written as splices, and whether
+/// they changed anything. Only the parts the edits touch are read into values: each material
+/// an edit names, each top-level member that gains or loses elements. `Ok(None)` for a plan
+/// this does not take (an edit of the root itself, a document that is not an object with
+/// members); the caller then applies it to the whole document.
+pub fn splice_edits<'e>(
+    text: &str,
+    root: Node,
+    edits: impl IntoIterator<Item = &'e Edit>,
+) -> Result<Option<(String, bool)>, EditError> {
+    let Some(object) = root
+        .as_object()
+        .filter(|o| !o.is_empty() && !o.has_duplicate_keys())
+    else {
+        return Ok(None);
+    };
+    // Each edit's unit: the element its pointer enters, unless some edit of that member adds,
+    // removes or replaces elements (then the whole member).
+    let mut placed: Vec<(&Edit, Unit)> = Vec::new();
+    let mut whole_members: std::collections::HashSet<String> = Default::default();
+    for edit in edits {
+        let pointer = match edit {
+            Edit::Set { pointer, .. } | Edit::Remove { pointer } => pointer.as_str(),
+            Edit::DeclareUsed { .. } => "/extensionsUsed",
+        };
+        let tokens = crate::asset::pointer::tokens(pointer);
+        let Some(member) = tokens.first() else {
+            return Ok(None);
+        };
+        let within_element =
+            tokens.len() > 2 || (tokens.len() == 2 && matches!(edit, Edit::Set { .. }));
+        let element = tokens
+            .get(1)
+            .filter(|_| within_element)
+            .and_then(|t| (t == "0" || !t.starts_with('0')).then(|| t.parse::<usize>().ok())?)
+            .filter(|i| {
+                object
+                    .get(member)
+                    .and_then(|m| m.as_array())
+                    .is_some_and(|a| *i < a.len())
+            });
+        if element.is_none() {
+            whole_members.insert(member.clone());
+        }
+        placed.push((
+            edit,
+            Unit {
+                member: member.clone(),
+                element,
+            },
+        ));
+    }
+    let mut units: Vec<(Unit, Vec<&Edit>)> = Vec::new();
+    let mut at: std::collections::HashMap<Unit, usize> = Default::default();
+    for (edit, mut unit) in placed {
+        if whole_members.contains(&unit.member) {
+            unit.element = None;
+        }
+        let i = *at.entry(unit.clone()).or_insert_with(|| {
+            units.push((unit, Vec::new()));
+            units.len() - 1
+        });
+        units[i].1.push(edit);
+    }
+    let layout = Layout::detect(text, root);
+    let entries = object.entries();
+    let members: Vec<(usize, Node)> = entries.iter().map(|(k, v)| (k.span().start, *v)).collect();
+    let mut splices = Vec::new();
+    let mut changed = false;
+    // What each unit must read back as: (its pointer, its value; `None` when removed).
+    let mut meant: Vec<(String, Option<Value>)> = Vec::with_capacity(units.len());
+    let done: Vec<Result<Option<UnitSplices>, EditError>> = units
+        .par_iter()
+        .map(|(unit, edits)| {
+            splice_unit(text, root, object, &entries, &members, &layout, unit, edits)
+        })
+        .collect();
+    for unit in done {
+        let Some(unit) = unit? else {
+            return Ok(None);
+        };
+        splices.extend(unit.splices);
+        changed |= unit.changed;
+        meant.push(unit.meant);
+    }
+    let Some(out) = assemble(text, splices) else {
+        return Ok(None);
+    };
+    // The check a spliced text passes before it is written: it is JSON, every part the plan
+    // touched reads back as meant (numbers as velvet writes them), and the root has the
+    // members it should; every other byte was copied.
+    let Ok(index) = crate::asset::tape::Tape::build(&out) else {
+        return Ok(None);
+    };
+    let new_root = index.root(&out);
+    let reads_back =
+        meant.par_iter().all(
+            |(pointer, value)| match (new_root.pointer(pointer), value) {
+                (Some(node), Some(value)) => matches(node, value, Compare::Written),
+                (None, None) => true,
+                _ => false,
+            },
+        );
+    let members_before = object.len();
+    let members_after = new_root.as_object().map_or(0, |o| o.len());
+    let added = meant
+        .iter()
+        .filter(|(p, v)| v.is_some() && root.pointer(p).is_none())
+        .count();
+    let removed = meant.iter().filter(|(_, v)| v.is_none()).count();
+    if !reads_back || members_after + removed != members_before + added {
+        return Ok(None);
+    }
+    Ok(Some((out, changed)))
+}
+
+/// What one unit contributes: its splices, whether its edits changed it, and what it must
+/// read back as (its pointer, its value; `None` when removed).
+struct UnitSplices {
+    splices: Vec<Splice>,
+    changed: bool,
+    meant: (String, Option<Value>),
+}
+
+/// The splices of one unit of [`splice_edits`]; `Ok(None)` for one it does not take.
+#[allow(clippy::too_many_arguments)]
+fn splice_unit(
+    text: &str,
+    root: Node,
+    object: crate::asset::tape::Object,
+    entries: &[(Node, Node)],
+    members: &[(usize, Node)],
+    layout: &Layout,
+    unit: &Unit,
+    edits: &[&Edit],
+) -> Result<Option<UnitSplices>, EditError> {
+    let mut splices = Vec::new();
+    let mut changed = false;
+    let meant: (String, Option<Value>);
+    let node = object.get(&unit.member);
+    match (unit.element, node) {
+        (Some(i), Some(node)) => {
+            let Some(element) = node.get(i) else {
+                return Ok(None);
+            };
+            let prefix = format!("/{}/{i}", crate::asset::pointer::escape(&unit.member));
+            let mut value = element.to_value();
+            for edit in edits {
+                let (Edit::Set { pointer, .. } | Edit::Remove { pointer }) = edit else {
+                    return Ok(None); // a declaration is never within an element
+                };
+                let Some(within) = pointer
+                    .strip_prefix(&prefix)
+                    .filter(|w| w.is_empty() || w.starts_with('/'))
+                else {
+                    return Ok(None);
+                };
+                match edit {
+                    Edit::Set { value: new, .. } if within.is_empty() => {
+                        let new = written(new.clone());
+                        changed |= value != new;
+                        value = new;
+                    }
+                    Edit::Set { value: new, .. } => {
+                        let within = Edit::set(within, new.clone());
+                        changed |= super::apply(&mut value, std::slice::from_ref(&within))?;
+                    }
+                    _ => {
+                        let within = Edit::remove(within);
+                        changed |= super::apply(&mut value, std::slice::from_ref(&within))?;
+                    }
+                }
+            }
+            diff(text, element, &value, layout, &mut splices);
+            meant = (prefix, Some(value));
+        }
+        (_, node) => {
+            let mut part = Map::new();
+            if let Some(node) = node {
+                part.insert(unit.member.clone(), node.to_value());
+            }
+            let mut part = Value::Object(part);
+            let owned: Vec<Edit> = edits.iter().map(|e| (*e).clone()).collect();
+            changed |= super::apply(&mut part, &owned)?;
+            let new = part.get(&unit.member);
+            match (node, new) {
+                (Some(node), Some(new)) => diff(text, node, new, layout, &mut splices),
+                (Some(_), None) => {
+                    let Some(i) = entries
+                        .iter()
+                        .position(|(k, _)| k.as_str().is_some_and(|k| k == unit.member))
+                    else {
+                        return Ok(None);
+                    };
+                    match removal(members, i) {
+                        Some(splice) => splices.push(splice),
+                        None => return Ok(None),
+                    }
+                }
+                (None, Some(new)) => {
+                    // Where the edit applier puts it: `extensionsUsed` after `asset` (or
+                    // first), anything else last.
+                    let anchor = if unit.member == "extensionsUsed" {
+                        entries
+                            .iter()
+                            .position(|(k, _)| k.as_str().is_some_and(|k| k == "asset"))
+                    } else {
+                        Some(members.len() - 1)
+                    };
+                    insert_members(
+                        text,
+                        root,
+                        members,
+                        &[(anchor, &unit.member, new)],
+                        layout,
+                        &mut splices,
+                    );
+                }
+                (None, None) => {}
+            }
+            let pointer = format!("/{}", crate::asset::pointer::escape(&unit.member));
+            meant = (pointer, part.get(&unit.member).cloned());
+        }
+    }
+    Ok(Some(UnitSplices {
+        splices,
+        changed,
+        meant,
+    }))
+}
+
+/// `text` with `splices` made; `None` if two overlap (never produced, but never risked).
+fn assemble(text: &str, mut splices: Vec<Splice>) -> Option<String> {
     splices.sort_by_key(|s| (s.start, s.end));
     let mut out =
         String::with_capacity(text.len() + splices.iter().map(|s| s.text.len()).sum::<usize>());
     let mut at = 0;
     for s in &splices {
         if s.start < at {
-            return None; // overlapping splices: never produced, but never risk a broken file
+            return None;
         }
         out.push_str(&text[at..s.start]);
         out.push_str(&s.text);
@@ -612,20 +858,9 @@ fn diff_object(
         // Members both leave and arrive, or all leave: the object is written anew, in place.
         return replace(text, span, &Value::Object(after.clone()), layout, out);
     }
-    for (i, ((key_start, value), key)) in members.iter().zip(&keys).enumerate() {
+    for (i, ((_, value), key)) in members.iter().zip(&keys).enumerate() {
         if removed[i] {
-            let (start, end) = match (i, members.get(i + 1)) {
-                // A member after the first takes the separator before it.
-                (i, _) if i > 0 => (members[i - 1].1.span().end, value.span().end),
-                // The first member takes the separator after it.
-                (_, Some((next_key, _))) => (*key_start, *next_key),
-                (_, None) => unreachable!("an object whose members all leave is replaced"),
-            };
-            out.push(Splice {
-                start,
-                end,
-                text: String::new(),
-            });
+            out.extend(removal(&members, i));
         } else {
             diff(text, *value, &after[key.as_ref()], layout, out);
         }
@@ -637,13 +872,62 @@ fn diff_object(
         // An empty object: written anew with its members.
         return replace(text, span, &Value::Object(after.clone()), layout, out);
     }
-    let layout = &layout.local(text, span.span().start, members[0].0);
+    // A new key goes after the member that precedes it in the edited document (the edit
+    // applier puts `extensionsUsed` after `asset`, say), or first when none does.
+    let position: std::collections::HashMap<&str, usize> = keys
+        .iter()
+        .enumerate()
+        .map(|(i, k)| (k.as_ref(), i))
+        .collect();
+    let mut anchor: Option<usize> = None;
+    let mut placed: Vec<(Option<usize>, &str, &Value)> = Vec::new();
+    for (key, value) in after {
+        match position.get(key.as_str()) {
+            Some(i) => anchor = Some(*i),
+            None => placed.push((anchor, key, value)),
+        }
+    }
+    insert_members(text, span, &members, &placed, layout, out);
+}
+
+/// The splice that removes member `i` of an object with `members` (as (where the key starts,
+/// the value)) with one separator; `None` for an only member (its object is written anew).
+fn removal(members: &[(usize, Node)], i: usize) -> Option<Splice> {
+    let (start, end) = match (i, members.get(i + 1)) {
+        // A member after the first takes the separator before it.
+        (i, _) if i > 0 => (members[i - 1].1.span().end, members[i].1.span().end),
+        // The first member takes the separator after it.
+        (_, Some((next_key, _))) => (members[i].0, *next_key),
+        (_, None) => return None,
+    };
+    Some(Splice {
+        start,
+        end,
+        text: String::new(),
+    })
+}
+
+/// Inserts new members into the object `span` (whose members are `members`, as (where the key
+/// starts, the value)): each after the member its anchor names, or first without one, in the
+/// order given, laid out as the object's own members are.
+fn insert_members(
+    text: &str,
+    span: Node,
+    members: &[(usize, Node)],
+    placed: &[(Option<usize>, &str, &Value)],
+    layout: &Layout,
+    out: &mut Vec<Splice>,
+) {
+    let Some(first) = members.first() else {
+        return;
+    };
+    let layout = &layout.local(text, span.span().start, first.0);
     let inline = layout.unit.is_none() || one_line(text, span);
-    let indent = line_indent(text, members[0].0).to_string();
+    let indent = line_indent(text, first.0).to_string();
     let separator = if inline {
         members
             .get(1)
-            .map(|(k, _)| text[members[0].1.span().end..*k].to_string())
+            .map(|(k, _)| text[first.1.span().end..*k].to_string())
             .unwrap_or_else(|| layout.inline_comma.clone())
     } else {
         format!(",{}{indent}", layout.newline)
@@ -656,38 +940,27 @@ fn diff_object(
             layout.render(value, &indent, inline)
         )
     };
-    // A new key goes after the member that precedes it in the edited document (the edit
-    // applier puts `extensionsUsed` after `asset`, say), or first when none does.
-    let position: std::collections::HashMap<&str, usize> = keys
-        .iter()
-        .enumerate()
-        .map(|(i, k)| (k.as_ref(), i))
-        .collect();
-    let mut anchor: Option<usize> = None;
     let mut leading = String::new();
     let mut after_member: Vec<(usize, String)> = Vec::new();
-    for (key, value) in after {
-        match position.get(key.as_str()) {
-            Some(i) => anchor = Some(*i),
-            None => match anchor {
-                None => {
-                    leading.push_str(&member_text(key, value));
-                    leading.push_str(&separator);
+    for &(anchor, key, value) in placed {
+        match anchor {
+            None => {
+                leading.push_str(&member_text(key, value));
+                leading.push_str(&separator);
+            }
+            Some(i) => match after_member.last_mut() {
+                Some((at, insert)) if *at == i => {
+                    insert.push_str(&separator);
+                    insert.push_str(&member_text(key, value));
                 }
-                Some(i) => match after_member.last_mut() {
-                    Some((at, insert)) if *at == i => {
-                        insert.push_str(&separator);
-                        insert.push_str(&member_text(key, value));
-                    }
-                    _ => after_member.push((i, separator.clone() + &member_text(key, value))),
-                },
+                _ => after_member.push((i, separator.clone() + &member_text(key, value))),
             },
         }
     }
     if !leading.is_empty() {
         out.push(Splice {
-            start: members[0].0,
-            end: members[0].0,
+            start: first.0,
+            end: first.0,
             text: leading,
         });
     }
@@ -772,6 +1045,47 @@ mod tests {
     fn add_fuzz(doc: &mut Value) {
         doc["materials"][0]["extensions"]["KHR_materials_fuzz"] =
             serde_json::json!({"fuzzColorFactor": [0.5, 0.25, 1.0], "fuzzRoughnessFactor": 0.5});
+    }
+
+    /// The edits written as splices give the bytes the whole-document path gives: an element
+    /// changed within, one replaced, a declaration created after `asset`, a member appended to,
+    /// a new top-level member; and a top-level member removed.
+    #[test]
+    fn edits_spliced_part_by_part_match_the_whole_document_path() {
+        let text = "{\n  \"asset\": {\"version\": \"2.0\"},\n  \"materials\": [\n    {\"name\": \"a\"},\n    {\"name\": \"b\", \"extensions\": {\"KHR_materials_sheen\": {\"sheenRoughnessFactor\": 0.800000011920929}}}\n  ],\n  \"images\": [{\"uri\": \"a.png\"}],\n  \"extras\": {\"k\": 1}\n}\n";
+        let edits = vec![
+            Edit::set(
+                "/materials/1/extensions/KHR_materials_fuzz",
+                serde_json::json!({"fuzzFactor": 1.0, "fuzzRoughnessFactor": 0.7499999999999999}),
+            ),
+            Edit::set("/materials/0", serde_json::json!({"name": "c"})),
+            Edit::declare_used("KHR_materials_fuzz"),
+            Edit::set("/images/1", serde_json::json!({"uri": "b.png"})),
+            Edit::set("/textures/0", serde_json::json!({"source": 1})),
+        ];
+        let tape = crate::asset::tape::Tape::build(text).unwrap();
+        let (out, changed) = splice_edits(text, tape.root(text), &edits)
+            .unwrap()
+            .unwrap();
+        assert!(changed);
+        let mut whole: Value = serde_json::from_str(text).unwrap();
+        super::super::apply(&mut whole, &edits).unwrap();
+        assert_eq!(out, spliced(text, &whole));
+        assert!(reads_as_written(&out, &whole));
+        // A top-level member removed takes its separator with it.
+        let remove = [Edit::remove("/extras")];
+        let (out, _) = splice_edits(text, tape.root(text), &remove)
+            .unwrap()
+            .unwrap();
+        let mut whole: Value = serde_json::from_str(text).unwrap();
+        super::super::apply(&mut whole, &remove).unwrap();
+        assert_eq!(out, spliced(text, &whole));
+        assert!(out.ends_with("[{\"uri\": \"a.png\"}]\n}\n"));
+        // A plan that sets what is there changes nothing, and writes the text as it was.
+        let same = [Edit::set("/materials/0/name", serde_json::json!("a"))];
+        let (out, changed) = splice_edits(text, tape.root(text), &same).unwrap().unwrap();
+        assert!(!changed);
+        assert_eq!(out, text);
     }
 
     #[test]

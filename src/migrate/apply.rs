@@ -184,9 +184,22 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
             plan.document.declarations.as_slice(),
             plan.relocation.edits.as_slice(),
         ]);
-    for edits in groups {
-        changed |= edit::apply(plan.asset.json_mut(), edits)
-            .map_err(|e| format!("{}: {e}", plan.input.display()))?;
+    // Without bakes the edits are written as splices straight into the loaded text, reading
+    // only the materials they touch; otherwise (or for a plan the splicer does not take) they
+    // are applied to the whole document.
+    let spliced = if bake_plan.is_empty() {
+        write::spliced_bytes(&plan.asset, groups.clone().flatten())
+            .map_err(|e| format!("{}: {e}", plan.input.display()))?
+    } else {
+        None
+    };
+    if let Some((_, spliced_changed)) = &spliced {
+        changed = *spliced_changed;
+    } else {
+        for edits in groups {
+            changed |= edit::apply(plan.asset.json_mut(), edits)
+                .map_err(|e| format!("{}: {e}", plan.input.display()))?;
+        }
     }
     if !changed && plan.in_place() {
         return Ok(Written::Untouched);
@@ -196,7 +209,10 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
         plan.bytes = Vec::new();
     }
     create_parent(&output)?;
-    let bytes = if bake_plan.is_empty() {
+    let bytes = if let Some((bytes, _)) = spliced.filter(|_| changed) {
+        copy_resources(&plan.relocation, plan.asset.root())?;
+        bytes
+    } else if bake_plan.is_empty() {
         copy_resources(&plan.relocation, plan.asset.json())?;
         if changed {
             write::to_bytes(&plan.asset, plan.asset.json(), plan.asset.bin.as_deref())

@@ -152,7 +152,10 @@ pub(crate) fn create_parent(path: &Path) -> Result<(), String> {
 /// Places a relocation's resource copies that the written document `json` still names (each a
 /// regular file, hard-linked or copied atomically from the resolved source), for migrate and
 /// bake alike.
-pub(crate) fn copy_resources(relocation: &Relocation, json: &Value) -> Result<(), String> {
+pub(crate) fn copy_resources<'a>(
+    relocation: &Relocation,
+    json: impl crate::asset::tape::JsonView<'a>,
+) -> Result<(), String> {
     let used = relative_uris(json);
     for copy in relocation
         .copies
