@@ -121,7 +121,7 @@ pub fn splice_edits<'e>(
     let mut splices = Vec::new();
     let mut changed = false;
     // What each unit must read back as: (its pointer, its value; `None` when removed).
-    let mut meant: Vec<(String, Option<Value>)> = Vec::with_capacity(units.len());
+    let mut meant: Vec<(String, Option<u64>)> = Vec::with_capacity(units.len());
     let done: Vec<Result<Option<UnitSplices>, EditError>> = units
         .par_iter()
         .map(|(unit, edits)| {
@@ -148,8 +148,8 @@ pub fn splice_edits<'e>(
     let new_root = index.root(&out);
     let reads_back =
         meant.par_iter().all(
-            |(pointer, value)| match (new_root.pointer(pointer), value) {
-                (Some(node), Some(value)) => matches(node, value, Compare::Written),
+            |(pointer, digest)| match (new_root.pointer(pointer), digest) {
+                (Some(node), Some(digest)) => written_digest(node.to_value()) == *digest,
                 (None, None) => true,
                 _ => false,
             },
@@ -168,11 +168,21 @@ pub fn splice_edits<'e>(
 }
 
 /// What one unit contributes: its splices, whether its edits changed it, and what it must
-/// read back as (its pointer, its value; `None` when removed).
+/// read back as (its pointer, the [`written_digest`] of its value; `None` when removed). A
+/// digest, not the value, is kept so that a plan touching every material does not hold them all.
 struct UnitSplices {
     splices: Vec<Splice>,
     changed: bool,
-    meant: (String, Option<Value>),
+    meant: (String, Option<u64>),
+}
+
+/// A digest of `value` with its numbers as velvet writes them ([`written`]), key order included:
+/// equal for a value and the text velvet writes for it.
+fn written_digest(value: Value) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut hasher = std::collections::hash_map::DefaultHasher::new();
+    written(value).to_string().hash(&mut hasher);
+    hasher.finish()
 }
 
 /// The splices of one unit of [`splice_edits`]; `Ok(None)` for one it does not take.
@@ -189,7 +199,7 @@ fn splice_unit(
 ) -> Result<Option<UnitSplices>, EditError> {
     let mut splices = Vec::new();
     let mut changed = false;
-    let meant: (String, Option<Value>);
+    let meant: (String, Option<u64>);
     let node = object.get(&unit.member);
     match (unit.element, node) {
         (Some(i), Some(node)) => {
@@ -225,7 +235,7 @@ fn splice_unit(
                 }
             }
             diff(text, element, &value, layout, &mut splices);
-            meant = (prefix, Some(value));
+            meant = (prefix, Some(written_digest(value)));
         }
         (_, node) => {
             let mut part = Map::new();
@@ -272,7 +282,10 @@ fn splice_unit(
                 (None, None) => {}
             }
             let pointer = format!("/{}", crate::asset::pointer::escape(&unit.member));
-            meant = (pointer, part.get(&unit.member).cloned());
+            meant = (
+                pointer,
+                part.get_mut(&unit.member).map(|v| written_digest(v.take())),
+            );
         }
     }
     Ok(Some(UnitSplices {
