@@ -24,7 +24,8 @@ glb=$(find "$root/fixtures" "$here/seeds" -name '*.glb' | sort)
     add validate $gltf $glb
     add migrate $gltf
     add bake $gltf $glb
+    add tape $gltf
 }
-for target in load_gltf load_glb validate migrate bake; do
+for target in load_gltf load_glb validate migrate bake tape; do
     printf '%s: %s inputs\n' "$target" "$(ls "$here/corpus/$target" | wc -l)"
 done

@@ -23,10 +23,10 @@ pub fn load(path: &str, data: &[u8]) -> asset::Loaded {
 pub fn touch_resources(asset: &Asset) {
     let count = |key: &str| {
         asset
-            .json
+            .root()
             .get(key)
-            .and_then(serde_json::Value::as_array)
-            .map_or(0, Vec::len)
+            .and_then(|a| a.as_array())
+            .map_or(0, |a| a.len())
     };
     for i in 0..count("buffers").min(8) {
         let _ = asset.buffer_bytes(i);

@@ -5,9 +5,10 @@
 //! limit and its flag, so that a user who meets one knows what to change.
 //!
 //! The limits exist so that a hostile or broken file costs a clear error, not a crash, a stack
-//! overflow or an out-of-memory kill: a parsed JSON value takes about ten times its text in
-//! memory, nesting is walked recursively (parsing, schema checks, source positions, dropping),
-//! and a decoded image takes up to eight bytes per pixel however small its file is.
+//! overflow or an out-of-memory kill: the document's index takes about its text again and a
+//! parsed JSON value (which the editors build) about eight times its text in memory, nesting is
+//! walked recursively (schema checks, rules, parsing values, dropping them), and a decoded
+//! image takes up to eight bytes per pixel however small its file is.
 
 use std::io::Read;
 use std::path::Path;
@@ -31,7 +32,8 @@ pub struct LoadOptions {
     pub allow_outside_uris: bool,
 }
 
-/// 64 MiB: a 20,000-material document is about 11 MB; the parsed value takes ~14× its text.
+/// 64 MiB: a 20,000-material document is about 11 MB; its index takes about as much again, a
+/// parsed value (built by the editors) ~8× the text.
 pub const DEFAULT_MAX_DOCUMENT_BYTES: u64 = 64 << 20;
 /// glTF documents nest about 8 deep; `extras` may go further.
 pub const DEFAULT_MAX_JSON_DEPTH: usize = 64;

@@ -1,6 +1,7 @@
-//! Asset I/O: turning a .gltf or .glb file into an [`Asset`] (the JSON as an order-preserving
-//! `serde_json::Value`, which is the source of truth, plus the GLB BIN chunk), lazy access to
-//! buffers and images, JSON pointers and source positions, and the atomic writer.
+//! Asset I/O: turning a .gltf or .glb file into an [`Asset`] (the JSON text, which is the
+//! source of truth, with its index from [`tape`], plus the GLB BIN chunk; a
+//! `serde_json::Value` of the document only when an editor asks), lazy access to buffers and
+//! images, JSON pointers and source positions, and the atomic writer.
 //!
 //! Nothing external is opened while loading: buffers and images are read when a rule or a
 //! conversion asks, and for images only the header when that is enough.
