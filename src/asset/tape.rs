@@ -161,11 +161,6 @@ impl Tape {
             at: 0,
         }
     }
-
-    /// Bytes held by the index (for memory figures).
-    pub fn heap_bytes(&self) -> usize {
-        self.entries.capacity() * std::mem::size_of::<Entry>() + self.elements.capacity() * 4
-    }
 }
 
 impl Builder<'_> {
@@ -781,10 +776,6 @@ impl<'a> Object<'a> {
 
     pub fn keys(&self) -> impl Iterator<Item = Cow<'a, str>> + 'a {
         self.iter().map(|(k, _)| k)
-    }
-
-    pub fn values(&self) -> impl Iterator<Item = Node<'a>> + 'a {
-        self.iter().map(|(_, v)| v)
     }
 }
 
