@@ -226,11 +226,13 @@ fn splice_unit(
                     }
                     Edit::Set { value: new, .. } => {
                         let within = Edit::set(within, new.clone());
-                        changed |= super::apply(&mut value, std::slice::from_ref(&within))?;
+                        changed |= super::apply(&mut value, std::slice::from_ref(&within))
+                            .map_err(|e| from_root(e, &prefix))?;
                     }
                     _ => {
                         let within = Edit::remove(within);
-                        changed |= super::apply(&mut value, std::slice::from_ref(&within))?;
+                        changed |= super::apply(&mut value, std::slice::from_ref(&within))
+                            .map_err(|e| from_root(e, &prefix))?;
                     }
                 }
             }
@@ -293,6 +295,35 @@ fn splice_unit(
         changed,
         meant,
     }))
+}
+
+/// An error from an edit applied within the element at `prefix`, its pointer given from the
+/// document's root as the whole-document applier gives it.
+fn from_root(error: EditError, prefix: &str) -> EditError {
+    match error {
+        EditError::Root { pointer } => EditError::Root {
+            pointer: format!("{prefix}{pointer}"),
+        },
+        EditError::NotAContainer {
+            pointer,
+            token,
+            kind,
+        } => EditError::NotAContainer {
+            pointer: format!("{prefix}{pointer}"),
+            token,
+            kind,
+        },
+        EditError::BadIndex {
+            pointer,
+            token,
+            len,
+        } => EditError::BadIndex {
+            pointer: format!("{prefix}{pointer}"),
+            token,
+            len,
+        },
+        other => other,
+    }
 }
 
 /// `text` with `splices` made; `None` if two overlap (never produced, but never risked).
@@ -1094,6 +1125,13 @@ mod tests {
         super::super::apply(&mut whole, &remove).unwrap();
         assert_eq!(out, spliced(text, &whole));
         assert!(out.ends_with("[{\"uri\": \"a.png\"}]\n}\n"));
+        // An edit that cannot be applied within an element fails as on the whole document.
+        let bad = [Edit::set("/materials/0/name/x", serde_json::json!(1))];
+        let mut whole: Value = serde_json::from_str(text).unwrap();
+        assert_eq!(
+            splice_edits(text, tape.root(text), &bad).unwrap_err(),
+            super::super::apply(&mut whole, &bad).unwrap_err()
+        );
         // A plan that sets what is there changes nothing, and writes the text as it was.
         let same = [Edit::set("/materials/0/name", serde_json::json!("a"))];
         let (out, changed) = splice_edits(text, tape.root(text), &same).unwrap().unwrap();
