@@ -112,11 +112,7 @@ impl JsonStyle {
 /// result is read once more to check it, neither time building a second document. A GLB's
 /// chunk padding belongs to the container and is set anew.
 pub fn to_bytes(asset: &Asset, json: &Value, bin: Option<&[u8]>) -> Vec<u8> {
-    let source = match asset.container {
-        Container::Gltf => asset.json_text.as_str(),
-        Container::Glb => asset.json_text.trim_end_matches(['\0', ' ']),
-    };
-    let spliced = crate::edit::splice::rewrite(source, asset.root(), json)
+    let spliced = crate::edit::splice::rewrite(source(asset), asset.root(), json)
         // The spliced text must read back as the document meant, numbers as velvet writes
         // them; if it ever did not, the document is written afresh rather than corrupted.
         .filter(|text| crate::edit::splice::reads_as_written(text, json));
@@ -124,6 +120,19 @@ pub fn to_bytes(asset: &Asset, json: &Value, bin: Option<&[u8]>) -> Vec<u8> {
         Some(text) => text.into_bytes(),
         None => JsonStyle::detect(&asset.json_text).render(json),
     };
+    in_container(asset, text, bin)
+}
+
+/// The loaded text splices are made into: a GLB chunk's padding belongs to the container.
+fn source(asset: &Asset) -> &str {
+    match asset.container {
+        Container::Gltf => asset.json_text.as_str(),
+        Container::Glb => asset.json_text.trim_end_matches(['\0', ' ']),
+    }
+}
+
+/// The file's bytes for JSON `text`: the text itself, or a GLB with `bin`.
+fn in_container(asset: &Asset, text: Vec<u8>, bin: Option<&[u8]>) -> Vec<u8> {
     match asset.container {
         Container::Gltf => text,
         Container::Glb => glb::join(&text, bin),
@@ -138,18 +147,12 @@ pub fn spliced_bytes<'e>(
     asset: &Asset,
     edits: impl IntoIterator<Item = &'e crate::edit::Edit>,
 ) -> Result<Option<(Vec<u8>, bool)>, crate::edit::EditError> {
-    let source = match asset.container {
-        Container::Gltf => asset.json_text.as_str(),
-        Container::Glb => asset.json_text.trim_end_matches(['\0', ' ']),
-    };
-    let Some((text, changed)) = crate::edit::splice::splice_edits(source, asset.root(), edits)?
+    let Some((text, changed)) =
+        crate::edit::splice::splice_edits(source(asset), asset.root(), edits)?
     else {
         return Ok(None);
     };
-    let bytes = match asset.container {
-        Container::Gltf => text.into_bytes(),
-        Container::Glb => glb::join(text.as_bytes(), asset.bin.as_deref()),
-    };
+    let bytes = in_container(asset, text.into_bytes(), asset.bin.as_deref());
     Ok(Some((bytes, changed)))
 }
 

@@ -299,31 +299,14 @@ fn splice_unit(
 
 /// An error from an edit applied within the element at `prefix`, its pointer given from the
 /// document's root as the whole-document applier gives it.
-fn from_root(error: EditError, prefix: &str) -> EditError {
-    match error {
-        EditError::Root { pointer } => EditError::Root {
-            pointer: format!("{prefix}{pointer}"),
-        },
-        EditError::NotAContainer {
-            pointer,
-            token,
-            kind,
-        } => EditError::NotAContainer {
-            pointer: format!("{prefix}{pointer}"),
-            token,
-            kind,
-        },
-        EditError::BadIndex {
-            pointer,
-            token,
-            len,
-        } => EditError::BadIndex {
-            pointer: format!("{prefix}{pointer}"),
-            token,
-            len,
-        },
-        other => other,
+fn from_root(mut error: EditError, prefix: &str) -> EditError {
+    if let EditError::Root { pointer }
+    | EditError::NotAContainer { pointer, .. }
+    | EditError::BadIndex { pointer, .. } = &mut error
+    {
+        pointer.insert_str(0, prefix);
     }
+    error
 }
 
 /// `text` with `splices` made; `None` if two overlap (never produced, but never risked).

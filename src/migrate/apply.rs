@@ -209,19 +209,19 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
         plan.bytes = Vec::new();
     }
     create_parent(&output)?;
-    let bytes = if let Some((bytes, _)) = spliced.filter(|_| changed) {
+    let bytes = if bake_plan.is_empty() {
+        // Without bakes no edit touches a URI that is copied (resources are copied or their
+        // URIs rewritten, never both), so the document as loaded names what the output uses.
         copy_resources(&plan.relocation, plan.asset.root())?;
-        bytes
-    } else if bake_plan.is_empty() {
-        copy_resources(&plan.relocation, plan.asset.json())?;
-        if changed {
-            write::to_bytes(&plan.asset, plan.asset.json(), plan.asset.bin.as_deref())
-        } else if plan.bytes.is_empty() {
+        match spliced {
+            Some((bytes, true)) => bytes,
+            _ if changed => {
+                write::to_bytes(&plan.asset, plan.asset.json(), plan.asset.bin.as_deref())
+            }
             // Edits that set what was there already: the input's own bytes, read again.
-            asset::read(&plan.input, &plan.asset.options)
-                .map_err(|d| format!("cannot read {}: {}", plan.input.display(), d.message))?
-        } else {
-            std::mem::take(&mut plan.bytes)
+            _ if plan.bytes.is_empty() => asset::read(&plan.input, &plan.asset.options)
+                .map_err(|d| format!("cannot read {}: {}", plan.input.display(), d.message))?,
+            _ => std::mem::take(&mut plan.bytes),
         }
     } else {
         let json = plan.asset.take_json();
