@@ -38,8 +38,8 @@ const KEY: u32 = 1 << (KIND_BITS + 1);
 /// An object that writes a key more than once.
 const DUPLICATES: u32 = 1 << (KIND_BITS + 2);
 const COUNT_SHIFT: u32 = KIND_BITS + 3;
-/// The largest number the word shared with the kind holds: an object's member count, or where
-/// an array's run starts in `Tape::elements`.
+/// The largest number the word shared with the kind holds: an object's member count, where
+/// an array's run starts in `Tape::elements`, or an unescaped key's [`key_print`].
 const MAX_AUX: u32 = (1 << (32 - COUNT_SHIFT)) - 1;
 
 /// One value (or one object key) in the index.
@@ -51,7 +51,8 @@ struct Entry {
     /// Index of the entry after this value and everything inside it.
     next: u32,
     /// Kind (3 bits), the flags above (3 bits), and for an object its member count, for an
-    /// array where its run starts in `Tape::elements`.
+    /// array where its run starts in `Tape::elements`, for an unescaped key its
+    /// [`key_print`].
     meta: u32,
 }
 
@@ -69,6 +70,19 @@ impl Entry {
 
     fn aux(&self) -> usize {
         (self.meta >> COUNT_SHIFT) as usize
+    }
+}
+
+/// A key's length, first and last byte in 26 bits: a lookup compares it with the entry before
+/// it reads the key's text, so that the keys a lookup passes over cost no read of the text
+/// (scattered through a large document, those reads are what lookups spent their time on).
+fn key_print(key: &[u8]) -> u32 {
+    match key {
+        [] => 0,
+        [first, ..] => {
+            let last = key[key.len() - 1];
+            ((key.len() as u32 & 0x3FF) << 16) | (u32::from(*first) << 8) | u32::from(last)
+        }
     }
 }
 
@@ -354,7 +368,12 @@ impl Builder<'_> {
         }
         let start = self.at;
         let escaped = self.string()?;
-        self.push(Kind::String, start, KEY | if escaped { ESCAPED } else { 0 });
+        let meta = if escaped {
+            KEY | ESCAPED
+        } else {
+            KEY | key_print(&self.bytes[start + 1..self.at - 1]) << COUNT_SHIFT
+        };
+        self.push(Kind::String, start, meta);
         self.skip_whitespace();
         if self.bytes.get(self.at) != Some(&b':') {
             return self.fail();
@@ -503,6 +522,18 @@ impl<'a> Node<'a> {
         self.entry().kind()
     }
 
+    /// Whether this key entry spells `key`, whose [`key_print`] is `print`. An unescaped key
+    /// whose print differs is told apart without reading the text.
+    fn key_is(&self, key: &str, print: u32) -> bool {
+        let e = self.entry();
+        if e.meta & ESCAPED == 0 {
+            e.aux() as u32 == print
+                && &self.text.as_bytes()[e.start as usize + 1..e.end as usize - 1] == key.as_bytes()
+        } else {
+            self.as_str().is_some_and(|s| s == key)
+        }
+    }
+
     /// The value's text, as written.
     pub fn raw(&self) -> &'a str {
         let e = self.entry();
@@ -641,19 +672,13 @@ impl<'a> Node<'a> {
         let node = *self;
         let entries = &self.tape.entries[self.at as usize + 1..self.entry().next as usize];
         let first = self.at + 1;
+        let print = key_print(key.as_bytes());
         entries.iter().enumerate().filter_map(move |(i, e)| {
             if e.meta & KEY == 0 {
                 return None;
             }
             let at = first + i as u32;
-            let k = node.node(at);
-            let raw = k.raw();
-            let matches = if e.meta & ESCAPED == 0 {
-                &raw[1..raw.len() - 1] == key
-            } else {
-                k.as_str().is_some_and(|s| s == key)
-            };
-            matches.then(|| node.node(at + 1))
+            node.node(at).key_is(key, print).then(|| node.node(at + 1))
         })
     }
 
@@ -704,23 +729,17 @@ impl<'a> Object<'a> {
         }
     }
 
-    /// Whether a key entry spells `key`.
-    fn key_is(&self, key_at: u32, key: &str) -> bool {
-        let k = self.node.node(key_at);
-        let e = k.entry();
-        if e.meta & ESCAPED == 0 {
-            let raw = k.raw();
-            &raw[1..raw.len() - 1] == key
-        } else {
-            k.as_str().is_some_and(|s| s == key)
-        }
+    /// Whether a key entry spells `key`, whose [`key_print`] is `print`.
+    fn key_is(&self, key_at: u32, key: &str, print: u32) -> bool {
+        self.node.node(key_at).key_is(key, print)
     }
 
     /// The value of `key`: the last one, if the key is written more than once.
     pub fn get(&self, key: &str) -> Option<Node<'a>> {
+        let print = key_print(key.as_bytes());
         let mut found = None;
         for (k, v) in self.raw_members() {
-            if self.key_is(k, key) {
+            if self.key_is(k, key, print) {
                 found = Some(v);
                 if !self.has_duplicates() {
                     break;
@@ -743,7 +762,8 @@ impl<'a> Object<'a> {
     }
 
     pub fn contains_key(&self, key: &str) -> bool {
-        self.raw_members().any(|(k, _)| self.key_is(k, key))
+        let print = key_print(key.as_bytes());
+        self.raw_members().any(|(k, _)| self.key_is(k, key, print))
     }
 
     /// Distinct keys.

@@ -4,7 +4,7 @@
 //! document. The published schemas do not forbid unknown properties, so those are found here by
 //! comparing keys with the properties the schemas define, and reported as warnings.
 
-use super::{layer_objects, Context, Rule};
+use super::{layer_objects, Context, LayerObject, Rule};
 use crate::asset::pointer;
 use crate::asset::tape::Node;
 use crate::asset::tape_schema::TapeJson;
@@ -223,18 +223,14 @@ fn unexpected(value: Node, tree: &PropertyTree, at: &str, out: &mut Vec<Diagnost
     let Some(obj) = value.as_object() else { return };
     for (key, child) in obj.iter() {
         let key = key.as_ref();
-        if tree.known.contains(key) && !tree.children.contains_key(key) {
-            continue;
-        }
-        let here = pointer::join(at, key);
         if !tree.known.contains(key) {
             out.push(Diagnostic::new(
                 &codes::UNEXPECTED_PROPERTY,
-                &here,
+                pointer::join(at, key),
                 format!("unexpected property '{key}'"),
             ));
         } else if let Some(sub) = tree.children.get(key) {
-            unexpected(child, sub, &here, out);
+            unexpected(child, sub, &pointer::join(at, key), out);
         }
     }
 }
@@ -266,34 +262,111 @@ impl Rule for SchemaCheck {
     }
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
+        // The findings on one object depend on its text alone, and libraries repeat the same
+        // layer object on many materials: each distinct text is checked once, its findings kept
+        // with pointers relative to the object.
+        let mut checked: HashMap<(&str, &str), Vec<Diagnostic>> = HashMap::new();
         for layer in layer_objects(cx.json()) {
-            let schema = if layer.extension == layers::SHEEN {
-                &cx.schemas.sheen
-            } else {
-                &cx.schemas.fuzz
-            };
-            // Most objects are valid, and the yes-or-no check is the cheaper walk.
-            let errors = (!schema.validator.is_valid(layer.value))
-                .then(|| schema.validator.iter_errors(layer.value));
-            for error in errors.into_iter().flatten() {
-                let code = code_for(error.kind());
-                let at = format!("{}{}", layer.pointer(), error.instance_path().as_str());
-                out.push(Diagnostic::new(code, at, error.to_string()));
-            }
-            let before = out.len();
-            unexpected(layer.value, &schema.properties, &layer.pointer(), out);
-            if layer.extension == layers::SHEEN {
-                // A property of the sheen draft is one fault, reported by the legacy rule under
-                // its more specific code, not here as well.
-                let legacy: Vec<String> = super::legacy_sheen::LEGACY_PROPERTIES
-                    .iter()
-                    .map(|name| pointer::join(&layer.pointer(), name))
-                    .collect();
-                let found = out.split_off(before);
-                out.extend(found.into_iter().filter(|d| {
-                    d.code != codes::UNEXPECTED_PROPERTY.name || !legacy.contains(&d.pointer)
-                }));
-            }
+            let found = checked
+                .entry((layer.extension, layer.value.raw()))
+                .or_insert_with(|| check_layer(cx.schemas, &layer));
+            let at = layer.pointer();
+            out.extend(found.iter().map(|d| Diagnostic {
+                pointer: format!("{at}{}", d.pointer),
+                ..d.clone()
+            }));
         }
+    }
+}
+
+/// The schema findings on one layer object, with pointers relative to it.
+fn check_layer(schemas: &Schemas, layer: &LayerObject<Node>) -> Vec<Diagnostic> {
+    let schema = if layer.extension == layers::SHEEN {
+        &schemas.sheen
+    } else {
+        &schemas.fuzz
+    };
+    let mut out = Vec::new();
+    // Most objects are valid, and the yes-or-no check is the cheaper walk.
+    let errors = (!schema.validator.is_valid(layer.value))
+        .then(|| schema.validator.iter_errors(layer.value));
+    for error in errors.into_iter().flatten() {
+        let code = code_for(error.kind());
+        out.push(Diagnostic::new(
+            code,
+            error.instance_path().as_str(),
+            error.to_string(),
+        ));
+    }
+    let before = out.len();
+    unexpected(layer.value, &schema.properties, "", &mut out);
+    if layer.extension == layers::SHEEN && out.len() > before {
+        // A property of the sheen draft is one fault, reported by the legacy rule under its
+        // more specific code, not here as well.
+        let legacy: Vec<String> = super::legacy_sheen::LEGACY_PROPERTIES
+            .iter()
+            .map(|name| pointer::join("", name))
+            .collect();
+        let found = out.split_off(before);
+        out.extend(
+            found.into_iter().filter(|d| {
+                d.code != codes::UNEXPECTED_PROPERTY.name || !legacy.contains(&d.pointer)
+            }),
+        );
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::asset::{load_bytes_with, LoadOptions};
+
+    fn schema_findings(text: &str) -> Vec<(String, String, String)> {
+        let loaded = load_bytes_with(
+            Path::new("memo.gltf"),
+            text.as_bytes(),
+            &LoadOptions::default(),
+        );
+        let asset = loaded.asset.expect("the document parses");
+        let schemas = Schemas::builtin();
+        let cx = Context {
+            asset: &asset,
+            schemas: &schemas,
+        };
+        let mut out = Vec::new();
+        SchemaCheck.check(&cx, &mut out);
+        out.into_iter()
+            .map(|d| (d.code.to_string(), d.pointer, d.message))
+            .collect()
+    }
+
+    #[test]
+    fn a_layer_object_repeated_on_several_materials_is_reported_at_each_of_them() {
+        let bad =
+            r#"{"KHR_materials_sheen":{"sheenRoughnessFactor":2,"sheenColor":[1,1,1],"x":{}}}"#;
+        let text = format!(
+            r#"{{"asset":{{"version":"2.0"}},"materials":[{{"extensions":{bad}}},{{}},{{"extensions":{bad}}}]}}"#
+        );
+        let at =
+            |m: usize, rest: &str| format!("/materials/{m}/extensions/KHR_materials_sheen{rest}");
+        let expected: Vec<(String, String, String)> = [0, 2]
+            .into_iter()
+            .flat_map(|m| {
+                [
+                    (
+                        "VALUE_NOT_IN_RANGE".to_string(),
+                        at(m, "/sheenRoughnessFactor"),
+                        "2 is greater than the maximum of 1.0".to_string(),
+                    ),
+                    (
+                        "UNEXPECTED_PROPERTY".to_string(),
+                        at(m, "/x"),
+                        "unexpected property 'x'".to_string(),
+                    ),
+                ]
+            })
+            .collect();
+        assert_eq!(schema_findings(&text), expected);
     }
 }
