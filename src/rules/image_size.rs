@@ -18,18 +18,18 @@ impl Rule for ImageSize {
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
         let json = cx.json();
-        let mut images = BTreeSet::new();
+        let mut textures = BTreeSet::new();
         for layer in layer_objects(json) {
-            for slot in slot_uses(&layer) {
-                let Some(index) = slot.texture.index else {
-                    continue;
-                };
-                let Some(texture) = json.get("textures").and_then(|t| t.get(index as usize)) else {
-                    continue;
-                };
-                for (image, _) in texture_sources(texture, &format!("/textures/{index}")) {
-                    images.extend(image);
-                }
+            textures.extend(slot_uses(&layer).filter_map(|slot| slot.texture.index));
+        }
+        let mut images = BTreeSet::new();
+        let texture_list = json.get("textures");
+        for index in textures {
+            let Some(texture) = texture_list.and_then(|t| t.get(index as usize)) else {
+                continue;
+            };
+            for (image, _) in texture_sources(texture, &format!("/textures/{index}")) {
+                images.extend(image);
             }
         }
         let count = json

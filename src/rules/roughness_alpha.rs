@@ -35,26 +35,22 @@ impl Rule for RoughnessAlpha {
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
         let json = cx.json();
+        let (textures, images) = (json.get("textures"), json.get("images"));
         for layer in layer_objects(json) {
             for slot in slot_uses(&layer) {
                 if slot.slot.channels != Channels::Alpha {
                     continue;
                 }
-                let Some(texture) = slot
-                    .texture
-                    .index
-                    .and_then(|t| json.get("textures")?.get(t as usize))
+                let Some(texture) = slot.texture.index.and_then(|t| textures?.get(t as usize))
                 else {
                     continue; // dangling: the references rule reports it
                 };
                 let texture_pointer =
                     format!("/textures/{}", slot.texture.index.unwrap_or_default());
                 for (image, _) in texture_sources(texture, &texture_pointer) {
-                    let Some(image) = image.filter(|i| {
-                        json.get("images")
-                            .and_then(|a| a.get(*i as usize))
-                            .is_some()
-                    }) else {
+                    let Some(image) =
+                        image.filter(|i| images.and_then(|a| a.get(*i as usize)).is_some())
+                    else {
                         continue;
                     };
                     match cx.asset.image_header(image as usize) {

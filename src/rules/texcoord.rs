@@ -22,14 +22,15 @@ impl Rule for TexCoords {
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
         let json = cx.json();
-        // material index -> texCoord sets its sheen/fuzz textures read, with the slot pointer.
-        let mut needs: HashMap<u64, Vec<(u64, SlotUse<Node>)>> = HashMap::new();
+        // material index -> the TEXCOORD_N attributes its sheen/fuzz textures read, each with
+        // its slot (named only in a finding).
+        let mut needs: HashMap<u64, Vec<(String, SlotUse<Node>)>> = HashMap::new();
         for layer in layer_objects(json) {
             for slot in slot_uses(&layer) {
-                needs
-                    .entry(layer.material as u64)
-                    .or_default()
-                    .push((effective_tex_coord(slot.value), slot));
+                needs.entry(layer.material as u64).or_default().push((
+                    format!("TEXCOORD_{}", effective_tex_coord(slot.value)),
+                    slot,
+                ));
             }
         }
         if needs.is_empty() {
@@ -44,14 +45,15 @@ impl Rule for TexCoords {
                     continue;
                 };
                 let attributes = primitive.get("attributes").and_then(|a| a.as_object());
-                for (set, slot) in slots {
-                    let slot_pointer = slot.pointer();
-                    let attribute = format!("TEXCOORD_{set}");
-                    if !attributes.is_some_and(|a| a.contains_key(&attribute)) {
+                for (attribute, slot) in slots {
+                    if !attributes.is_some_and(|a| a.contains_key(attribute)) {
                         out.push(Diagnostic::new(
                             &MESH_PRIMITIVE_TOO_FEW_TEXCOORDS,
                             format!("/meshes/{m}/primitives/{p}/material"),
-                            format!("material {material}'s {slot_pointer} reads {attribute}, which this primitive does not have"),
+                            format!(
+                                "material {material}'s {} reads {attribute}, which this primitive does not have",
+                                slot.pointer()
+                            ),
                         ));
                     }
                 }
