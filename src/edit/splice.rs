@@ -149,7 +149,7 @@ pub fn splice_edits<'e>(
     let reads_back =
         meant.par_iter().all(
             |(pointer, digest)| match (new_root.pointer(pointer), digest) {
-                (Some(node), Some(digest)) => written_digest(node.to_value()) == *digest,
+                (Some(node), Some(digest)) => node_digest(node) == *digest,
                 (None, None) => true,
                 _ => false,
             },
@@ -168,7 +168,7 @@ pub fn splice_edits<'e>(
 }
 
 /// What one unit contributes: its splices, whether its edits changed it, and what it must
-/// read back as (its pointer, the [`written_digest`] of its value; `None` when removed). A
+/// read back as (its pointer, the [`value_digest`] of its value; `None` when removed). A
 /// digest, not the value, is kept so that a plan touching every material does not hold them all.
 struct UnitSplices {
     splices: Vec<Splice>,
@@ -176,13 +176,96 @@ struct UnitSplices {
     meant: (String, Option<u64>),
 }
 
-/// A digest of `value` with its numbers as velvet writes them ([`written`]), key order included:
-/// equal for a value and the text velvet writes for it.
-fn written_digest(value: Value) -> u64 {
-    use std::hash::{Hash, Hasher};
-    let mut hasher = std::collections::hash_map::DefaultHasher::new();
-    written(value).to_string().hash(&mut hasher);
-    hasher.finish()
+/// A digest of what a value reads as when velvet writes it: key order, decoded strings, and
+/// numbers as [`number_text`] writes them. [`value_digest`] (what a unit is meant to hold) and
+/// [`node_digest`] (what the written text holds) feed the same stream, so a unit is checked
+/// without rebuilding either side as a value.
+struct Digest(std::collections::hash_map::DefaultHasher);
+
+impl Digest {
+    fn new() -> Digest {
+        Digest(std::collections::hash_map::DefaultHasher::new())
+    }
+
+    fn tag(&mut self, tag: u8) {
+        std::hash::Hasher::write_u8(&mut self.0, tag);
+    }
+
+    /// A tagged, length-prefixed run of bytes, so that no two streams run together.
+    fn text(&mut self, tag: u8, text: &str) {
+        use std::hash::Hasher;
+        self.0.write_u8(tag);
+        self.0.write_usize(text.len());
+        self.0.write(text.as_bytes());
+    }
+
+    fn finish(&self) -> u64 {
+        std::hash::Hasher::finish(&self.0)
+    }
+}
+
+/// The [`Digest`] of `value` as velvet writes it.
+fn value_digest(value: &Value) -> u64 {
+    fn feed(d: &mut Digest, value: &Value) {
+        match value {
+            Value::Null => d.tag(b'n'),
+            Value::Bool(b) => d.tag(if *b { b't' } else { b'f' }),
+            Value::Number(n) => d.text(b'#', &raw_number_text(n.as_str())),
+            Value::String(s) => d.text(b'"', s),
+            Value::Array(items) => {
+                d.tag(b'[');
+                items.iter().for_each(|v| feed(d, v));
+                d.tag(b']');
+            }
+            Value::Object(map) => {
+                d.tag(b'{');
+                for (k, v) in map {
+                    d.text(b':', k);
+                    feed(d, v);
+                }
+                d.tag(b'}');
+            }
+        }
+    }
+    let mut d = Digest::new();
+    feed(&mut d, value);
+    d.finish()
+}
+
+/// The [`Digest`] of the value `node` indexes, read as a `Value` would read it (a key written
+/// twice: at its first place, with its last value).
+fn node_digest(node: Node) -> u64 {
+    fn feed(d: &mut Digest, node: Node) {
+        match node.kind() {
+            Kind::Null => d.tag(b'n'),
+            Kind::Bool => d.tag(if node.as_bool() == Some(true) {
+                b't'
+            } else {
+                b'f'
+            }),
+            Kind::Number => d.text(b'#', &raw_number_text(node.raw())),
+            Kind::String => d.text(b'"', &node.as_str().unwrap_or_default()),
+            Kind::Array => {
+                d.tag(b'[');
+                node.as_array()
+                    .into_iter()
+                    .flat_map(|a| a.iter())
+                    .for_each(|v| feed(d, v));
+                d.tag(b']');
+            }
+            Kind::Object => {
+                d.tag(b'{');
+                for (k, v) in node.as_object().into_iter().flat_map(|o| o.iter()) {
+                    d.text(b':', &k);
+                    feed(d, v);
+                }
+                d.tag(b'}');
+            }
+        }
+    }
+    let mut d = Digest::new();
+    feed(&mut d, node);
+    d.finish()
 }
 
 /// The splices of one unit of [`splice_edits`]; `Ok(None)` for one it does not take.
@@ -237,7 +320,7 @@ fn splice_unit(
                 }
             }
             diff(text, element, &value, layout, &mut splices);
-            meant = (prefix, Some(written_digest(value)));
+            meant = (prefix, Some(value_digest(&value)));
         }
         (_, node) => {
             let mut part = Map::new();
@@ -284,10 +367,7 @@ fn splice_unit(
                 (None, None) => {}
             }
             let pointer = format!("/{}", crate::asset::pointer::escape(&unit.member));
-            meant = (
-                pointer,
-                part.get_mut(&unit.member).map(|v| written_digest(v.take())),
-            );
+            meant = (pointer, part.get(&unit.member).map(value_digest));
         }
     }
     Ok(Some(UnitSplices {
@@ -491,6 +571,8 @@ struct Layout {
     inline_comma: String,
     /// Whether arrays of numbers are written on one line in a pretty file.
     inline_number_arrays: bool,
+    /// Where the text's line breaks are, found on first use (shared by the local layouts).
+    line_breaks: std::sync::Arc<std::sync::OnceLock<Vec<u32>>>,
 }
 
 impl Layout {
@@ -508,6 +590,7 @@ impl Layout {
             colon: ":".to_string(),
             inline_comma: ",".to_string(),
             inline_number_arrays: false,
+            line_breaks: Default::default(),
         };
         let mut seen_colon = false;
         let mut seen_comma = false;
@@ -571,8 +654,8 @@ impl Layout {
     /// member at `member_start`, where the file mixes units (tabs in one place, spaces in
     /// another).
     fn local(&self, text: &str, container_start: usize, member_start: usize) -> Layout {
-        let outer = line_indent(text, container_start);
-        let inner = line_indent(text, member_start);
+        let outer = self.line_indent(text, container_start);
+        let inner = self.line_indent(text, member_start);
         let mut layout = self.clone();
         if self.unit.is_some() && inner.len() > outer.len() && inner.starts_with(outer) {
             layout.unit = Some(inner[outer.len()..].to_string());
@@ -619,7 +702,8 @@ impl Layout {
                     out.push(']');
                 }
             }
-            Value::Number(n) => out.push_str(&number_text(n)),
+            Value::Number(n) => out.push_str(&raw_number_text(n.as_str())),
+            Value::String(text) => push_string(out, text),
             other => out.push_str(&other.to_string()),
         }
     }
@@ -631,7 +715,7 @@ impl Layout {
                 if i > 0 {
                     out.push_str(&self.inline_comma);
                 }
-                out.push_str(&Value::String(key.clone()).to_string());
+                push_string(out, key);
                 out.push_str(&self.colon);
                 self.write(value, indent, true, out);
             }
@@ -646,7 +730,7 @@ impl Layout {
             }
             out.push_str(self.newline);
             out.push_str(&inner);
-            out.push_str(&Value::String(key.clone()).to_string());
+            push_string(out, key);
             out.push_str(&self.colon);
             self.write(value, &inner, false, out);
         }
@@ -681,39 +765,45 @@ fn visit(node: Node, f: &mut dyn FnMut(Node) -> bool) -> bool {
 /// or fewer, otherwise rounded to that many and written as the shortest decimal that reads
 /// back.
 pub fn number_text(n: &serde_json::Number) -> String {
-    let text = n.to_string();
+    raw_number_text(n.as_str()).into_owned()
+}
+
+/// [`number_text`] of a number written `text` (as serde_json writes and reads numbers, with
+/// their spelling kept): borrowed exactly when the spelling stays.
+fn raw_number_text(text: &str) -> std::borrow::Cow<'_, str> {
+    use std::borrow::Cow;
     let decimals = match text.find(['e', 'E']) {
         Some(_) => usize::MAX,
         None => text.find('.').map_or(0, |dot| text.len() - dot - 1),
     };
     if decimals <= DECIMALS as usize {
-        return text;
+        return Cow::Borrowed(text);
     }
-    let Some(x) = n.as_f64() else { return text };
+    let Some(x) = text.parse::<f64>().ok().filter(|x| x.is_finite()) else {
+        return Cow::Borrowed(text);
+    };
     let scale = 10f64.powi(DECIMALS);
     let rounded = (x * scale).round() / scale;
     if rounded == x {
-        return text; // already at that precision (`5E-1`): the spelling stays
+        return Cow::Borrowed(text); // already at that precision (`5E-1`): the spelling stays
     }
     if rounded == 0.0 {
-        return "0".to_string();
+        return Cow::Owned("0".to_string());
     }
     // Display writes the shortest decimal that reads back as the same f64.
-    format!("{rounded}")
+    Cow::Owned(format!("{rounded}"))
 }
 
 /// `value` with every number as velvet writes it (see [`number_text`]): edits store what the
 /// file will hold, so that planning again compares like with like.
 pub fn written(value: Value) -> Value {
     match value {
-        Value::Number(n) => {
-            let text = number_text(&n);
-            if text == n.to_string() {
-                Value::Number(n)
-            } else {
+        Value::Number(n) => match raw_number_text(n.as_str()) {
+            std::borrow::Cow::Borrowed(_) => Value::Number(n),
+            std::borrow::Cow::Owned(text) => {
                 serde_json::from_str(&text).map_or(Value::Number(n), Value::Number)
             }
-        }
+        },
         Value::Array(items) => Value::Array(items.into_iter().map(written).collect()),
         Value::Object(map) => {
             Value::Object(map.into_iter().map(|(k, v)| (k, written(v))).collect())
@@ -722,12 +812,31 @@ pub fn written(value: Value) -> Value {
     }
 }
 
-/// The indentation of the line `at` lies on.
-fn line_indent(text: &str, at: usize) -> &str {
-    let line_start = text[..at].rfind('\n').map_or(0, |p| p + 1);
-    let line = &text[line_start..];
-    let len = line.len() - line.trim_start_matches([' ', '\t']).len();
-    &line[..len]
+/// `text` as a JSON string, escaped as serde_json escapes it.
+fn push_string(out: &mut String, text: &str) {
+    if text.bytes().any(|b| b == b'"' || b == b'\\' || b < 0x20) {
+        out.push_str(&Value::from(text).to_string());
+    } else {
+        out.push('"');
+        out.push_str(text);
+        out.push('"');
+    }
+}
+
+impl Layout {
+    /// The indentation of the line `at` lies on. Line breaks are looked up, not searched for
+    /// backwards: in a minified document (one line) a backward search from every edit would
+    /// read the whole text before it each time.
+    fn line_indent<'t>(&self, text: &'t str, at: usize) -> &'t str {
+        let breaks = self
+            .line_breaks
+            .get_or_init(|| text.match_indices('\n').map(|(i, _)| i as u32).collect());
+        let before = breaks.partition_point(|&b| (b as usize) < at);
+        let line_start = before.checked_sub(1).map_or(0, |i| breaks[i] as usize + 1);
+        let line = &text[line_start..];
+        let len = line.len() - line.trim_start_matches([' ', '\t']).len();
+        &line[..len]
+    }
 }
 
 fn one_line(text: &str, node: Node) -> bool {
@@ -847,7 +956,11 @@ fn replace(text: &str, node: Node, after: &Value, layout: &Layout, out: &mut Vec
     out.push(Splice {
         start: span.start,
         end: span.end,
-        text: layout.render(after, line_indent(text, span.start), was_one_line_container),
+        text: layout.render(
+            after,
+            layout.line_indent(text, span.start),
+            was_one_line_container,
+        ),
     });
 }
 
@@ -950,7 +1063,7 @@ fn insert_members(
     };
     let layout = &layout.local(text, span.span().start, first.0);
     let inline = layout.unit.is_none() || one_line(text, span);
-    let indent = line_indent(text, first.0).to_string();
+    let indent = layout.line_indent(text, first.0).to_string();
     let separator = if inline {
         members
             .get(1)
@@ -960,12 +1073,11 @@ fn insert_members(
         format!(",{}{indent}", layout.newline)
     };
     let member_text = |key: &str, value: &Value| {
-        format!(
-            "{}{}{}",
-            Value::String(key.to_string()),
-            layout.colon,
-            layout.render(value, &indent, inline)
-        )
+        let mut text = String::new();
+        push_string(&mut text, key);
+        text.push_str(&layout.colon);
+        layout.write(value, &indent, inline || layout.unit.is_none(), &mut text);
+        text
     };
     let mut leading = String::new();
     let mut after_member: Vec<(usize, String)> = Vec::new();
@@ -1023,7 +1135,7 @@ fn append(
         return;
     };
     let layout = &layout.local(text, span.span().start, first.span().start);
-    let indent = line_indent(text, last.span().start).to_string();
+    let indent = layout.line_indent(text, last.span().start).to_string();
     let separator = if inline {
         existing
             .get(1)
@@ -1196,6 +1308,69 @@ mod tests {
         assert_eq!(number_text(&spelled), "1e-1"); // serde_json's own spelling of 1E-1
         let noisy: serde_json::Number = serde_json::from_str("7.5E-8").unwrap();
         assert_eq!(number_text(&noisy), "0");
+    }
+
+    #[test]
+    fn a_value_and_the_text_velvet_writes_for_it_have_one_digest_and_other_texts_another() {
+        let digest_of_text = |text: &str| {
+            let tape = crate::asset::tape::Tape::build(text).unwrap();
+            node_digest(tape.root(text))
+        };
+        let meant = serde_json::json!({
+            "name": "caf\u{e9} \"1\"",
+            "f": [0.7499999999999999, 1.0, 2, 7.5e-8],
+            "on": true,
+            "none": null,
+            "inner": {"k": -0.5}
+        });
+        let digest = value_digest(&meant);
+        // As written: noise rounded, escapes of either spelling, any layout; a key written twice
+        // reads as its last value at its first place.
+        for text in [
+            r#"{"name":"caf\u00e9 \"1\"","f":[0.75,1.0,2,0],"on":true,"none":null,"inner":{"k":-0.5}}"#,
+            "{\n  \"name\": \"café \\\"1\\\"\",\n  \"f\": [0.75, 1.0, 2, 0],\n  \"on\": true,\n  \"none\": null,\n  \"inner\": {\"k\": -0.5}\n}",
+            r#"{"name":"x","f":[0.75,1.0,2,0],"on":true,"none":null,"inner":{"k":-0.5},"name":"café \"1\""}"#,
+        ] {
+            assert_eq!(digest_of_text(text), digest, "{text}");
+        }
+        for other in [
+            r#"{"name":"café \"1\"","f":[0.75,1.0,2,0.1],"on":true,"none":null,"inner":{"k":-0.5}}"#,
+            r#"{"f":[0.75,1.0,2,0],"name":"café \"1\"","on":true,"none":null,"inner":{"k":-0.5}}"#,
+            r#"{"name":"café \"1\"","f":[0.75,1.0,2,0],"on":false,"none":null,"inner":{"k":-0.5}}"#,
+            r#"{"name":"café \"1\"","f":[0.75,1.0,2,0],"on":true,"none":null,"inner":{"k":"-0.5"}}"#,
+            r#"{"name":"café \"1\"","f":[[0.75,1.0],2,0],"on":true,"none":null,"inner":{"k":-0.5}}"#,
+        ] {
+            assert_ne!(digest_of_text(other), digest, "{other}");
+        }
+    }
+
+    #[test]
+    fn line_indent_is_the_indentation_of_the_line_a_position_lies_on() {
+        let text = "{\r\n\t\"a\": {\r\n\t\t\"b\": 1\r\n\t},\n    \"c\": 2}";
+        let tape = crate::asset::tape::Tape::build(text).unwrap();
+        let layout = Layout::detect(text, tape.root(text));
+        let at = |needle: &str| text.find(needle).unwrap();
+        assert_eq!(layout.line_indent(text, 0), "");
+        assert_eq!(layout.line_indent(text, at("\"a\"")), "\t");
+        assert_eq!(layout.line_indent(text, at("\"b\"")), "\t\t");
+        assert_eq!(layout.line_indent(text, at("1")), "\t\t");
+        assert_eq!(layout.line_indent(text, at("\"c\"")), "    ");
+        assert_eq!(layout.line_indent(text, text.len()), "    ");
+        let minified = r#"{"a":{"b":1},"c":2}"#;
+        let tape = crate::asset::tape::Tape::build(minified).unwrap();
+        let layout = Layout::detect(minified, tape.root(minified));
+        assert_eq!(
+            layout.line_indent(minified, minified.find("\"c\"").unwrap()),
+            ""
+        );
+    }
+
+    #[test]
+    fn written_rounds_a_number_below_the_precision_to_zero() {
+        assert_eq!(
+            written(serde_json::json!([7.5e-8, 0.5])).to_string(),
+            "[0,0.5]"
+        );
     }
 
     #[test]
