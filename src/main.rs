@@ -403,14 +403,14 @@ fn validate(args: ValidateArgs, color: ColorChoice, quiet: bool) -> ExitCode {
         Ok(r) => r,
         Err(e) => return usage_error(e),
     };
-    let schemas = match &args.schema_dir {
+    let validator = match &args.schema_dir {
         Some(dir) => match Schemas::with_overrides(dir) {
-            Ok(s) => s,
+            Ok(schemas) => Validator::new(schemas, Settings::default()),
             Err(e) => return usage_error(e),
         },
-        None => Schemas::builtin(),
+        None => Validator::builtin(Settings::default()),
     };
-    let validator = Validator::new(schemas, Settings::default())
+    let validator = validator
         .with_load_options(args.load.options())
         .with_positions(args.format.shows_positions());
     let progress = report::progress_bar(quiet);

@@ -94,7 +94,7 @@ impl FileReport {
 /// A validator for one run: schemas compiled once, settings applied to every file, every file
 /// loaded under the same limits.
 pub struct Validator {
-    pub schemas: Schemas,
+    schemas: Compiled,
     pub settings: Settings,
     pub load: asset::LoadOptions,
     /// Whether findings are placed in the source text (line and column); a report format that
@@ -102,8 +102,55 @@ pub struct Validator {
     pub positions: bool,
 }
 
+/// The schemas of a run: at hand, or compiling on a thread of their own while the first file
+/// is read (compiling the core schemas takes about as long as reading a large file).
+enum Compiled {
+    Ready(Schemas),
+    Compiling {
+        thread: std::sync::Mutex<Option<std::thread::JoinHandle<Schemas>>>,
+        done: std::sync::OnceLock<Schemas>,
+    },
+}
+
+impl Compiled {
+    fn get(&self) -> &Schemas {
+        match self {
+            Compiled::Ready(schemas) => schemas,
+            Compiled::Compiling { thread, done } => done.get_or_init(|| {
+                let handle = thread
+                    .lock()
+                    .unwrap_or_else(|e| e.into_inner())
+                    .take()
+                    .expect("the compiling thread is joined once, under the OnceLock");
+                // The built-in schemas are tested to compile; a panic there is a bug, and is
+                // raised again here rather than hidden.
+                handle
+                    .join()
+                    .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+            }),
+        }
+    }
+}
+
 impl Validator {
     pub fn new(schemas: Schemas, settings: Settings) -> Validator {
+        Validator::with_compiled(Compiled::Ready(schemas), settings)
+    }
+
+    /// A validator with the built-in schemas, which compile in the background until the first
+    /// file's rules need them.
+    pub fn builtin(settings: Settings) -> Validator {
+        let thread = std::thread::spawn(Schemas::builtin);
+        Validator::with_compiled(
+            Compiled::Compiling {
+                thread: std::sync::Mutex::new(Some(thread)),
+                done: std::sync::OnceLock::new(),
+            },
+            settings,
+        )
+    }
+
+    fn with_compiled(schemas: Compiled, settings: Settings) -> Validator {
         Validator {
             schemas,
             settings,
@@ -182,10 +229,15 @@ impl Validator {
         };
         let cx = Context {
             asset: &asset,
-            schemas: &self.schemas,
+            schemas: self.schemas.get(),
         };
-        diagnostics.extend(run_rules(&cx, asset.json_text.len() >= PARALLEL_RULES_FROM));
-        let info = asset_info(asset.root());
+        let parallel = asset.json_text.len() >= PARALLEL_RULES_FROM;
+        let (found, info) = if parallel {
+            rayon::join(|| run_rules(&cx, true), || asset_info(asset.root()))
+        } else {
+            (run_rules(&cx, false), asset_info(asset.root()))
+        };
+        diagnostics.extend(found);
         let mut report = self.finish(
             settings,
             path.to_path_buf(),
@@ -285,11 +337,14 @@ fn strings(json: Node, key: &str) -> Vec<String> {
 }
 
 fn asset_info(json: Node) -> AssetInfo {
-    let with = |ext: &str| {
-        crate::rules::materials(json)
-            .filter(|m| m.get("extensions").is_some_and(|e| e.get(ext).is_some()))
-            .count()
-    };
+    let (mut materials, mut sheen, mut fuzz) = (0, 0, 0);
+    for material in crate::rules::materials(json) {
+        materials += 1;
+        if let Some(extensions) = material.get("extensions").and_then(|e| e.as_object()) {
+            sheen += usize::from(extensions.contains_key(layers::SHEEN));
+            fuzz += usize::from(extensions.contains_key(layers::FUZZ));
+        }
+    }
     let text = |p: &str| {
         json.pointer(p)
             .and_then(|s| s.as_str())
@@ -300,9 +355,9 @@ fn asset_info(json: Node) -> AssetInfo {
         generator: text("/asset/generator"),
         extensions_used: strings(json, "extensionsUsed"),
         extensions_required: strings(json, "extensionsRequired"),
-        material_count: crate::rules::materials(json).count(),
-        sheen_material_count: with(layers::SHEEN),
-        fuzz_material_count: with(layers::FUZZ),
+        material_count: materials,
+        sheen_material_count: sheen,
+        fuzz_material_count: fuzz,
     }
 }
 
