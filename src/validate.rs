@@ -227,10 +227,7 @@ impl Validator {
         let Some(asset) = loaded.asset else {
             return self.finish(settings, path.to_path_buf(), None, 0, diagnostics, None);
         };
-        let cx = Context {
-            asset: &asset,
-            schemas: self.schemas.get(),
-        };
+        let cx = Context::new(&asset, self.schemas.get());
         let parallel = asset.json_text.len() >= PARALLEL_RULES_FROM;
         let (found, info) = if parallel {
             rayon::join(|| run_rules(&cx, true), || asset_info(asset.root()))
@@ -394,10 +391,7 @@ mod tests {
         );
         let asset = loaded.asset.expect("the document parses");
         let schemas = Schemas::builtin();
-        let cx = Context {
-            asset: &asset,
-            schemas: &schemas,
-        };
+        let cx = Context::new(&asset, &schemas);
         let sequential = run_rules(&cx, false);
         assert!(sequential.len() > 500, "{} findings", sequential.len());
         for _ in 0..4 {

@@ -1,7 +1,7 @@
 //! Layer order with a clear coat: sheen lies under KHR_materials_clearcoat, fuzz over it. The
 //! same material converted from one to the other changes its look where the coat is strong.
 
-use super::{layer_objects, Context, Rule};
+use super::{Context, Rule};
 use crate::diagnostics::{Code, Diagnostic, Severity};
 use crate::layers;
 
@@ -24,7 +24,7 @@ impl Rule for Clearcoat {
     }
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
-        for layer in layer_objects(cx.json()) {
+        for layer in cx.layer_objects() {
             if layer.extensions.get(layers::CLEARCOAT).is_none() {
                 continue;
             }

@@ -4,7 +4,7 @@
 //! or fuzz extension that no material uses is a warning: it makes loaders without it refuse or
 //! warn for nothing.
 
-use super::{layer_objects, Context, Rule};
+use super::{Context, Rule};
 use crate::asset::pointer;
 use crate::asset::tape::{Kind, Node};
 use crate::diagnostics::{Code, Diagnostic, Severity};
@@ -107,7 +107,7 @@ fn check_lists(json: Node, declared: &BTreeSet<String>, out: &mut Vec<Diagnostic
         }
     }
     let mut used = [false, false];
-    for layer in layer_objects(json) {
+    for layer in super::layer_objects(json) {
         used[usize::from(layer.extension == layers::FUZZ)] = true;
     }
     for (k, name) in names(json, "extensionsUsed") {

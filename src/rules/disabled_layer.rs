@@ -3,9 +3,8 @@
 //! effect, which usually means a forgotten factor: exporters often write the texture and rely
 //! on a default that turns the layer off.
 
-use super::{layer_objects, slot_uses, Context, Rule};
+use super::{slot_uses, Context, Rule};
 use crate::diagnostics::{Code, Diagnostic, Severity};
-use crate::layers::{self, FuzzView, SheenView};
 
 pub const SHEEN_TEXTURE_WITHOUT_EFFECT: Code = Code::new(
     "KHR_MATERIALS_SHEEN_TEXTURE_WITHOUT_EFFECT",
@@ -26,25 +25,20 @@ impl Rule for DisabledLayer {
     }
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
-        for layer in layer_objects(cx.json()) {
-            let (off, code, why) = if layer.extension == layers::SHEEN {
-                let Some(view) = SheenView::read(layer.value) else {
-                    continue;
-                };
-                (
+        for read in cx.layers() {
+            let layer = read.object;
+            let (off, code, why) = match (&read.sheen, &read.fuzz) {
+                (Some(view), _) => (
                     !view.is_on(),
                     &SHEEN_TEXTURE_WITHOUT_EFFECT,
                     "sheenColorFactor is [0, 0, 0]",
-                )
-            } else {
-                let Some(view) = FuzzView::read(layer.value) else {
-                    continue;
-                };
-                (
+                ),
+                (_, Some(view)) => (
                     !view.is_on(),
                     &FUZZ_TEXTURE_WITHOUT_EFFECT,
                     "fuzzFactor is 0",
-                )
+                ),
+                (None, None) => continue,
             };
             if !off {
                 continue;

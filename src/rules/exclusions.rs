@@ -3,7 +3,7 @@
 //! warns (MULTIPLE_EXTENSIONS); a loader may drop the layer or the material's look, so velvet
 //! reports an error.
 
-use super::{layer_objects, Context, Rule};
+use super::{Context, Rule};
 use crate::diagnostics::{Code, Diagnostic, Severity};
 use crate::layers;
 
@@ -26,7 +26,7 @@ impl Rule for Exclusions {
     }
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
-        for layer in layer_objects(cx.json()) {
+        for layer in cx.layer_objects() {
             for excluded in [layers::SPEC_GLOSS, layers::UNLIT] {
                 if layer.extensions.get(excluded).is_some() {
                     let code = if layer.extension == layers::SHEEN {

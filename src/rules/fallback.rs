@@ -6,7 +6,7 @@
 
 use super::{Context, Rule};
 use crate::diagnostics::{Code, Diagnostic, Severity};
-use crate::layers::{self, FuzzView, SheenView};
+use crate::layers;
 
 pub const FUZZ_WITHOUT_FALLBACK: Code = Code::new(
     "KHR_MATERIALS_FUZZ_WITHOUT_FALLBACK",
@@ -41,15 +41,13 @@ impl Rule for Fallback {
             .get("extensionsRequired")
             .and_then(|r| r.as_array())
             .is_some_and(|a| a.iter().any(|e| e.is_str(layers::FUZZ)));
-        for (i, material) in super::materials(json).enumerate() {
-            let Some(exts) = material.get("extensions") else {
-                continue;
-            };
-            let Some(fuzz) = exts.get(layers::FUZZ).and_then(FuzzView::read) else {
+        for pair in cx.material_layers() {
+            let i = pair.material;
+            let Some(fuzz) = pair.fuzz else {
                 continue;
             };
             let fuzz_pointer = format!("/materials/{i}/extensions/{}", layers::FUZZ);
-            match exts.get(layers::SHEEN).and_then(SheenView::read) {
+            match pair.sheen {
                 None if !fuzz_required && fuzz.is_on() => out.push(Diagnostic::new(
                     &FUZZ_WITHOUT_FALLBACK,
                     &fuzz_pointer,

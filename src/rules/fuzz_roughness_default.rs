@@ -2,9 +2,9 @@
 //! schema 0.0. A material that leaves fuzzRoughnessFactor out while the layer is on looks
 //! different in loaders that follow one or the other.
 
-use super::{layer_objects, Context, Rule};
+use super::{Context, Rule};
 use crate::diagnostics::{Code, Diagnostic, Severity};
-use crate::layers::{self, FuzzView};
+use crate::layers;
 
 pub const FUZZ_ROUGHNESS_DEFAULT_AMBIGUOUS: Code = Code::new(
     "KHR_MATERIALS_FUZZ_ROUGHNESS_DEFAULT_AMBIGUOUS",
@@ -20,8 +20,8 @@ impl Rule for FuzzRoughnessDefault {
     }
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
-        for layer in layer_objects(cx.json()).filter(|l| l.extension == layers::FUZZ) {
-            let Some(fuzz) = FuzzView::read(layer.value) else {
+        for read in cx.layers() {
+            let (layer, Some(fuzz)) = (read.object, &read.fuzz) else {
                 continue;
             };
             if fuzz.is_on() && layer.value.get("fuzzRoughnessFactor").is_none() {

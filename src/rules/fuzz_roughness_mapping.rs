@@ -23,7 +23,7 @@
 use super::{Context, Rule};
 use crate::asset::pointer;
 use crate::diagnostics::{Code, Diagnostic, Severity};
-use crate::layers::{self, FuzzView, SheenView};
+use crate::layers;
 use crate::shading::mapping::{
     fuzz_roughness_for_sheen, sheen_roughness_for_fuzz, POOR_MATCH_BELOW,
 };
@@ -45,14 +45,9 @@ impl Rule for FuzzRoughnessMapping {
     }
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
-        for (i, material) in super::materials(cx.json()).enumerate() {
-            let Some(exts) = material.get("extensions") else {
-                continue;
-            };
-            let (Some(fuzz), Some(sheen)) = (
-                exts.get(layers::FUZZ).and_then(FuzzView::read),
-                exts.get(layers::SHEEN).and_then(SheenView::read),
-            ) else {
+        for pair in cx.material_layers() {
+            let i = pair.material;
+            let (Some(fuzz), Some(sheen)) = (pair.fuzz, pair.sheen) else {
                 continue;
             };
             let Some(alpha) = fuzz.roughness_factor else {
@@ -98,10 +93,7 @@ mod tests {
             crate::asset::load_bytes(std::path::Path::new("memory/rule.gltf"), text.as_bytes());
         let asset = loaded.asset.unwrap();
         let schemas = crate::rules::schema::Schemas::builtin();
-        let cx = Context {
-            asset: &asset,
-            schemas: &schemas,
-        };
+        let cx = Context::new(&asset, &schemas);
         let mut out = Vec::new();
         FuzzRoughnessMapping.check(&cx, &mut out);
         out.into_iter().map(|d| d.pointer).collect()

@@ -5,7 +5,7 @@
 //! Images whose header cannot be read are left to the rules that need the header (they report
 //! why); this rule does not repeat that.
 
-use super::{layer_objects, slot_uses, texture_sources, Context, Rule};
+use super::{slot_uses, texture_sources, Context, Rule};
 use crate::diagnostics::{codes, Code, Diagnostic};
 use std::collections::BTreeSet;
 
@@ -19,7 +19,7 @@ impl Rule for ImageSize {
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
         let json = cx.json();
         let mut textures = BTreeSet::new();
-        for layer in layer_objects(json) {
+        for layer in cx.layer_objects() {
             textures.extend(slot_uses(&layer).filter_map(|slot| slot.texture.index));
         }
         let mut images = BTreeSet::new();

@@ -2,7 +2,7 @@
 //! roughness taken from the material). Ratified loaders ignore those properties, so such a
 //! material shows no sheen; `velvet migrate` upgrades it.
 
-use super::{layer_objects, Context, Rule};
+use super::{Context, Rule};
 use crate::asset::pointer;
 use crate::diagnostics::{Code, Diagnostic, Severity};
 use crate::layers;
@@ -23,7 +23,7 @@ impl Rule for LegacySheen {
     }
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
-        for layer in layer_objects(cx.json()).filter(|l| l.extension == layers::SHEEN) {
+        for layer in cx.layer_objects().filter(|l| l.extension == layers::SHEEN) {
             for name in LEGACY_PROPERTIES {
                 if layer.value.get(name).is_some() {
                     out.push(Diagnostic::new(

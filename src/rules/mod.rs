@@ -27,19 +27,92 @@ pub mod texcoord;
 use crate::asset::tape::{JsonView, Node};
 use crate::asset::{pointer, Asset};
 use crate::diagnostics::{Code, Diagnostic};
-use crate::layers::{self, Slot, TextureRef};
+use crate::layers::{self, FuzzView, SheenView, Slot, TextureRef};
 
 /// What a rule sees: the asset and the schemas compiled for this run.
 pub struct Context<'a> {
     pub asset: &'a Asset,
     pub schemas: &'a schema::Schemas,
+    /// The sheen and fuzz objects, found and read once for every rule.
+    layers: std::sync::OnceLock<Vec<Layer<'a>>>,
 }
 
 impl<'a> Context<'a> {
+    pub fn new(asset: &'a Asset, schemas: &'a schema::Schemas) -> Context<'a> {
+        Context {
+            asset,
+            schemas,
+            layers: std::sync::OnceLock::new(),
+        }
+    }
+
     /// The document, read through the asset's index.
     pub fn json(&self) -> Node<'a> {
         self.asset.root()
     }
+
+    /// Every sheen and fuzz object with its values, in material order (a material's sheen
+    /// before its fuzz): found and read on first use, then shared by the rules, which read the
+    /// same objects many times over.
+    pub fn layers(&self) -> &[Layer<'a>] {
+        self.layers.get_or_init(|| {
+            layer_objects(self.json())
+                .map(|object| Layer {
+                    sheen: (object.extension == layers::SHEEN)
+                        .then(|| SheenView::read(object.value))
+                        .flatten(),
+                    fuzz: (object.extension == layers::FUZZ)
+                        .then(|| FuzzView::read(object.value))
+                        .flatten(),
+                    object,
+                })
+                .collect()
+        })
+    }
+
+    /// [`layer_objects`] of the document, from [`Context::layers`].
+    pub fn layer_objects(&self) -> impl Iterator<Item = LayerObject<Node<'a>>> + '_ {
+        self.layers().iter().map(|l| l.object)
+    }
+
+    /// Each material that has a sheen or fuzz object, with the two read (`None` when absent or
+    /// not an object).
+    pub fn material_layers(&self) -> impl Iterator<Item = MaterialLayers<'_>> + '_ {
+        let layers = self.layers();
+        let mut at = 0;
+        std::iter::from_fn(move || {
+            let first = layers.get(at)?;
+            let mut pair = MaterialLayers {
+                material: first.object.material,
+                sheen: None,
+                fuzz: None,
+            };
+            while let Some(layer) = layers
+                .get(at)
+                .filter(|l| l.object.material == pair.material)
+            {
+                pair.sheen = pair.sheen.or(layer.sheen.as_ref());
+                pair.fuzz = pair.fuzz.or(layer.fuzz.as_ref());
+                at += 1;
+            }
+            Some(pair)
+        })
+    }
+}
+
+/// One sheen or fuzz object and its values (defaults applied); the view of the other
+/// extension is `None`, as is a view of a value that is not an object.
+pub struct Layer<'a> {
+    pub object: LayerObject<Node<'a>>,
+    pub sheen: Option<SheenView>,
+    pub fuzz: Option<FuzzView>,
+}
+
+/// A material's sheen and fuzz, read.
+pub struct MaterialLayers<'l> {
+    pub material: usize,
+    pub sheen: Option<&'l SheenView>,
+    pub fuzz: Option<&'l FuzzView>,
 }
 /// A validation rule.
 pub trait Rule: Sync {
@@ -217,4 +290,63 @@ pub fn texture_sources<'a>(
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::asset::{load_bytes_with, LoadOptions};
+
+    #[test]
+    fn material_layers_pair_each_materials_sheen_and_fuzz_as_read() {
+        let text = r#"{"asset":{"version":"2.0"},"materials":[
+            {"extensions":{"KHR_materials_sheen":{"sheenRoughnessFactor":0.25}}},
+            {},
+            {"extensions":{"KHR_materials_fuzz":{"fuzzFactor":1},"KHR_materials_sheen":{"sheenColorFactor":[1,1,1]}}},
+            {"extensions":{"KHR_materials_fuzz":7}},
+            {"extensions":{"KHR_materials_fuzz":{"fuzzRoughnessFactor":0.5}}}
+        ]}"#;
+        let loaded = load_bytes_with(
+            std::path::Path::new("pairs.gltf"),
+            text.as_bytes(),
+            &LoadOptions::default(),
+        );
+        let asset = loaded.asset.expect("the document parses");
+        let schemas = schema::Schemas::builtin();
+        let cx = Context::new(&asset, &schemas);
+        let pairs: Vec<(usize, Option<f64>, Option<f64>)> = cx
+            .material_layers()
+            .map(|p| {
+                (
+                    p.material,
+                    p.sheen.map(|s| s.roughness_factor + s.color_factor[0]),
+                    p.fuzz
+                        .map(|f| f.factor + f.roughness_factor.unwrap_or(-1.0)),
+                )
+            })
+            .collect();
+        assert_eq!(
+            pairs,
+            [
+                (0, Some(0.25), None),
+                (2, Some(1.0), Some(0.0)),
+                (3, None, None),
+                (4, None, Some(0.5)),
+            ]
+        );
+        let objects: Vec<(usize, &str)> = cx
+            .layer_objects()
+            .map(|l| (l.material, l.extension))
+            .collect();
+        assert_eq!(
+            objects,
+            [
+                (0, layers::SHEEN),
+                (2, layers::SHEEN),
+                (2, layers::FUZZ),
+                (3, layers::FUZZ),
+                (4, layers::FUZZ)
+            ]
+        );
+    }
 }

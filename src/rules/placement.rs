@@ -30,7 +30,7 @@ impl Rule for Placement {
             .iter()
             .map(|name| json.members_named(name).count())
             .sum::<usize>();
-        if keys == super::layer_objects(json).count() {
+        if keys == cx.layer_objects().count() {
             return;
         }
         let mut path = String::new();

@@ -285,10 +285,7 @@ mod tests {
                 .asset
                 .unwrap();
         let schemas = crate::rules::schema::Schemas::builtin();
-        let cx = Context {
-            asset: &asset,
-            schemas: &schemas,
-        };
+        let cx = Context::new(&asset, &schemas);
         let mut out = Vec::new();
         References.check(&cx, &mut out);
         out.into_iter().map(|d| d.pointer).collect()

@@ -3,7 +3,7 @@
 //! the roughness equals the factor everywhere — usually a texture exported into the wrong
 //! channel. Judged from the image header alone; images that cannot be read are reported once.
 
-use super::{layer_objects, slot_uses, texture_sources, Context, Rule};
+use super::{slot_uses, texture_sources, Context, Rule};
 use crate::diagnostics::{codes, Code, Diagnostic, Severity};
 use crate::layers::{self, Channels};
 
@@ -36,7 +36,7 @@ impl Rule for RoughnessAlpha {
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
         let json = cx.json();
         let (textures, images) = (json.get("textures"), json.get("images"));
-        for layer in layer_objects(json) {
+        for layer in cx.layer_objects() {
             for slot in slot_uses(&layer) {
                 if slot.slot.channels != Channels::Alpha {
                     continue;

@@ -4,7 +4,7 @@
 //! document. The published schemas do not forbid unknown properties, so those are found here by
 //! comparing keys with the properties the schemas define, and reported as warnings.
 
-use super::{layer_objects, Context, LayerObject, Rule};
+use super::{Context, LayerObject, Rule};
 use crate::asset::pointer;
 use crate::asset::tape::Node;
 use crate::asset::tape_schema::TapeJson;
@@ -266,7 +266,7 @@ impl Rule for SchemaCheck {
         // layer object on many materials: each distinct text is checked once, its findings kept
         // with pointers relative to the object.
         let mut checked: HashMap<(&str, &str), Vec<Diagnostic>> = HashMap::new();
-        for layer in layer_objects(cx.json()) {
+        for layer in cx.layer_objects() {
             let found = checked
                 .entry((layer.extension, layer.value.raw()))
                 .or_insert_with(|| check_layer(cx.schemas, &layer));
@@ -330,10 +330,7 @@ mod tests {
         );
         let asset = loaded.asset.expect("the document parses");
         let schemas = Schemas::builtin();
-        let cx = Context {
-            asset: &asset,
-            schemas: &schemas,
-        };
+        let cx = Context::new(&asset, &schemas);
         let mut out = Vec::new();
         SchemaCheck.check(&cx, &mut out);
         out.into_iter()

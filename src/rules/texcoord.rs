@@ -2,7 +2,7 @@
 //! KHR_texture_transform substitutes) needs every mesh primitive drawn with that material to
 //! carry TEXCOORD_N, or loaders sample garbage or refuse the mesh.
 
-use super::{effective_tex_coord, layer_objects, slot_uses, Context, Rule, SlotUse};
+use super::{effective_tex_coord, slot_uses, Context, Rule, SlotUse};
 use crate::asset::tape::Node;
 use crate::diagnostics::{Code, Diagnostic, Severity};
 use std::collections::HashMap;
@@ -25,7 +25,7 @@ impl Rule for TexCoords {
         // material index -> the TEXCOORD_N attributes its sheen/fuzz textures read, each with
         // its slot (named only in a finding).
         let mut needs: HashMap<u64, Vec<(String, SlotUse<Node>)>> = HashMap::new();
-        for layer in layer_objects(json) {
+        for layer in cx.layer_objects() {
             for slot in slot_uses(&layer) {
                 needs.entry(layer.material as u64).or_default().push((
                     format!("TEXCOORD_{}", effective_tex_coord(slot.value)),
