@@ -93,10 +93,62 @@ pub fn report_pretty(report: &FileReport) -> String {
     serde_json::to_string_pretty(&shape(report)).expect("a report serialises")
 }
 
-/// One report as an object, pretty-printed and followed by a newline, written straight to
-/// `out` (a report of tens of thousands of findings is never held as text).
+/// How many messages one task of [`write_pretty`] writes.
+const MESSAGES_PER_TASK: usize = 4096;
+
+/// One report as an object, pretty-printed and followed by a newline, as
+/// [`report_pretty`] writes it. The messages, which are nearly all of a large report, are
+/// written in parallel, a run of them per task, and joined in order; the rest of the report
+/// is written around them.
 pub fn write_pretty(out: &mut impl std::io::Write, report: &FileReport) -> std::io::Result<()> {
-    serde_json::to_writer_pretty(&mut *out, &shape(report))?;
+    use rayon::prelude::*;
+    let mut outline = shape(report);
+    outline.issues.messages.clear();
+    let outline = serde_json::to_string_pretty(&outline)?;
+    // An empty list is written `[]`; no string value holds this text, as its quotes would be
+    // escaped there.
+    const EMPTY: &str = "\n    \"messages\": [],";
+    let at = match outline.find(EMPTY) {
+        Some(at) if !report.findings.is_empty() => at,
+        _ => {
+            out.write_all(outline.as_bytes())?;
+            return out.write_all(b"\n");
+        }
+    };
+    let runs: Vec<Vec<u8>> = report
+        .findings
+        .par_chunks(MESSAGES_PER_TASK)
+        .map(|run| {
+            let mut text = Vec::with_capacity(run.len() * 200);
+            for (i, finding) in run.iter().enumerate() {
+                if i > 0 {
+                    text.extend_from_slice(b",\n      ");
+                }
+                let d = &finding.diagnostic;
+                text.extend_from_slice(b"{\n        \"code\": ");
+                serde_json::to_writer(&mut text, d.code).expect("a string serialises");
+                text.extend_from_slice(b",\n        \"message\": ");
+                serde_json::to_writer(&mut text, &d.message).expect("a string serialises");
+                text.extend_from_slice(b",\n        \"severity\": ");
+                text.extend_from_slice((d.severity as u8).to_string().as_bytes());
+                text.extend_from_slice(b",\n        \"pointer\": ");
+                serde_json::to_writer(&mut text, &d.pointer).expect("a string serialises");
+                text.extend_from_slice(b"\n      }");
+            }
+            text
+        })
+        .collect();
+    // Up to the list's opening bracket, the messages, then from the comma after the list on.
+    out.write_all(outline[..at + EMPTY.len() - 2].as_bytes())?;
+    out.write_all(b"\n      ")?;
+    for (i, run) in runs.iter().enumerate() {
+        if i > 0 {
+            out.write_all(b",\n      ")?;
+        }
+        out.write_all(run)?;
+    }
+    out.write_all(b"\n    ]")?;
+    out.write_all(outline[at + EMPTY.len() - 1..].as_bytes())?;
     out.write_all(b"\n")
 }
 
@@ -117,4 +169,71 @@ pub fn render_lines(reports: &[FileReport]) -> String {
         .iter()
         .map(|r| serde_json::to_string(&shape(r)).expect("a report serialises") + "\n")
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::diagnostics::{Diagnostic, Severity};
+    use crate::validate::{Counts, Finding};
+
+    fn report(messages: usize, info: bool) -> FileReport {
+        let severities = [
+            Severity::Error,
+            Severity::Warning,
+            Severity::Info,
+            Severity::Hint,
+        ];
+        let findings: Vec<Finding> = (0..messages)
+            .map(|i| Finding {
+                diagnostic: Diagnostic {
+                    code: "UNEXPECTED_PROPERTY",
+                    message: format!("finding {i}: \"quoted\", a\nline, a tab\t, \u{1} and é"),
+                    severity: severities[i % 4],
+                    pointer: format!("/materials/{i}/extensions/a~1b"),
+                    position: None,
+                },
+                position: None,
+            })
+            .collect();
+        FileReport {
+            path: "dir/\"odd\" name.gltf".into(),
+            container: Some(crate::asset::Container::Gltf),
+            json_offset: 0,
+            counts: Counts {
+                errors: messages,
+                ..Counts::default()
+            },
+            findings,
+            omitted: 0,
+            info: info.then(|| AssetInfo {
+                version: Some("2.0".into()),
+                generator: None,
+                extensions_used: vec!["KHR_materials_sheen".into()],
+                extensions_required: Vec::new(),
+                material_count: 3,
+                sheen_material_count: 1,
+                fuzz_material_count: 0,
+            }),
+        }
+    }
+
+    #[test]
+    fn the_report_written_in_parallel_is_the_report_serde_writes() {
+        for (messages, info) in [
+            (0, true),
+            (1, false),
+            (3, true),
+            (MESSAGES_PER_TASK * 2 + 7, true),
+        ] {
+            let report = report(messages, info);
+            let mut written = Vec::new();
+            write_pretty(&mut written, &report).unwrap();
+            let expected = report_pretty(&report) + "\n";
+            assert!(
+                written == expected.as_bytes(),
+                "{messages} messages: written differs from serde's"
+            );
+        }
+    }
 }
