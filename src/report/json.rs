@@ -139,7 +139,7 @@ pub fn write_pretty(out: &mut impl std::io::Write, report: &FileReport) -> std::
         })
         .collect();
     // Up to the list's opening bracket, the messages, then from the comma after the list on.
-    out.write_all(outline[..at + EMPTY.len() - 2].as_bytes())?;
+    out.write_all(&outline.as_bytes()[..at + EMPTY.len() - 2])?;
     out.write_all(b"\n      ")?;
     for (i, run) in runs.iter().enumerate() {
         if i > 0 {
@@ -148,7 +148,7 @@ pub fn write_pretty(out: &mut impl std::io::Write, report: &FileReport) -> std::
         out.write_all(run)?;
     }
     out.write_all(b"\n    ]")?;
-    out.write_all(outline[at + EMPTY.len() - 1..].as_bytes())?;
+    out.write_all(&outline.as_bytes()[at + EMPTY.len() - 1..])?;
     out.write_all(b"\n")
 }
 
