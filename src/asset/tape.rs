@@ -179,9 +179,27 @@ impl Tape {
 
 impl Builder<'_> {
     fn skip_whitespace(&mut self) {
-        while let Some(b' ' | b'\n' | b'\r' | b'\t') = self.bytes.get(self.at) {
-            self.at += 1;
+        const SPACES: u64 = u64::from_ne_bytes([b' '; 8]);
+        let bytes = self.bytes;
+        let mut at = self.at;
+        loop {
+            match bytes.get(at) {
+                Some(b'\n') => {
+                    at += 1;
+                    // Indentation, a large part of a pretty-printed file, is passed eight
+                    // spaces at a time.
+                    while let Some(word) = bytes.get(at..at + 8) {
+                        if u64::from_ne_bytes(word.try_into().expect("eight bytes")) != SPACES {
+                            break;
+                        }
+                        at += 8;
+                    }
+                }
+                Some(b' ' | b'\r' | b'\t') => at += 1,
+                _ => break,
+            }
         }
+        self.at = at;
     }
 
     fn fail<T>(&self) -> Result<T, TapeError> {

@@ -94,7 +94,9 @@ pub fn report_pretty(report: &FileReport) -> String {
 }
 
 /// How many messages one task of [`write_pretty`] writes.
-const MESSAGES_PER_TASK: usize = 4096;
+const MESSAGES_PER_TASK: usize = 1024;
+/// How many tasks' text [`write_pretty`] holds at once.
+const RUNS_IN_HAND: usize = 8;
 
 /// One report as an object, pretty-printed and followed by a newline, as
 /// [`report_pretty`] writes it. The messages, which are nearly all of a large report, are
@@ -115,37 +117,45 @@ pub fn write_pretty(out: &mut impl std::io::Write, report: &FileReport) -> std::
             return out.write_all(b"\n");
         }
     };
-    let runs: Vec<Vec<u8>> = report
-        .findings
-        .par_chunks(MESSAGES_PER_TASK)
-        .map(|run| {
-            let mut text = Vec::with_capacity(run.len() * 200);
-            for (i, finding) in run.iter().enumerate() {
-                if i > 0 {
-                    text.extend_from_slice(b",\n      ");
-                }
-                let d = &finding.diagnostic;
-                text.extend_from_slice(b"{\n        \"code\": ");
-                serde_json::to_writer(&mut text, d.code).expect("a string serialises");
-                text.extend_from_slice(b",\n        \"message\": ");
-                serde_json::to_writer(&mut text, &d.message).expect("a string serialises");
-                text.extend_from_slice(b",\n        \"severity\": ");
-                text.extend_from_slice((d.severity as u8).to_string().as_bytes());
-                text.extend_from_slice(b",\n        \"pointer\": ");
-                serde_json::to_writer(&mut text, &d.pointer).expect("a string serialises");
-                text.extend_from_slice(b"\n      }");
+    let write_run = |run: &[crate::validate::Finding]| {
+        // A message takes some 300 bytes; the run grows past that once at most.
+        let mut text = Vec::with_capacity(run.len() * 320);
+        for (i, finding) in run.iter().enumerate() {
+            if i > 0 {
+                text.extend_from_slice(b",\n      ");
             }
-            text
-        })
-        .collect();
+            let d = &finding.diagnostic;
+            text.extend_from_slice(b"{\n        \"code\": ");
+            serde_json::to_writer(&mut text, d.code).expect("a string serialises");
+            text.extend_from_slice(b",\n        \"message\": ");
+            serde_json::to_writer(&mut text, &d.message).expect("a string serialises");
+            text.extend_from_slice(b",\n        \"severity\": ");
+            text.extend_from_slice((d.severity as u8).to_string().as_bytes());
+            text.extend_from_slice(b",\n        \"pointer\": ");
+            serde_json::to_writer(&mut text, &d.pointer).expect("a string serialises");
+            text.extend_from_slice(b"\n      }");
+        }
+        text
+    };
     // Up to the list's opening bracket, the messages, then from the comma after the list on.
     out.write_all(&outline.as_bytes()[..at + EMPTY.len() - 2])?;
     out.write_all(b"\n      ")?;
-    for (i, run) in runs.iter().enumerate() {
-        if i > 0 {
-            out.write_all(b",\n      ")?;
+    // A few runs at a time, so that the text in hand stays small and its memory is reused.
+    for (w, window) in report
+        .findings
+        .chunks(MESSAGES_PER_TASK * RUNS_IN_HAND)
+        .enumerate()
+    {
+        let runs: Vec<Vec<u8>> = window
+            .par_chunks(MESSAGES_PER_TASK)
+            .map(write_run)
+            .collect();
+        for (i, run) in runs.iter().enumerate() {
+            if w > 0 || i > 0 {
+                out.write_all(b",\n      ")?;
+            }
+            out.write_all(run)?;
         }
-        out.write_all(run)?;
     }
     out.write_all(b"\n    ]")?;
     out.write_all(&outline.as_bytes()[at + EMPTY.len() - 1..])?;
@@ -224,7 +234,7 @@ mod tests {
             (0, true),
             (1, false),
             (3, true),
-            (MESSAGES_PER_TASK * 2 + 7, true),
+            (MESSAGES_PER_TASK * (RUNS_IN_HAND + 1) + 7, true),
         ] {
             let report = report(messages, info);
             let mut written = Vec::new();

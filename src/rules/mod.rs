@@ -56,8 +56,10 @@ impl<'a> Context<'a> {
     /// same objects many times over.
     pub fn layers(&self) -> &[Layer<'a>] {
         self.layers.get_or_init(|| {
-            layer_objects(self.json())
-                .map(|object| Layer {
+            let materials = self.json().get("materials").and_then(|m| m.as_array());
+            let mut layers = Vec::with_capacity(materials.map_or(0, |m| m.len()));
+            layers.extend(layer_objects(self.json()).map(|object| {
+                Layer {
                     sheen: (object.extension == layers::SHEEN)
                         .then(|| SheenView::read(object.value))
                         .flatten(),
@@ -65,8 +67,9 @@ impl<'a> Context<'a> {
                         .then(|| FuzzView::read(object.value))
                         .flatten(),
                     object,
-                })
-                .collect()
+                }
+            }));
+            layers
         })
     }
 
