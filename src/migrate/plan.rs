@@ -9,6 +9,7 @@ use crate::asset::tape::Node;
 use crate::asset::Asset;
 use crate::edit::Edit;
 use crate::layers;
+use rayon::prelude::*;
 use serde::Serialize;
 use serde_json::Value;
 
@@ -150,7 +151,9 @@ pub fn plan_document(asset: &Asset, options: &Options) -> DocumentPlan {
         .get("materials")
         .and_then(|m| m.as_array())
         .map_or(0, |m| m.len());
+    // Materials are planned side by side; the list keeps their order.
     let mut materials: Vec<MaterialPlan> = (0..count)
+        .into_par_iter()
         .filter_map(|i| plan_material(asset, i, options))
         .collect();
     super::budget::plan(asset, &mut materials, options.budget);
