@@ -117,7 +117,7 @@ pub fn upgrade(cx: &MaterialCx, sheen: &Value, plan: &mut MaterialPlan) -> Optio
     let mut color_texture = None;
     if let Some(texture) = sheen.get("sheenTexture") {
         let problem = if texture.is_object() {
-            texture_unusable(cx.json(), cx.index, texture)
+            texture_unusable(cx, texture)
         } else {
             Some("it is not a textureInfo object".to_string())
         };

@@ -12,6 +12,7 @@ use crate::layers;
 use rayon::prelude::*;
 use serde::Serialize;
 use serde_json::Value;
+use std::collections::HashMap;
 
 /// What happens to one material.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -74,6 +75,56 @@ pub struct MaterialCx<'a> {
     pub index: usize,
     pub material: &'a Value,
     pub options: &'a Options,
+    /// The document's primitives by material, shared by every material's plan.
+    pub primitives: &'a Primitives<'a>,
+}
+
+/// The mesh primitives drawn with each material: (mesh, primitive, the TEXCOORD_n attributes
+/// it has; `None` when `attributes` is not an object). Found in one walk of the meshes, on
+/// first use, for every material that asks: a search of all meshes per material would cost
+/// materials × primitives.
+pub struct Primitives<'a> {
+    json: Node<'a>,
+    by_material: std::sync::OnceLock<HashMap<u64, Vec<PrimitiveSets>>>,
+}
+
+type PrimitiveSets = (usize, usize, Option<Vec<String>>);
+
+impl<'a> Primitives<'a> {
+    pub fn new(json: Node<'a>) -> Primitives<'a> {
+        Primitives {
+            json,
+            by_material: std::sync::OnceLock::new(),
+        }
+    }
+
+    /// The primitives drawn with `material`, in document order.
+    fn of(&self, material: usize) -> &[PrimitiveSets] {
+        let by_material = self.by_material.get_or_init(|| {
+            let mut by_material: HashMap<u64, Vec<_>> = HashMap::new();
+            for (m, mesh) in crate::rules::elements(self.json.get("meshes")).enumerate() {
+                for (p, primitive) in crate::rules::elements(mesh.get("primitives")).enumerate() {
+                    if let Some(material) = primitive.get("material").and_then(|v| v.as_u64()) {
+                        let sets =
+                            primitive
+                                .get("attributes")
+                                .and_then(|a| a.as_object())
+                                .map(|a| {
+                                    a.keys()
+                                        .filter(|k| k.starts_with("TEXCOORD_"))
+                                        .map(|k| k.into_owned())
+                                        .collect()
+                                });
+                        by_material.entry(material).or_default().push((m, p, sets));
+                    }
+                }
+            }
+            by_material
+        });
+        by_material
+            .get(&(material as u64))
+            .map_or(&[], Vec::as_slice)
+    }
 }
 
 impl<'a> MaterialCx<'a> {
@@ -152,9 +203,10 @@ pub fn plan_document(asset: &Asset, options: &Options) -> DocumentPlan {
         .and_then(|m| m.as_array())
         .map_or(0, |m| m.len());
     // Materials are planned side by side; the list keeps their order.
+    let primitives = Primitives::new(asset.root());
     let mut materials: Vec<MaterialPlan> = (0..count)
         .into_par_iter()
-        .filter_map(|i| plan_material(asset, i, options))
+        .filter_map(|i| plan_material(asset, i, options, &primitives))
         .collect();
     super::budget::plan(asset, &mut materials, options.budget);
     let declared: Vec<std::borrow::Cow<str>> =
@@ -187,7 +239,12 @@ pub fn plan_document(asset: &Asset, options: &Options) -> DocumentPlan {
 }
 
 /// The plan of material `index`, or `None` when it has neither sheen nor fuzz.
-pub fn plan_material(asset: &Asset, index: usize, options: &Options) -> Option<MaterialPlan> {
+pub fn plan_material(
+    asset: &Asset,
+    index: usize,
+    options: &Options,
+    primitives: &Primitives,
+) -> Option<MaterialPlan> {
     // The material alone is read into a value: the document is never built as one.
     let node = asset.root().get("materials")?.get(index)?;
     let layer_nodes = node.get("extensions")?;
@@ -231,6 +288,7 @@ pub fn plan_material(asset: &Asset, index: usize, options: &Options) -> Option<M
         index,
         material,
         options,
+        primitives,
     };
     match (sheen, fuzz) {
         (Some(sheen), None) => {
@@ -262,44 +320,30 @@ pub(crate) fn number_like(original: Option<&Value>, value: f64) -> Value {
 /// The texCoord set a textureInfo reads, and the first primitive drawn with `material` that
 /// lacks it, if any (carrying such a texture into a slot velvet checks would add an error).
 pub(crate) fn primitive_lacking_tex_coord(
-    json: Node,
+    primitives: &Primitives,
     material: usize,
     texture_info: &Value,
 ) -> Option<String> {
     let set = crate::rules::effective_tex_coord(texture_info);
     let attribute = format!("TEXCOORD_{set}");
-    let meshes = json.get("meshes").and_then(|m| m.as_array())?;
-    for (m, mesh) in meshes.iter().enumerate() {
-        let Some(primitives) = mesh.get("primitives").and_then(|p| p.as_array()) else {
-            continue;
-        };
-        for (p, primitive) in primitives.iter().enumerate() {
-            if primitive.get("material").and_then(|v| v.as_u64()) != Some(material as u64) {
-                continue;
-            }
-            let attributes = primitive.get("attributes");
-            if attributes.and_then(|a| a.get(attribute.as_str())).is_none() {
-                return Some(format!("mesh {m} primitive {p} has no {attribute}"));
-            }
-        }
-    }
-    None
+    primitives
+        .of(material)
+        .iter()
+        .find(|(_, _, sets)| !sets.as_ref().is_some_and(|s| s.contains(&attribute)))
+        .map(|(m, p, _)| format!("mesh {m} primitive {p} has no {attribute}"))
 }
 
 /// Why a textureInfo cannot be carried into a checked slot, if it cannot: its index names no
 /// texture, or a primitive lacks its texCoord set.
-pub(crate) fn texture_unusable(
-    json: Node,
-    material: usize,
-    texture_info: &Value,
-) -> Option<String> {
-    let textures = json
+pub(crate) fn texture_unusable(cx: &MaterialCx, texture_info: &Value) -> Option<String> {
+    let textures = cx
+        .json()
         .get("textures")
         .and_then(|t| t.as_array())
         .map_or(0, |t| t.len());
     match texture_info.get("index").and_then(Value::as_u64) {
         Some(i) if (i as usize) < textures => {
-            primitive_lacking_tex_coord(json, material, texture_info)
+            primitive_lacking_tex_coord(cx.primitives, cx.index, texture_info)
         }
         Some(i) => Some(format!(
             "its index {i} names no texture (the asset has {textures})"
