@@ -209,7 +209,7 @@ impl Validator {
             "",
             format!("cannot read folder {}: {error}", path.display()),
         );
-        self.finish(settings, path, None, 0, vec![d], None)
+        self.finish(settings, path, None, 0, vec![vec![d]], None)
     }
 
     /// Validates a file already loaded (or that failed to load).
@@ -223,9 +223,16 @@ impl Validator {
         loaded: asset::Loaded,
         settings: &Settings,
     ) -> FileReport {
-        let mut diagnostics = loaded.diagnostics;
+        let diagnostics = loaded.diagnostics;
         let Some(asset) = loaded.asset else {
-            return self.finish(settings, path.to_path_buf(), None, 0, diagnostics, None);
+            return self.finish(
+                settings,
+                path.to_path_buf(),
+                None,
+                0,
+                vec![diagnostics],
+                None,
+            );
         };
         let cx = Context::new(&asset, self.schemas.get());
         let parallel = asset.json_text.len() >= PARALLEL_RULES_FROM;
@@ -234,13 +241,16 @@ impl Validator {
         } else {
             (run_rules(&cx, false), asset_info(asset.root()))
         };
-        diagnostics.extend(found);
+        // The rules' shared reading of the document goes before the findings are listed.
+        drop(cx);
+        let mut groups = found;
+        groups.insert(0, diagnostics);
         let mut report = self.finish(
             settings,
             path.to_path_buf(),
             Some(asset.container),
             asset.json_offset,
-            diagnostics,
+            groups,
             Some(info),
         );
         if self.positions && !report.findings.is_empty() {
@@ -261,41 +271,47 @@ impl Validator {
         report
     }
 
+    /// The report of one file from its findings, in groups (the loader's, then each rule's):
+    /// each group is moved into the report's list and freed, so the findings are never held
+    /// twice over.
     fn finish(
         &self,
         settings: &Settings,
         path: PathBuf,
         container: Option<Container>,
         json_offset: usize,
-        mut diagnostics: Vec<Diagnostic>,
+        groups: Vec<Vec<Diagnostic>>,
         info: Option<AssetInfo>,
     ) -> FileReport {
-        diagnostics.retain(|d| !settings.ignore.contains(d.code));
+        let mut findings: Vec<Finding> = Vec::with_capacity(groups.iter().map(Vec::len).sum());
         let mut counts = Counts::default();
-        for d in &mut diagnostics {
-            if let Some(s) = settings.severity_overrides.get(d.code) {
-                d.severity = *s;
+        for group in groups {
+            for mut diagnostic in group {
+                if settings.ignore.contains(diagnostic.code) {
+                    continue;
+                }
+                if let Some(s) = settings.severity_overrides.get(diagnostic.code) {
+                    diagnostic.severity = *s;
+                }
+                counts.add(diagnostic.severity);
+                findings.push(Finding {
+                    position: diagnostic.position,
+                    diagnostic,
+                });
             }
-            counts.add(d.severity);
         }
         let mut omitted = 0;
-        if let Some(max) = settings.max_issues.filter(|max| diagnostics.len() > *max) {
+        if let Some(max) = settings.max_issues.filter(|max| findings.len() > *max) {
             // The listing keeps the most severe findings: errors before warnings before infos.
-            diagnostics.sort_by_key(|d| d.severity);
-            omitted = diagnostics.len() - max;
-            diagnostics.truncate(max);
+            findings.sort_by_key(|f| f.diagnostic.severity);
+            omitted = findings.len() - max;
+            findings.truncate(max);
         }
         FileReport {
             path,
             container,
             json_offset,
-            findings: diagnostics
-                .into_iter()
-                .map(|diagnostic| Finding {
-                    position: diagnostic.position,
-                    diagnostic,
-                })
-                .collect(),
+            findings,
             counts,
             omitted,
             info,
@@ -303,26 +319,24 @@ impl Validator {
     }
 }
 
-/// Every registered rule's findings, in registry order. In parallel, each rule keeps its own
-/// list and the lists are joined in registry order, so the report does not depend on which
-/// rule finished first.
-fn run_rules(cx: &Context, parallel: bool) -> Vec<Diagnostic> {
+/// Every registered rule's findings, in registry order, a list per rule. In parallel each
+/// rule keeps its own list, so the report does not depend on which rule finished first.
+fn run_rules(cx: &Context, parallel: bool) -> Vec<Vec<Diagnostic>> {
     if parallel {
-        let found: Vec<Vec<Diagnostic>> = rules::REGISTRY
+        rules::REGISTRY
             .par_iter()
             .map(|rule| {
                 let mut out = Vec::new();
                 rule.check(cx, &mut out);
                 out
             })
-            .collect();
-        found.into_iter().flatten().collect()
+            .collect()
     } else {
         let mut out = Vec::new();
         for rule in rules::REGISTRY {
             rule.check(cx, &mut out);
         }
-        out
+        vec![out]
     }
 }
 
@@ -392,10 +406,10 @@ mod tests {
         let asset = loaded.asset.expect("the document parses");
         let schemas = Schemas::builtin();
         let cx = Context::new(&asset, &schemas);
-        let sequential = run_rules(&cx, false);
+        let sequential: Vec<Diagnostic> = run_rules(&cx, false).concat();
         assert!(sequential.len() > 500, "{} findings", sequential.len());
         for _ in 0..4 {
-            assert_eq!(run_rules(&cx, true), sequential);
+            assert_eq!(run_rules(&cx, true).concat(), sequential);
         }
     }
 }

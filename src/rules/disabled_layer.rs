@@ -27,7 +27,7 @@ impl Rule for DisabledLayer {
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
         for read in cx.layers() {
             let layer = read.object;
-            let (off, code, why) = match (&read.sheen, &read.fuzz) {
+            let (off, code, why) = match (read.sheen(), read.fuzz()) {
                 (Some(view), _) => (
                     !view.is_on(),
                     &SHEEN_TEXTURE_WITHOUT_EFFECT,

@@ -21,7 +21,7 @@ impl Rule for FuzzRoughnessDefault {
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
         for read in cx.layers() {
-            let (layer, Some(fuzz)) = (read.object, &read.fuzz) else {
+            let (layer, Some(fuzz)) = (read.object, read.fuzz()) else {
                 continue;
             };
             if fuzz.is_on() && layer.value.get("fuzzRoughnessFactor").is_none() {

@@ -56,18 +56,14 @@ impl<'a> Context<'a> {
     /// same objects many times over.
     pub fn layers(&self) -> &[Layer<'a>] {
         self.layers.get_or_init(|| {
-            let materials = self.json().get("materials").and_then(|m| m.as_array());
-            let mut layers = Vec::with_capacity(materials.map_or(0, |m| m.len()));
-            layers.extend(layer_objects(self.json()).map(|object| {
-                Layer {
-                    sheen: (object.extension == layers::SHEEN)
-                        .then(|| SheenView::read(object.value))
-                        .flatten(),
-                    fuzz: (object.extension == layers::FUZZ)
-                        .then(|| FuzzView::read(object.value))
-                        .flatten(),
-                    object,
-                }
+            // Counted first, so that the list is allocated once at its size.
+            let mut layers = Vec::with_capacity(layer_objects(self.json()).count());
+            layers.extend(layer_objects(self.json()).map(|object| Layer {
+                view: match object.extension {
+                    layers::SHEEN => SheenView::read(object.value).map(View::Sheen),
+                    _ => FuzzView::read(object.value).map(View::Fuzz),
+                },
+                object,
             }));
             layers
         })
@@ -94,8 +90,8 @@ impl<'a> Context<'a> {
                 .get(at)
                 .filter(|l| l.object.material == pair.material)
             {
-                pair.sheen = pair.sheen.or(layer.sheen.as_ref());
-                pair.fuzz = pair.fuzz.or(layer.fuzz.as_ref());
+                pair.sheen = pair.sheen.or(layer.sheen());
+                pair.fuzz = pair.fuzz.or(layer.fuzz());
                 at += 1;
             }
             Some(pair)
@@ -103,12 +99,36 @@ impl<'a> Context<'a> {
     }
 }
 
-/// One sheen or fuzz object and its values (defaults applied); the view of the other
-/// extension is `None`, as is a view of a value that is not an object.
+/// One sheen or fuzz object and its values (defaults applied); `None` for a value that is not
+/// an object.
 pub struct Layer<'a> {
     pub object: LayerObject<Node<'a>>,
-    pub sheen: Option<SheenView>,
-    pub fuzz: Option<FuzzView>,
+    view: Option<View>,
+}
+
+/// A layer object's values: one of the two, kept in one place (a large document has tens of
+/// thousands).
+enum View {
+    Sheen(SheenView),
+    Fuzz(FuzzView),
+}
+
+impl Layer<'_> {
+    /// The values of a KHR_materials_sheen object.
+    pub fn sheen(&self) -> Option<&SheenView> {
+        match &self.view {
+            Some(View::Sheen(view)) => Some(view),
+            _ => None,
+        }
+    }
+
+    /// The values of a KHR_materials_fuzz object.
+    pub fn fuzz(&self) -> Option<&FuzzView> {
+        match &self.view {
+            Some(View::Fuzz(view)) => Some(view),
+            _ => None,
+        }
+    }
 }
 
 /// A material's sheen and fuzz, read.
