@@ -9,7 +9,6 @@ use crate::asset::tape::Node;
 use crate::asset::Asset;
 use crate::edit::Edit;
 use crate::layers;
-use rayon::prelude::*;
 use serde::Serialize;
 use serde_json::Value;
 use std::collections::HashMap;
@@ -202,10 +201,11 @@ pub fn plan_document(asset: &Asset, options: &Options) -> DocumentPlan {
         .get("materials")
         .and_then(|m| m.as_array())
         .map_or(0, |m| m.len());
-    // Materials are planned side by side; the list keeps their order.
+    // Materials are planned one after another: planned side by side on the thread pool, their
+    // plans came from the workers' own allocator arenas and the run's peak memory grew by a
+    // tenth (measured on the library), for a saving of a fortieth of its time.
     let primitives = Primitives::new(asset.root());
     let mut materials: Vec<MaterialPlan> = (0..count)
-        .into_par_iter()
         .filter_map(|i| plan_material(asset, i, options, &primitives))
         .collect();
     super::budget::plan(asset, &mut materials, options.budget);
