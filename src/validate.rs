@@ -106,28 +106,14 @@ pub struct Validator {
 /// is read (compiling the core schemas takes about as long as reading a large file).
 enum Compiled {
     Ready(Schemas),
-    Compiling {
-        thread: std::sync::Mutex<Option<std::thread::JoinHandle<Schemas>>>,
-        done: std::sync::OnceLock<Schemas>,
-    },
+    Compiling(std::sync::LazyLock<Schemas, Box<dyn FnOnce() -> Schemas + Send>>),
 }
 
 impl Compiled {
     fn get(&self) -> &Schemas {
         match self {
             Compiled::Ready(schemas) => schemas,
-            Compiled::Compiling { thread, done } => done.get_or_init(|| {
-                let handle = thread
-                    .lock()
-                    .unwrap_or_else(|e| e.into_inner())
-                    .take()
-                    .expect("the compiling thread is joined once, under the OnceLock");
-                // The built-in schemas are tested to compile; a panic there is a bug, and is
-                // raised again here rather than hidden.
-                handle
-                    .join()
-                    .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
-            }),
+            Compiled::Compiling(schemas) => schemas,
         }
     }
 }
@@ -141,11 +127,15 @@ impl Validator {
     /// file's rules need them.
     pub fn builtin(settings: Settings) -> Validator {
         let thread = std::thread::spawn(Schemas::builtin);
+        // The built-in schemas are tested to compile; a panic there is a bug, raised again
+        // where the schemas are first needed rather than hidden.
+        let joined: Box<dyn FnOnce() -> Schemas + Send> = Box::new(move || {
+            thread
+                .join()
+                .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+        });
         Validator::with_compiled(
-            Compiled::Compiling {
-                thread: std::sync::Mutex::new(Some(thread)),
-                done: std::sync::OnceLock::new(),
-            },
+            Compiled::Compiling(std::sync::LazyLock::new(joined)),
             settings,
         )
     }

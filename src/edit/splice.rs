@@ -243,7 +243,11 @@ fn node_digest(node: Node) -> u64 {
             } else {
                 b'f'
             }),
-            Kind::Number => d.text(b'#', &raw_number_text(node.raw())),
+            // Spelled as serde_json reads it (`1E-1` as `1e-1`), as the meant value holds it.
+            Kind::Number => match node.raw().parse::<serde_json::Number>() {
+                Ok(n) => d.text(b'#', &raw_number_text(n.as_str())),
+                Err(_) => d.text(b'#', node.raw()),
+            },
             Kind::String => d.text(b'"', &node.as_str().unwrap_or_default()),
             Kind::Array => {
                 d.tag(b'[');
@@ -1316,6 +1320,12 @@ mod tests {
             let tape = crate::asset::tape::Tape::build(text).unwrap();
             node_digest(tape.root(text))
         };
+        let spelled: Value = serde_json::from_str(r#"[1E-1, 2e+3]"#).unwrap();
+        assert_eq!(
+            value_digest(&spelled),
+            digest_of_text("[\n  1E-1,\n  2e+3\n]"),
+            "a number reads alike from the text and from the value read from it, whatever its spelling"
+        );
         let meant = serde_json::json!({
             "name": "caf\u{e9} \"1\"",
             "f": [0.7499999999999999, 1.0, 2, 7.5e-8],
