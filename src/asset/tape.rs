@@ -747,17 +747,12 @@ impl<'a> Object<'a> {
         }
     }
 
-    /// Whether a key entry spells `key`, whose [`key_print`] is `print`.
-    fn key_is(&self, key_at: u32, key: &str, print: u32) -> bool {
-        self.node.node(key_at).key_is(key, print)
-    }
-
     /// The value of `key`: the last one, if the key is written more than once.
     pub fn get(&self, key: &str) -> Option<Node<'a>> {
         let print = key_print(key.as_bytes());
         let mut found = None;
         for (k, v) in self.raw_members() {
-            if self.key_is(k, key, print) {
+            if self.node.node(k).key_is(key, print) {
                 found = Some(v);
                 if !self.has_duplicates() {
                     break;
@@ -781,7 +776,8 @@ impl<'a> Object<'a> {
 
     pub fn contains_key(&self, key: &str) -> bool {
         let print = key_print(key.as_bytes());
-        self.raw_members().any(|(k, _)| self.key_is(k, key, print))
+        self.raw_members()
+            .any(|(k, _)| self.node.node(k).key_is(key, print))
     }
 
     /// Distinct keys.

@@ -53,6 +53,15 @@ struct InfoShape<'a> {
 
 const VALIDATOR_VERSION: &str = concat!("velvet ", env!("CARGO_PKG_VERSION"));
 
+fn message_shape(f: &crate::validate::Finding) -> MessageShape<'_> {
+    MessageShape {
+        code: f.diagnostic.code,
+        message: &f.diagnostic.message,
+        severity: f.diagnostic.severity as u8,
+        pointer: &f.diagnostic.pointer,
+    }
+}
+
 fn shape(report: &FileReport) -> ReportShape<'_> {
     let c = report.counts;
     ReportShape {
@@ -64,16 +73,7 @@ fn shape(report: &FileReport) -> ReportShape<'_> {
             num_warnings: c.warnings,
             num_infos: c.infos,
             num_hints: c.hints,
-            messages: report
-                .findings
-                .iter()
-                .map(|f| MessageShape {
-                    code: f.diagnostic.code,
-                    message: &f.diagnostic.message,
-                    severity: f.diagnostic.severity as u8,
-                    pointer: &f.diagnostic.pointer,
-                })
-                .collect(),
+            messages: report.findings.iter().map(message_shape).collect(),
             truncated: report.truncated(),
         },
         info: report.info.as_ref().map(|info: &AssetInfo| InfoShape {
@@ -117,23 +117,25 @@ pub fn write_pretty(out: &mut impl std::io::Write, report: &FileReport) -> std::
             return out.write_all(b"\n");
         }
     };
+    // Each message as the pretty printer writes it alone, moved to the list's depth: a line
+    // break in JSON text is never inside a string, so indenting after each one is exact.
     let write_run = |run: &[crate::validate::Finding]| {
         // A message takes some 300 bytes; the run grows past that once at most.
         let mut text = Vec::with_capacity(run.len() * 320);
+        let mut one = Vec::with_capacity(512);
         for (i, finding) in run.iter().enumerate() {
             if i > 0 {
                 text.extend_from_slice(b",\n      ");
             }
-            let d = &finding.diagnostic;
-            text.extend_from_slice(b"{\n        \"code\": ");
-            serde_json::to_writer(&mut text, d.code).expect("a string serialises");
-            text.extend_from_slice(b",\n        \"message\": ");
-            serde_json::to_writer(&mut text, &d.message).expect("a string serialises");
-            text.extend_from_slice(b",\n        \"severity\": ");
-            text.extend_from_slice((d.severity as u8).to_string().as_bytes());
-            text.extend_from_slice(b",\n        \"pointer\": ");
-            serde_json::to_writer(&mut text, &d.pointer).expect("a string serialises");
-            text.extend_from_slice(b"\n      }");
+            one.clear();
+            serde_json::to_writer_pretty(&mut one, &message_shape(finding))
+                .expect("a message serialises");
+            for (j, line) in one.split(|&b| b == b'\n').enumerate() {
+                if j > 0 {
+                    text.extend_from_slice(b"\n      ");
+                }
+                text.extend_from_slice(line);
+            }
         }
         text
     };

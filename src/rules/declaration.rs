@@ -63,7 +63,11 @@ impl Rule for Declaration {
             .map(|(_, n)| n)
             .collect();
         undeclared(json, &declared, out);
-        check_lists(json, &declared, out);
+        let mut used = [false, false];
+        for layer in cx.layer_objects() {
+            used[usize::from(layer.extension == layers::FUZZ)] = true;
+        }
+        check_lists(json, &declared, used, out);
     }
 }
 
@@ -95,8 +99,14 @@ fn undeclared(json: Node, declared: &BTreeSet<String>, out: &mut Vec<Diagnostic>
     });
 }
 
-/// The findings about extensionsUsed and extensionsRequired themselves.
-fn check_lists(json: Node, declared: &BTreeSet<String>, out: &mut Vec<Diagnostic>) {
+/// The findings about extensionsUsed and extensionsRequired themselves; `used` says whether
+/// any material has a sheen, and a fuzz, object.
+fn check_lists(
+    json: Node,
+    declared: &BTreeSet<String>,
+    used: [bool; 2],
+    out: &mut Vec<Diagnostic>,
+) {
     for (k, name) in names(json, "extensionsRequired") {
         if !declared.contains(&name) {
             out.push(Diagnostic::new(
@@ -105,10 +115,6 @@ fn check_lists(json: Node, declared: &BTreeSet<String>, out: &mut Vec<Diagnostic
                 format!("{name} is required but not in extensionsUsed"),
             ));
         }
-    }
-    let mut used = [false, false];
-    for layer in super::layer_objects(json) {
-        used[usize::from(layer.extension == layers::FUZZ)] = true;
     }
     for (k, name) in names(json, "extensionsUsed") {
         let (is_used, code) = match name.as_str() {
