@@ -274,6 +274,7 @@ impl Validator {
         info: Option<AssetInfo>,
     ) -> FileReport {
         let mut findings: Vec<Finding> = Vec::with_capacity(groups.iter().map(Vec::len).sum());
+        asset::pages::advise_huge(&mut findings);
         let mut counts = Counts::default();
         for group in groups {
             for mut diagnostic in group {

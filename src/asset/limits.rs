@@ -147,8 +147,15 @@ pub fn find_too_deep(text: &str, max_depth: usize) -> Option<TooDeep> {
 /// document limit; one byte more is read so that a longer stream is seen to be longer.
 pub fn read_asset_file(path: &Path, options: &LoadOptions) -> std::io::Result<Vec<u8>> {
     let mut file = std::fs::File::open(path)?;
-    if file.metadata()?.is_file() {
+    let metadata = file.metadata()?;
+    if metadata.is_file() {
+        // Sized to the file (and one byte more, to see that it ends there) before it is read,
+        // so that a large one can be advised huge pages (see super::pages).
+        let size = usize::try_from(metadata.len()).unwrap_or(0);
         let mut bytes = Vec::new();
+        if bytes.try_reserve_exact(size.saturating_add(1)).is_ok() {
+            super::pages::advise_huge(&mut bytes);
+        }
         file.read_to_end(&mut bytes)?;
         return Ok(bytes);
     }

@@ -9,6 +9,7 @@
 pub mod discover;
 pub mod glb;
 pub mod limits;
+pub mod pages;
 pub mod pointer;
 pub mod position;
 pub mod resource;

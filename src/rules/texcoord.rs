@@ -5,7 +5,7 @@
 use super::{effective_tex_coord, slot_uses, Context, Rule, SlotUse};
 use crate::asset::tape::Node;
 use crate::diagnostics::{Code, Diagnostic, Severity};
-use std::collections::HashMap;
+use std::borrow::Cow;
 
 pub const MESH_PRIMITIVE_TOO_FEW_TEXCOORDS: Code = Code::new(
     "MESH_PRIMITIVE_TOO_FEW_TEXCOORDS",
@@ -22,31 +22,35 @@ impl Rule for TexCoords {
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
         let json = cx.json();
-        // material index -> the TEXCOORD_N attributes its sheen/fuzz textures read, each with
-        // its slot (named only in a finding).
-        let mut needs: HashMap<u64, Vec<(String, SlotUse<Node>)>> = HashMap::new();
-        for layer in cx.layer_objects() {
-            for slot in slot_uses(&layer) {
-                needs.entry(layer.material as u64).or_default().push((
-                    format!("TEXCOORD_{}", effective_tex_coord(slot.value)),
-                    slot,
-                ));
-            }
-        }
+        // Each sheen/fuzz texture slot with the TEXCOORD set it reads, in material order (the
+        // order the layers come in), so that a primitive's material finds its slots by a
+        // binary search: a large document has a material per primitive.
+        let needs: Vec<(usize, u64, SlotUse<Node>)> = cx
+            .layer_objects()
+            .flat_map(|layer| slot_uses(&layer))
+            .map(|slot| (slot.material, effective_tex_coord(slot.value), slot))
+            .collect();
         if needs.is_empty() {
             return;
         }
+        // Attribute names by set, written once each.
+        let mut names: Vec<String> = Vec::new();
         for (m, mesh) in super::elements(json.get("meshes")).enumerate() {
             for (p, primitive) in super::elements(mesh.get("primitives")).enumerate() {
                 let Some(material) = primitive.get("material").and_then(|v| v.as_u64()) else {
                     continue;
                 };
-                let Some(slots) = needs.get(&material) else {
+                let Ok(material) = usize::try_from(material) else {
                     continue;
                 };
+                let first = needs.partition_point(|(of, _, _)| *of < material);
+                let slots = needs[first..]
+                    .iter()
+                    .take_while(|(of, _, _)| *of == material);
                 let attributes = primitive.get("attributes").and_then(|a| a.as_object());
-                for (attribute, slot) in slots {
-                    if !attributes.is_some_and(|a| a.contains_key(attribute)) {
+                for (_, set, slot) in slots {
+                    let attribute = attribute_name(&mut names, *set);
+                    if !attributes.is_some_and(|a| a.contains_key(&attribute)) {
                         out.push(Diagnostic::new(
                             &MESH_PRIMITIVE_TOO_FEW_TEXCOORDS,
                             format!("/meshes/{m}/primitives/{p}/material"),
@@ -60,4 +64,17 @@ impl Rule for TexCoords {
             }
         }
     }
+}
+
+/// `TEXCOORD_{set}`, from `names` (indexed by set) once it has been written; a set past the
+/// few a mesh has is written on each call rather than kept.
+fn attribute_name(names: &mut Vec<String>, set: u64) -> Cow<'_, str> {
+    const KEPT: u64 = 16;
+    if set >= KEPT {
+        return Cow::Owned(format!("TEXCOORD_{set}"));
+    }
+    while names.len() as u64 <= set {
+        names.push(format!("TEXCOORD_{}", names.len()));
+    }
+    Cow::Borrowed(&names[set as usize])
 }
