@@ -177,6 +177,7 @@ impl<W: std::io::Write> Stream<W> {
             }
         };
         let _ = self.out.write_all(text.as_bytes());
+        release(report);
     }
 
     /// Writes out what is buffered.
@@ -189,6 +190,7 @@ impl<W: std::io::Write> Stream<W> {
         if let (Format::Json, false, [one]) = (self.format, self.json_array, self.kept.as_slice()) {
             let _ = json::write_pretty(&mut self.out, one);
             let _ = self.out.flush();
+            self.kept.drain(..).for_each(release);
             return;
         }
         let text = match self.format {
@@ -200,6 +202,19 @@ impl<W: std::io::Write> Stream<W> {
         };
         let _ = self.out.write_all(text.as_bytes());
         let _ = self.out.flush();
+        self.kept.drain(..).for_each(release);
+    }
+}
+
+/// Reports from this many findings are freed on the thread pool.
+const RELEASED_ELSEWHERE_FROM: usize = 4096;
+
+/// Frees a report that has been written. A large one is freed on the thread pool, so that the
+/// next report, or the end of the run, does not wait for its findings' tens of thousands of
+/// frees (a tenth of a large document's run went to them).
+fn release(report: FileReport) {
+    if report.findings.len() >= RELEASED_ELSEWHERE_FROM {
+        rayon::spawn(move || drop(report));
     }
 }
 
