@@ -513,7 +513,7 @@ impl Builder<'_> {
 /// control character. Eight bytes are tested at a time (the bit tricks for "has a zero byte" and
 /// "has a byte below n"): strings are most of a glTF's bytes, keys and URIs among them. In each
 /// test only bytes above a true hit can be false hits, so the lowest hit of the three is exact.
-fn string_stop(bytes: &[u8]) -> Option<usize> {
+pub fn string_stop(bytes: &[u8]) -> Option<usize> {
     const ONES: u64 = u64::from_ne_bytes([1; 8]);
     const HIGHS: u64 = u64::from_ne_bytes([0x80; 8]);
     let zero_in = |v: u64| v.wrapping_sub(ONES) & !v;

@@ -6,6 +6,7 @@
 //! thousands of findings is written without first being copied into a JSON tree.
 
 use super::display_path;
+use crate::asset::tape::string_stop;
 use crate::validate::{AssetInfo, FileReport};
 use serde::Serialize;
 
@@ -117,25 +118,14 @@ pub fn write_pretty(out: &mut impl std::io::Write, report: &FileReport) -> std::
             return out.write_all(b"\n");
         }
     };
-    // Each message as the pretty printer writes it alone, moved to the list's depth: a line
-    // break in JSON text is never inside a string, so indenting after each one is exact.
     let write_run = |run: &[crate::validate::Finding]| {
         // A message takes some 300 bytes; the run grows past that once at most.
         let mut text = Vec::with_capacity(run.len() * 320);
-        let mut one = Vec::with_capacity(512);
         for (i, finding) in run.iter().enumerate() {
             if i > 0 {
                 text.extend_from_slice(b",\n      ");
             }
-            one.clear();
-            serde_json::to_writer_pretty(&mut one, &message_shape(finding))
-                .expect("a message serialises");
-            for (j, line) in one.split(|&b| b == b'\n').enumerate() {
-                if j > 0 {
-                    text.extend_from_slice(b"\n      ");
-                }
-                text.extend_from_slice(line);
-            }
+            push_message(&mut text, &message_shape(finding));
         }
         text
     };
@@ -162,6 +152,51 @@ pub fn write_pretty(out: &mut impl std::io::Write, report: &FileReport) -> std::
     out.write_all(b"\n    ]")?;
     out.write_all(&outline.as_bytes()[at + EMPTY.len() - 1..])?;
     out.write_all(b"\n")
+}
+
+/// A message as the pretty printer writes it within the report's list (its fields at depth 4,
+/// its closing brace at depth 3). Written here rather than by the printer because a large
+/// report is nearly all messages, and the printer spent most of its time on them.
+fn push_message(out: &mut Vec<u8>, m: &MessageShape) {
+    out.extend_from_slice(b"{\n        \"code\": ");
+    push_string(out, m.code);
+    out.extend_from_slice(b",\n        \"message\": ");
+    push_string(out, m.message);
+    out.extend_from_slice(b",\n        \"severity\": ");
+    // Writing to a Vec cannot fail.
+    let _ = std::io::Write::write_fmt(out, format_args!("{}", m.severity));
+    out.extend_from_slice(b",\n        \"pointer\": ");
+    push_string(out, m.pointer);
+    out.extend_from_slice(b"\n      }");
+}
+
+/// `text` as a JSON string, escaped as serde_json escapes it: quote, backslash and control
+/// characters (`\b \f \n \r \t` by name, the others as `\u00xx`), nothing else. Plain runs
+/// are found eight bytes at a time ([`string_stop`]) and copied whole.
+fn push_string(out: &mut Vec<u8>, text: &str) {
+    let mut rest = text.as_bytes();
+    out.push(b'"');
+    while let Some(stop) = string_stop(rest) {
+        out.extend_from_slice(&rest[..stop]);
+        match rest[stop] {
+            b'"' => out.extend_from_slice(b"\\\""),
+            b'\\' => out.extend_from_slice(b"\\\\"),
+            0x08 => out.extend_from_slice(b"\\b"),
+            0x0C => out.extend_from_slice(b"\\f"),
+            b'\n' => out.extend_from_slice(b"\\n"),
+            b'\r' => out.extend_from_slice(b"\\r"),
+            b'\t' => out.extend_from_slice(b"\\t"),
+            control => {
+                const HEX: &[u8; 16] = b"0123456789abcdef";
+                out.extend_from_slice(b"\\u00");
+                out.push(HEX[usize::from(control >> 4)]);
+                out.push(HEX[usize::from(control & 0xF)]);
+            }
+        }
+        rest = &rest[stop + 1..];
+    }
+    out.extend_from_slice(rest);
+    out.push(b'"');
 }
 
 /// One report as an object; several as an array.
@@ -200,7 +235,9 @@ mod tests {
             .map(|i| Finding {
                 diagnostic: Diagnostic {
                     code: "UNEXPECTED_PROPERTY",
-                    message: format!("finding {i}: \"quoted\", a\nline, a tab\t, \u{1} and é"),
+                    message: format!(
+                        "finding {i}: \"quoted\", a\nline, a tab\t, \u{1}, \u{8}\u{c}\r\u{1f}\u{7f} \\ / and é"
+                    ),
                     severity: severities[i % 4],
                     pointer: format!("/materials/{i}/extensions/a~1b"),
                     position: None,
@@ -227,6 +264,28 @@ mod tests {
                 sheen_material_count: 1,
                 fuzz_material_count: 0,
             }),
+        }
+    }
+
+    #[test]
+    fn strings_are_escaped_as_serde_json_escapes_them() {
+        let ascii: String = (0u8..=0x7F).map(char::from).collect();
+        let shifted: String = ascii.chars().cycle().skip(37).take(300).collect();
+        for text in [
+            ascii.as_str(),
+            shifted.as_str(),
+            "",
+            "plain text past eight bytes",
+            "é\u{1F600}\u{2028}\u{7f}",
+            "\"\\\"\\",
+            "a\u{0}b",
+        ] {
+            let mut ours = Vec::new();
+            push_string(&mut ours, text);
+            assert_eq!(
+                String::from_utf8(ours).unwrap(),
+                serde_json::to_string(text).unwrap()
+            );
         }
     }
 
