@@ -163,8 +163,12 @@ fn push_message(out: &mut Vec<u8>, m: &MessageShape) {
     out.extend_from_slice(b",\n        \"message\": ");
     push_string(out, m.message);
     out.extend_from_slice(b",\n        \"severity\": ");
-    // Writing to a Vec cannot fail.
-    let _ = std::io::Write::write_fmt(out, format_args!("{}", m.severity));
+    // Severities are 0 to 3; the formatter is kept for any other number.
+    match m.severity {
+        digit @ 0..=9 => out.push(b'0' + digit),
+        // Writing to a Vec cannot fail.
+        n => drop(std::io::Write::write_fmt(out, format_args!("{n}"))),
+    }
     out.extend_from_slice(b",\n        \"pointer\": ");
     push_string(out, m.pointer);
     out.extend_from_slice(b"\n      }");
