@@ -191,9 +191,12 @@ impl Builder<'_> {
                 Some(b'\n') => {
                     at += 1;
                     // Indentation, a large part of a pretty-printed file, is passed eight
-                    // spaces at a time.
+                    // spaces at a time, and the spaces that start the last word at once.
                     while let Some(word) = bytes.get(at..at + 8) {
-                        if u64::from_ne_bytes(word.try_into().expect("eight bytes")) != SPACES {
+                        let others =
+                            u64::from_le_bytes(word.try_into().expect("eight bytes")) ^ SPACES;
+                        if others != 0 {
+                            at += (others.trailing_zeros() / 8) as usize;
                             break;
                         }
                         at += 8;
@@ -373,8 +376,16 @@ impl Builder<'_> {
                 )
             }
         };
+        // Two unescaped keys whose prints differ differ: most pairs are told apart without
+        // reading their text.
+        let may_match = |a: u32, b: u32| {
+            let (a, b) = (&self.entries[a as usize], &self.entries[b as usize]);
+            (a.meta | b.meta) & ESCAPED != 0 || a.aux() == b.aux()
+        };
         let found = if keys.len() <= 16 {
-            (1..keys.len()).any(|i| (0..i).any(|j| text(keys[i]) == text(keys[j])))
+            (1..keys.len()).any(|i| {
+                (0..i).any(|j| may_match(keys[i], keys[j]) && text(keys[i]) == text(keys[j]))
+            })
         } else {
             let mut seen = std::collections::HashSet::with_capacity(keys.len());
             !keys.iter().all(|&k| seen.insert(text(k)))
