@@ -4,7 +4,24 @@ use serde_json::Value;
 
 /// Escapes one reference token (`~` → `~0`, `/` → `~1`).
 pub fn escape(segment: &str) -> String {
-    segment.replace('~', "~0").replace('/', "~1")
+    let mut out = String::with_capacity(segment.len());
+    push_escaped(&mut out, segment);
+    out
+}
+
+/// Appends `segment` to `out` escaped as [`escape`] escapes it, without a copy of its own.
+pub fn push_escaped(out: &mut String, segment: &str) {
+    let mut rest = segment;
+    while let Some(at) = rest.find(['~', '/']) {
+        out.push_str(&rest[..at]);
+        out.push_str(if rest.as_bytes()[at] == b'~' {
+            "~0"
+        } else {
+            "~1"
+        });
+        rest = &rest[at + 1..];
+    }
+    out.push_str(rest);
 }
 
 /// Undoes `escape`.
@@ -50,6 +67,13 @@ mod tests {
     #[test]
     fn escapes_tilde_before_slash_so_both_round_trip() {
         assert_eq!(escape("a/b~c"), "a~1b~0c");
+        assert_eq!(escape("~1"), "~01");
+        assert_eq!(escape("/~/"), "~1~0~1");
+        assert_eq!(escape("plain"), "plain");
+        assert_eq!(escape(""), "");
+        let mut pointer = String::from("/materials");
+        push_escaped(&mut pointer, "é/x");
+        assert_eq!(pointer, "/materialsé~1x");
         assert_eq!(unescape("a~1b~0c"), "a/b~c");
         assert_eq!(unescape("~01"), "~1");
         assert_eq!(join("/extras", "x/y"), "/extras/x~1y");

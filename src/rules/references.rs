@@ -128,10 +128,18 @@ impl Rule for References {
                 }
             };
             if index >= len as u64 {
-                let at: String = path
-                    .iter()
-                    .map(|t| format!("/{}", pointer::escape(&t.text())))
-                    .collect();
+                let mut at = String::with_capacity(64);
+                for token in path {
+                    at.push('/');
+                    match token {
+                        Token::Index(i) => {
+                            use std::fmt::Write;
+                            // Writing to a String cannot fail.
+                            let _ = write!(at, "{i}");
+                        }
+                        Token::Key(key) => pointer::push_escaped(&mut at, key),
+                    }
+                }
                 let message = unresolved_message(&at, index, &target, len);
                 found.push((link, Diagnostic::new(&UNRESOLVED_REFERENCE, at, message)));
             }
