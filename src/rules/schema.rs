@@ -270,6 +270,9 @@ impl Rule for SchemaCheck {
             let found = checked
                 .entry((layer.extension, layer.value.raw()))
                 .or_insert_with(|| check_layer(cx.schemas, &layer));
+            if found.is_empty() {
+                continue;
+            }
             let at = layer.pointer();
             out.extend(found.iter().map(|d| Diagnostic {
                 pointer: format!("{at}{}", d.pointer),
