@@ -8,6 +8,7 @@
 
 pub mod discover;
 pub mod glb;
+pub mod json_text;
 pub mod limits;
 pub mod pages;
 pub mod pointer;

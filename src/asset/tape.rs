@@ -435,7 +435,7 @@ impl Builder<'_> {
         let mut escaped = false;
         loop {
             // The text is UTF-8 already: only quotes, backslashes and control characters matter.
-            match string_stop(&self.bytes[self.at..]) {
+            match super::json_text::string_stop(&self.bytes[self.at..]) {
                 None => {
                     self.at = self.bytes.len();
                     return self.fail();
@@ -518,32 +518,6 @@ impl Builder<'_> {
         }
         Ok(())
     }
-}
-
-/// Where the first byte that ends a run of plain string text stands: a quote, a backslash or a
-/// control character. Eight bytes are tested at a time (the bit tricks for "has a zero byte" and
-/// "has a byte below n"): strings are most of a glTF's bytes, keys and URIs among them. In each
-/// test only bytes above a true hit can be false hits, so the lowest hit of the three is exact.
-pub fn string_stop(bytes: &[u8]) -> Option<usize> {
-    const ONES: u64 = u64::from_ne_bytes([1; 8]);
-    const HIGHS: u64 = u64::from_ne_bytes([0x80; 8]);
-    let zero_in = |v: u64| v.wrapping_sub(ONES) & !v;
-    let mut at = 0;
-    while let Some(word) = bytes.get(at..at + 8) {
-        let w = u64::from_le_bytes(word.try_into().expect("eight bytes"));
-        let hits = (zero_in(w ^ (ONES * u64::from(b'"')))
-            | zero_in(w ^ (ONES * u64::from(b'\\')))
-            | (w.wrapping_sub(ONES * 0x20) & !w))
-            & HIGHS;
-        if hits != 0 {
-            return Some(at + (hits.trailing_zeros() / 8) as usize);
-        }
-        at += 8;
-    }
-    bytes[at..]
-        .iter()
-        .position(|&b| b == b'"' || b == b'\\' || b < 0x20)
-        .map(|i| at + i)
 }
 
 /// One value of an indexed text. Cheap to copy.
@@ -1248,18 +1222,6 @@ mod properties {
     }
 
     proptest! {
-        /// The word-at-a-time scan stops where a byte-at-a-time scan does, on any bytes.
-        #[test]
-        fn string_stop_finds_the_first_quote_backslash_or_control_byte(
-            bytes in prop::collection::vec(
-                prop_oneof![Just(b'"'), Just(b'\\'), 0u8..0x20, 0x20u8..=0xFF, 0x20u8..0x7F],
-                0..40,
-            ),
-        ) {
-            let expected = bytes.iter().position(|&b| b == b'"' || b == b'\\' || b < 0x20);
-            prop_assert_eq!(string_stop(&bytes), expected);
-        }
-
         /// Any JSON text, and any cut or one-byte change of it, gets the same verdict from the
         /// index as from serde_json, and the same values when both read it.
         #[test]

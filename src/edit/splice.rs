@@ -26,6 +26,7 @@
 //! same reason.
 
 use super::{Edit, EditError};
+use crate::asset::json_text::push_quoted;
 use crate::asset::tape::{Kind, Node};
 use rayon::prelude::*;
 use serde_json::{Map, Value};
@@ -707,7 +708,7 @@ impl Layout {
                 }
             }
             Value::Number(n) => out.push_str(&raw_number_text(n.as_str())),
-            Value::String(text) => push_string(out, text),
+            Value::String(text) => push_quoted(out, text),
             other => out.push_str(&other.to_string()),
         }
     }
@@ -719,7 +720,7 @@ impl Layout {
                 if i > 0 {
                     out.push_str(&self.inline_comma);
                 }
-                push_string(out, key);
+                push_quoted(out, key);
                 out.push_str(&self.colon);
                 self.write(value, indent, true, out);
             }
@@ -734,7 +735,7 @@ impl Layout {
             }
             out.push_str(self.newline);
             out.push_str(&inner);
-            push_string(out, key);
+            push_quoted(out, key);
             out.push_str(&self.colon);
             self.write(value, &inner, false, out);
         }
@@ -813,17 +814,6 @@ pub fn written(value: Value) -> Value {
             Value::Object(map.into_iter().map(|(k, v)| (k, written(v))).collect())
         }
         other => other,
-    }
-}
-
-/// `text` as a JSON string, escaped as serde_json escapes it.
-fn push_string(out: &mut String, text: &str) {
-    if text.bytes().any(|b| b == b'"' || b == b'\\' || b < 0x20) {
-        out.push_str(&Value::from(text).to_string());
-    } else {
-        out.push('"');
-        out.push_str(text);
-        out.push('"');
     }
 }
 
@@ -1078,7 +1068,7 @@ fn insert_members(
     };
     let member_text = |key: &str, value: &Value| {
         let mut text = String::new();
-        push_string(&mut text, key);
+        push_quoted(&mut text, key);
         text.push_str(&layout.colon);
         layout.write(value, &indent, inline || layout.unit.is_none(), &mut text);
         text

@@ -6,7 +6,7 @@
 //! thousands of findings is written without first being copied into a JSON tree.
 
 use super::display_path;
-use crate::asset::tape::string_stop;
+use crate::asset::json_text::push_quoted;
 use crate::validate::{AssetInfo, FileReport};
 use serde::Serialize;
 
@@ -120,10 +120,10 @@ pub fn write_pretty(out: &mut impl std::io::Write, report: &FileReport) -> std::
     };
     let write_run = |run: &[crate::validate::Finding]| {
         // A message takes some 300 bytes; the run grows past that once at most.
-        let mut text = Vec::with_capacity(run.len() * 320);
+        let mut text = String::with_capacity(run.len() * 320);
         for (i, finding) in run.iter().enumerate() {
             if i > 0 {
-                text.extend_from_slice(b",\n      ");
+                text.push_str(",\n      ");
             }
             push_message(&mut text, &message_shape(finding));
         }
@@ -138,7 +138,7 @@ pub fn write_pretty(out: &mut impl std::io::Write, report: &FileReport) -> std::
         .chunks(MESSAGES_PER_TASK * RUNS_IN_HAND)
         .enumerate()
     {
-        let runs: Vec<Vec<u8>> = window
+        let runs: Vec<String> = window
             .par_chunks(MESSAGES_PER_TASK)
             .map(write_run)
             .collect();
@@ -146,7 +146,7 @@ pub fn write_pretty(out: &mut impl std::io::Write, report: &FileReport) -> std::
             if w > 0 || i > 0 {
                 out.write_all(b",\n      ")?;
             }
-            out.write_all(run)?;
+            out.write_all(run.as_bytes())?;
         }
     }
     out.write_all(b"\n    ]")?;
@@ -157,50 +157,21 @@ pub fn write_pretty(out: &mut impl std::io::Write, report: &FileReport) -> std::
 /// A message as the pretty printer writes it within the report's list (its fields at depth 4,
 /// its closing brace at depth 3). Written here rather than by the printer because a large
 /// report is nearly all messages, and the printer spent most of its time on them.
-fn push_message(out: &mut Vec<u8>, m: &MessageShape) {
-    out.extend_from_slice(b"{\n        \"code\": ");
-    push_string(out, m.code);
-    out.extend_from_slice(b",\n        \"message\": ");
-    push_string(out, m.message);
-    out.extend_from_slice(b",\n        \"severity\": ");
+fn push_message(out: &mut String, m: &MessageShape) {
+    out.push_str("{\n        \"code\": ");
+    push_quoted(out, m.code);
+    out.push_str(",\n        \"message\": ");
+    push_quoted(out, m.message);
+    out.push_str(",\n        \"severity\": ");
     // Severities are 0 to 3; the formatter is kept for any other number.
     match m.severity {
-        digit @ 0..=9 => out.push(b'0' + digit),
-        // Writing to a Vec cannot fail.
-        n => drop(std::io::Write::write_fmt(out, format_args!("{n}"))),
+        digit @ 0..=9 => out.push(char::from(b'0' + digit)),
+        // Writing to a String cannot fail.
+        n => drop(std::fmt::Write::write_fmt(out, format_args!("{n}"))),
     }
-    out.extend_from_slice(b",\n        \"pointer\": ");
-    push_string(out, m.pointer);
-    out.extend_from_slice(b"\n      }");
-}
-
-/// `text` as a JSON string, escaped as serde_json escapes it: quote, backslash and control
-/// characters (`\b \f \n \r \t` by name, the others as `\u00xx`), nothing else. Plain runs
-/// are found eight bytes at a time ([`string_stop`]) and copied whole.
-fn push_string(out: &mut Vec<u8>, text: &str) {
-    let mut rest = text.as_bytes();
-    out.push(b'"');
-    while let Some(stop) = string_stop(rest) {
-        out.extend_from_slice(&rest[..stop]);
-        match rest[stop] {
-            b'"' => out.extend_from_slice(b"\\\""),
-            b'\\' => out.extend_from_slice(b"\\\\"),
-            0x08 => out.extend_from_slice(b"\\b"),
-            0x0C => out.extend_from_slice(b"\\f"),
-            b'\n' => out.extend_from_slice(b"\\n"),
-            b'\r' => out.extend_from_slice(b"\\r"),
-            b'\t' => out.extend_from_slice(b"\\t"),
-            control => {
-                const HEX: &[u8; 16] = b"0123456789abcdef";
-                out.extend_from_slice(b"\\u00");
-                out.push(HEX[usize::from(control >> 4)]);
-                out.push(HEX[usize::from(control & 0xF)]);
-            }
-        }
-        rest = &rest[stop + 1..];
-    }
-    out.extend_from_slice(rest);
-    out.push(b'"');
+    out.push_str(",\n        \"pointer\": ");
+    push_quoted(out, m.pointer);
+    out.push_str("\n      }");
 }
 
 /// One report as an object; several as an array.
@@ -268,28 +239,6 @@ mod tests {
                 sheen_material_count: 1,
                 fuzz_material_count: 0,
             }),
-        }
-    }
-
-    #[test]
-    fn strings_are_escaped_as_serde_json_escapes_them() {
-        let ascii: String = (0u8..=0x7F).map(char::from).collect();
-        let shifted: String = ascii.chars().cycle().skip(37).take(300).collect();
-        for text in [
-            ascii.as_str(),
-            shifted.as_str(),
-            "",
-            "plain text past eight bytes",
-            "é\u{1F600}\u{2028}\u{7f}",
-            "\"\\\"\\",
-            "a\u{0}b",
-        ] {
-            let mut ours = Vec::new();
-            push_string(&mut ours, text);
-            assert_eq!(
-                String::from_utf8(ours).unwrap(),
-                serde_json::to_string(text).unwrap()
-            );
         }
     }
 
