@@ -211,7 +211,7 @@ const RELEASED_ELSEWHERE_FROM: usize = 4096;
 
 /// Frees a report that has been written. A large one is freed on the thread pool, so that the
 /// next report, or the end of the run, does not wait for its findings' tens of thousands of
-/// frees (a tenth of a large document's run went to them).
+/// frees (some 5 % of a 20,000-material document's run went to them).
 fn release(report: FileReport) {
     if report.findings.len() >= RELEASED_ELSEWHERE_FROM {
         rayon::spawn(move || drop(report));
