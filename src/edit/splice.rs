@@ -129,10 +129,16 @@ pub fn splice_edits<'e>(
             splice_unit(text, root, object, &entries, &members, &layout, unit, edits)
         })
         .collect();
+    let mut all_checked = true;
     for unit in done {
         let Some(unit) = unit? else {
             return Ok(None);
         };
+        match unit.checked {
+            Some(false) => return Ok(None),
+            Some(true) => {}
+            None => all_checked = false,
+        }
         splices.extend(unit.splices);
         changed |= unit.changed;
         meant.push(unit.meant);
@@ -140,6 +146,11 @@ pub fn splice_edits<'e>(
     let Some(out) = assemble(text, splices) else {
         return Ok(None);
     };
+    if all_checked {
+        // Every unit's value was read back alone, and every byte outside them was copied: the
+        // whole text need not be indexed again.
+        return Ok(Some((out, changed)));
+    }
     // The check a spliced text passes before it is written: it is JSON, every part the plan
     // touched reads back as meant (numbers as velvet writes them), and the root has the
     // members it should; every other byte was copied.
@@ -175,6 +186,10 @@ struct UnitSplices {
     splices: Vec<Splice>,
     changed: bool,
     meant: (String, Option<u64>),
+    /// Whether the unit's value reads back as meant, when all its splices lie inside one value
+    /// of the loaded text and that value was checked alone ([`reads_back_within`]); `None` when
+    /// only the whole written text can tell (a top-level member added or removed).
+    checked: Option<bool>,
 }
 
 /// A digest of what a value reads as when velvet writes it: key order, decoded strings, and
@@ -207,70 +222,268 @@ impl Digest {
 
 /// The [`Digest`] of `value` as velvet writes it.
 fn value_digest(value: &Value) -> u64 {
-    fn feed(d: &mut Digest, value: &Value) {
-        match value {
-            Value::Null => d.tag(b'n'),
-            Value::Bool(b) => d.tag(if *b { b't' } else { b'f' }),
-            Value::Number(n) => d.text(b'#', &raw_number_text(n.as_str())),
-            Value::String(s) => d.text(b'"', s),
-            Value::Array(items) => {
-                d.tag(b'[');
-                items.iter().for_each(|v| feed(d, v));
-                d.tag(b']');
+    let mut d = Digest::new();
+    feed_value(&mut d, value);
+    d.finish()
+}
+
+fn feed_value(d: &mut Digest, value: &Value) {
+    match value {
+        Value::Null => d.tag(b'n'),
+        Value::Bool(b) => d.tag(if *b { b't' } else { b'f' }),
+        Value::Number(n) => d.text(b'#', &raw_number_text(n.as_str())),
+        Value::String(s) => d.text(b'"', s),
+        Value::Array(items) => {
+            d.tag(b'[');
+            items.iter().for_each(|v| feed_value(d, v));
+            d.tag(b']');
+        }
+        Value::Object(map) => {
+            d.tag(b'{');
+            for (k, v) in map {
+                d.text(b':', k);
+                feed_value(d, v);
             }
-            Value::Object(map) => {
-                d.tag(b'{');
-                for (k, v) in map {
-                    d.text(b':', k);
-                    feed(d, v);
-                }
-                d.tag(b'}');
-            }
+            d.tag(b'}');
         }
     }
-    let mut d = Digest::new();
-    feed(&mut d, value);
-    d.finish()
 }
 
 /// The [`Digest`] of the value `node` indexes, read as a `Value` would read it (a key written
 /// twice: at its first place, with its last value).
 fn node_digest(node: Node) -> u64 {
-    fn feed(d: &mut Digest, node: Node) {
-        match node.kind() {
-            Kind::Null => d.tag(b'n'),
-            Kind::Bool => d.tag(if node.as_bool() == Some(true) {
-                b't'
-            } else {
-                b'f'
-            }),
-            // Spelled as serde_json reads it (`1E-1` as `1e-1`), as the meant value holds it.
-            Kind::Number => match node.raw().parse::<serde_json::Number>() {
-                Ok(n) => d.text(b'#', &raw_number_text(n.as_str())),
-                Err(_) => d.text(b'#', node.raw()),
-            },
-            Kind::String => d.text(b'"', &node.as_str().unwrap_or_default()),
-            Kind::Array => {
-                d.tag(b'[');
-                node.as_array()
-                    .into_iter()
-                    .flat_map(|a| a.iter())
-                    .for_each(|v| feed(d, v));
-                d.tag(b']');
+    let mut d = Digest::new();
+    feed_node(&mut d, node);
+    d.finish()
+}
+
+fn feed_node(d: &mut Digest, node: Node) {
+    match node.kind() {
+        Kind::Null => d.tag(b'n'),
+        Kind::Bool => d.tag(if node.as_bool() == Some(true) {
+            b't'
+        } else {
+            b'f'
+        }),
+        // Spelled as serde_json reads it (`1E-1` as `1e-1`), as the meant value holds it.
+        Kind::Number => match node.raw().parse::<serde_json::Number>() {
+            Ok(n) => d.text(b'#', &raw_number_text(n.as_str())),
+            Err(_) => d.text(b'#', node.raw()),
+        },
+        Kind::String => d.text(b'"', &node.as_str().unwrap_or_default()),
+        Kind::Array => {
+            d.tag(b'[');
+            node.as_array()
+                .into_iter()
+                .flat_map(|a| a.iter())
+                .for_each(|v| feed_node(d, v));
+            d.tag(b']');
+        }
+        Kind::Object => {
+            d.tag(b'{');
+            for (k, v) in node.as_object().into_iter().flat_map(|o| o.iter()) {
+                d.text(b':', &k);
+                feed_node(d, v);
             }
-            Kind::Object => {
-                d.tag(b'{');
-                for (k, v) in node.as_object().into_iter().flat_map(|o| o.iter()) {
-                    d.text(b':', &k);
-                    feed(d, v);
-                }
-                d.tag(b'}');
+            d.tag(b'}');
+        }
+    }
+}
+
+/// One edit of [`members_set_in_place`]: where it sets, as tokens below the element, and the
+/// value as velvet writes it.
+struct MemberSet {
+    tokens: Vec<String>,
+    value: Value,
+}
+
+/// The splices of an element unit whose edits each set a member of an object the element
+/// already holds (the fuzz object a migration adds to a material's `extensions`, a factor it
+/// replaces), made from the index alone: the element is not read into a value, edited and
+/// compared with its text, which for a migration of every material was most of the writer's
+/// work. Returns the splices, whether they change anything, and the digest the element must
+/// read back as, fed from the index with the set values in their places, as the edited value
+/// would feed it. `None` for edits of another kind (a removal, an array element, a path through
+/// a missing key or an object that writes a key twice, two edits of one place); the caller then
+/// takes the general way.
+fn members_set_in_place(
+    text: &str,
+    element: Node,
+    prefix: &str,
+    edits: &[&Edit],
+    layout: &Layout,
+) -> Option<(Vec<Splice>, bool, u64)> {
+    let mut sets: Vec<MemberSet> = Vec::with_capacity(edits.len());
+    for edit in edits {
+        let Edit::Set { pointer, value } = edit else {
+            return None;
+        };
+        let within = pointer
+            .strip_prefix(prefix)
+            .filter(|w| w.starts_with('/'))?;
+        sets.push(MemberSet {
+            tokens: crate::asset::pointer::tokens(within),
+            value: written(value.clone()),
+        });
+    }
+    // No edit's place lies at or inside another's: each is made on the text as loaded.
+    for (i, a) in sets.iter().enumerate() {
+        for b in &sets[i + 1..] {
+            let n = a.tokens.len().min(b.tokens.len());
+            if a.tokens[..n] == b.tokens[..n] {
+                return None;
             }
         }
     }
+    let mut splices = Vec::new();
+    let mut changed = false;
+    // New members by the object that receives them, in the order the edits add them.
+    let mut inserts: Vec<(Node, Vec<(&str, &Value)>)> = Vec::new();
+    for set in &sets {
+        let (key, path) = set.tokens.split_last()?;
+        let mut parent = element;
+        for token in path {
+            parent = member_or_element(parent, token)?;
+        }
+        let object = parent
+            .as_object()
+            .filter(|o| !o.is_empty() && !o.has_duplicate_keys())?;
+        match object.get(key) {
+            Some(old) => {
+                changed |= !matches(old, &set.value, Compare::Exact);
+                diff(text, old, &set.value, layout, &mut splices);
+            }
+            None => {
+                changed = true;
+                let at = parent.span().start;
+                match inserts.iter_mut().find(|(p, _)| p.span().start == at) {
+                    Some((_, new)) => new.push((key, &set.value)),
+                    None => inserts.push((parent, vec![(key.as_str(), &set.value)])),
+                }
+            }
+        }
+    }
+    for (parent, new) in &inserts {
+        let members: Vec<(usize, Node)> = parent
+            .as_object()?
+            .entries()
+            .iter()
+            .map(|(k, v)| (k.span().start, *v))
+            .collect();
+        // A new key goes last, as the edit applier puts it: after the last member.
+        let last = Some(members.len() - 1);
+        let placed: Vec<(Option<usize>, &str, &Value)> = new
+            .iter()
+            .map(|(key, value)| (last, *key, *value))
+            .collect();
+        insert_members(text, *parent, &members, &placed, layout, &mut splices);
+    }
     let mut d = Digest::new();
-    feed(&mut d, node);
-    d.finish()
+    let sets: Vec<(&[String], &Value)> = sets
+        .iter()
+        .map(|s| (s.tokens.as_slice(), &s.value))
+        .collect();
+    feed_edited(&mut d, element, &sets);
+    Some((splices, changed, d.finish()))
+}
+
+/// The member `token` of an object that writes each key once, or element `token` (written
+/// without leading zeros) of an array.
+fn member_or_element<'a>(node: Node<'a>, token: &str) -> Option<Node<'a>> {
+    match node.kind() {
+        Kind::Object => node
+            .as_object()
+            .filter(|o| !o.has_duplicate_keys())?
+            .get(token),
+        Kind::Array => {
+            let canonical = token == "0" || (!token.starts_with('0') && !token.is_empty());
+            let index = token
+                .parse::<usize>()
+                .ok()
+                .filter(|_| canonical && token.bytes().all(|b| b.is_ascii_digit()))?;
+            node.as_array()?.get(index)
+        }
+        _ => None,
+    }
+}
+
+/// Feeds `node` as [`feed_node`] does, with each of `sets` (tokens below `node`, value) in its
+/// place: a set member where the member stands, a new one after the object's members, in
+/// order. Every set's path exists in `node` up to its last token (see [`members_set_in_place`]).
+fn feed_edited(d: &mut Digest, node: Node, sets: &[(&[String], &Value)]) {
+    if sets.is_empty() {
+        return feed_node(d, node);
+    }
+    let below = |token: &str| -> Vec<(&[String], &Value)> {
+        sets.iter()
+            .filter(|(t, _)| t.len() > 1 && t[0] == token)
+            .map(|(t, v)| (&t[1..], *v))
+            .collect()
+    };
+    match node.kind() {
+        Kind::Object => {
+            let Some(object) = node.as_object() else {
+                return feed_node(d, node);
+            };
+            d.tag(b'{');
+            for (key, member) in object.iter() {
+                d.text(b':', &key);
+                match sets.iter().find(|(t, _)| t.len() == 1 && t[0] == key) {
+                    Some((_, new)) => feed_value(d, new),
+                    None => feed_edited(d, member, &below(&key)),
+                }
+            }
+            for (tokens, new) in sets {
+                if tokens.len() == 1 && !object.contains_key(&tokens[0]) {
+                    d.text(b':', &tokens[0]);
+                    feed_value(d, new);
+                }
+            }
+            d.tag(b'}');
+        }
+        Kind::Array => {
+            d.tag(b'[');
+            for (i, item) in node
+                .as_array()
+                .into_iter()
+                .flat_map(|a| a.iter())
+                .enumerate()
+            {
+                feed_edited(d, item, &below(&i.to_string()));
+            }
+            d.tag(b']');
+        }
+        _ => feed_node(d, node),
+    }
+}
+
+/// Whether the value spanning `within` in `text` reads back as `digest` once `splices` (all
+/// inside that span) are made: the read-back check of one unit. The rest of the text is copied
+/// as it was, so a text whose every changed span reads back holds the whole document meant.
+fn reads_back_within(
+    text: &str,
+    within: std::ops::Range<usize>,
+    splices: &[Splice],
+    digest: u64,
+) -> bool {
+    let mut order: Vec<&Splice> = splices.iter().collect();
+    order.sort_by_key(|s| (s.start, s.end));
+    let added: usize = splices.iter().map(|s| s.text.len()).sum();
+    let mut out = String::with_capacity(within.len() + added);
+    let mut at = within.start;
+    for s in order {
+        if s.start < at || s.end > within.end {
+            return false;
+        }
+        out.push_str(&text[at..s.start]);
+        out.push_str(&s.text);
+        at = s.end;
+    }
+    out.push_str(&text[at..within.end]);
+    match crate::asset::tape::Tape::build(&out) {
+        Ok(index) => node_digest(index.root(&out)) == digest,
+        Err(_) => false,
+    }
 }
 
 /// The splices of one unit of [`splice_edits`]; `Ok(None)` for one it does not take.
@@ -288,6 +501,7 @@ fn splice_unit(
     let mut splices = Vec::new();
     let mut changed = false;
     let meant: (String, Option<u64>);
+    let mut checked = None;
     let node = object.get(&unit.member);
     match (unit.element, node) {
         (Some(i), Some(node)) => {
@@ -295,6 +509,17 @@ fn splice_unit(
                 return Ok(None);
             };
             let prefix = format!("/{}/{i}", crate::asset::pointer::escape(&unit.member));
+            if let Some((splices, changed, digest)) =
+                members_set_in_place(text, element, &prefix, edits, layout)
+            {
+                let checked = reads_back_within(text, element.span(), &splices, digest);
+                return Ok(Some(UnitSplices {
+                    splices,
+                    changed,
+                    meant: (prefix, Some(digest)),
+                    checked: Some(checked),
+                }));
+            }
             let mut value = element.to_value();
             for edit in edits {
                 let (Edit::Set { pointer, .. } | Edit::Remove { pointer }) = edit else {
@@ -325,7 +550,9 @@ fn splice_unit(
                 }
             }
             diff(text, element, &value, layout, &mut splices);
-            meant = (prefix, Some(value_digest(&value)));
+            let digest = value_digest(&value);
+            checked = Some(reads_back_within(text, element.span(), &splices, digest));
+            meant = (prefix, Some(digest));
         }
         (_, node) => {
             let mut part = Map::new();
@@ -337,7 +564,11 @@ fn splice_unit(
             changed |= super::apply(&mut part, &owned)?;
             let new = part.get(&unit.member);
             match (node, new) {
-                (Some(node), Some(new)) => diff(text, node, new, layout, &mut splices),
+                (Some(node), Some(new)) => {
+                    diff(text, node, new, layout, &mut splices);
+                    let digest = value_digest(new);
+                    checked = Some(reads_back_within(text, node.span(), &splices, digest));
+                }
                 (Some(_), None) => {
                     let Some(i) = entries
                         .iter()
@@ -379,6 +610,7 @@ fn splice_unit(
         splices,
         changed,
         meant,
+        checked,
     }))
 }
 
@@ -1226,6 +1458,113 @@ mod tests {
         let (out, changed) = splice_edits(text, tape.root(text), &same).unwrap().unwrap();
         assert!(!changed);
         assert_eq!(out, text);
+    }
+
+    #[test]
+    fn members_set_in_an_existing_object_are_spliced_from_the_index_as_the_general_way_does() {
+        // Layouts: two spaces with one-line objects, tabs with CRLF, minified; a number
+        // spelled with an exponent.
+        let texts = [
+            "{\n  \"materials\": [\n    {\"name\": \"a\", \"extras\": {\"k\": 1}},\n    {\n      \"name\": \"b\",\n      \"extensions\": {\n        \"KHR_materials_sheen\": {\"sheenRoughnessFactor\": 5E-1}\n      }\n    }\n  ]\n}\n",
+            "{\r\n\t\"materials\": [\r\n\t\t{\"name\": \"a\"},\r\n\t\t{\r\n\t\t\t\"extensions\": {\r\n\t\t\t\t\"KHR_materials_sheen\": {\r\n\t\t\t\t\t\"sheenRoughnessFactor\": 0.5\r\n\t\t\t\t}\r\n\t\t\t},\r\n\t\t\t\"name\": \"b\"\r\n\t\t}\r\n\t]\r\n}",
+            "{\"materials\":[{\"name\":\"a\"},{\"name\":\"b\",\"extensions\":{\"KHR_materials_sheen\":{\"sheenRoughnessFactor\":0.5}}}]}",
+        ];
+        let edits = vec![
+            Edit::set(
+                "/materials/1/extensions/KHR_materials_fuzz",
+                serde_json::json!({"fuzzColorFactor": [1, 0.5, 0.25], "fuzzRoughnessFactor": 0.7499999999999999}),
+            ),
+            Edit::set(
+                "/materials/1/extensions/KHR_materials_sheen/sheenRoughnessFactor",
+                serde_json::json!(0.25),
+            ),
+            Edit::set("/materials/1/name", serde_json::json!("b2")),
+        ];
+        for text in texts {
+            let tape = crate::asset::tape::Tape::build(text).unwrap();
+            let root = tape.root(text);
+            let element = root.pointer("/materials/1").unwrap();
+            let refs: Vec<&Edit> = edits.iter().collect();
+            let layout = Layout::detect(text, root);
+            let (_, changed, digest) =
+                members_set_in_place(text, element, "/materials/1", &refs, &layout)
+                    .expect("sets of members of existing objects take the index's way");
+            assert!(changed);
+            let mut whole: Value = serde_json::from_str(text).unwrap();
+            super::super::apply(&mut whole, &edits).unwrap();
+            assert_eq!(digest, value_digest(&whole["materials"][1]), "{text}");
+            let (out, _) = splice_edits(text, root, &edits).unwrap().unwrap();
+            assert_eq!(out, spliced(text, &whole), "{text}");
+            assert!(reads_as_written(&out, &whole));
+        }
+        // Removals, paths through missing objects and two edits of one place take the general
+        // way, which gives the same text.
+        let text = texts[0];
+        let tape = crate::asset::tape::Tape::build(text).unwrap();
+        let root = tape.root(text);
+        let element = root.pointer("/materials/1").unwrap();
+        let layout = Layout::detect(text, root);
+        for others in [
+            vec![Edit::remove("/materials/1/name")],
+            vec![Edit::set("/materials/1/extras/a", serde_json::json!(1))],
+            vec![
+                Edit::set("/materials/1/extensions", serde_json::json!({})),
+                Edit::set("/materials/1/extensions/x", serde_json::json!(1)),
+            ],
+        ] {
+            let refs: Vec<&Edit> = others.iter().collect();
+            assert!(members_set_in_place(text, element, "/materials/1", &refs, &layout).is_none());
+            let mut whole: Value = serde_json::from_str(text).unwrap();
+            super::super::apply(&mut whole, &others).unwrap();
+            let (out, _) = splice_edits(text, root, &others).unwrap().unwrap();
+            assert_eq!(out, spliced(text, &whole));
+        }
+        // An object that writes a key twice, beside the path an edit takes, stays as written
+        // (the whole-document way writes it anew) and reads as a value reads it.
+        let text =
+            "{\"materials\": [{\"extras\": {\"k\": 1, \"k\": 2}, \"extensions\": {\"x\": 1}}]}";
+        let tape = crate::asset::tape::Tape::build(text).unwrap();
+        let fuzz = [Edit::set("/materials/0/extensions/y", serde_json::json!(2))];
+        let (out, _) = splice_edits(text, tape.root(text), &fuzz).unwrap().unwrap();
+        assert_eq!(
+            out,
+            "{\"materials\": [{\"extras\": {\"k\": 1, \"k\": 2}, \"extensions\": {\"x\": 1, \"y\": 2}}]}"
+        );
+        let mut whole: Value = serde_json::from_str(text).unwrap();
+        super::super::apply(&mut whole, &fuzz).unwrap();
+        let written = crate::asset::tape::Tape::build(&out).unwrap();
+        assert_eq!(node_digest(written.root(&out)), value_digest(&whole));
+    }
+
+    #[test]
+    fn a_unit_is_read_back_alone_and_refused_when_its_text_holds_something_else() {
+        let text = r#"{"m": [{"a": 1}, {"b": [2, 3]}]}"#;
+        let tape = crate::asset::tape::Tape::build(text).unwrap();
+        let element = tape.root(text).pointer("/m/1").unwrap();
+        let span = element.span();
+        let meant = value_digest(&serde_json::json!({"b": [2, 3], "c": 0.5}));
+        let splice = |start: usize, end: usize, text: &str| Splice {
+            start,
+            end,
+            text: text.to_string(),
+        };
+        let end = span.end - 1; // before the element's closing brace
+        assert!(reads_back_within(
+            text,
+            span.clone(),
+            &[splice(end, end, r#", "c": 0.5"#)],
+            meant
+        ));
+        for wrong in [
+            vec![splice(end, end, r#", "c": 0.25"#)],
+            vec![splice(end, end, r#" "c": 0.5"#)],
+            vec![splice(end, end, r#", "c": 0.5}"#)],
+            vec![splice(end, end, r#", "c": 0.5, "c": 1"#)],
+            // A splice outside the unit's span is never taken for it.
+            vec![splice(span.end, span.end, r#", "c": 0.5"#)],
+        ] {
+            assert!(!reads_back_within(text, span.clone(), &wrong, meant));
+        }
     }
 
     #[test]
