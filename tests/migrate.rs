@@ -1859,3 +1859,69 @@ fn the_roughness_plan_shares_a_texture_within_the_budget_and_bakes_per_material_
         assert!(errors(&output).is_empty(), "{:?}", errors(&output));
     }
 }
+
+/// A migration with bakes changes only the baked material, the declaration and the texture
+/// lists: the other materials (their numbers as exported, `0.80000001192092896`), the meshes
+/// and a texture the baked material's sheen and another material still name all come out as
+/// they went in, and the output validates as the input does.
+#[test]
+fn a_migration_with_bakes_leaves_every_other_part_of_the_text_as_it_was() {
+    let dir = tempfile::tempdir().unwrap();
+    let data: Vec<u8> = [0u8, 26, 128, 255]
+        .iter()
+        .flat_map(|&a| [200, 100, 50, a])
+        .collect();
+    png_file(
+        &dir.path().join("rough.png"),
+        2,
+        2,
+        image::ColorType::Rgba8,
+        &data,
+    );
+    let other = "{\"name\": \"base\", \"pbrMetallicRoughness\": {\"baseColorFactor\": [0.80000001192092896, 1E-1, 1, 1], \"baseColorTexture\": {\"index\": 0}}}";
+    let mesh = "{\"primitives\": [{\"attributes\": {\"POSITION\": 0, \"TEXCOORD_0\": 1}, \"material\": 1}]}";
+    let text = format!(
+        "{{\n\t\"asset\": {{\"version\": \"2.0\"}},\n\t\"materials\": [\n\t\t{other},\n\t\t{{\"extensions\": {{\"KHR_materials_sheen\": {{\"sheenColorFactor\": [1, 1, 1], \"sheenRoughnessFactor\": 0.5, \"sheenRoughnessTexture\": {{\"index\": 0}}}}}}}}\n\t],\n\t\"meshes\": [\n\t\t{mesh}\n\t],\n\t\"textures\": [{{\"source\": 0}}],\n\t\"images\": [{{\"uri\": \"rough.png\"}}],\n\t\"extensionsUsed\": [\"KHR_materials_sheen\"]\n}}"
+    );
+    let input = dir.path().join("chair.gltf");
+    std::fs::write(&input, &text).unwrap();
+    let output = dir.path().join("out/chair.gltf");
+    let report = migrate::run(&request(
+        vec![input.clone()],
+        Destination::File(output.clone()),
+        Options::default(),
+    ))
+    .unwrap();
+    assert_eq!(report.files[0].outcome, FileOutcome::Changed);
+    assert_eq!(report.files[0].textures_added, 1);
+    let written = std::fs::read_to_string(&output).unwrap();
+    for kept in [other, mesh, "{\"source\": 0}", "{\"uri\": \"rough.png\"}"] {
+        assert!(
+            written.contains(kept),
+            "{kept} is kept as written:\n{written}"
+        );
+    }
+    let doc: Value = serde_json::from_str(&written).unwrap();
+    let fuzz = &doc["materials"][1]["extensions"]["KHR_materials_fuzz"];
+    assert_eq!(fuzz["fuzzRoughnessTexture"]["index"], 1);
+    assert_eq!(doc["textures"][1]["source"], 1);
+    assert_eq!(
+        doc["materials"][1]["extensions"]["KHR_materials_sheen"]["sheenRoughnessTexture"],
+        serde_json::json!({"index": 0})
+    );
+    assert_eq!(
+        doc["extensionsUsed"],
+        serde_json::json!(["KHR_materials_sheen", "KHR_materials_fuzz"])
+    );
+    // Tabs and one-line objects as the file writes them: no line but the baked material's,
+    // the texture and image lists' and the declaration's changed.
+    let before: Vec<&str> = text.lines().collect();
+    let after: Vec<&str> = written.lines().collect();
+    assert_eq!(after.len(), before.len(), "{written}");
+    let changed: Vec<usize> = (0..before.len())
+        .filter(|&i| after[i] != before[i])
+        .collect();
+    assert_eq!(changed, [4, 9, 10, 11], "{written}");
+    // The mesh names no accessors (the scene is cut short): that finding, and no other.
+    assert_eq!(errors(&output), errors(&input));
+}

@@ -21,6 +21,10 @@ pub enum Edit {
     /// Sets the value at `pointer`. Missing objects on the way are created; an array index may
     /// name an existing element (replaced) or the end of the array (appended, also as `-`).
     Set { pointer: String, value: Value },
+    /// Sets the value at `pointer` exactly as given: its numbers keep their spelling, where
+    /// [`Edit::Set`] writes them as velvet writes numbers. For a part of the document read
+    /// from it and changed in place (what a bake applied), whose numbers the change left alone.
+    Replace { pointer: String, value: Value },
     /// Removes the value at `pointer` (an absent value is not an error: the plan's intent holds).
     Remove { pointer: String },
     /// Adds `extension` to `extensionsUsed` unless it is there; creates the array after `asset`
@@ -31,6 +35,13 @@ pub enum Edit {
 impl Edit {
     pub fn set(pointer: impl Into<String>, value: Value) -> Edit {
         Edit::Set {
+            pointer: pointer.into(),
+            value,
+        }
+    }
+
+    pub fn replace(pointer: impl Into<String>, value: Value) -> Edit {
+        Edit::Replace {
             pointer: pointer.into(),
             value,
         }
@@ -53,6 +64,7 @@ impl fmt::Display for Edit {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Edit::Set { pointer, value } => write!(f, "set {pointer} = {value}"),
+            Edit::Replace { pointer, value } => write!(f, "replace {pointer} = {value}"),
             Edit::Remove { pointer } => write!(f, "remove {pointer}"),
             Edit::DeclareUsed { extension } => write!(f, "declare {extension} in /extensionsUsed"),
         }
@@ -88,6 +100,7 @@ pub fn apply(json: &mut Value, edits: &[Edit]) -> Result<bool, EditError> {
     for edit in edits {
         changed |= match edit {
             Edit::Set { pointer, value } => set(json, pointer, splice::written(value.clone()))?,
+            Edit::Replace { pointer, value } => set(json, pointer, value.clone())?,
             Edit::Remove { pointer } => remove(json, pointer)?,
             Edit::DeclareUsed { extension } => declare_used(json, extension)?,
         };

@@ -74,15 +74,17 @@ pub fn splice_edits<'e>(
     let mut whole_members: std::collections::HashSet<String> = Default::default();
     for edit in edits {
         let pointer = match edit {
-            Edit::Set { pointer, .. } | Edit::Remove { pointer } => pointer.as_str(),
+            Edit::Set { pointer, .. }
+            | Edit::Replace { pointer, .. }
+            | Edit::Remove { pointer } => pointer.as_str(),
             Edit::DeclareUsed { .. } => "/extensionsUsed",
         };
         let tokens = crate::asset::pointer::tokens(pointer);
         let Some(member) = tokens.first() else {
             return Ok(None);
         };
-        let within_element =
-            tokens.len() > 2 || (tokens.len() == 2 && matches!(edit, Edit::Set { .. }));
+        let within_element = tokens.len() > 2
+            || (tokens.len() == 2 && matches!(edit, Edit::Set { .. } | Edit::Replace { .. }));
         let element = tokens
             .get(1)
             .filter(|_| within_element)
@@ -522,7 +524,10 @@ fn splice_unit(
             }
             let mut value = element.to_value();
             for edit in edits {
-                let (Edit::Set { pointer, .. } | Edit::Remove { pointer }) = edit else {
+                let (Edit::Set { pointer, .. }
+                | Edit::Replace { pointer, .. }
+                | Edit::Remove { pointer }) = edit
+                else {
                     return Ok(None); // a declaration is never within an element
                 };
                 let Some(within) = pointer
@@ -537,8 +542,17 @@ fn splice_unit(
                         changed |= value != new;
                         value = new;
                     }
+                    Edit::Replace { value: new, .. } if within.is_empty() => {
+                        changed |= value != *new;
+                        value = new.clone();
+                    }
                     Edit::Set { value: new, .. } => {
                         let within = Edit::set(within, new.clone());
+                        changed |= super::apply(&mut value, std::slice::from_ref(&within))
+                            .map_err(|e| from_root(e, &prefix))?;
+                    }
+                    Edit::Replace { value: new, .. } => {
+                        let within = Edit::replace(within, new.clone());
                         changed |= super::apply(&mut value, std::slice::from_ref(&within))
                             .map_err(|e| from_root(e, &prefix))?;
                     }

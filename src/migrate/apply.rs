@@ -6,6 +6,7 @@
 //! in place, not written at all). A file the loader could not read cleanly is not migrated:
 //! rewriting it would hide the fault (a truncated BIN chunk would come out "fixed").
 
+use super::bake_part::BakePart;
 use super::plan::{plan_document, DocumentPlan};
 use super::textures;
 use super::Options;
@@ -133,6 +134,8 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
         &plan.relocation,
     ));
     let mut baked = Vec::with_capacity(bake_plan.recipes.len());
+    // A .gltf whose new images are files: each is written as it is encoded.
+    let streamed = plan.asset.container == asset::Container::Gltf && !plan.embed;
     if !bake_plan.is_empty() {
         let options = BakeOptions {
             kernel: KernelOptions {
@@ -144,13 +147,12 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
             ),
             ..BakeOptions::default()
         };
+        // The images as loaded, read alone (the whole document is not built for them).
         let images = plan
             .asset
-            .json()
+            .root()
             .get("images")
-            .cloned()
-            .unwrap_or(serde_json::Value::Null);
-        let streamed = plan.asset.container == asset::Container::Gltf && !plan.embed;
+            .map_or(serde_json::Value::Null, |images| images.to_value());
         let results = {
             let sink = file_sink(&names, &images, &bake_plan);
             bake_into(
@@ -193,8 +195,23 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
     } else {
         None
     };
+    // With bakes whose images are files already, the bake is applied to the part of the
+    // document it reads and changes, and the edits go there too (see `baked_by_part`); the
+    // whole document is built only when that part cannot take them.
+    let by_part = if !bake_plan.is_empty()
+        && streamed
+        && baked
+            .iter()
+            .all(|b| b.stored.is_some() || b.encoded.is_none())
+    {
+        baked_by_part(plan, &bake_plan, &mut baked, &mut names)?
+    } else {
+        None
+    };
     if let Some((_, spliced_changed)) = &spliced {
         changed = *spliced_changed;
+    } else if let Some((_, part_changed, _)) = &by_part {
+        changed = *part_changed;
     } else {
         for edits in groups {
             changed |= edit::apply(plan.asset.json_mut(), edits)
@@ -223,6 +240,9 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
                 .map_err(|d| format!("cannot read {}: {}", plan.input.display(), d.message))?,
             _ => std::mem::take(&mut plan.bytes),
         }
+    } else if let Some((bytes, _, outputs)) = by_part {
+        plan.baked = outputs;
+        bytes
     } else {
         let json = plan.asset.take_json();
         let applied = bake_apply(
@@ -249,4 +269,72 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
     } else {
         Written::Copied
     })
+}
+
+/// Applies `bake_plan` and the file's edits to the part of the document the bake reads and
+/// changes ([`BakePart`]: the top level without the scene's geometry, and the materials the
+/// bake's slots lie in), then writes them into the loaded text as splices, with the edits of
+/// every other material, and places the resource copies the output names. Returns the output's
+/// bytes, whether they differ from the input and what became of each baked output; `None` when the part cannot take this plan
+/// (nothing written, `baked` as it was), and the caller applies it to the whole document. Every
+/// new image must be a file already (`baked` holds no bytes), so that the bake can be applied
+/// again to the whole document.
+fn baked_by_part(
+    plan: &FilePlan,
+    bake_plan: &crate::bake::plan::BakePlan,
+    baked: &mut Vec<crate::bake::engine::Baked>,
+    names: &mut FileNames,
+) -> Result<Option<(Vec<u8>, bool, Vec<OutputReport>)>, String> {
+    let Some(mut part) = BakePart::new(&plan.asset, bake_plan) else {
+        return Ok(None);
+    };
+    let fail = |e: edit::EditError| format!("{}: {e}", plan.input.display());
+    let edits = plan
+        .document
+        .materials
+        .iter()
+        .flat_map(|m| &m.edits)
+        .chain(&plan.document.declarations)
+        .chain(&plan.relocation.edits);
+    let mut json = std::mem::take(&mut part.json);
+    let mut others: Vec<&edit::Edit> = Vec::new();
+    for e in edits {
+        if part.holds(e) {
+            edit::apply(&mut json, std::slice::from_ref(e)).map_err(fail)?;
+        } else {
+            others.push(e);
+        }
+    }
+    let as_baked = baked.clone();
+    let applied = bake_apply(
+        json,
+        None,
+        plan.asset.container,
+        bake_plan,
+        baked,
+        ApplyOptions { embed: plan.embed },
+        names,
+    );
+    if applied.dropped != crate::bake::prune::Dropped::default() || !applied.files.is_empty() {
+        // Dropping renumbers references the part does not hold.
+        *baked = as_baked;
+        return Ok(None);
+    }
+    copy_resources(&plan.relocation, &applied.json)?;
+    let part_edits = part.into_edits(&plan.asset, applied.json);
+    let spliced = write::spliced_bytes(&plan.asset, others.iter().copied().chain(&part_edits))
+        .map_err(fail)?;
+    let (bytes, changed) = match spliced {
+        Some(written) => written,
+        None => {
+            // A text the splicer does not take: the edits on the whole document.
+            let mut whole = plan.asset.json().clone();
+            for e in others.iter().copied().chain(&part_edits) {
+                edit::apply(&mut whole, std::slice::from_ref(e)).map_err(fail)?;
+            }
+            let bytes = write::to_bytes(&plan.asset, &whole, plan.asset.bin.as_deref());
+            (bytes, true)
+        }
+    };
+    Ok(Some((bytes, changed, applied.outputs)))
 }

@@ -11,6 +11,7 @@
 //! engine.
 
 pub mod apply;
+pub mod bake_part;
 pub mod batch;
 pub mod budget;
 pub mod fallback;
