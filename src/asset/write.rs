@@ -37,20 +37,28 @@ fn injected_fault() -> Option<Fault> {
     })
 }
 
-/// Writes `bytes` into a temporary file, or half of them and then the injected fault.
-fn write_temporary(file: &mut impl Write, bytes: &[u8]) -> io::Result<()> {
+/// Writes `output` into a temporary file, or half of it and then the injected fault.
+fn write_temporary(file: &mut impl Write, output: &Output) -> io::Result<()> {
     static WRITES: AtomicUsize = AtomicUsize::new(0);
     let Some(fault) = injected_fault() else {
-        return file.write_all(bytes);
+        return output.pieces().try_for_each(|piece| file.write_all(piece));
     };
     let n = WRITES.fetch_add(1, Ordering::SeqCst);
     let after = match fault {
         Fault::Error { after } | Fault::Abort { after } => after,
     };
     if n < after {
-        return file.write_all(bytes);
+        return output.pieces().try_for_each(|piece| file.write_all(piece));
     }
-    file.write_all(&bytes[..bytes.len() / 2])?;
+    let mut half = output.len() / 2;
+    for piece in output.pieces() {
+        let take = piece.len().min(half);
+        file.write_all(&piece[..take])?;
+        half -= take;
+        if half == 0 {
+            break;
+        }
+    }
     file.flush()?;
     match fault {
         Fault::Abort { .. } => std::process::abort(),
@@ -143,17 +151,22 @@ fn in_container(asset: &Asset, text: Vec<u8>, bin: Option<&[u8]>) -> Vec<u8> {
 /// [`crate::edit::splice::splice_edits`]), and whether they changed anything; `Ok(None)` for a
 /// plan the splicer does not take or a text that does not read back as meant, which the caller
 /// then applies to the whole document.
-pub fn spliced_bytes<'e>(
-    asset: &Asset,
+pub fn spliced_bytes<'a, 'e>(
+    asset: &'a Asset,
     edits: impl IntoIterator<Item = &'e crate::edit::Edit>,
-) -> Result<Option<(Vec<u8>, bool)>, crate::edit::EditError> {
-    let Some((text, changed)) =
+) -> Result<Option<(Output<'a>, bool)>, crate::edit::EditError> {
+    let Some((spliced, changed)) =
         crate::edit::splice::splice_edits(source(asset), asset.root(), edits)?
     else {
         return Ok(None);
     };
-    let bytes = in_container(asset, text.into_bytes(), asset.bin.as_deref());
-    Ok(Some((bytes, changed)))
+    let output = match asset.container {
+        Container::Gltf => Output::Spliced(spliced),
+        Container::Glb => {
+            Output::Bytes(glb::join(spliced.to_text().as_bytes(), asset.bin.as_deref()).into())
+        }
+    };
+    Ok(Some((output, changed)))
 }
 
 /// True when an edit left the document as loaded, so the input's bytes can stand as they are.
@@ -161,10 +174,44 @@ pub fn unchanged(asset: &Asset, json: &Value, bin: Option<&[u8]>) -> bool {
     asset.json() == json && asset.bin.as_deref() == bin
 }
 
+/// An output file's bytes: whole, or the text of a .gltf written as splices into its loaded
+/// text, written piece by piece (see [`crate::edit::splice::Spliced`]).
+#[derive(Debug)]
+pub enum Output<'t> {
+    Bytes(std::borrow::Cow<'t, [u8]>),
+    Spliced(crate::edit::splice::Spliced<'t>),
+}
+
+impl Output<'_> {
+    /// The bytes in order, a run at a time.
+    fn pieces(&self) -> Box<dyn Iterator<Item = &[u8]> + '_> {
+        match self {
+            Output::Bytes(bytes) => Box::new(std::iter::once(bytes.as_ref())),
+            Output::Spliced(spliced) => Box::new(spliced.pieces()),
+        }
+    }
+
+    pub fn len(&self) -> usize {
+        match self {
+            Output::Bytes(bytes) => bytes.len(),
+            Output::Spliced(spliced) => spliced.len(),
+        }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
 /// Writes `bytes` to `path` atomically: into a temporary file in the same folder, flushed to
 /// disk, then renamed over `path`. On any failure the temporary file is removed and `path` is
 /// as it was.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    write_output_atomic(path, &Output::Bytes(bytes.into()))
+}
+
+/// Writes `output` to `path` atomically, as [`write_atomic`] writes bytes.
+pub fn write_output_atomic(path: &Path, output: &Output) -> io::Result<()> {
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
@@ -179,7 +226,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
         builder.permissions(std::fs::Permissions::from_mode(0o666));
     }
     let mut tmp = builder.tempfile_in(dir)?;
-    write_temporary(&mut tmp, bytes)?;
+    write_temporary(&mut tmp, output)?;
     tmp.as_file().sync_all()?;
     if let Ok(meta) = std::fs::metadata(path) {
         // Keep the permissions of a file being replaced.

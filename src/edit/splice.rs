@@ -41,7 +41,7 @@ pub fn rewrite(text: &str, root: Node, after: &Value) -> Option<String> {
     let layout = Layout::detect(text, root);
     let mut splices = Vec::new();
     diff(text, root, after, &layout, &mut splices);
-    assemble(text, splices)
+    Spliced::new(text, splices).map(|spliced| spliced.to_text())
 }
 
 /// A part of the document an edit plan changes: a top-level member, or one element of a
@@ -57,11 +57,11 @@ struct Unit {
 /// an edit names, each top-level member that gains or loses elements. `Ok(None)` for a plan
 /// this does not take (an edit of the root itself, a document that is not an object with
 /// members); the caller then applies it to the whole document.
-pub fn splice_edits<'e>(
-    text: &str,
+pub fn splice_edits<'t, 'e>(
+    text: &'t str,
     root: Node,
     edits: impl IntoIterator<Item = &'e Edit>,
-) -> Result<Option<(String, bool)>, EditError> {
+) -> Result<Option<(Spliced<'t>, bool)>, EditError> {
     let Some(object) = root
         .as_object()
         .filter(|o| !o.is_empty() && !o.has_duplicate_keys())
@@ -145,14 +145,15 @@ pub fn splice_edits<'e>(
         changed |= unit.changed;
         meant.push(unit.meant);
     }
-    let Some(out) = assemble(text, splices) else {
+    let Some(spliced) = Spliced::new(text, splices) else {
         return Ok(None);
     };
     if all_checked {
         // Every unit's value was read back alone, and every byte outside them was copied: the
-        // whole text need not be indexed again.
-        return Ok(Some((out, changed)));
+        // whole text need not be indexed again, nor held as one string.
+        return Ok(Some((spliced, changed)));
     }
+    let out = spliced.to_text();
     // The check a spliced text passes before it is written: it is JSON, every part the plan
     // touched reads back as meant (numbers as velvet writes them), and the root has the
     // members it should; every other byte was copied.
@@ -178,7 +179,72 @@ pub fn splice_edits<'e>(
     if !reads_back || members_after + removed != members_before + added {
         return Ok(None);
     }
-    Ok(Some((out, changed)))
+    drop(index);
+    drop(out);
+    Ok(Some((spliced, changed)))
+}
+
+/// A text written as splices into a source text, kept as the source and the splices (sorted,
+/// none overlapping) rather than joined: an output of the size of its input is written to its
+/// file piece by piece ([`Spliced::pieces`]) and never held as a second copy of the text.
+#[derive(Debug)]
+pub struct Spliced<'t> {
+    source: &'t str,
+    splices: Vec<Splice>,
+}
+
+impl<'t> Spliced<'t> {
+    /// `None` if two splices overlap (never produced, but never risked).
+    fn new(source: &'t str, mut splices: Vec<Splice>) -> Option<Spliced<'t>> {
+        splices.sort_by_key(|s| (s.start, s.end));
+        let mut at = 0;
+        for s in &splices {
+            if s.start < at || s.end > source.len() {
+                return None;
+            }
+            at = s.end;
+        }
+        Some(Spliced { source, splices })
+    }
+
+    /// The text in order: spans of the source and the splices' texts between them.
+    fn runs(&self) -> impl Iterator<Item = &str> + '_ {
+        let mut at = 0;
+        self.splices
+            .iter()
+            .flat_map(move |s| {
+                let kept = &self.source[at..s.start];
+                at = s.end;
+                [kept, s.text.as_str()]
+            })
+            .chain(std::iter::once_with(move || {
+                let last = self.splices.last().map_or(0, |s| s.end);
+                &self.source[last..]
+            }))
+    }
+
+    /// The text's bytes in order, a run at a time.
+    pub fn pieces(&self) -> impl Iterator<Item = &[u8]> + '_ {
+        self.runs().map(str::as_bytes)
+    }
+
+    /// The text's length in bytes.
+    pub fn len(&self) -> usize {
+        let removed: usize = self.splices.iter().map(|s| s.end - s.start).sum();
+        let added: usize = self.splices.iter().map(|s| s.text.len()).sum();
+        self.source.len() - removed + added
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The text, joined.
+    pub fn to_text(&self) -> String {
+        let mut out = String::with_capacity(self.len());
+        self.runs().for_each(|run| out.push_str(run));
+        out
+    }
 }
 
 /// What one unit contributes: its splices, whether its edits changed it, and what it must
@@ -638,24 +704,6 @@ fn from_root(mut error: EditError, prefix: &str) -> EditError {
         pointer.insert_str(0, prefix);
     }
     error
-}
-
-/// `text` with `splices` made; `None` if two overlap (never produced, but never risked).
-fn assemble(text: &str, mut splices: Vec<Splice>) -> Option<String> {
-    splices.sort_by_key(|s| (s.start, s.end));
-    let mut out =
-        String::with_capacity(text.len() + splices.iter().map(|s| s.text.len()).sum::<usize>());
-    let mut at = 0;
-    for s in &splices {
-        if s.start < at {
-            return None;
-        }
-        out.push_str(&text[at..s.start]);
-        out.push_str(&s.text);
-        at = s.end;
-    }
-    out.push_str(&text[at..]);
-    Some(out)
 }
 
 /// A replacement of `text[start..end]`.
@@ -1400,6 +1448,15 @@ fn append(
 mod tests {
     use super::*;
 
+    /// [`splice_edits`] with its text joined.
+    fn splice_edits_text<'e>(
+        text: &str,
+        root: Node,
+        edits: impl IntoIterator<Item = &'e Edit>,
+    ) -> Result<Option<(String, bool)>, EditError> {
+        splice_edits(text, root, edits).map(|o| o.map(|(s, c)| (s.to_text(), c)))
+    }
+
     /// `after` written as splices into `text`.
     fn spliced(text: &str, after: &Value) -> String {
         let tape = crate::asset::tape::Tape::build(text).unwrap();
@@ -1443,7 +1500,7 @@ mod tests {
             Edit::set("/textures/0", serde_json::json!({"source": 1})),
         ];
         let tape = crate::asset::tape::Tape::build(text).unwrap();
-        let (out, changed) = splice_edits(text, tape.root(text), &edits)
+        let (out, changed) = splice_edits_text(text, tape.root(text), &edits)
             .unwrap()
             .unwrap();
         assert!(changed);
@@ -1453,7 +1510,7 @@ mod tests {
         assert!(reads_as_written(&out, &whole));
         // A top-level member removed takes its separator with it.
         let remove = [Edit::remove("/extras")];
-        let (out, _) = splice_edits(text, tape.root(text), &remove)
+        let (out, _) = splice_edits_text(text, tape.root(text), &remove)
             .unwrap()
             .unwrap();
         let mut whole: Value = serde_json::from_str(text).unwrap();
@@ -1464,12 +1521,14 @@ mod tests {
         let bad = [Edit::set("/materials/0/name/x", serde_json::json!(1))];
         let mut whole: Value = serde_json::from_str(text).unwrap();
         assert_eq!(
-            splice_edits(text, tape.root(text), &bad).unwrap_err(),
+            splice_edits_text(text, tape.root(text), &bad).unwrap_err(),
             super::super::apply(&mut whole, &bad).unwrap_err()
         );
         // A plan that sets what is there changes nothing, and writes the text as it was.
         let same = [Edit::set("/materials/0/name", serde_json::json!("a"))];
-        let (out, changed) = splice_edits(text, tape.root(text), &same).unwrap().unwrap();
+        let (out, changed) = splice_edits_text(text, tape.root(text), &same)
+            .unwrap()
+            .unwrap();
         assert!(!changed);
         assert_eq!(out, text);
     }
@@ -1507,7 +1566,7 @@ mod tests {
             let mut whole: Value = serde_json::from_str(text).unwrap();
             super::super::apply(&mut whole, &edits).unwrap();
             assert_eq!(digest, value_digest(&whole["materials"][1]), "{text}");
-            let (out, _) = splice_edits(text, root, &edits).unwrap().unwrap();
+            let (out, _) = splice_edits_text(text, root, &edits).unwrap().unwrap();
             assert_eq!(out, spliced(text, &whole), "{text}");
             assert!(reads_as_written(&out, &whole));
         }
@@ -1530,7 +1589,7 @@ mod tests {
             assert!(members_set_in_place(text, element, "/materials/1", &refs, &layout).is_none());
             let mut whole: Value = serde_json::from_str(text).unwrap();
             super::super::apply(&mut whole, &others).unwrap();
-            let (out, _) = splice_edits(text, root, &others).unwrap().unwrap();
+            let (out, _) = splice_edits_text(text, root, &others).unwrap().unwrap();
             assert_eq!(out, spliced(text, &whole));
         }
         // An object that writes a key twice, beside the path an edit takes, stays as written
@@ -1539,7 +1598,9 @@ mod tests {
             "{\"materials\": [{\"extras\": {\"k\": 1, \"k\": 2}, \"extensions\": {\"x\": 1}}]}";
         let tape = crate::asset::tape::Tape::build(text).unwrap();
         let fuzz = [Edit::set("/materials/0/extensions/y", serde_json::json!(2))];
-        let (out, _) = splice_edits(text, tape.root(text), &fuzz).unwrap().unwrap();
+        let (out, _) = splice_edits_text(text, tape.root(text), &fuzz)
+            .unwrap()
+            .unwrap();
         assert_eq!(
             out,
             "{\"materials\": [{\"extras\": {\"k\": 1, \"k\": 2}, \"extensions\": {\"x\": 1, \"y\": 2}}]}"
@@ -1548,6 +1609,33 @@ mod tests {
         super::super::apply(&mut whole, &fuzz).unwrap();
         let written = crate::asset::tape::Tape::build(&out).unwrap();
         assert_eq!(node_digest(written.root(&out)), value_digest(&whole));
+    }
+
+    #[test]
+    fn a_spliced_text_is_written_piece_by_piece_as_the_joined_text() {
+        let text = "{\"a\": [1, 2], \"b\": \"é\"}";
+        let splice = |start: usize, end: usize, text: &str| Splice {
+            start,
+            end,
+            text: text.to_string(),
+        };
+        // Given out of order; one at the very start, one replacing a span, one at the end.
+        let spliced = Spliced::new(
+            text,
+            vec![
+                splice(text.len(), text.len(), "\n"),
+                splice(7, 8, "3"),
+                splice(0, 0, ""),
+            ],
+        )
+        .unwrap();
+        let joined: Vec<u8> = spliced.pieces().flatten().copied().collect();
+        assert_eq!(spliced.to_text(), "{\"a\": [3, 2], \"b\": \"é\"}\n");
+        assert_eq!(joined, spliced.to_text().as_bytes());
+        assert_eq!(spliced.len(), spliced.to_text().len());
+        // Overlapping splices, or one past the end, are never taken.
+        assert!(Spliced::new(text, vec![splice(1, 5, ""), splice(4, 6, "")]).is_none());
+        assert!(Spliced::new(text, vec![splice(text.len(), text.len() + 1, "")]).is_none());
     }
 
     #[test]

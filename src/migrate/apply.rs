@@ -10,6 +10,7 @@ use super::bake_part::BakePart;
 use super::plan::{plan_document, DocumentPlan};
 use super::textures;
 use super::Options;
+use crate::asset::write::Output;
 use crate::asset::{self, write, Asset};
 use crate::bake::apply::{apply as bake_apply, ApplyOptions, OutputReport};
 use crate::bake::{bake_into, BakeOptions, KernelOptions};
@@ -175,6 +176,79 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
     }
     let mut names = names.into_inner().unwrap_or_else(|e| e.into_inner());
     let names_dir = names.dir().to_path_buf();
+    let input = plan.input.clone();
+    let in_place = plan.in_place();
+    let fail = |e: edit::EditError| format!("{}: {e}", input.display());
+    // Without bakes the edits are written as splices straight into the loaded text, reading
+    // only the materials they touch. With bakes whose images are files already, the bake is
+    // applied to the part of the document it reads and changes, and the edits go there too
+    // (see `baked_by_part`). Otherwise, or for a plan neither takes, everything is applied to
+    // the whole document.
+    let spliced: Option<PartWritten> = if bake_plan.is_empty() {
+        let edits = plan
+            .document
+            .materials
+            .iter()
+            .flat_map(|m| &m.edits)
+            .chain(&plan.document.declarations)
+            .chain(&plan.relocation.edits);
+        write::spliced_bytes(&plan.asset, edits)
+            .map_err(fail)?
+            .map(|(out, changed)| (out, changed, Vec::new()))
+    } else if streamed
+        && baked
+            .iter()
+            .all(|b| b.stored.is_some() || b.encoded.is_none())
+    {
+        baked_by_part(
+            &plan.asset,
+            &plan.document,
+            &plan.relocation,
+            &input,
+            plan.embed,
+            &bake_plan,
+            &mut baked,
+            &mut names,
+        )?
+    } else {
+        None
+    };
+    if let Some((out, changed, outputs)) = spliced {
+        if !changed && in_place {
+            return Ok(Written::Untouched);
+        }
+        create_parent(&output)?;
+        let out = if bake_plan.is_empty() {
+            // Without bakes no edit touches a URI that is copied (resources are copied or
+            // their URIs rewritten, never both), so the document as loaded names what the
+            // output uses.
+            copy_resources(&plan.relocation, plan.asset.root())?;
+            match changed {
+                true => out,
+                // Edits that set what was there already: the input's own bytes.
+                false if plan.bytes.is_empty() => Output::Bytes(
+                    asset::read(&input, &plan.asset.options)
+                        .map_err(|d| format!("cannot read {}: {}", input.display(), d.message))?
+                        .into(),
+                ),
+                false => Output::Bytes(std::mem::take(&mut plan.bytes).into()),
+            }
+        } else {
+            out
+        };
+        write::write_output_atomic(&output, &out)
+            .map_err(|e| format!("cannot write {}: {e}", output.display()))?;
+        drop(out);
+        if changed {
+            plan.bytes = Vec::new();
+        }
+        plan.baked = outputs;
+        return Ok(if changed {
+            Written::Changed
+        } else {
+            Written::Copied
+        });
+    }
     // The edits are applied where they lie in the plan (a large document's are not copied).
     let mut changed = false;
     let groups = plan
@@ -186,39 +260,10 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
             plan.document.declarations.as_slice(),
             plan.relocation.edits.as_slice(),
         ]);
-    // Without bakes the edits are written as splices straight into the loaded text, reading
-    // only the materials they touch; otherwise (or for a plan the splicer does not take) they
-    // are applied to the whole document.
-    let spliced = if bake_plan.is_empty() {
-        write::spliced_bytes(&plan.asset, groups.clone().flatten())
-            .map_err(|e| format!("{}: {e}", plan.input.display()))?
-    } else {
-        None
-    };
-    // With bakes whose images are files already, the bake is applied to the part of the
-    // document it reads and changes, and the edits go there too (see `baked_by_part`); the
-    // whole document is built only when that part cannot take them.
-    let by_part = if !bake_plan.is_empty()
-        && streamed
-        && baked
-            .iter()
-            .all(|b| b.stored.is_some() || b.encoded.is_none())
-    {
-        baked_by_part(plan, &bake_plan, &mut baked, &mut names)?
-    } else {
-        None
-    };
-    if let Some((_, spliced_changed)) = &spliced {
-        changed = *spliced_changed;
-    } else if let Some((_, part_changed, _)) = &by_part {
-        changed = *part_changed;
-    } else {
-        for edits in groups {
-            changed |= edit::apply(plan.asset.json_mut(), edits)
-                .map_err(|e| format!("{}: {e}", plan.input.display()))?;
-        }
+    for edits in groups {
+        changed |= edit::apply(plan.asset.json_mut(), edits).map_err(fail)?;
     }
-    if !changed && plan.in_place() {
+    if !changed && in_place {
         return Ok(Written::Untouched);
     }
     if changed {
@@ -227,22 +272,13 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
     }
     create_parent(&output)?;
     let bytes = if bake_plan.is_empty() {
-        // Without bakes no edit touches a URI that is copied (resources are copied or their
-        // URIs rewritten, never both), so the document as loaded names what the output uses.
         copy_resources(&plan.relocation, plan.asset.root())?;
-        match spliced {
-            Some((bytes, true)) => bytes,
-            _ if changed => {
-                write::to_bytes(&plan.asset, plan.asset.json(), plan.asset.bin.as_deref())
-            }
-            // Edits that set what was there already: the input's own bytes, read again.
-            _ if plan.bytes.is_empty() => asset::read(&plan.input, &plan.asset.options)
-                .map_err(|d| format!("cannot read {}: {}", plan.input.display(), d.message))?,
-            _ => std::mem::take(&mut plan.bytes),
+        match changed {
+            true => write::to_bytes(&plan.asset, plan.asset.json(), plan.asset.bin.as_deref()),
+            false if plan.bytes.is_empty() => asset::read(&input, &plan.asset.options)
+                .map_err(|d| format!("cannot read {}: {}", input.display(), d.message))?,
+            false => std::mem::take(&mut plan.bytes),
         }
-    } else if let Some((bytes, _, outputs)) = by_part {
-        plan.baked = outputs;
-        bytes
     } else {
         let json = plan.asset.take_json();
         let applied = bake_apply(
@@ -271,6 +307,10 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
     })
 }
 
+/// What [`baked_by_part`] wrote: the output, whether it differs from the input, and what became
+/// of each baked output.
+type PartWritten<'a> = (Output<'a>, bool, Vec<OutputReport>);
+
 /// Applies `bake_plan` and the file's edits to the part of the document the bake reads and
 /// changes ([`BakePart`]: the top level without the scene's geometry, and the materials the
 /// bake's slots lie in), then writes them into the loaded text as splices, with the edits of
@@ -279,23 +319,27 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
 /// (nothing written, `baked` as it was), and the caller applies it to the whole document. Every
 /// new image must be a file already (`baked` holds no bytes), so that the bake can be applied
 /// again to the whole document.
-fn baked_by_part(
-    plan: &FilePlan,
+#[allow(clippy::too_many_arguments)]
+fn baked_by_part<'a>(
+    asset: &'a Asset,
+    document: &DocumentPlan,
+    relocation: &Relocation,
+    input: &std::path::Path,
+    embed: bool,
     bake_plan: &crate::bake::plan::BakePlan,
     baked: &mut Vec<crate::bake::engine::Baked>,
     names: &mut FileNames,
-) -> Result<Option<(Vec<u8>, bool, Vec<OutputReport>)>, String> {
-    let Some(mut part) = BakePart::new(&plan.asset, bake_plan) else {
+) -> Result<Option<PartWritten<'a>>, String> {
+    let Some(mut part) = BakePart::new(asset, bake_plan) else {
         return Ok(None);
     };
-    let fail = |e: edit::EditError| format!("{}: {e}", plan.input.display());
-    let edits = plan
-        .document
+    let fail = |e: edit::EditError| format!("{}: {e}", input.display());
+    let edits = document
         .materials
         .iter()
         .flat_map(|m| &m.edits)
-        .chain(&plan.document.declarations)
-        .chain(&plan.relocation.edits);
+        .chain(&document.declarations)
+        .chain(&relocation.edits);
     let mut json = std::mem::take(&mut part.json);
     let mut others: Vec<&edit::Edit> = Vec::new();
     for e in edits {
@@ -309,10 +353,10 @@ fn baked_by_part(
     let applied = bake_apply(
         json,
         None,
-        plan.asset.container,
+        asset.container,
         bake_plan,
         baked,
-        ApplyOptions { embed: plan.embed },
+        ApplyOptions { embed },
         names,
     );
     if applied.dropped != crate::bake::prune::Dropped::default() || !applied.files.is_empty() {
@@ -320,20 +364,20 @@ fn baked_by_part(
         *baked = as_baked;
         return Ok(None);
     }
-    copy_resources(&plan.relocation, &applied.json)?;
-    let part_edits = part.into_edits(&plan.asset, applied.json);
-    let spliced = write::spliced_bytes(&plan.asset, others.iter().copied().chain(&part_edits))
-        .map_err(fail)?;
+    copy_resources(relocation, &applied.json)?;
+    let part_edits = part.into_edits(asset, applied.json);
+    let spliced =
+        write::spliced_bytes(asset, others.iter().copied().chain(&part_edits)).map_err(fail)?;
     let (bytes, changed) = match spliced {
         Some(written) => written,
         None => {
             // A text the splicer does not take: the edits on the whole document.
-            let mut whole = plan.asset.json().clone();
+            let mut whole = asset.json().clone();
             for e in others.iter().copied().chain(&part_edits) {
                 edit::apply(&mut whole, std::slice::from_ref(e)).map_err(fail)?;
             }
-            let bytes = write::to_bytes(&plan.asset, &whole, plan.asset.bin.as_deref());
-            (bytes, true)
+            let bytes = write::to_bytes(asset, &whole, asset.bin.as_deref());
+            (Output::Bytes(bytes.into()), true)
         }
     };
     Ok(Some((bytes, changed, applied.outputs)))
