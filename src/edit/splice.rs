@@ -359,14 +359,15 @@ fn feed_node(d: &mut Digest, node: Node) {
 }
 
 /// One edit of [`members_set_in_place`]: where it sets, as tokens below the element, and the
-/// value as velvet writes it.
+/// value the text will hold (a [`Edit::Set`]'s as velvet writes it, a [`Edit::Replace`]'s as
+/// given).
 struct MemberSet {
     tokens: Vec<String>,
     value: Value,
 }
 
-/// The splices of an element unit whose edits each set a member of an object the element
-/// already holds (the fuzz object a migration adds to a material's `extensions`, a factor it
+/// The splices of an element unit whose edits each set or replace a member of an object the
+/// element already holds (the fuzz object a migration adds to a material's `extensions`, a factor it
 /// replaces), made from the index alone: the element is not read into a value, edited and
 /// compared with its text, which for a migration of every material was most of the writer's
 /// work. Returns the splices, whether they change anything, and the digest the element must
@@ -383,15 +384,17 @@ fn members_set_in_place(
 ) -> Option<(Vec<Splice>, bool, u64)> {
     let mut sets: Vec<MemberSet> = Vec::with_capacity(edits.len());
     for edit in edits {
-        let Edit::Set { pointer, value } = edit else {
-            return None;
+        let (pointer, value) = match edit {
+            Edit::Set { pointer, value } => (pointer, written(value.clone())),
+            Edit::Replace { pointer, value } => (pointer, value.clone()),
+            _ => return None,
         };
         let within = pointer
             .strip_prefix(prefix)
             .filter(|w| w.starts_with('/'))?;
         sets.push(MemberSet {
             tokens: crate::asset::pointer::tokens(within),
-            value: written(value.clone()),
+            value,
         });
     }
     // No edit's place lies at or inside another's: each is made on the text as loaded.

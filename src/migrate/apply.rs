@@ -330,7 +330,7 @@ fn baked_by_part<'a>(
     baked: &mut Vec<crate::bake::engine::Baked>,
     names: &mut FileNames,
 ) -> Result<Option<PartWritten<'a>>, String> {
-    let Some(mut part) = BakePart::new(asset, bake_plan) else {
+    let Some(mut part) = BakePart::new(asset, bake_plan, document) else {
         return Ok(None);
     };
     let fail = |e: edit::EditError| format!("{}: {e}", input.display());

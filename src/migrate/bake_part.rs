@@ -3,24 +3,29 @@
 //!
 //! A bake adds images and textures, points textureInfos at them and sets factors. Of the
 //! document it reads and changes only the top-level members other than the scene's geometry,
-//! and the materials its slots name. [`BakePart`] holds those as values (every other material
-//! as `null`), takes the migration's edits of them, and after the bake gives back the edits
-//! that write the result into the source text as splices: each baked material and each
-//! member that changed, replaced whole ([`Edit::Replace`]: the numbers the bake left keep their
-//! spelling). The migration's edits of every other material are spliced as they are.
+//! and in the materials its slots name, the layer objects it bakes. [`BakePart`] holds those
+//! as values: the top-level members whole, and of each baked material only its places (the
+//! layer objects the bake's slots name and the values the migration's edits set, with the
+//! objects on the way to them; every other material is `null`). It takes the migration's
+//! edits of those places, and after the bake gives back the edits that write the result into
+//! the source text as splices: each place and each member that changed, replaced whole
+//! ([`Edit::Replace`]: the numbers the bake left keep their spelling). The migration's edits of
+//! every other material are spliced as they are.
 //!
 //! Dropping what a bake left unreferenced needs the whole document (a texture may be named by
 //! a material outside the part, and dropping renumbers every reference), so the caller does
 //! not use a part whose bake dropped anything. A migration drops nothing in practice: the
 //! sheen it keeps still names the textures its bakes read.
 
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 
 use serde_json::{Map, Value};
 
+use crate::asset::tape::{Kind, Node};
 use crate::asset::{pointer, Asset};
 use crate::bake::plan::BakePlan;
 use crate::edit::Edit;
+use crate::migrate::plan::DocumentPlan;
 
 /// Top-level members no bake reads or changes: the bulk of a large scene.
 const LEFT_OUT: [&str; 7] = [
@@ -36,29 +41,86 @@ const LEFT_OUT: [&str; 7] = [
 /// The part of a document a bake plan applies to.
 #[derive(Debug)]
 pub struct BakePart {
-    /// The document's top level without the members in [`LEFT_OUT`]; of `materials`, only
-    /// those in `materials` are read, the others are `null`.
+    /// The document's top level without the members in [`LEFT_OUT`]; of `materials`, only the
+    /// places below, with the objects on the way to them; the other materials are `null`.
     pub json: Value,
-    /// The materials the plan's slots lie in.
-    materials: BTreeSet<usize>,
+    /// Per material in the part, the places it holds (pointers from the root; none lies inside
+    /// another).
+    places: BTreeMap<usize, Vec<String>>,
 }
 
 impl BakePart {
-    /// The part of `asset`'s document that `bake` applies to; `None` when a slot lies outside
-    /// the material it names, or the document is not an object that writes each key once.
-    pub fn new(asset: &Asset, bake: &BakePlan) -> Option<BakePart> {
-        let mut materials = BTreeSet::new();
+    /// The part of `asset`'s document that `bake` and the edits of `document` apply to;
+    /// `None` when a slot lies outside the material it names, or the document is not an
+    /// object that writes each key once.
+    pub fn new(asset: &Asset, bake: &BakePlan, document: &DocumentPlan) -> Option<BakePart> {
+        let mut layers: BTreeMap<usize, Vec<&str>> = BTreeMap::new();
         for slot in &bake.slots {
             let prefix = format!("/materials/{}/", slot.material);
             if !slot.layer_pointer.starts_with(&prefix) {
                 return None;
             }
-            materials.insert(slot.material);
+            layers
+                .entry(slot.material)
+                .or_default()
+                .push(&slot.layer_pointer);
         }
-        let object = asset
-            .root()
-            .as_object()
-            .filter(|o| !o.has_duplicate_keys())?;
+        // The places the edits set first, in their order (new keys go into an object in the
+        // order the edits add them), then the layers baked.
+        let mut places: BTreeMap<usize, Vec<String>> = BTreeMap::new();
+        for material in &document.materials {
+            let Some(baked) = layers.get(&material.index) else {
+                continue;
+            };
+            let prefix = format!("/materials/{}/", material.index);
+            let list = places.entry(material.index).or_default();
+            for edit in &material.edits {
+                list.push(match edit {
+                    Edit::Set { pointer, .. }
+                    | Edit::Replace { pointer, .. }
+                    | Edit::Remove { pointer }
+                        if pointer.starts_with(&prefix) =>
+                    {
+                        pointer.clone()
+                    }
+                    // Anything else: the whole material.
+                    _ => format!("/materials/{}", material.index),
+                });
+            }
+            list.extend(baked.iter().map(|p| p.to_string()));
+        }
+        for (material, baked) in &layers {
+            places
+                .entry(*material)
+                .or_insert_with(|| baked.iter().map(|p| p.to_string()).collect());
+        }
+        // Every textureInfo that names a texture a bake replaces is held too, so that the
+        // bake, seeing it, keeps that texture as it would on the whole document; one outside
+        // the materials leaves the part unused.
+        let replaced: BTreeSet<usize> = bake.slots.iter().map(|s| s.texture).collect();
+        let root = asset.root();
+        let object = root.as_object().filter(|o| !o.has_duplicate_keys())?;
+        for (key, node) in object.iter() {
+            let mut found = Vec::new();
+            let mut at = pointer::join("", &key);
+            naming(node, &mut at, &key, &replaced, &mut found);
+            match key.as_ref() {
+                "materials" => {
+                    for info in found {
+                        let index = pointer::tokens(&info)[1].parse::<usize>().ok()?;
+                        places.entry(index).or_default().push(info);
+                    }
+                }
+                _ if LEFT_OUT.contains(&key.as_ref()) && !found.is_empty() => return None,
+                _ => {}
+            }
+        }
+        for list in places.values_mut() {
+            let all = list.clone();
+            let mut seen = std::collections::HashSet::new();
+            // Each place once, and none inside another (it is held by the outer one).
+            list.retain(|p| seen.insert(p.clone()) && !all.iter().any(|q| inside(p, q)));
+        }
         let mut part = Map::new();
         for (key, node) in object.iter() {
             if LEFT_OUT.contains(&key.as_ref()) {
@@ -66,16 +128,14 @@ impl BakePart {
             }
             let value = if key == "materials" {
                 let items = node.as_array()?;
-                Value::Array(
-                    items
-                        .iter()
-                        .enumerate()
-                        .map(|(i, material)| match materials.contains(&i) {
-                            true => material.to_value(),
-                            false => Value::Null,
-                        })
-                        .collect(),
-                )
+                let mut materials = Vec::with_capacity(items.len());
+                for (i, material) in items.iter().enumerate() {
+                    materials.push(match places.get(&i) {
+                        Some(list) => sparse(material, &format!("/materials/{i}"), list)?,
+                        None => Value::Null,
+                    });
+                }
+                Value::Array(materials)
             } else {
                 node.to_value()
             };
@@ -83,7 +143,7 @@ impl BakePart {
         }
         Some(BakePart {
             json: Value::Object(part),
-            materials,
+            places,
         })
     }
 
@@ -100,49 +160,148 @@ impl BakePart {
             [] => false,
             [member] if member == "materials" => false,
             [member, index, ..] if member == "materials" => index
-                .parse()
-                .is_ok_and(|i: usize| self.materials.contains(&i) && i.to_string() == *index),
+                .parse::<usize>()
+                .ok()
+                .filter(|i| i.to_string() == *index)
+                .and_then(|i| self.places.get(&i))
+                .is_some_and(|list| list.iter().any(|p| p == pointer || inside(pointer, p))),
             [member, ..] => !LEFT_OUT.contains(&member.as_str()),
         }
     }
 
-    /// The edits that write `json` (this part after the bake) into `asset`'s text: each
-    /// material of the part and each member that differs from the document as loaded,
-    /// replaced whole; a member the bake removed, removed.
-    pub fn into_edits(self, asset: &Asset, json: Value) -> Vec<Edit> {
+    /// The edits that write `json` (this part after the bake) into `asset`'s text: each place
+    /// of a material and each member that differs from the document as loaded, replaced whole
+    /// (removed when the part no longer holds it).
+    pub fn into_edits(self, asset: &Asset, mut json: Value) -> Vec<Edit> {
         let root = asset.root();
-        let Value::Object(part) = json else {
-            return Vec::new();
-        };
         let mut edits = Vec::new();
+        for list in self.places.values() {
+            for place in list {
+                match json.pointer_mut(place).map(std::mem::take) {
+                    Some(value) => edits.push(Edit::replace(place.clone(), value)),
+                    None if root.pointer(place).is_some() => {
+                        edits.push(Edit::remove(place.clone()))
+                    }
+                    None => {}
+                }
+            }
+        }
+        let Value::Object(part) = json else {
+            return edits;
+        };
         for key in root.as_object().into_iter().flat_map(|o| o.keys()) {
             if !LEFT_OUT.contains(&key.as_ref()) && !part.contains_key(key.as_ref()) {
                 edits.push(Edit::remove(pointer::join("", key)));
             }
         }
         for (key, value) in part {
-            match (key.as_str(), value) {
-                ("materials", Value::Array(mut items)) => {
-                    for &i in &self.materials {
-                        if let Some(material) = items.get_mut(i) {
-                            let material = std::mem::take(material);
-                            edits.push(Edit::replace(format!("/materials/{i}"), material));
-                        }
-                    }
-                }
-                (_, value) => {
-                    if root
-                        .get(&key)
-                        .is_some_and(|loaded| loaded.to_value() == value)
-                    {
-                        continue;
-                    }
-                    edits.push(Edit::replace(pointer::join("", &key), value));
-                }
+            if key == "materials" {
+                continue;
             }
+            if root
+                .get(&key)
+                .is_some_and(|loaded| loaded.to_value() == value)
+            {
+                continue;
+            }
+            edits.push(Edit::replace(pointer::join("", &key), value));
         }
         edits
     }
+}
+
+/// Appends to `found` the pointer of every textureInfo in `node` (at pointer `at`, the value
+/// of `key`) that names one of `textures`, found as a bake's pruning finds references: an
+/// object under a key ending in `Texture` with an integer `index`.
+fn naming(
+    node: Node,
+    at: &mut String,
+    key: &str,
+    textures: &BTreeSet<usize>,
+    found: &mut Vec<String>,
+) {
+    match node.kind() {
+        Kind::Object => {
+            let Some(object) = node.as_object() else {
+                return;
+            };
+            if key.ends_with("Texture") {
+                let index = object.get("index").and_then(|i| i.as_u64());
+                if index.is_some_and(|i| textures.contains(&(i as usize))) {
+                    found.push(at.clone());
+                }
+            }
+            for (k, v) in object.iter() {
+                let len = at.len();
+                at.push('/');
+                pointer::push_escaped(at, &k);
+                naming(v, at, &k, textures, found);
+                at.truncate(len);
+            }
+        }
+        Kind::Array => {
+            for (i, v) in node
+                .as_array()
+                .into_iter()
+                .flat_map(|a| a.iter())
+                .enumerate()
+            {
+                let len = at.len();
+                at.push('/');
+                at.push_str(&i.to_string());
+                naming(v, at, key, textures, found);
+                at.truncate(len);
+            }
+        }
+        _ => {}
+    }
+}
+
+/// Whether `pointer` lies inside `outer` (below it, not at it).
+fn inside(pointer: &str, outer: &str) -> bool {
+    pointer.len() > outer.len()
+        && pointer.starts_with(outer)
+        && pointer.as_bytes()[outer.len()] == b'/'
+}
+
+/// Of `material` (at `at`), the values at `places` as loaded, with the objects on the way to
+/// them and nothing else; `None` when a way passes through something other than an object
+/// that writes each key once.
+fn sparse(material: Node, at: &str, places: &[String]) -> Option<Value> {
+    if places.iter().any(|p| p == at) {
+        return Some(material.to_value());
+    }
+    let mut out = Map::new();
+    for place in places {
+        let tokens = pointer::tokens(place.strip_prefix(at)?);
+        let (last, way) = tokens.split_last()?;
+        let mut node = Some(material);
+        let mut object = &mut out;
+        for token in way {
+            node = match node {
+                Some(n) => {
+                    let o = n.as_object().filter(|o| !o.has_duplicate_keys())?;
+                    o.get(token)
+                }
+                None => None,
+            };
+            if node.is_some_and(|n| !n.is_object()) {
+                return None;
+            }
+            object = object
+                .entry(token.clone())
+                .or_insert_with(|| Value::Object(Map::new()))
+                .as_object_mut()?;
+        }
+        let here = match node {
+            Some(n) => n.as_object().filter(|o| !o.has_duplicate_keys())?.get(last),
+            None => None,
+        };
+        if let Some(value) = here {
+            object.insert(last.clone(), value.to_value());
+        }
+    }
+    Some(Value::Object(out))
 }
 
 #[cfg(test)]
@@ -155,53 +314,81 @@ mod tests {
         loaded.asset.expect("a document")
     }
 
+    fn no_edits() -> DocumentPlan {
+        DocumentPlan {
+            materials: Vec::new(),
+            declarations: Vec::new(),
+        }
+    }
+
+    fn slot(material: usize, layer: &str) -> SlotPlan {
+        SlotPlan {
+            material,
+            extension: crate::layers::FUZZ,
+            texture_key: "fuzzRoughnessTexture",
+            factor_key: "fuzzRoughnessFactor",
+            layer_pointer: format!("/materials/{material}/extensions/{layer}"),
+            texture: 0,
+            factor: vec![1.0],
+            written_factor: None,
+            sources: Vec::new(),
+        }
+    }
+
     fn plan_for(material: usize) -> BakePlan {
         BakePlan {
-            slots: vec![SlotPlan {
-                material,
-                extension: crate::layers::FUZZ,
-                texture_key: "fuzzRoughnessTexture",
-                factor_key: "fuzzRoughnessFactor",
-                layer_pointer: format!("/materials/{material}/extensions/KHR_materials_fuzz"),
-                texture: 0,
-                factor: vec![1.0],
-                written_factor: None,
-                sources: Vec::new(),
-            }],
+            slots: vec![
+                slot(material, "KHR_materials_fuzz"),
+                slot(material, "KHR_materials_sheen"),
+            ],
             ..BakePlan::default()
         }
     }
 
     #[test]
-    fn a_part_holds_the_baked_materials_and_the_members_a_bake_reads_and_nothing_else() {
+    fn a_part_holds_the_layers_baked_and_the_members_a_bake_reads_and_nothing_else() {
         let text = r#"{"asset": {"version": "2.0"}, "meshes": [{"primitives": []}],
-            "materials": [{"name": "a"}, {"name": "b", "k": 0.80000001192092896}],
+            "materials": [{"name": "a"}, {"name": "b", "extensions": {"KHR_materials_sheen":
+            {"sheenRoughnessFactor": 0.80000001192092896}}}],
             "textures": [{"source": 0}], "images": [{"uri": "a.png"}]}"#;
         let asset = asset(text);
-        let part = BakePart::new(&asset, &plan_for(1)).unwrap();
+        let fuzz = "/materials/1/extensions/KHR_materials_fuzz";
+        let mut plan = crate::migrate::plan::plan_document(&asset, &Default::default());
+        plan.materials.retain(|m| m.index == 1);
+        plan.materials[0].edits = vec![Edit::set(fuzz, serde_json::json!({"fuzzFactor": 1}))];
+        let part = BakePart::new(&asset, &plan_for(1), &plan).unwrap();
         let value = |text: &str| serde_json::from_str::<Value>(text).unwrap();
+        // The sheen as loaded; the fuzz is not there until the edit sets it.
         assert_eq!(
             part.json,
             value(
                 r#"{"asset": {"version": "2.0"},
-                "materials": [null, {"name": "b", "k": 0.80000001192092896}],
+                "materials": [null, {"extensions": {"KHR_materials_sheen":
+                {"sheenRoughnessFactor": 0.80000001192092896}}}],
                 "textures": [{"source": 0}], "images": [{"uri": "a.png"}]}"#
             )
         );
         for (edit, held) in [
-            (Edit::set("/materials/1/extensions/x", Value::Null), true),
+            (Edit::set(fuzz, Value::Null), true),
+            (Edit::set(format!("{fuzz}/fuzzFactor"), Value::Null), true),
+            (Edit::set("/materials/1/name", Value::Null), false),
             (Edit::set("/materials/0/extensions/x", Value::Null), false),
-            (Edit::set("/materials/01/name", Value::Null), false),
+            (
+                Edit::set("/materials/01/extensions/KHR_materials_fuzz", Value::Null),
+                false,
+            ),
             (Edit::set("/images/0/uri", Value::Null), true),
             (Edit::set("/meshes/0/name", Value::Null), false),
             (Edit::declare_used("KHR_materials_fuzz"), true),
         ] {
             assert_eq!(part.holds(&edit), held, "{edit}");
         }
-        // After the bake: the baked material and the members that changed are replaced whole,
-        // with the numbers the bake left as they were written; what did not change is left.
+        // After the edit and the bake: each place and the members that changed are replaced
+        // whole, with the numbers the bake left as they were written; what did not change is
+        // left.
         let mut after = part.json.clone();
-        after["materials"][1]["name"] = "b2".into();
+        crate::edit::apply(&mut after, &plan.materials[0].edits).unwrap();
+        after.pointer_mut(fuzz).unwrap()["fuzzRoughnessTexture"] = serde_json::json!({"index": 1});
         after["textures"]
             .as_array_mut()
             .unwrap()
@@ -211,8 +398,12 @@ mod tests {
             edits,
             vec![
                 Edit::replace(
-                    "/materials/1",
-                    value(r#"{"name": "b2", "k": 0.80000001192092896}"#)
+                    fuzz,
+                    serde_json::json!({"fuzzFactor": 1, "fuzzRoughnessTexture": {"index": 1}})
+                ),
+                Edit::replace(
+                    "/materials/1/extensions/KHR_materials_sheen",
+                    value(r#"{"sheenRoughnessFactor": 0.80000001192092896}"#)
                 ),
                 Edit::replace(
                     "/textures",
@@ -223,10 +414,32 @@ mod tests {
     }
 
     #[test]
+    fn a_textureinfo_naming_a_replaced_texture_is_held_wherever_it_is_or_the_part_is_not_used() {
+        // Material 0 is not baked but names texture 0, which the bake of material 1 replaces:
+        // the part holds that textureInfo (and nothing else of material 0), so the bake sees
+        // the texture is still named.
+        let text = r#"{"materials": [{"name": "a", "normalTexture": {"index": 0, "scale": 2}},
+            {"extensions": {"KHR_materials_sheen": {"sheenRoughnessTexture": {"index": 0}}}}],
+            "textures": [{"source": 0}]}"#;
+        let part = BakePart::new(&asset(text), &plan_for(1), &no_edits()).unwrap();
+        assert_eq!(
+            part.json["materials"],
+            serde_json::json!([
+                {"normalTexture": {"index": 0, "scale": 2}},
+                {"extensions": {"KHR_materials_sheen": {"sheenRoughnessTexture": {"index": 0}}}}
+            ])
+        );
+        // Named from outside the materials (a mesh's extension here): no part.
+        let text = r#"{"materials": [{}, {}], "textures": [{"source": 0}],
+            "meshes": [{"extensions": {"x": {"occlusionTexture": {"index": 0}}}}]}"#;
+        assert!(BakePart::new(&asset(text), &plan_for(1), &no_edits()).is_none());
+    }
+
+    #[test]
     fn a_slot_outside_the_material_it_names_gives_no_part() {
         let asset = asset(r#"{"materials": [{}]}"#);
         let mut plan = plan_for(0);
         plan.slots[0].layer_pointer = "/extensions/x".to_string();
-        assert!(BakePart::new(&asset, &plan).is_none());
+        assert!(BakePart::new(&asset, &plan, &no_edits()).is_none());
     }
 }
