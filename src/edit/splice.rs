@@ -48,7 +48,9 @@ pub fn rewrite(text: &str, root: Node, after: &Value) -> Option<String> {
 /// top-level array (a material, an image).
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
 struct Unit {
-    member: String,
+    /// The member's name, shared by every edit of it (a plan may name the same member by the
+    /// ten thousand).
+    member: std::sync::Arc<str>,
     element: Option<usize>,
 }
 
@@ -71,7 +73,8 @@ pub fn splice_edits<'t, 'e>(
     // Each edit's unit: the element its pointer enters, unless some edit of that member adds,
     // removes or replaces elements (then the whole member).
     let mut placed: Vec<(&Edit, Unit)> = Vec::new();
-    let mut whole_members: std::collections::HashSet<String> = Default::default();
+    let mut whole_members: std::collections::HashSet<std::sync::Arc<str>> = Default::default();
+    let mut names: std::collections::HashMap<String, std::sync::Arc<str>> = Default::default();
     for edit in edits {
         let pointer = match edit {
             Edit::Set { pointer, .. }
@@ -95,16 +98,18 @@ pub fn splice_edits<'t, 'e>(
                     .and_then(|m| m.as_array())
                     .is_some_and(|a| *i < a.len())
             });
+        let member = match names.get(member.as_str()) {
+            Some(name) => name.clone(),
+            None => {
+                let name: std::sync::Arc<str> = member.as_str().into();
+                names.insert(member.clone(), name.clone());
+                name
+            }
+        };
         if element.is_none() {
             whole_members.insert(member.clone());
         }
-        placed.push((
-            edit,
-            Unit {
-                member: member.clone(),
-                element,
-            },
-        ));
+        placed.push((edit, Unit { member, element }));
     }
     let mut units: Vec<(Unit, Vec<&Edit>)> = Vec::new();
     let mut at: std::collections::HashMap<Unit, usize> = Default::default();
@@ -361,9 +366,9 @@ fn feed_node(d: &mut Digest, node: Node) {
 /// One edit of [`members_set_in_place`]: where it sets, as tokens below the element, and the
 /// value the text will hold (a [`Edit::Set`]'s as velvet writes it, a [`Edit::Replace`]'s as
 /// given).
-struct MemberSet {
+struct MemberSet<'e> {
     tokens: Vec<String>,
-    value: Value,
+    value: std::borrow::Cow<'e, Value>,
 }
 
 /// The splices of an element unit whose edits each set or replace a member of an object the
@@ -382,11 +387,14 @@ fn members_set_in_place(
     edits: &[&Edit],
     layout: &Layout,
 ) -> Option<(Vec<Splice>, bool, u64)> {
+    use std::borrow::Cow;
     let mut sets: Vec<MemberSet> = Vec::with_capacity(edits.len());
     for edit in edits {
         let (pointer, value) = match edit {
-            Edit::Set { pointer, value } => (pointer, written(value.clone())),
-            Edit::Replace { pointer, value } => (pointer, value.clone()),
+            // Borrowed unless a number is rounded: a plan's values are not copied.
+            Edit::Set { pointer, value } if is_written(value) => (pointer, Cow::Borrowed(value)),
+            Edit::Set { pointer, value } => (pointer, Cow::Owned(written(value.clone()))),
+            Edit::Replace { pointer, value } => (pointer, Cow::Borrowed(value)),
             _ => return None,
         };
         let within = pointer
@@ -452,7 +460,7 @@ fn members_set_in_place(
     let mut d = Digest::new();
     let sets: Vec<(&[String], &Value)> = sets
         .iter()
-        .map(|s| (s.tokens.as_slice(), &s.value))
+        .map(|s| (s.tokens.as_slice(), s.value.as_ref()))
         .collect();
     feed_edited(&mut d, element, &sets);
     Some((splices, changed, d.finish()))
@@ -640,12 +648,12 @@ fn splice_unit(
         (_, node) => {
             let mut part = Map::new();
             if let Some(node) = node {
-                part.insert(unit.member.clone(), node.to_value());
+                part.insert(unit.member.to_string(), node.to_value());
             }
             let mut part = Value::Object(part);
             let owned: Vec<Edit> = edits.iter().map(|e| (*e).clone()).collect();
             changed |= super::apply(&mut part, &owned)?;
-            let new = part.get(&unit.member);
+            let new = part.get(&*unit.member);
             match (node, new) {
                 (Some(node), Some(new)) => {
                     diff(text, node, new, layout, &mut splices);
@@ -655,7 +663,7 @@ fn splice_unit(
                 (Some(_), None) => {
                     let Some(i) = entries
                         .iter()
-                        .position(|(k, _)| k.as_str().is_some_and(|k| k == unit.member))
+                        .position(|(k, _)| k.as_str().is_some_and(|k| *k == *unit.member))
                     else {
                         return Ok(None);
                     };
@@ -667,7 +675,7 @@ fn splice_unit(
                 (None, Some(new)) => {
                     // Where the edit applier puts it: `extensionsUsed` after `asset` (or
                     // first), anything else last.
-                    let anchor = if unit.member == "extensionsUsed" {
+                    let anchor = if &*unit.member == "extensionsUsed" {
                         entries
                             .iter()
                             .position(|(k, _)| k.as_str().is_some_and(|k| k == "asset"))
@@ -678,7 +686,7 @@ fn splice_unit(
                         text,
                         root,
                         members,
-                        &[(anchor, &unit.member, new)],
+                        &[(anchor, &unit.member[..], new)],
                         layout,
                         &mut splices,
                     );
@@ -686,7 +694,7 @@ fn splice_unit(
                 (None, None) => {}
             }
             let pointer = format!("/{}", crate::asset::pointer::escape(&unit.member));
-            meant = (pointer, part.get(&unit.member).map(value_digest));
+            meant = (pointer, part.get(&*unit.member).map(value_digest));
         }
     }
     Ok(Some(UnitSplices {
@@ -1094,6 +1102,16 @@ fn raw_number_text(text: &str) -> std::borrow::Cow<'_, str> {
     }
     // Display writes the shortest decimal that reads back as the same f64.
     Cow::Owned(format!("{rounded}"))
+}
+
+/// Whether every number in `value` is already as velvet writes it (see [`written`]).
+fn is_written(value: &Value) -> bool {
+    match value {
+        Value::Number(n) => matches!(raw_number_text(n.as_str()), std::borrow::Cow::Borrowed(_)),
+        Value::Array(items) => items.iter().all(is_written),
+        Value::Object(map) => map.values().all(is_written),
+        _ => true,
+    }
 }
 
 /// `value` with every number as velvet writes it (see [`number_text`]): edits store what the

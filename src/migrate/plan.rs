@@ -63,6 +63,15 @@ impl MaterialPlan {
         self.notes.push(note);
     }
 
+    /// Cuts the plan's lists to their length. A plan is kept to the end of the run, for its
+    /// report; grown by doubling, the lists of a large library's plans held a third more.
+    fn shrink_to_fit(&mut self) {
+        self.edits.shrink_to_fit();
+        self.notes.shrink_to_fit();
+        self.bakes.shrink_to_fit();
+        self.conversions.shrink_to_fit();
+    }
+
     pub fn migrated(&self) -> bool {
         !self.conversions.is_empty()
     }
@@ -207,8 +216,13 @@ pub fn plan_document(asset: &Asset, options: &Options) -> DocumentPlan {
     let primitives = Primitives::new(asset.root());
     let mut materials: Vec<MaterialPlan> = (0..count)
         .filter_map(|i| plan_material(asset, i, options, &primitives))
+        .map(|mut plan| {
+            plan.shrink_to_fit();
+            plan
+        })
         .collect();
     super::budget::plan(asset, &mut materials, options.budget);
+    materials.iter_mut().for_each(MaterialPlan::shrink_to_fit);
     let declared: Vec<std::borrow::Cow<str>> =
         crate::rules::elements(asset.root().get("extensionsUsed"))
             .filter_map(|e| e.as_str())
