@@ -38,6 +38,10 @@ const LEFT_OUT: [&str; 7] = [
     "cameras",
 ];
 
+/// The member of the part that names, for the bake's pruning, the replaced textures that
+/// something outside the part names; not a glTF key (the colon), never written.
+const STAND_IN: &str = "velvet:named-elsewhere";
+
 /// The part of a document a bake plan applies to.
 #[derive(Debug)]
 pub struct BakePart {
@@ -94,32 +98,36 @@ impl BakePart {
                 .entry(*material)
                 .or_insert_with(|| baked.iter().map(|p| p.to_string()).collect());
         }
-        // Every textureInfo that names a texture a bake replaces is held too, so that the
-        // bake, seeing it, keeps that texture as it would on the whole document; one outside
-        // the materials leaves the part unused.
-        let replaced: BTreeSet<usize> = bake.slots.iter().map(|s| s.texture).collect();
-        let root = asset.root();
-        let object = root.as_object().filter(|o| !o.has_duplicate_keys())?;
-        for (key, node) in object.iter() {
-            let mut found = Vec::new();
-            let mut at = pointer::join("", &key);
-            naming(node, &mut at, &key, &replaced, &mut found);
-            match key.as_ref() {
-                "materials" => {
-                    for info in found {
-                        let index = pointer::tokens(&info)[1].parse::<usize>().ok()?;
-                        places.entry(index).or_default().push(info);
-                    }
-                }
-                _ if LEFT_OUT.contains(&key.as_ref()) && !found.is_empty() => return None,
-                _ => {}
-            }
-        }
         for list in places.values_mut() {
             let all = list.clone();
             let mut seen = std::collections::HashSet::new();
             // Each place once, and none inside another (it is held by the outer one).
             list.retain(|p| seen.insert(p.clone()) && !all.iter().any(|q| inside(p, q)));
+        }
+        // A texture a bake replaces that a textureInfo outside the places names (another
+        // material, another layer of the same one, a mesh's extension) is named in the part by
+        // a stand-in, so that the bake, seeing it named, keeps the texture as it would on the
+        // whole document. The stand-in is never written.
+        let replaced: BTreeSet<usize> = bake.slots.iter().map(|s| s.texture).collect();
+        let root = asset.root();
+        let object = root.as_object().filter(|o| !o.has_duplicate_keys())?;
+        let mut named_elsewhere = BTreeSet::new();
+        for (key, node) in object.iter() {
+            let mut found = Vec::new();
+            let mut at = pointer::join("", &key);
+            naming(node, &mut at, &key, &replaced, &mut found);
+            for (info, texture) in found {
+                let material = match pointer::tokens(&info).as_slice() {
+                    [member, index, ..] if member == "materials" => index.parse::<usize>().ok(),
+                    _ => None,
+                };
+                let held = material
+                    .and_then(|m| places.get(&m))
+                    .is_some_and(|list| list.iter().any(|p| *p == info || inside(&info, p)));
+                if !held {
+                    named_elsewhere.insert(texture);
+                }
+            }
         }
         let mut part = Map::new();
         for (key, node) in object.iter() {
@@ -140,6 +148,13 @@ impl BakePart {
                 node.to_value()
             };
             part.insert(key.into_owned(), value);
+        }
+        if !named_elsewhere.is_empty() {
+            let stand_ins = named_elsewhere
+                .iter()
+                .map(|t| serde_json::json!({ "namedElsewhereTexture": { "index": t } }))
+                .collect();
+            part.insert(STAND_IN.to_string(), Value::Array(stand_ins));
         }
         Some(BakePart {
             json: Value::Object(part),
@@ -195,7 +210,7 @@ impl BakePart {
             }
         }
         for (key, value) in part {
-            if key == "materials" {
+            if key == "materials" || key == STAND_IN {
                 continue;
             }
             if root
@@ -211,14 +226,14 @@ impl BakePart {
 }
 
 /// Appends to `found` the pointer of every textureInfo in `node` (at pointer `at`, the value
-/// of `key`) that names one of `textures`, found as a bake's pruning finds references: an
+/// of `key`) that names one of `textures`, with the texture it names, found as a bake's pruning finds references: an
 /// object under a key ending in `Texture` with an integer `index`.
 fn naming(
     node: Node,
     at: &mut String,
     key: &str,
     textures: &BTreeSet<usize>,
-    found: &mut Vec<String>,
+    found: &mut Vec<(String, usize)>,
 ) {
     match node.kind() {
         Kind::Object => {
@@ -227,8 +242,8 @@ fn naming(
             };
             if key.ends_with("Texture") {
                 let index = object.get("index").and_then(|i| i.as_u64());
-                if index.is_some_and(|i| textures.contains(&(i as usize))) {
-                    found.push(at.clone());
+                if let Some(i) = index.filter(|i| textures.contains(&(*i as usize))) {
+                    found.push((at.clone(), i as usize));
                 }
             }
             for (k, v) in object.iter() {
@@ -414,25 +429,28 @@ mod tests {
     }
 
     #[test]
-    fn a_textureinfo_naming_a_replaced_texture_is_held_wherever_it_is_or_the_part_is_not_used() {
-        // Material 0 is not baked but names texture 0, which the bake of material 1 replaces:
-        // the part holds that textureInfo (and nothing else of material 0), so the bake sees
-        // the texture is still named.
+    fn a_replaced_texture_named_outside_the_places_is_named_in_the_part_by_a_stand_in() {
+        // Material 0 is not baked but names texture 0, which the bake of material 1 replaces;
+        // so does a mesh's extension. The part names texture 0 once by a stand-in (so the bake
+        // keeps it), holds nothing of material 0, and the stand-in is never written.
         let text = r#"{"materials": [{"name": "a", "normalTexture": {"index": 0, "scale": 2}},
             {"extensions": {"KHR_materials_sheen": {"sheenRoughnessTexture": {"index": 0}}}}],
+            "meshes": [{"extensions": {"x": {"occlusionTexture": {"index": 0}}}}],
             "textures": [{"source": 0}]}"#;
-        let part = BakePart::new(&asset(text), &plan_for(1), &no_edits()).unwrap();
+        let asset = asset(text);
+        let mut plan = plan_for(1);
+        plan.slots.truncate(1); // the fuzz layer alone: the sheen's textureInfo lies outside
+        let part = BakePart::new(&asset, &plan, &no_edits()).unwrap();
         assert_eq!(
-            part.json["materials"],
-            serde_json::json!([
-                {"normalTexture": {"index": 0, "scale": 2}},
-                {"extensions": {"KHR_materials_sheen": {"sheenRoughnessTexture": {"index": 0}}}}
-            ])
+            part.json,
+            serde_json::json!({
+                "materials": [null, {"extensions": {}}],
+                "textures": [{"source": 0}],
+                STAND_IN: [{"namedElsewhereTexture": {"index": 0}}]
+            })
         );
-        // Named from outside the materials (a mesh's extension here): no part.
-        let text = r#"{"materials": [{}, {}], "textures": [{"source": 0}],
-            "meshes": [{"extensions": {"x": {"occlusionTexture": {"index": 0}}}}]}"#;
-        assert!(BakePart::new(&asset(text), &plan_for(1), &no_edits()).is_none());
+        let after = part.json.clone();
+        assert_eq!(part.into_edits(&asset, after), Vec::<Edit>::new());
     }
 
     #[test]
