@@ -288,6 +288,7 @@ fn emit(text: &[u8]) {
 }
 
 fn main() -> ExitCode {
+    velvet::asset::pages::one_heap();
     let cli = Cli::parse();
     match cli.command {
         Command::Validate(args) => validate(args, cli.color, cli.quiet),

@@ -7,7 +7,9 @@
 //! fault per 2 MiB. The advice changes no byte and is ignored where it cannot be taken; on
 //! other systems this does nothing.
 //!
-//! `libc` is the crate for the call: std has no binding for `madvise`.
+//! The process's threads also allocate from one heap ([`one_heap`]).
+//!
+//! `libc` is the crate for the calls: std has no binding for `madvise` or `mallopt`.
 
 /// Buffers from this size (bytes) are advised: below it a huge page would mostly back other
 /// allocations.
@@ -88,5 +90,21 @@ mod tests {
                 "the buffer's mapping is advised huge pages"
             );
         }
+    }
+}
+
+/// Makes every thread of the process allocate from one heap: glibc's malloc gives each new
+/// thread an arena of its own, and what a thread pool's workers free stays in theirs, unused
+/// by the other threads. A migration's workers make and drop thousands of small values in
+/// turn (the units they splice, the values they read back); with an arena each, the default
+/// migration of the 20,000-material library peaked at 116 MiB, with one 106 MiB, in the same
+/// time at 2 threads (2.7 s; contention on the one arena cost nothing measurable). Call it
+/// first thing, before any other thread starts. Elsewhere than glibc this does nothing.
+pub fn one_heap() {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    // SAFETY: mallopt sets a tunable of the allocator; called before any thread exists, it
+    // changes how later allocations are placed and nothing already allocated.
+    unsafe {
+        libc::mallopt(libc::M_ARENA_MAX, 1);
     }
 }
