@@ -128,8 +128,9 @@ pub fn splice_edits<'t, 'e>(
     let members: Vec<(usize, Node)> = entries.iter().map(|(k, v)| (k.span().start, *v)).collect();
     let mut splices = Vec::new();
     let mut changed = false;
-    // What each unit must read back as: (its pointer, its value; `None` when removed).
-    let mut meant: Vec<(String, Option<u64>)> = Vec::with_capacity(units.len());
+    // What each unit not read back alone must read back as from the whole text: (its
+    // pointer, its value's digest; `None` when removed).
+    let mut meant: Vec<(String, Option<u64>)> = Vec::new();
     let done: Vec<Result<Option<UnitSplices>, EditError>> = units
         .par_iter()
         .map(|(unit, edits)| {
@@ -148,7 +149,10 @@ pub fn splice_edits<'t, 'e>(
         }
         splices.extend(unit.splices);
         changed |= unit.changed;
-        meant.push(unit.meant);
+        if unit.checked.is_none() {
+            // Only what was not read back alone is read back from the whole text.
+            meant.push(unit.meant);
+        }
     }
     let Some(spliced) = Spliced::new(text, splices) else {
         return Ok(None);
@@ -1133,15 +1137,25 @@ pub fn written(value: Value) -> Value {
 }
 
 impl Layout {
-    /// The indentation of the line `at` lies on. Line breaks are looked up, not searched for
-    /// backwards: in a minified document (one line) a backward search from every edit would
-    /// read the whole text before it each time.
+    /// The indentation of the line `at` lies on. The line's start is searched for backwards
+    /// over a short stretch (a pretty document's line); past that, line breaks are looked up:
+    /// in a minified document (one line) a backward search from every edit would read the
+    /// whole text before it each time. The table of line breaks is made only then, so a pretty
+    /// document does not hold one (2 MiB for a 10 MB library).
     fn line_indent<'t>(&self, text: &'t str, at: usize) -> &'t str {
-        let breaks = self
-            .line_breaks
-            .get_or_init(|| text.match_indices('\n').map(|(i, _)| i as u32).collect());
-        let before = breaks.partition_point(|&b| (b as usize) < at);
-        let line_start = before.checked_sub(1).map_or(0, |i| breaks[i] as usize + 1);
+        const NEAR: usize = 4096;
+        let from = at.saturating_sub(NEAR);
+        let line_start = match text.as_bytes()[from..at].iter().rposition(|&b| b == b'\n') {
+            Some(i) => from + i + 1,
+            None if from == 0 => 0,
+            None => {
+                let breaks = self
+                    .line_breaks
+                    .get_or_init(|| text.match_indices('\n').map(|(i, _)| i as u32).collect());
+                let before = breaks.partition_point(|&b| (b as usize) < at);
+                before.checked_sub(1).map_or(0, |i| breaks[i] as usize + 1)
+            }
+        };
         let line = &text[line_start..];
         let len = line.len() - line.trim_start_matches([' ', '\t']).len();
         &line[..len]
