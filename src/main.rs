@@ -621,7 +621,12 @@ fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
             preview_failed = true;
         }
     }
-    if report.failed() || preview_failed || (args.check && report.summary.would_change > 0) {
+    let failed =
+        report.failed() || preview_failed || (args.check && report.summary.would_change > 0);
+    // The process ends next: a library's report (a plan for every material) is left to the
+    // exit rather than freed value by value.
+    std::mem::forget(report);
+    if failed {
         ExitCode::from(1)
     } else {
         ExitCode::SUCCESS

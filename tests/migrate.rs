@@ -843,7 +843,7 @@ fn dry_run_prints_the_plan_and_writes_nothing() {
         "{text}"
     );
     assert!(text.contains(
-        "    set /materials/0/extensions/KHR_materials_fuzz = {\"fuzzFactor\":0.9,\"fuzzColorFactor\":[1.0,0.7777777777777777,0.6666666666666666],\"fuzzRoughnessFactor\":0.6236}\n"
+        "    set /materials/0/extensions/KHR_materials_fuzz = {\"fuzzFactor\":0.9,\"fuzzColorFactor\":[1.0,0.777778,0.666667],\"fuzzRoughnessFactor\":0.6236}\n"
     ), "{text}");
     assert!(
         text.contains("  declare KHR_materials_fuzz in /extensionsUsed\n"),
