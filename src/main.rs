@@ -288,7 +288,7 @@ fn emit(text: &[u8]) {
 }
 
 fn main() -> ExitCode {
-    velvet::asset::pages::one_heap();
+    velvet::asset::pages::limit_heaps();
     let cli = Cli::parse();
     match cli.command {
         Command::Validate(args) => validate(args, cli.color, cli.quiet),

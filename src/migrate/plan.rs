@@ -220,9 +220,9 @@ pub fn plan_document(asset: &Asset, options: &Options) -> DocumentPlan {
         .map_or(0, |m| m.len());
     // Materials are planned one after another: planned side by side on the thread pool, their
     // plans came from the workers' own allocator arenas and the run's peak memory grew by a
-    // tenth (measured on the library); with one arena for the process (see
-    // `asset::pages::one_heap`) the workers wait on each other's allocations instead, and the
-    // planning took longer than on one thread.
+    // tenth (measured on the library); with one arena for the whole process the workers
+    // waited on each other's allocations instead, and the planning took longer than on one
+    // thread (see `asset::pages::limit_heaps`).
     let primitives = Primitives::new(asset.root());
     let mut materials: Vec<MaterialPlan> = (0..count)
         .filter_map(|i| plan_material(asset, i, options, &primitives))
