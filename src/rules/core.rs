@@ -260,6 +260,11 @@ fn one_of_names(at: &str) -> &'static str {
 pub struct CoreStructure;
 
 impl Rule for CoreStructure {
+    /// Among the dearest rules on a large document: the whole document against the official schemas.
+    fn cost(&self) -> u32 {
+        7
+    }
+
     fn codes(&self) -> &'static [&'static Code] {
         &[
             &codes::TYPE_MISMATCH,

@@ -143,6 +143,12 @@ pub trait Rule: Sync {
     fn codes(&self) -> &'static [&'static Code];
     /// Checks the asset, pushing what it finds.
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>);
+    /// How long the rule takes on a large document, relative to the others (1: a walk of the
+    /// layers, or less). Rules run side by side start with the dearest, so that the cores
+    /// finish together.
+    fn cost(&self) -> u32 {
+        1
+    }
 }
 
 /// Every rule, in the order their findings are reported.

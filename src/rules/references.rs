@@ -94,6 +94,11 @@ pub const LINKS: &[(&str, &str)] = &[
 pub struct References;
 
 impl Rule for References {
+    /// Among the dearest rules on a large document: it walks every value of the document.
+    fn cost(&self) -> u32 {
+        10
+    }
+
     fn codes(&self) -> &'static [&'static Code] {
         &[&UNRESOLVED_REFERENCE]
     }

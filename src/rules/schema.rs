@@ -257,6 +257,11 @@ fn code_for(kind: &ValidationErrorKind) -> &'static Code {
 pub struct SchemaCheck;
 
 impl Rule for SchemaCheck {
+    /// Among the dearest rules on a large document: every layer object against its schema.
+    fn cost(&self) -> u32 {
+        10
+    }
+
     fn codes(&self) -> &'static [&'static Code] {
         codes::SCHEMA
     }

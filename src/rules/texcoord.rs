@@ -16,6 +16,11 @@ pub const MESH_PRIMITIVE_TOO_FEW_TEXCOORDS: Code = Code::new(
 pub struct TexCoords;
 
 impl Rule for TexCoords {
+    /// Among the dearest rules on a large document: every primitive of every mesh.
+    fn cost(&self) -> u32 {
+        10
+    }
+
     fn codes(&self) -> &'static [&'static Code] {
         &[&MESH_PRIMITIVE_TOO_FEW_TEXCOORDS]
     }
