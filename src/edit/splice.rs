@@ -19,6 +19,10 @@
 //! `0.7499999999999999` in an output file. Numbers that already have at most that many
 //! decimals (copied from the input, or integers) keep their spelling.
 //!
+//! [`splice_edits`] takes a plan's edits instead of a whole edited document: only the parts
+//! they touch are read, each part's new text is read back alone, and the result is a
+//! [`Spliced`] text, written to its file piece by piece rather than joined.
+//!
 //! The spans come from the document's index ([`crate::asset::tape`]), built when it was loaded:
 //! the source is not read a second time. No maintained crate offers format-preserving edits of
 //! JSON text (toml_edit's equivalent for JSON does not exist). The check a spliced text passes

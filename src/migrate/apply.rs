@@ -1,6 +1,8 @@
 //! One file, planned then written: load, plan the materials ([`plan_document`]) and the
-//! relocation of resources ([`relocate`]), then apply the edits to a copy of the document and
-//! write it atomically.
+//! relocation of resources ([`relocate`]), bake the textures the plan needs, then write the
+//! edits as splices into the loaded text (with bakes, through the part of the document they
+//! change, [`BakePart`]), or where that cannot be done, apply them to the whole document; the
+//! output is written atomically.
 //!
 //! A file whose document comes out as it went in is written as the input's own bytes (and,
 //! in place, not written at all). A file the loader could not read cleanly is not migrated:

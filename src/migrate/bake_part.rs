@@ -45,7 +45,7 @@ const STAND_IN: &str = "velvet:named-elsewhere";
 /// The part of a document a bake plan applies to.
 #[derive(Debug)]
 pub struct BakePart {
-    /// The document's top level without the members in [`LEFT_OUT`]; of `materials`, only the
+    /// The document's top level without the geometry (meshes, nodes, accessors, …); of `materials`, only the
     /// places below, with the objects on the way to them; the other materials are `null`.
     pub json: Value,
     /// Per material in the part, the places it holds (pointers from the root; none lies inside

@@ -8,7 +8,7 @@
 //! many files in parallel and sums up. Each conversion rule is one file: [`sheen_to_fuzz`],
 //! [`fallback`], [`legacy`]. The roughness choice between the layers lives in [`roughness`]
 //! alone. Textures that a conversion must bake are planned in [`textures`] and made by the bake
-//! engine.
+//! engine, then applied to the part of the document they change ([`bake_part`]).
 
 pub mod apply;
 pub mod bake_part;
