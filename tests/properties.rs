@@ -7,7 +7,9 @@
 //! - migrate twice = migrate once (the second run writes the first's bytes);
 //! - bake twice = bake once;
 //! - migrate leaves every byte of the JSON it does not own as it was: with the sheen and fuzz
-//!   objects and `extensionsUsed` set aside, the output's text equals the input's.
+//!   objects and `extensionsUsed` set aside, the output's text equals the input's;
+//! - a migration's edits spliced part by part (each part read back alone) give the text the
+//!   whole edited document gives.
 
 use base64::Engine;
 use proptest::prelude::*;
@@ -423,6 +425,23 @@ proptest! {
         prop_assert_eq!(unrelated_text(&before), unrelated_text(&after));
         // What migrate owns loads again too: the output is a document velvet reads.
         prop_assert!(velvet::asset::load(&output).asset.is_some());
+    }
+
+    #[test]
+    fn edits_spliced_part_by_part_give_the_text_of_the_whole_edited_document(doc in document()) {
+        let text = text(&doc);
+        let loaded = velvet::asset::load_bytes(Path::new("doc.gltf"), text.as_bytes());
+        let asset = loaded.asset.expect("a generated document loads");
+        let plan = migrate::plan::plan_document(&asset, &Options::default());
+        let edits: Vec<_> = plan.edits().cloned().collect();
+        let spliced = velvet::edit::splice::splice_edits(&text, asset.root(), &edits)
+            .unwrap()
+            .map(|(out, _)| out.to_text());
+        let mut whole = asset.root().to_value();
+        velvet::edit::apply(&mut whole, &edits).unwrap();
+        let rewritten = velvet::edit::splice::rewrite(&text, asset.root(), &whole);
+        prop_assert!(spliced.is_some());
+        prop_assert_eq!(spliced, rewritten);
     }
 }
 

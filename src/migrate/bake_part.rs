@@ -45,8 +45,9 @@ const STAND_IN: &str = "velvet:named-elsewhere";
 /// The part of a document a bake plan applies to.
 #[derive(Debug)]
 pub struct BakePart {
-    /// The document's top level without the geometry (meshes, nodes, accessors, …); of `materials`, only the
-    /// places below, with the objects on the way to them; the other materials are `null`.
+    /// The document's top level without the geometry (meshes, nodes, accessors, …); of
+    /// `materials`, only the places below, with the objects on the way to them; the other
+    /// materials are `null`.
     pub json: Value,
     /// Per material in the part, the places it holds (pointers from the root; none lies inside
     /// another).
