@@ -33,10 +33,12 @@ pub enum Edit {
 }
 
 impl Edit {
+    /// Sets `value`, its numbers as velvet writes them ([`splice::written`]): a plan holds,
+    /// and a dry run shows, what the file will hold.
     pub fn set(pointer: impl Into<String>, value: Value) -> Edit {
         Edit::Set {
             pointer: pointer.into(),
-            value,
+            value: splice::written(value),
         }
     }
 

@@ -63,17 +63,9 @@ impl MaterialPlan {
         self.notes.push(note);
     }
 
-    /// Cuts the plan's lists to their length, and writes its values' numbers as the file will
-    /// hold them. A plan is kept to the end of the run, for its report; grown by doubling, the
-    /// lists of a large library's plans held a third more.
+    /// Cuts the plan's lists to their length. A plan is kept to the end of the run, for its
+    /// report; grown by doubling, the lists of a large library's plans held a third more.
     fn shrink_to_fit(&mut self) {
-        for edit in &mut self.edits {
-            // The values as the file will hold them (see `splice::written`): the plan shows
-            // what is written, and the writer need not copy a value to round it.
-            if let Edit::Set { value, .. } = edit {
-                *value = crate::edit::splice::written(std::mem::take(value));
-            }
-        }
         self.edits.shrink_to_fit();
         self.notes.shrink_to_fit();
         self.bakes.shrink_to_fit();
