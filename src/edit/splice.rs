@@ -1113,7 +1113,7 @@ fn raw_number_text(text: &str) -> std::borrow::Cow<'_, str> {
 }
 
 /// Whether every number in `value` is already as velvet writes it (see [`written`]).
-pub fn is_written(value: &Value) -> bool {
+fn is_written(value: &Value) -> bool {
     match value {
         Value::Number(n) => matches!(raw_number_text(n.as_str()), std::borrow::Cow::Borrowed(_)),
         Value::Array(items) => items.iter().all(is_written),

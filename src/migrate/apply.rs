@@ -187,13 +187,7 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
     // (see `baked_by_part`). Otherwise, or for a plan neither takes, everything is applied to
     // the whole document.
     let spliced: Option<PartWritten> = if bake_plan.is_empty() {
-        let edits = plan
-            .document
-            .materials
-            .iter()
-            .flat_map(|m| &m.edits)
-            .chain(&plan.document.declarations)
-            .chain(&plan.relocation.edits);
+        let edits = plan.document.edits().chain(&plan.relocation.edits);
         write::spliced_bytes(&plan.asset, edits)
             .map_err(fail)?
             .map(|(out, changed)| (out, changed, Vec::new()))
@@ -227,23 +221,13 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
             copy_resources(&plan.relocation, plan.asset.root())?;
             match changed {
                 true => out,
-                // Edits that set what was there already: the input's own bytes.
-                false if plan.bytes.is_empty() => Output::Bytes(
-                    asset::read(&input, &plan.asset.options)
-                        .map_err(|d| format!("cannot read {}: {}", input.display(), d.message))?
-                        .into(),
-                ),
-                false => Output::Bytes(std::mem::take(&mut plan.bytes).into()),
+                false => Output::Bytes(input_bytes(plan)?.into()),
             }
         } else {
             out
         };
         write::write_output_atomic(&output, &out)
             .map_err(|e| format!("cannot write {}: {e}", output.display()))?;
-        drop(out);
-        if changed {
-            plan.bytes = Vec::new();
-        }
         plan.baked = outputs;
         return Ok(if changed {
             Written::Changed
@@ -277,9 +261,7 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
         copy_resources(&plan.relocation, plan.asset.root())?;
         match changed {
             true => write::to_bytes(&plan.asset, plan.asset.json(), plan.asset.bin.as_deref()),
-            false if plan.bytes.is_empty() => asset::read(&input, &plan.asset.options)
-                .map_err(|d| format!("cannot read {}: {}", input.display(), d.message))?,
-            false => std::mem::take(&mut plan.bytes),
+            false => input_bytes(plan)?,
         }
     } else {
         let json = plan.asset.take_json();
@@ -309,6 +291,16 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
     })
 }
 
+/// The input's own bytes, for an output whose edits set what was there already: kept from
+/// loading when the plan changes nothing, else read again.
+fn input_bytes(plan: &mut FilePlan) -> Result<Vec<u8>, String> {
+    if !plan.bytes.is_empty() {
+        return Ok(std::mem::take(&mut plan.bytes));
+    }
+    asset::read(&plan.input, &plan.asset.options)
+        .map_err(|d| format!("cannot read {}: {}", plan.input.display(), d.message))
+}
+
 /// What [`baked_by_part`] wrote: the output, whether it differs from the input, and what became
 /// of each baked output.
 type PartWritten<'a> = (Output<'a>, bool, Vec<OutputReport>);
@@ -317,10 +309,10 @@ type PartWritten<'a> = (Output<'a>, bool, Vec<OutputReport>);
 /// changes ([`BakePart`]: the top level without the scene's geometry, and the materials the
 /// bake's slots lie in), then writes them into the loaded text as splices, with the edits of
 /// every other material, and places the resource copies the output names. Returns the output's
-/// bytes, whether they differ from the input and what became of each baked output; `None` when the part cannot take this plan
-/// (nothing written, `baked` as it was), and the caller applies it to the whole document. Every
-/// new image must be a file already (`baked` holds no bytes), so that the bake can be applied
-/// again to the whole document.
+/// bytes, whether they differ from the input and what became of each baked output; `None`
+/// when the part cannot take this plan (nothing written, `baked` as it was), and the caller
+/// applies it to the whole document. Every new image must be a file already (`baked` holds no
+/// bytes), so that the bake can be applied again to the whole document.
 #[allow(clippy::too_many_arguments)]
 fn baked_by_part<'a>(
     asset: &'a Asset,
@@ -336,12 +328,7 @@ fn baked_by_part<'a>(
         return Ok(None);
     };
     let fail = |e: edit::EditError| format!("{}: {e}", input.display());
-    let edits = document
-        .materials
-        .iter()
-        .flat_map(|m| &m.edits)
-        .chain(&document.declarations)
-        .chain(&relocation.edits);
+    let edits = document.edits().chain(&relocation.edits);
     let mut json = std::mem::take(&mut part.json);
     let mut others: Vec<&edit::Edit> = Vec::new();
     for e in edits {
@@ -362,7 +349,8 @@ fn baked_by_part<'a>(
         names,
     );
     if applied.dropped != crate::bake::prune::Dropped::default() || !applied.files.is_empty() {
-        // Dropping renumbers references the part does not hold.
+        // Dropping renumbers references the part does not hold; files to write would be
+        // images the bake did not write as it encoded them.
         *baked = as_baked;
         return Ok(None);
     }
@@ -374,7 +362,7 @@ fn baked_by_part<'a>(
         Some(written) => written,
         None => {
             // A text the splicer does not take: the edits on the whole document.
-            let mut whole = asset.json().clone();
+            let mut whole = asset.root().to_value();
             for e in others.iter().copied().chain(&part_edits) {
                 edit::apply(&mut whole, std::slice::from_ref(e)).map_err(fail)?;
             }
