@@ -14,6 +14,7 @@ use std::collections::BTreeSet;
 use serde_json::Value;
 
 use crate::asset::pointer;
+use crate::asset::tape::JsonView;
 use crate::rules::texture_sources;
 
 /// What was dropped (indices before dropping).
@@ -29,30 +30,41 @@ pub struct Dropped {
     pub bin_bytes: usize,
 }
 
-/// Every (pointer, index) naming a texture.
-fn texture_refs(json: &Value) -> Vec<(String, usize)> {
-    fn walk(value: &Value, at: &str, key: &str, out: &mut Vec<(String, usize)>) {
-        match value {
-            Value::Object(map) => {
-                if key.ends_with("Texture") {
-                    if let Some(i) = map.get("index").and_then(Value::as_u64) {
-                        out.push((format!("{at}/index"), i as usize));
-                    }
-                }
-                for (k, v) in map {
-                    walk(v, &pointer::join(at, k), k, out);
-                }
-            }
-            Value::Array(items) => {
-                for (i, v) in items.iter().enumerate() {
-                    walk(v, &format!("{at}/{i}"), key, out);
+/// Every (pointer, index) naming a texture: the `index` of an object under a key ending in
+/// `Texture`. Read from a document or from its index alike (migrate's bake part asks the
+/// loaded text which replaced textures are named outside it, by this same convention).
+pub(crate) fn texture_refs<'a>(json: impl JsonView<'a>) -> Vec<(String, usize)> {
+    fn walk<'a>(
+        value: impl JsonView<'a>,
+        at: &mut String,
+        key: &str,
+        out: &mut Vec<(String, usize)>,
+    ) {
+        if let Some(members) = value.members() {
+            if key.ends_with("Texture") {
+                if let Some(i) = value.member("index").and_then(JsonView::unsigned) {
+                    out.push((format!("{at}/index"), i as usize));
                 }
             }
-            _ => {}
+            for (k, v) in members {
+                let len = at.len();
+                at.push('/');
+                pointer::push_escaped(at, &k);
+                walk(v, at, &k, out);
+                at.truncate(len);
+            }
+        } else if let Some(len) = value.length() {
+            for (i, v) in (0..len).filter_map(|i| Some((i, value.element(i)?))) {
+                let end = at.len();
+                at.push('/');
+                at.push_str(&i.to_string());
+                walk(v, at, key, out);
+                at.truncate(end);
+            }
         }
     }
     let mut out = Vec::new();
-    walk(json, "", "", &mut out);
+    walk(json, &mut String::new(), "", &mut out);
     out
 }
 
@@ -144,7 +156,7 @@ pub fn prune(
     images: &BTreeSet<usize>,
 ) -> Dropped {
     let mut dropped = Dropped::default();
-    let t_refs = texture_refs(json);
+    let t_refs = texture_refs(&*json);
     let drop_textures: BTreeSet<usize> = textures
         .iter()
         .copied()

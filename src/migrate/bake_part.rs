@@ -21,7 +21,7 @@ use std::collections::{BTreeMap, BTreeSet};
 
 use serde_json::{Map, Value};
 
-use crate::asset::tape::{Kind, Node};
+use crate::asset::tape::Node;
 use crate::asset::{pointer, Asset};
 use crate::bake::plan::BakePlan;
 use crate::edit::Edit;
@@ -73,14 +73,15 @@ impl BakePart {
         // The places the edits set first, in their order (new keys go into an object in the
         // order the edits add them), then the layers baked.
         let mut places: BTreeMap<usize, Vec<String>> = BTreeMap::new();
-        for material in &document.materials {
-            let Some(baked) = layers.get(&material.index) else {
-                continue;
-            };
-            let prefix = format!("/materials/{}/", material.index);
-            let list = places.entry(material.index).or_default();
-            for edit in &material.edits {
-                list.push(match edit {
+        for (&material, baked) in &layers {
+            let prefix = format!("/materials/{material}/");
+            let edits = document
+                .materials
+                .binary_search_by_key(&material, |m| m.index)
+                .map_or(&[][..], |at| &document.materials[at].edits[..]);
+            let list = edits
+                .iter()
+                .map(|edit| match edit {
                     Edit::Set { pointer, .. }
                     | Edit::Replace { pointer, .. }
                     | Edit::Remove { pointer }
@@ -89,15 +90,11 @@ impl BakePart {
                         pointer.clone()
                     }
                     // Anything else: the whole material.
-                    _ => format!("/materials/{}", material.index),
-                });
-            }
-            list.extend(baked.iter().map(|p| p.to_string()));
-        }
-        for (material, baked) in &layers {
-            places
-                .entry(*material)
-                .or_insert_with(|| baked.iter().map(|p| p.to_string()).collect());
+                    _ => format!("/materials/{material}"),
+                })
+                .chain(baked.iter().map(|p| p.to_string()))
+                .collect();
+            places.insert(material, list);
         }
         for list in places.values_mut() {
             let all = list.clone();
@@ -113,21 +110,19 @@ impl BakePart {
         let root = asset.root();
         let object = root.as_object().filter(|o| !o.has_duplicate_keys())?;
         let mut named_elsewhere = BTreeSet::new();
-        for (key, node) in object.iter() {
-            let mut found = Vec::new();
-            let mut at = pointer::join("", &key);
-            naming(node, &mut at, &key, &replaced, &mut found);
-            for (info, texture) in found {
-                let material = match pointer::tokens(&info).as_slice() {
-                    [member, index, ..] if member == "materials" => index.parse::<usize>().ok(),
-                    _ => None,
-                };
-                let held = material
-                    .and_then(|m| places.get(&m))
-                    .is_some_and(|list| list.iter().any(|p| *p == info || inside(&info, p)));
-                if !held {
-                    named_elsewhere.insert(texture);
-                }
+        for (index, texture) in crate::bake::prune::texture_refs(root) {
+            if !replaced.contains(&texture) {
+                continue;
+            }
+            let material = match pointer::tokens(&index).as_slice() {
+                [member, i, ..] if member == "materials" => i.parse::<usize>().ok(),
+                _ => None,
+            };
+            let held = material
+                .and_then(|m| places.get(&m))
+                .is_some_and(|list| list.iter().any(|p| inside(&index, p)));
+            if !held {
+                named_elsewhere.insert(texture);
             }
         }
         let mut part = Map::new();
@@ -223,53 +218,6 @@ impl BakePart {
             edits.push(Edit::replace(pointer::join("", &key), value));
         }
         edits
-    }
-}
-
-/// Appends to `found` the pointer of every textureInfo in `node` (at pointer `at`, the value
-/// of `key`) that names one of `textures`, with the texture it names, found as a bake's pruning finds references: an
-/// object under a key ending in `Texture` with an integer `index`.
-fn naming(
-    node: Node,
-    at: &mut String,
-    key: &str,
-    textures: &BTreeSet<usize>,
-    found: &mut Vec<(String, usize)>,
-) {
-    match node.kind() {
-        Kind::Object => {
-            let Some(object) = node.as_object() else {
-                return;
-            };
-            if key.ends_with("Texture") {
-                let index = object.get("index").and_then(|i| i.as_u64());
-                if let Some(i) = index.filter(|i| textures.contains(&(*i as usize))) {
-                    found.push((at.clone(), i as usize));
-                }
-            }
-            for (k, v) in object.iter() {
-                let len = at.len();
-                at.push('/');
-                pointer::push_escaped(at, &k);
-                naming(v, at, &k, textures, found);
-                at.truncate(len);
-            }
-        }
-        Kind::Array => {
-            for (i, v) in node
-                .as_array()
-                .into_iter()
-                .flat_map(|a| a.iter())
-                .enumerate()
-            {
-                let len = at.len();
-                at.push('/');
-                at.push_str(&i.to_string());
-                naming(v, at, key, textures, found);
-                at.truncate(len);
-            }
-        }
-        _ => {}
     }
 }
 
