@@ -192,8 +192,6 @@ pub fn splice_edits<'t, 'e>(
     if !reads_back || members_after + removed != members_before + added {
         return Ok(None);
     }
-    drop(index);
-    drop(out);
     Ok(Some((spliced, changed)))
 }
 
@@ -209,31 +207,12 @@ pub struct Spliced<'t> {
 impl<'t> Spliced<'t> {
     /// `None` if two splices overlap (never produced, but never risked).
     fn new(source: &'t str, mut splices: Vec<Splice>) -> Option<Spliced<'t>> {
-        splices.sort_by_key(|s| (s.start, s.end));
-        let mut at = 0;
-        for s in &splices {
-            if s.start < at || s.end > source.len() {
-                return None;
-            }
-            at = s.end;
-        }
-        Some(Spliced { source, splices })
+        in_order(&mut splices, 0..source.len()).then_some(Spliced { source, splices })
     }
 
     /// The text in order: spans of the source and the splices' texts between them.
     fn runs(&self) -> impl Iterator<Item = &str> + '_ {
-        let mut at = 0;
-        self.splices
-            .iter()
-            .flat_map(move |s| {
-                let kept = &self.source[at..s.start];
-                at = s.end;
-                [kept, s.text.as_str()]
-            })
-            .chain(std::iter::once_with(move || {
-                let last = self.splices.last().map_or(0, |s| s.end);
-                &self.source[last..]
-            }))
+        runs(self.source, 0..self.source.len(), &self.splices)
     }
 
     /// The text's bytes in order, a run at a time.
@@ -544,29 +523,54 @@ fn feed_edited(d: &mut Digest, node: Node, sets: &[(&[String], &Value)]) {
     }
 }
 
-/// Whether the value spanning `within` in `text` reads back as `digest` once `splices` (all
-/// inside that span) are made: the read-back check of one unit. The rest of the text is copied
-/// as it was, so a text whose every changed span reads back holds the whole document meant.
-fn reads_back_within(
-    text: &str,
-    within: std::ops::Range<usize>,
-    splices: &[Splice],
-    digest: u64,
-) -> bool {
-    let mut order: Vec<&Splice> = splices.iter().collect();
-    order.sort_by_key(|s| (s.start, s.end));
-    let added: usize = splices.iter().map(|s| s.text.len()).sum();
-    let mut out = String::with_capacity(within.len() + added);
+/// Sorts `splices` and tells whether they lie inside `within`, none overlapping another.
+fn in_order(splices: &mut [Splice], within: std::ops::Range<usize>) -> bool {
+    splices.sort_by_key(|s| (s.start, s.end));
     let mut at = within.start;
-    for s in order {
+    for s in splices.iter() {
         if s.start < at || s.end > within.end {
             return false;
         }
-        out.push_str(&text[at..s.start]);
-        out.push_str(&s.text);
         at = s.end;
     }
-    out.push_str(&text[at..within.end]);
+    true
+}
+
+/// `text[within]` with `splices` (in order, inside `within`) made, a run at a time: spans of
+/// the text and the splices' texts between them.
+fn runs<'a>(
+    text: &'a str,
+    within: std::ops::Range<usize>,
+    splices: &'a [Splice],
+) -> impl Iterator<Item = &'a str> + 'a {
+    let mut at = within.start;
+    splices
+        .iter()
+        .flat_map(move |s| {
+            let kept = &text[at..s.start];
+            at = s.end;
+            [kept, s.text.as_str()]
+        })
+        .chain(std::iter::once_with(move || {
+            let last = splices.last().map_or(within.start, |s| s.end);
+            &text[last..within.end]
+        }))
+}
+
+/// Whether the value spanning `within` in `text` reads back as `digest` once `splices` (all
+/// inside that span; sorted here) are made: the read-back check of one unit. The rest of the
+/// text is copied as it was, so a text whose every changed span reads back holds the whole
+/// document meant.
+fn reads_back_within(
+    text: &str,
+    within: std::ops::Range<usize>,
+    splices: &mut [Splice],
+    digest: u64,
+) -> bool {
+    if !in_order(splices, within.clone()) {
+        return false;
+    }
+    let out: String = runs(text, within, splices).collect();
     match crate::asset::tape::Tape::build(&out) {
         Ok(index) => node_digest(index.root(&out)) == digest,
         Err(_) => false,
@@ -596,10 +600,10 @@ fn splice_unit(
                 return Ok(None);
             };
             let prefix = format!("/{}/{i}", crate::asset::pointer::escape(&unit.member));
-            if let Some((splices, changed, digest)) =
+            if let Some((mut splices, changed, digest)) =
                 members_set_in_place(text, element, &prefix, edits, layout)
             {
-                let checked = reads_back_within(text, element.span(), &splices, digest);
+                let checked = reads_back_within(text, element.span(), &mut splices, digest);
                 return Ok(Some(UnitSplices {
                     splices,
                     changed,
@@ -650,7 +654,12 @@ fn splice_unit(
             }
             diff(text, element, &value, layout, &mut splices);
             let digest = value_digest(&value);
-            checked = Some(reads_back_within(text, element.span(), &splices, digest));
+            checked = Some(reads_back_within(
+                text,
+                element.span(),
+                &mut splices,
+                digest,
+            ));
             meant = (prefix, Some(digest));
         }
         (_, node) => {
@@ -666,7 +675,7 @@ fn splice_unit(
                 (Some(node), Some(new)) => {
                     diff(text, node, new, layout, &mut splices);
                     let digest = value_digest(new);
-                    checked = Some(reads_back_within(text, node.span(), &splices, digest));
+                    checked = Some(reads_back_within(text, node.span(), &mut splices, digest));
                 }
                 (Some(_), None) => {
                     let Some(i) = entries
@@ -1693,10 +1702,10 @@ mod tests {
         assert!(reads_back_within(
             text,
             span.clone(),
-            &[splice(end, end, r#", "c": 0.5"#)],
+            &mut [splice(end, end, r#", "c": 0.5"#)],
             meant
         ));
-        for wrong in [
+        for mut wrong in [
             vec![splice(end, end, r#", "c": 0.25"#)],
             vec![splice(end, end, r#" "c": 0.5"#)],
             vec![splice(end, end, r#", "c": 0.5}"#)],
@@ -1704,7 +1713,7 @@ mod tests {
             // A splice outside the unit's span is never taken for it.
             vec![splice(span.end, span.end, r#", "c": 0.5"#)],
         ] {
-            assert!(!reads_back_within(text, span.clone(), &wrong, meant));
+            assert!(!reads_back_within(text, span.clone(), &mut wrong, meant));
         }
     }
 
