@@ -40,16 +40,14 @@ fn injected_fault() -> Option<Fault> {
 /// Writes `output` into a temporary file, or half of it and then the injected fault.
 fn write_temporary(file: &mut impl Write, output: &Output) -> io::Result<()> {
     static WRITES: AtomicUsize = AtomicUsize::new(0);
-    let Some(fault) = injected_fault() else {
+    // The writes before the first `after` are whole.
+    let fault = injected_fault().filter(|fault| {
+        let (Fault::Error { after } | Fault::Abort { after }) = *fault;
+        WRITES.fetch_add(1, Ordering::SeqCst) >= after
+    });
+    let Some(fault) = fault else {
         return output.pieces().try_for_each(|piece| file.write_all(piece));
     };
-    let n = WRITES.fetch_add(1, Ordering::SeqCst);
-    let after = match fault {
-        Fault::Error { after } | Fault::Abort { after } => after,
-    };
-    if n < after {
-        return output.pieces().try_for_each(|piece| file.write_all(piece));
-    }
     let mut half = output.len() / 2;
     for piece in output.pieces() {
         let take = piece.len().min(half);
