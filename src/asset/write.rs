@@ -46,7 +46,7 @@ fn write_temporary(file: &mut impl Write, output: &Output) -> io::Result<()> {
         WRITES.fetch_add(1, Ordering::SeqCst) >= after
     });
     let Some(fault) = fault else {
-        return output.pieces().try_for_each(|piece| file.write_all(piece));
+        return write_pieces(file, output.pieces());
     };
     let mut half = output.len() / 2;
     for piece in output.pieces() {
@@ -62,6 +62,34 @@ fn write_temporary(file: &mut impl Write, output: &Output) -> io::Result<()> {
         Fault::Abort { .. } => std::process::abort(),
         Fault::Error { .. } => Err(io::Error::other("injected write fault")),
     }
+}
+
+/// The most pieces one write hands the kernel (Linux's `IOV_MAX`).
+const PIECES_PER_WRITE: usize = 1024;
+
+/// Writes `pieces` in order, many to a call (`writev`): a spliced output is a run of the
+/// source and a splice per edit, and a migration of every material of a large document has
+/// tens of thousands of them, which one write each would spend most of the writing on calls.
+fn write_pieces<'p>(
+    file: &mut impl Write,
+    pieces: impl Iterator<Item = &'p [u8]>,
+) -> io::Result<()> {
+    let mut pieces = pieces.filter(|p| !p.is_empty()).peekable();
+    let mut batch: Vec<io::IoSlice> = Vec::with_capacity(PIECES_PER_WRITE);
+    while pieces.peek().is_some() {
+        batch.clear();
+        batch.extend(pieces.by_ref().take(PIECES_PER_WRITE).map(io::IoSlice::new));
+        let mut slices = batch.as_mut_slice();
+        while !slices.is_empty() {
+            match file.write_vectored(slices) {
+                Ok(0) => return Err(io::ErrorKind::WriteZero.into()),
+                Ok(n) => io::IoSlice::advance_slices(&mut slices, n),
+                Err(e) if e.kind() == io::ErrorKind::Interrupted => {}
+                Err(e) => return Err(e),
+            }
+        }
+    }
+    Ok(())
 }
 
 /// How the input's JSON was laid out, so that an edited file keeps its look.
@@ -360,5 +388,77 @@ mod tests {
         let target = dir.path().join("missing").join("out.gltf");
         assert!(write_atomic(&target, b"x").is_err());
         assert!(!target.exists());
+    }
+
+    /// A writer that takes at most `bytes` bytes from at most `slices` slices a call, and
+    /// counts its calls: the short writes a file or pipe may make.
+    struct Trickle {
+        got: Vec<u8>,
+        bytes: usize,
+        slices: usize,
+        calls: usize,
+    }
+
+    impl Trickle {
+        fn new(bytes: usize, slices: usize) -> Trickle {
+            Trickle {
+                got: Vec::new(),
+                bytes,
+                slices,
+                calls: 0,
+            }
+        }
+    }
+
+    impl Write for Trickle {
+        fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+            self.write_vectored(&[io::IoSlice::new(buf)])
+        }
+
+        fn write_vectored(&mut self, bufs: &[io::IoSlice<'_>]) -> io::Result<usize> {
+            self.calls += 1;
+            let mut taken = 0;
+            for buf in bufs.iter().take(self.slices) {
+                let n = buf.len().min(self.bytes - taken);
+                self.got.extend_from_slice(&buf[..n]);
+                taken += n;
+                if n < buf.len() {
+                    break;
+                }
+            }
+            Ok(taken)
+        }
+
+        fn flush(&mut self) -> io::Result<()> {
+            Ok(())
+        }
+    }
+
+    /// 3,000 pieces (more than two batches of `PIECES_PER_WRITE`), every third one empty.
+    fn pieces() -> Vec<Vec<u8>> {
+        (0..3000u32)
+            .map(|i| match i % 3 {
+                0 => Vec::new(),
+                _ => format!("{i},").into_bytes(),
+            })
+            .collect()
+    }
+
+    #[test]
+    fn pieces_are_written_whole_and_in_order_through_short_writes() {
+        let pieces = pieces();
+        let mut short = Trickle::new(5, 2);
+        write_pieces(&mut short, pieces.iter().map(Vec::as_slice)).unwrap();
+        assert_eq!(short.got, pieces.concat());
+    }
+
+    #[test]
+    fn pieces_go_out_a_batch_a_call() {
+        let pieces = pieces();
+        let mut file = Trickle::new(usize::MAX, usize::MAX);
+        write_pieces(&mut file, pieces.iter().map(Vec::as_slice)).unwrap();
+        assert_eq!(file.got, pieces.concat());
+        // 2,000 non-empty pieces, 1,024 a call.
+        assert_eq!(file.calls, 2);
     }
 }
