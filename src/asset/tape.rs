@@ -563,6 +563,11 @@ impl<'a> Node<'a> {
         }
     }
 
+    /// The whole text the index was built from, of which this value is a span.
+    pub fn text(&self) -> &'a str {
+        self.text
+    }
+
     /// The value's text, as written.
     pub fn raw(&self) -> &'a str {
         let e = self.entry();
