@@ -611,7 +611,9 @@ fn reads_back_within(
     if !in_order(splices, within.clone()) {
         return false;
     }
-    let out: String = runs(text, within, splices).collect();
+    let added: usize = splices.iter().map(|s| s.text.len()).sum();
+    let mut out = String::with_capacity(within.len() + added);
+    runs(text, within, splices).for_each(|run| out.push_str(run));
     match crate::asset::tape::Tape::build(&out) {
         Ok(index) => node_digest(index.root(&out)) == digest,
         Err(_) => false,
@@ -1523,7 +1525,9 @@ fn insert_members(
         format!(",{}{indent}", layout.newline)
     };
     let member_text = |key: &str, value: &Value| {
-        let mut text = String::new();
+        // Room for a layer object of a few members, so that writing it grows the string once
+        // at most.
+        let mut text = String::with_capacity(256);
         push_quoted(&mut text, key);
         text.push_str(&layout.colon);
         layout.write(value, &indent, inline || layout.unit.is_none(), &mut text);
