@@ -75,15 +75,28 @@ fn write_pieces<'p>(
     pieces: impl Iterator<Item = &'p [u8]>,
 ) -> io::Result<()> {
     let mut pieces = pieces.filter(|p| !p.is_empty()).peekable();
-    let mut batch: Vec<io::IoSlice> = Vec::with_capacity(PIECES_PER_WRITE);
+    let mut pending: Vec<&[u8]> = Vec::with_capacity(PIECES_PER_WRITE);
+    let mut slices: Vec<io::IoSlice> = Vec::with_capacity(PIECES_PER_WRITE);
     while pieces.peek().is_some() {
-        batch.clear();
-        batch.extend(pieces.by_ref().take(PIECES_PER_WRITE).map(io::IoSlice::new));
-        let mut slices = batch.as_mut_slice();
-        while !slices.is_empty() {
-            match file.write_vectored(slices) {
+        pending.clear();
+        pending.extend(pieces.by_ref().take(PIECES_PER_WRITE));
+        let mut first = 0;
+        while first < pending.len() {
+            slices.clear();
+            slices.extend(pending[first..].iter().map(|p| io::IoSlice::new(p)));
+            match file.write_vectored(&slices) {
                 Ok(0) => return Err(io::ErrorKind::WriteZero.into()),
-                Ok(n) => io::IoSlice::advance_slices(&mut slices, n),
+                Ok(mut written) => {
+                    // A short write: the pieces it took whole are done, the next one is
+                    // taken from where it stopped.
+                    while first < pending.len() && written >= pending[first].len() {
+                        written -= pending[first].len();
+                        first += 1;
+                    }
+                    if written > 0 {
+                        pending[first] = &pending[first][written..];
+                    }
+                }
                 Err(e) if e.kind() == io::ErrorKind::Interrupted => {}
                 Err(e) => return Err(e),
             }
