@@ -46,26 +46,27 @@ impl Rule for Fallback {
             let Some(fuzz) = pair.fuzz else {
                 continue;
             };
-            let fuzz_pointer = format!("/materials/{i}/extensions/{}", layers::FUZZ);
             match pair.sheen {
                 None if !fuzz_required && fuzz.is_on() => out.push(Diagnostic::new(
                     &FUZZ_WITHOUT_FALLBACK,
-                    &fuzz_pointer,
+                    format!("/materials/{i}/extensions/{}", layers::FUZZ),
                     "loaders without KHR_materials_fuzz show no layer here; `velvet migrate` adds a KHR_materials_sheen fallback",
                 )),
                 None => {}
                 Some(sheen) => {
                     let sheen_pointer = format!("/materials/{i}/extensions/{}", layers::SHEEN);
+                    let contradiction =
+                        (sheen.is_on() != fuzz.is_on()).then(|| sheen_pointer.clone());
                     out.push(Diagnostic::new(
                         &FUZZ_WITH_SHEEN_FALLBACK,
-                        &sheen_pointer,
+                        sheen_pointer,
                         "KHR_materials_fuzz takes precedence; this sheen is the fallback for loaders without it",
                     ));
-                    if sheen.is_on() != fuzz.is_on() {
+                    if let Some(sheen_pointer) = contradiction {
                         let (on, off) = if fuzz.is_on() { ("fuzz", "sheen fallback") } else { ("sheen fallback", "fuzz") };
                         out.push(Diagnostic::new(
                             &FUZZ_FALLBACK_CONTRADICTS,
-                            &sheen_pointer,
+                            sheen_pointer,
                             format!("the {on} is switched on but the {off} is off: loaders with and without fuzz disagree on whether this material has a layer"),
                         ));
                     }

@@ -20,6 +20,13 @@ impl Rule for FuzzRoughnessDefault {
     }
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
+        // One text for every finding, written once.
+        let message = format!(
+            "fuzzRoughnessFactor is omitted: the draft's table gives {} and its schema {}; loaders may differ, so write it explicitly (velvet assumes {})",
+            layers::FUZZ_ROUGHNESS_DEFAULT_TABLE,
+            layers::FUZZ_ROUGHNESS_DEFAULT_SCHEMA,
+            layers::FUZZ_ROUGHNESS_DEFAULT_TABLE
+        );
         for read in cx.layers() {
             let (layer, Some(fuzz)) = (read.object, read.fuzz()) else {
                 continue;
@@ -28,12 +35,7 @@ impl Rule for FuzzRoughnessDefault {
                 out.push(Diagnostic::new(
                     &FUZZ_ROUGHNESS_DEFAULT_AMBIGUOUS,
                     layer.pointer(),
-                    format!(
-                        "fuzzRoughnessFactor is omitted: the draft's table gives {} and its schema {}; loaders may differ, so write it explicitly (velvet assumes {})",
-                        layers::FUZZ_ROUGHNESS_DEFAULT_TABLE,
-                        layers::FUZZ_ROUGHNESS_DEFAULT_SCHEMA,
-                        layers::FUZZ_ROUGHNESS_DEFAULT_TABLE
-                    ),
+                    message.clone(),
                 ));
             }
         }

@@ -24,14 +24,20 @@ impl Rule for LegacySheen {
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
         for layer in cx.layer_objects().filter(|l| l.extension == layers::SHEEN) {
+            // Written once per layer that has a finding, and joined rather than formatted: a
+            // draft-era library has thousands.
+            let mut layer_pointer = None;
             for name in LEGACY_PROPERTIES {
                 if layer.value.get(name).is_some() {
+                    let at = layer_pointer.get_or_insert_with(|| layer.pointer());
                     out.push(Diagnostic::new(
                         &SHEEN_LEGACY_DRAFT,
-                        pointer::join(&layer.pointer(), name),
-                        format!(
-                            "{name} belongs to the pre-ratification KHR_materials_sheen draft and is ignored by ratified loaders; `velvet migrate` upgrades it"
-                        ),
+                        pointer::join(at, name),
+                        [
+                            name,
+                            " belongs to the pre-ratification KHR_materials_sheen draft and is ignored by ratified loaders; `velvet migrate` upgrades it",
+                        ]
+                        .concat(),
                     ));
                 }
             }
