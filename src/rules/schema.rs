@@ -279,9 +279,14 @@ impl Rule for SchemaCheck {
                 continue;
             }
             let at = layer.pointer();
+            // Each field but the pointer copied: a clone of the whole finding would copy its
+            // relative pointer only to drop it.
             out.extend(found.iter().map(|d| Diagnostic {
-                pointer: format!("{at}{}", d.pointer),
-                ..d.clone()
+                code: d.code,
+                message: d.message.clone(),
+                severity: d.severity,
+                pointer: [at.as_str(), d.pointer.as_str()].concat(),
+                position: d.position,
             }));
         }
     }
