@@ -47,6 +47,16 @@ pub fn join(base: &str, segment: impl std::fmt::Display) -> String {
     out
 }
 
+/// The array index a reference token names: decimal digits without a leading zero (but `0`),
+/// as RFC 6901 and serde_json read it; `None` for any other token (`-`, a sign, `01`, a
+/// number past `usize`).
+pub fn array_index(token: &str) -> Option<usize> {
+    let canonical = !token.is_empty()
+        && token.bytes().all(|b| b.is_ascii_digit())
+        && (token == "0" || !token.starts_with('0'));
+    canonical.then(|| token.parse().ok()).flatten()
+}
+
 /// The reference tokens of a pointer, unescaped. `""` has none.
 pub fn tokens(pointer: &str) -> Vec<String> {
     if pointer.is_empty() {
@@ -79,5 +89,24 @@ mod tests {
         assert_eq!(join("/extras", "x/y"), "/extras/x~1y");
         assert_eq!(tokens("/a~1b/0/~0"), vec!["a/b", "0", "~"]);
         assert!(tokens("").is_empty());
+    }
+
+    #[test]
+    fn array_indices_are_digits_without_a_leading_zero_or_sign() {
+        assert_eq!(array_index("0"), Some(0));
+        assert_eq!(array_index("12"), Some(12));
+        for token in [
+            "",
+            "-",
+            "01",
+            "00",
+            "+1",
+            "-1",
+            "1a",
+            " 1",
+            "99999999999999999999999",
+        ] {
+            assert_eq!(array_index(token), None, "{token:?}");
+        }
     }
 }

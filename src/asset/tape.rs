@@ -683,13 +683,8 @@ impl<'a> Node<'a> {
             };
             node = match node.kind() {
                 Kind::Object => node.as_object()?.get(&token)?,
-                Kind::Array => {
-                    // As serde_json: decimal digits without a leading zero (but "0").
-                    if token.starts_with('+') || (token.len() > 1 && token.starts_with('0')) {
-                        return None;
-                    }
-                    node.as_array()?.get(token.parse().ok()?)?
-                }
+                // As serde_json: decimal digits without a leading zero (but "0").
+                Kind::Array => node.as_array()?.get(super::pointer::array_index(&token)?)?,
                 _ => return None,
             };
         }

@@ -132,13 +132,7 @@ fn array_index(token: &str, len: usize, append: bool, path: &str) -> Result<usiz
         return if append { Ok(len) } else { Err(bad()) };
     }
     // RFC 6901: no leading zeros, no sign.
-    if token.is_empty()
-        || (token.len() > 1 && token.starts_with('0'))
-        || !token.bytes().all(|b| b.is_ascii_digit())
-    {
-        return Err(bad());
-    }
-    let index: usize = token.parse().map_err(|_| bad())?;
+    let index = crate::asset::pointer::array_index(token).ok_or_else(bad)?;
     if index < len || (append && index == len) {
         Ok(index)
     } else {

@@ -127,8 +127,7 @@ pub fn splice_edits<'t, 'e>(
         };
         let element = second
             .filter(|_| within_element)
-            .map(crate::asset::pointer::unescape)
-            .and_then(|t| (t == "0" || !t.starts_with('0')).then(|| t.parse::<usize>().ok())?)
+            .and_then(|t| crate::asset::pointer::array_index(&crate::asset::pointer::unescape(t)))
             .filter(|i| members[m].len.is_some_and(|len| *i < len));
         if element.is_none() {
             members[m].whole = true;
@@ -502,14 +501,9 @@ fn member_or_element<'a>(node: Node<'a>, token: &str) -> Option<Node<'a>> {
             .as_object()
             .filter(|o| !o.has_duplicate_keys())?
             .get(token),
-        Kind::Array => {
-            let canonical = token == "0" || (!token.starts_with('0') && !token.is_empty());
-            let index = token
-                .parse::<usize>()
-                .ok()
-                .filter(|_| canonical && token.bytes().all(|b| b.is_ascii_digit()))?;
-            node.as_array()?.get(index)
-        }
+        Kind::Array => node
+            .as_array()?
+            .get(crate::asset::pointer::array_index(token)?),
         _ => None,
     }
 }
