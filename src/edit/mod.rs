@@ -42,6 +42,20 @@ impl Edit {
         }
     }
 
+    /// The same edit at `pointer`: an edit of a part of the document, given from the part's
+    /// own root. A declaration, which has no pointer, is itself.
+    pub fn at(&self, pointer: &str) -> Edit {
+        match self {
+            Edit::Set { value, .. } => Edit::Set {
+                pointer: pointer.to_string(),
+                value: value.clone(),
+            },
+            Edit::Replace { value, .. } => Edit::replace(pointer, value.clone()),
+            Edit::Remove { .. } => Edit::remove(pointer),
+            Edit::DeclareUsed { .. } => self.clone(),
+        }
+    }
+
     pub fn replace(pointer: impl Into<String>, value: Value) -> Edit {
         Edit::Replace {
             pointer: pointer.into(),

@@ -50,7 +50,7 @@ pub fn rewrite(text: &str, root: Node, after: &Value) -> Option<String> {
 
 /// A part of the document an edit plan changes: a top-level member, or one element of a
 /// top-level array (a material, an image).
-#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone)]
 struct Unit {
     /// The member's name, shared by every edit of it (a plan may name the same member by the
     /// ten thousand).
@@ -137,7 +137,8 @@ pub fn splice_edits<'t, 'e>(
     let mut units: Vec<(Unit, Vec<&Edit>)> = Vec::new();
     for (edit, m, element) in placed {
         let member = &mut members[m];
-        let slot = match element.filter(|_| !member.whole) {
+        let element = element.filter(|_| !member.whole);
+        let slot = match element {
             None => &mut member.whole_unit,
             Some(i) => {
                 if member.element_units.is_empty() {
@@ -150,7 +151,7 @@ pub fn splice_edits<'t, 'e>(
             units.push((
                 Unit {
                     member: member.name.clone(),
-                    element: element.filter(|_| !member.whole),
+                    element,
                 },
                 Vec::new(),
             ));
@@ -672,19 +673,8 @@ fn splice_unit(
                         changed |= value != *new;
                         value = new.clone();
                     }
-                    Edit::Set { value: new, .. } => {
-                        let within = Edit::set(within, new.clone());
-                        changed |= super::apply(&mut value, std::slice::from_ref(&within))
-                            .map_err(|e| from_root(e, &prefix))?;
-                    }
-                    Edit::Replace { value: new, .. } => {
-                        let within = Edit::replace(within, new.clone());
-                        changed |= super::apply(&mut value, std::slice::from_ref(&within))
-                            .map_err(|e| from_root(e, &prefix))?;
-                    }
                     _ => {
-                        let within = Edit::remove(within);
-                        changed |= super::apply(&mut value, std::slice::from_ref(&within))
+                        changed |= super::apply(&mut value, &[edit.at(within)])
                             .map_err(|e| from_root(e, &prefix))?;
                     }
                 }
