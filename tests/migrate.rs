@@ -83,6 +83,16 @@ fn request(inputs: Vec<PathBuf>, destination: Destination, options: Options) -> 
     }
 }
 
+/// Migrates `input` into the file `output` with the default options.
+fn migrate_to(input: &Path, output: &Path) -> migrate::RunReport {
+    migrate::run(&request(
+        vec![input.to_path_buf()],
+        Destination::File(output.to_path_buf()),
+        Options::default(),
+    ))
+    .unwrap()
+}
+
 fn blessing() -> bool {
     std::env::var_os("VELVET_BLESS").is_some()
 }
@@ -330,12 +340,7 @@ fn glb_in_gives_glb_out_with_padded_chunks_and_the_same_bin() {
     let input = dir.path().join("chair.glb");
     std::fs::write(&input, glb::join(json, Some(&bin))).unwrap();
     let output = dir.path().join("out.glb");
-    let report = migrate::run(&request(
-        vec![input.clone()],
-        Destination::File(output.clone()),
-        Options::default(),
-    ))
-    .unwrap();
+    let report = migrate_to(&input, &output);
     assert_eq!(report.files[0].outcome, FileOutcome::Changed);
     let bytes = std::fs::read(&output).unwrap();
     assert_eq!(
@@ -1491,12 +1496,7 @@ fn black_fuzz_with_an_intensity_texture_bakes_nothing_and_is_left_as_it_is() {
     )
     .unwrap();
     let output = dir.path().join("black.out.gltf");
-    let report = migrate::run(&request(
-        vec![input.clone()],
-        Destination::File(output.clone()),
-        Options::default(),
-    ))
-    .unwrap();
+    let report = migrate_to(&input, &output);
     let result = &report.files[0];
     assert_eq!(result.outcome, FileOutcome::Copied);
     assert_eq!(result.materials[0].skipped, Some(Skip::BlackFuzz));
@@ -1886,12 +1886,7 @@ fn a_migration_with_bakes_leaves_every_other_part_of_the_text_as_it_was() {
     let input = dir.path().join("chair.gltf");
     std::fs::write(&input, &text).unwrap();
     let output = dir.path().join("out/chair.gltf");
-    let report = migrate::run(&request(
-        vec![input.clone()],
-        Destination::File(output.clone()),
-        Options::default(),
-    ))
-    .unwrap();
+    let report = migrate_to(&input, &output);
     assert_eq!(report.files[0].outcome, FileOutcome::Changed);
     assert_eq!(report.files[0].textures_added, 1);
     let written = std::fs::read_to_string(&output).unwrap();
