@@ -26,6 +26,9 @@ pub fn push_escaped(out: &mut String, segment: &str) {
 
 /// Undoes `escape`.
 pub fn unescape(token: &str) -> String {
+    if !token.contains('~') {
+        return token.to_string();
+    }
     token.replace("~1", "/").replace("~0", "~")
 }
 

@@ -714,7 +714,19 @@ impl<'a> Node<'a> {
     /// The value as a `serde_json::Value`, for the few places that need one (error reports,
     /// comparisons of whole values).
     pub fn to_value(&self) -> Value {
-        serde_json::from_str(self.raw()).unwrap_or(Value::Null)
+        match self.kind() {
+            // A scalar is made directly (a number keeps its text, as serde_json reads it).
+            Kind::Null => Value::Null,
+            Kind::Bool => Value::Bool(self.as_bool() == Some(true)),
+            Kind::Number => self
+                .raw()
+                .parse::<serde_json::Number>()
+                .map_or(Value::Null, Value::Number),
+            Kind::String => self
+                .as_str()
+                .map_or(Value::Null, |s| Value::String(s.into_owned())),
+            Kind::Array | Kind::Object => serde_json::from_str(self.raw()).unwrap_or(Value::Null),
+        }
     }
 }
 

@@ -178,17 +178,17 @@ pub fn splice_edits<'t, 'e>(
         let Some(unit) = unit? else {
             return Ok(None);
         };
-        match unit.checked {
-            Some(false) => return Ok(None),
-            Some(true) => {}
-            None => all_checked = false,
+        match unit.check {
+            UnitCheck::Alone(false) => return Ok(None),
+            UnitCheck::Alone(true) => {}
+            // Only what was not read back alone is read back from the whole text.
+            UnitCheck::Whole(pointer, digest) => {
+                all_checked = false;
+                meant.push((pointer, digest));
+            }
         }
         splices.extend(unit.splices);
         changed |= unit.changed;
-        if unit.checked.is_none() {
-            // Only what was not read back alone is read back from the whole text.
-            meant.push(unit.meant);
-        }
     }
     let Some(spliced) = Spliced::new(text, splices) else {
         return Ok(None);
@@ -271,17 +271,24 @@ impl<'t> Spliced<'t> {
     }
 }
 
-/// What one unit contributes: its splices, whether its edits changed it, and what it must
-/// read back as (its pointer, the [`value_digest`] of its value; `None` when removed). A
-/// digest, not the value, is kept so that a plan touching every material does not hold them all.
+/// What one unit contributes: its splices, whether its edits changed it, and how it was
+/// checked.
 struct UnitSplices {
     splices: Vec<Splice>,
     changed: bool,
-    meant: (String, Option<u64>),
-    /// Whether the unit's value reads back as meant, when all its splices lie inside one value
-    /// of the loaded text and that value was checked alone ([`reads_back_within`]); `None` when
-    /// only the whole written text can tell (a top-level member added or removed).
-    checked: Option<bool>,
+    check: UnitCheck,
+}
+
+/// How a unit's new text is known to read back as meant.
+enum UnitCheck {
+    /// Checked alone, when all its splices lie inside one value of the loaded text: whether
+    /// that value reads back as meant ([`reads_back_within`], or for members inserted into
+    /// objects, [`inserted_members_read_as`]).
+    Alone(bool),
+    /// Only the whole written text can tell (a top-level member added or removed): the unit's
+    /// pointer and the [`value_digest`] of its value (`None` when removed). A digest, not the
+    /// value, is kept so that a plan touching every material does not hold them all.
+    Whole(String, Option<u64>),
 }
 
 /// A digest of what a value reads as when velvet writes it: key order, decoded strings, and
@@ -403,9 +410,10 @@ struct MemberSet<'e> {
 /// element already holds (the fuzz object a migration adds to a material's `extensions`, a factor it
 /// replaces), made from the index alone: the element is not read into a value, edited and
 /// compared with its text, which for a migration of every material was most of the writer's
-/// work. Returns the splices, whether they change anything, and the digest the element must
-/// read back as, fed from the index with the set values in their places, as the edited value
-/// would feed it. `None` for edits of another kind (a removal, an array element, a path through
+/// work. Returns the splices, whether they change anything, and how the element reads back
+/// as meant: when every edit adds a member, whether each inserted text reads as its members
+/// ([`inserted_members_read_as`]); otherwise the digest the element must read back as, fed
+/// from the index with the set values in their places, as the edited value would feed it. `None` for edits of another kind (a removal, an array element, a path through
 /// a missing key or an object that writes a key twice, two edits of one place); the caller then
 /// takes the general way.
 fn members_set_in_place(
@@ -414,7 +422,7 @@ fn members_set_in_place(
     prefix: &str,
     edits: &[&Edit],
     layout: &Layout,
-) -> Option<(Vec<Splice>, bool, u64)> {
+) -> Option<(Vec<Splice>, bool, ElementCheck)> {
     use std::borrow::Cow;
     let mut sets: Vec<MemberSet> = Vec::with_capacity(edits.len());
     for edit in edits {
@@ -444,6 +452,8 @@ fn members_set_in_place(
     }
     let mut splices = Vec::new();
     let mut changed = false;
+    // Whether some edit sets a member the element holds already.
+    let mut replaced = false;
     // New members by the object that receives them, in the order the edits add them.
     let mut inserts: Vec<(Node, Vec<(&str, &Value)>)> = Vec::new();
     for set in &sets {
@@ -457,6 +467,7 @@ fn members_set_in_place(
             .filter(|o| !o.is_empty() && !o.has_duplicate_keys())?;
         match object.get(key) {
             Some(old) => {
+                replaced = true;
                 changed |= !matches(old, &set.value, Compare::Exact);
                 diff(text, old, &set.value, layout, &mut splices);
             }
@@ -485,13 +496,57 @@ fn members_set_in_place(
             .collect();
         insert_members(text, *parent, &members, &placed, layout, &mut splices);
     }
+    if !replaced {
+        // Only new members, each put after the last member of an object that holds no such
+        // key (checked above, with no key written twice): every other byte of the element is
+        // its own, so it reads back as meant exactly when each inserted text reads as the
+        // members it adds. One insertion per object, in the order of `inserts`.
+        let reads_back = splices.len() == inserts.len()
+            && splices
+                .iter()
+                .zip(&inserts)
+                .all(|(splice, (_, new))| inserted_members_read_as(&splice.text, new));
+        return Some((splices, changed, ElementCheck::Inserted(reads_back)));
+    }
     let mut d = Digest::new();
     let sets: Vec<(&[String], &Value)> = sets
         .iter()
         .map(|s| (s.tokens.as_slice(), s.value.as_ref()))
         .collect();
     feed_edited(&mut d, element, &sets);
-    Some((splices, changed, d.finish()))
+    Some((splices, changed, ElementCheck::Digest(d.finish())))
+}
+
+/// How [`members_set_in_place`] knows its element reads back as meant.
+enum ElementCheck {
+    /// Members were only added: whether each inserted text reads as its members.
+    Inserted(bool),
+    /// The digest the element's new text must read back as.
+    Digest(u64),
+}
+
+/// Whether `inserted`, the text put after an object's last member, reads as `members` added
+/// after it: for each, a comma, its key, a colon and its value as velvet writes it; then
+/// nothing but whitespace. The scan validates what it reads (a key's characters and escapes,
+/// each scalar parsed), so the object stays JSON with exactly these members added.
+fn inserted_members_read_as(inserted: &str, members: &[(&str, &Value)]) -> bool {
+    let mut scanner = Scanner {
+        text: inserted,
+        at: 0,
+    };
+    for (key, value) in members {
+        if scanner.eat(b',').is_none() {
+            return false;
+        }
+        let Some(at) = scanner.key() else {
+            return false;
+        };
+        if key_at(inserted, at).as_deref() != Some(*key) || scanner.holds(value) != Some(true) {
+            return false;
+        }
+    }
+    scanner.skip_ws();
+    scanner.at == inserted.len()
 }
 
 /// The member `token` of an object that writes each key once, or element `token` (written
@@ -629,24 +684,36 @@ fn splice_unit(
 ) -> Result<Option<UnitSplices>, EditError> {
     let mut splices = Vec::new();
     let mut changed = false;
-    let meant: (String, Option<u64>);
-    let mut checked = None;
+    let check: UnitCheck;
     let node = object.get(&unit.member);
     match (unit.element, node) {
         (Some(i), Some(node)) => {
             let Some(element) = node.get(i) else {
                 return Ok(None);
             };
-            let prefix = format!("/{}/{i}", crate::asset::pointer::escape(&unit.member));
-            if let Some((mut splices, changed, digest)) =
+            let prefix = {
+                use std::fmt::Write;
+                let mut prefix = String::with_capacity(unit.member.len() + 8);
+                prefix.push('/');
+                crate::asset::pointer::push_escaped(&mut prefix, &unit.member);
+                let _ = write!(prefix, "/{i}"); // writing to a String cannot fail
+                prefix
+            };
+            if let Some((mut splices, changed, check)) =
                 members_set_in_place(text, element, &prefix, edits, layout)
             {
-                let checked = reads_back_within(text, element.span(), &mut splices, digest);
+                let reads_back = match check {
+                    ElementCheck::Inserted(reads_back) => {
+                        reads_back && in_order(&mut splices, element.span())
+                    }
+                    ElementCheck::Digest(digest) => {
+                        reads_back_within(text, element.span(), &mut splices, digest)
+                    }
+                };
                 return Ok(Some(UnitSplices {
                     splices,
                     changed,
-                    meant: (prefix, Some(digest)),
-                    checked: Some(checked),
+                    check: UnitCheck::Alone(reads_back),
                 }));
             }
             let mut value = element.to_value();
@@ -681,13 +748,12 @@ fn splice_unit(
             }
             diff(text, element, &value, layout, &mut splices);
             let digest = value_digest(&value);
-            checked = Some(reads_back_within(
+            check = UnitCheck::Alone(reads_back_within(
                 text,
                 element.span(),
                 &mut splices,
                 digest,
             ));
-            meant = (prefix, Some(digest));
         }
         (_, node) => {
             let mut part = Map::new();
@@ -698,11 +764,12 @@ fn splice_unit(
             let owned: Vec<Edit> = edits.iter().map(|e| (*e).clone()).collect();
             changed |= super::apply(&mut part, &owned)?;
             let new = part.get(&*unit.member);
-            match (node, new) {
+            let pointer = || format!("/{}", crate::asset::pointer::escape(&unit.member));
+            check = match (node, new) {
                 (Some(node), Some(new)) => {
                     diff(text, node, new, layout, &mut splices);
                     let digest = value_digest(new);
-                    checked = Some(reads_back_within(text, node.span(), &mut splices, digest));
+                    UnitCheck::Alone(reads_back_within(text, node.span(), &mut splices, digest))
                 }
                 (Some(_), None) => {
                     let Some(i) = entries
@@ -715,6 +782,7 @@ fn splice_unit(
                         Some(splice) => splices.push(splice),
                         None => return Ok(None),
                     }
+                    UnitCheck::Whole(pointer(), None)
                 }
                 (None, Some(new)) => {
                     // Where the edit applier puts it: `extensionsUsed` after `asset` (or
@@ -734,18 +802,16 @@ fn splice_unit(
                         layout,
                         &mut splices,
                     );
+                    UnitCheck::Whole(pointer(), Some(value_digest(new)))
                 }
-                (None, None) => {}
-            }
-            let pointer = format!("/{}", crate::asset::pointer::escape(&unit.member));
-            meant = (pointer, part.get(&*unit.member).map(value_digest));
+                (None, None) => UnitCheck::Whole(pointer(), None),
+            };
         }
     }
     Ok(Some(UnitSplices {
         splices,
         changed,
-        meant,
-        checked,
+        check,
     }))
 }
 
@@ -790,6 +856,8 @@ impl Scanner<'_> {
         (self.peek()? == byte).then(|| self.at += 1)
     }
 
+    /// Steps over the string at the cursor; `None` where it holds a control character, which
+    /// JSON allows only escaped (escapes are read where the string is decoded).
     fn string(&mut self) -> Option<()> {
         self.at += 1; // the opening quote
         loop {
@@ -799,6 +867,7 @@ impl Scanner<'_> {
                     return Some(());
                 }
                 b'\\' => self.at += 2,
+                0..=0x1f => return None,
                 _ => self.at += 1,
             }
         }
@@ -854,17 +923,31 @@ impl Scanner<'_> {
                 if self.open(b'}')? {
                     return Some(map.is_empty());
                 }
-                let mut seen = std::collections::HashSet::with_capacity(map.len());
+                // Each key once. The keys read are kept in a list for a small object (a layer
+                // object, checked by the ten thousand), in a set for a large one.
+                let small = map.len() <= 16;
+                let mut seen_list = Vec::with_capacity(if small { map.len() } else { 0 });
+                let mut seen_set = std::collections::HashSet::new();
+                let mut count = 0;
                 loop {
                     let key = key_at(self.text, self.key()?)?;
                     let Some(member) = map.get(key.as_ref()) else {
                         return Some(false);
                     };
-                    if !seen.insert(key) || !self.holds(member)? {
+                    let first = if small {
+                        !seen_list.contains(&key) && {
+                            seen_list.push(key);
+                            true
+                        }
+                    } else {
+                        seen_set.insert(key)
+                    };
+                    if !first || !self.holds(member)? {
                         return Some(false);
                     }
+                    count += 1;
                     if !self.next(b'}')? {
-                        return Some(seen.len() == map.len());
+                        return Some(count == map.len());
                     }
                 }
             }
@@ -1057,7 +1140,7 @@ impl<'t> Layout<'t> {
                     }
                     out.push(']');
                 } else {
-                    let inner = format!("{indent}{}", self.unit.as_deref().unwrap_or(""));
+                    let inner = concat(&[indent, self.unit.as_deref().unwrap_or("")]);
                     out.push('[');
                     for (i, item) in items.iter().enumerate() {
                         if i > 0 {
@@ -1092,7 +1175,7 @@ impl<'t> Layout<'t> {
             out.push('}');
             return;
         }
-        let inner = format!("{indent}{}", self.unit.as_deref().unwrap_or(""));
+        let inner = concat(&[indent, self.unit.as_deref().unwrap_or("")]);
         out.push('{');
         for (i, (key, value)) in map.iter().enumerate() {
             if i > 0 {
@@ -1145,8 +1228,11 @@ fn raw_number_text(text: &str) -> std::borrow::Cow<'_, str> {
     match written_number(text) {
         WrittenNumber::Kept(text) => Cow::Borrowed(text),
         WrittenNumber::Zero => Cow::Owned("0".to_string()),
-        // Display writes the shortest decimal that reads back as the same f64.
-        WrittenNumber::Rounded(x) => Cow::Owned(format!("{x}")),
+        WrittenNumber::Rounded(x) => {
+            let mut text = StackText::new();
+            write_rounded(x, &mut text);
+            Cow::Owned(text.as_str().to_string())
+        }
     }
 }
 
@@ -1161,10 +1247,23 @@ enum WrittenNumber<'a> {
 }
 
 fn written_number(text: &str) -> WrittenNumber<'_> {
-    let decimals = match text.find(['e', 'E']) {
-        Some(_) => usize::MAX,
-        None => text.find('.').map_or(0, |dot| text.len() - dot - 1),
-    };
+    // One pass over the bytes (a number's text is short, and this runs for every number of
+    // every unit written and checked): an exponent, or the digits after the point.
+    let mut decimals = 0;
+    let mut point = None;
+    for (i, b) in text.bytes().enumerate() {
+        match b {
+            b'e' | b'E' => {
+                decimals = usize::MAX;
+                break;
+            }
+            b'.' => point = Some(i),
+            _ => {}
+        }
+    }
+    if decimals == 0 {
+        decimals = point.map_or(0, |dot| text.len() - dot - 1);
+    }
     if decimals <= DECIMALS as usize {
         return WrittenNumber::Kept(text);
     }
@@ -1190,25 +1289,76 @@ fn with_written_number<R>(text: &str, f: impl FnOnce(&str) -> R) -> R {
         WrittenNumber::Kept(text) => f(text),
         WrittenNumber::Zero => f("0"),
         WrittenNumber::Rounded(x) => {
-            use std::fmt::Write;
-            let mut buffer = StackText {
-                bytes: [0; 40],
-                len: 0,
-            };
-            match write!(buffer, "{x}") {
-                // Only ASCII digits, sign and point were written.
-                Ok(()) => f(std::str::from_utf8(&buffer.bytes[..buffer.len]).unwrap_or_default()),
-                // Longer than the buffer (a large magnitude, written without an exponent).
-                Err(_) => f(&format!("{x}")),
-            }
+            let mut text = StackText::new();
+            write_rounded(x, &mut text);
+            f(text.as_str())
         }
     }
 }
 
-/// A short text written on the stack; a write past its end fails.
+/// Writes `x`, a number rounded to [`DECIMALS`] places, as the shortest decimal that reads back
+/// as it: what `Display` writes for an `f64`. Below 10⁹ that is its whole millionths written
+/// out, trailing zeros cut, and is made so with integer arithmetic: doubles there lie closer
+/// together than half a millionth, so no shorter decimal reads back as `x`, and the one
+/// written does (`x` is the double nearest to it). Larger magnitudes take `Display`.
+fn write_rounded(x: f64, out: &mut StackText) {
+    use std::fmt::Write;
+    const SCALE: f64 = 1e6;
+    if x.abs() < 1e9 {
+        let millionths = (x * SCALE).round();
+        let whole = millionths.abs() as u64;
+        if millionths < 0.0 {
+            out.push(b'-');
+        }
+        let (int, mut fraction) = (whole / 1_000_000, whole % 1_000_000);
+        let _ = write!(out, "{int}");
+        if fraction != 0 {
+            let mut digits = 6;
+            while fraction % 10 == 0 {
+                fraction /= 10;
+                digits -= 1;
+            }
+            let _ = write!(out, ".{fraction:0digits$}");
+        }
+        return;
+    }
+    if write!(out, "{x}").is_err() {
+        // Longer than the buffer (a large magnitude, written without an exponent).
+        out.overflow = Some(format!("{x}"));
+    }
+}
+
+/// A short text written on the stack; a write past its end fails (the text is then kept in
+/// `overflow` by its writer).
 struct StackText {
     bytes: [u8; 40],
     len: usize,
+    overflow: Option<String>,
+}
+
+impl StackText {
+    fn new() -> StackText {
+        StackText {
+            bytes: [0; 40],
+            len: 0,
+            overflow: None,
+        }
+    }
+
+    fn push(&mut self, byte: u8) {
+        if let Some(room) = self.bytes.get_mut(self.len) {
+            *room = byte;
+            self.len += 1;
+        }
+    }
+
+    fn as_str(&self) -> &str {
+        match &self.overflow {
+            Some(text) => text,
+            // Only ASCII digits, sign and point are written.
+            None => std::str::from_utf8(&self.bytes[..self.len]).unwrap_or_default(),
+        }
+    }
 }
 
 impl std::fmt::Write for StackText {
@@ -1218,6 +1368,37 @@ impl std::fmt::Write for StackText {
         room.copy_from_slice(s.as_bytes());
         self.len = end;
         Ok(())
+    }
+}
+
+/// A number velvet computed, as it writes it: what [`written`] makes of `Value::from(x)`,
+/// without writing `x` out and reading it back (a sheen's fuzz colour is three such numbers,
+/// by the twenty thousand in a library).
+pub fn written_f64(x: f64) -> Value {
+    if !x.is_finite() || x.abs() >= 1e9 {
+        return written(Value::from(x)); // not finite, or large: the general way
+    }
+    let scale = 10f64.powi(DECIMALS);
+    let rounded = (x * scale).round() / scale;
+    if rounded == x {
+        // Already at that precision: `Value::from` writes the shortest decimal that reads back.
+        Value::from(x)
+    } else if rounded == 0.0 {
+        Value::from(0u8)
+    } else {
+        rounded_number(rounded).map_or_else(|| written(Value::from(x)), Value::Number)
+    }
+}
+
+/// The number written as [`write_rounded`] writes the rounded `x`. serde_json makes a number
+/// of a given text only by reading it; its own writing of `x` is taken where it gives the same
+/// text, which is cheaper.
+fn rounded_number(x: f64) -> Option<serde_json::Number> {
+    let mut text = StackText::new();
+    write_rounded(x, &mut text);
+    match serde_json::Number::from_f64(x) {
+        Some(n) if n.as_str() == text.as_str() => Some(n),
+        _ => text.as_str().parse().ok(),
     }
 }
 
@@ -1234,12 +1415,15 @@ fn is_written(value: &Value) -> bool {
 /// `value` with every number as velvet writes it (see [`number_text`]): edits store what the
 /// file will hold, so that planning again compares like with like.
 pub fn written(value: Value) -> Value {
+    if matches!(value, Value::Array(_) | Value::Object(_)) && is_written(&value) {
+        // Kept as it is: a container of written numbers is not rebuilt.
+        return value;
+    }
     match value {
-        Value::Number(n) => match raw_number_text(n.as_str()) {
-            std::borrow::Cow::Borrowed(_) => Value::Number(n),
-            std::borrow::Cow::Owned(text) => {
-                serde_json::from_str(&text).map_or(Value::Number(n), Value::Number)
-            }
+        Value::Number(n) => match written_number(n.as_str()) {
+            WrittenNumber::Kept(_) => Value::Number(n),
+            WrittenNumber::Zero => Value::from(0u8),
+            WrittenNumber::Rounded(x) => rounded_number(x).map_or(Value::Number(n), Value::Number),
         },
         Value::Array(items) => Value::Array(items.into_iter().map(written).collect()),
         Value::Object(map) => {
@@ -1273,6 +1457,14 @@ impl Layout<'_> {
         let len = line.len() - line.trim_start_matches([' ', '\t']).len();
         &line[..len]
     }
+}
+
+/// `parts` joined, in a string made at its size (`format!` took a tenth of writing a layer
+/// object, by the twenty thousand).
+fn concat(parts: &[&str]) -> String {
+    let mut out = String::with_capacity(parts.iter().map(|p| p.len()).sum());
+    parts.iter().for_each(|p| out.push_str(p));
+    out
 }
 
 fn one_line(text: &str, node: Node) -> bool {
@@ -1358,6 +1550,27 @@ fn matches(node: Node, value: &Value, compare: Compare) -> bool {
 
 /// True when the scalar written `raw` is `value`.
 fn scalar_matches(raw: &str, value: &Value, compare: Compare) -> bool {
+    // The scalars velvet writes and checks by the ten thousand, compared as text: a number
+    // without an exponent (serde_json reads it with its text as written), a string without
+    // escapes, a literal. Anything else is read by serde_json.
+    match value {
+        Value::Number(b) if is_plain_number(raw) => {
+            return raw == b.as_str()
+                || (compare == Compare::Written && with_written_number(b.as_str(), |t| t == raw));
+        }
+        Value::String(b) if raw.len() >= 2 && !raw.contains('\\') => {
+            let bytes = raw.as_bytes();
+            return bytes[0] == b'"'
+                && bytes[raw.len() - 1] == b'"'
+                && !bytes[1..raw.len() - 1]
+                    .iter()
+                    .any(|&c| c < 0x20 || c == b'"')
+                && raw[1..raw.len() - 1] == **b;
+        }
+        Value::Bool(b) if matches!(raw, "true" | "false") => return (raw == "true") == *b,
+        Value::Null if raw == "null" => return true,
+        _ => {}
+    }
     match serde_json::from_str::<Value>(raw) {
         Ok(Value::Number(a)) if compare == Compare::Written => {
             // A number the edit left keeps its spelling (`0.800000011920929` from an
@@ -1366,6 +1579,23 @@ fn scalar_matches(raw: &str, value: &Value, compare: Compare) -> bool {
         }
         Ok(v) => v == *value,
         Err(_) => false,
+    }
+}
+
+/// Whether `raw` is a JSON number without an exponent: `-?(0|[1-9][0-9]*)(\.[0-9]+)?`.
+fn is_plain_number(raw: &str) -> bool {
+    let digits = raw.strip_prefix('-').unwrap_or(raw).as_bytes();
+    let int_end = digits
+        .iter()
+        .position(|b| !b.is_ascii_digit())
+        .unwrap_or(digits.len());
+    let int_ok = int_end == 1 || (int_end > 1 && digits[0] != b'0');
+    match &digits[int_end..] {
+        [] => int_ok,
+        [b'.', fraction @ ..] => {
+            int_ok && !fraction.is_empty() && fraction.iter().all(u8::is_ascii_digit)
+        }
+        _ => false,
     }
 }
 
@@ -1506,32 +1736,34 @@ fn insert_members(
             .map(|(k, _)| text[first.1.span().end..*k].to_string())
             .unwrap_or_else(|| layout.inline_comma().to_string())
     } else {
-        format!(",{}{indent}", layout.newline)
+        concat(&[",", layout.newline, &indent])
     };
-    let member_text = |key: &str, value: &Value| {
-        // Room for a layer object of a few members, so that writing it grows the string once
-        // at most.
-        let mut text = String::with_capacity(256);
-        push_quoted(&mut text, key);
+    let push_member = |text: &mut String, key: &str, value: &Value| {
+        push_quoted(text, key);
         text.push_str(&layout.colon);
-        layout.write(value, &indent, inline || layout.unit.is_none(), &mut text);
-        text
+        layout.write(value, &indent, inline || layout.unit.is_none(), text);
     };
+    // Room for a layer object of a few members, so that writing one grows a string once at
+    // most.
+    const ROOM: usize = 256;
     let mut leading = String::new();
     let mut after_member: Vec<(usize, String)> = Vec::new();
     for &(anchor, key, value) in placed {
         match anchor {
             None => {
-                leading.push_str(&member_text(key, value));
+                leading.reserve(ROOM);
+                push_member(&mut leading, key, value);
                 leading.push_str(&separator);
             }
-            Some(i) => match after_member.last_mut() {
-                Some((at, insert)) if *at == i => {
-                    insert.push_str(&separator);
-                    insert.push_str(&member_text(key, value));
+            Some(i) => {
+                if !matches!(after_member.last(), Some((at, _)) if *at == i) {
+                    after_member.push((i, String::with_capacity(ROOM)));
                 }
-                _ => after_member.push((i, separator.clone() + &member_text(key, value))),
-            },
+                if let Some((_, insert)) = after_member.last_mut() {
+                    insert.push_str(&separator);
+                    push_member(insert, key, value);
+                }
+            }
         }
     }
     if !leading.is_empty() {
@@ -1580,7 +1812,7 @@ fn append(
             .map(|second| text[first.span().end..second.span().start].to_string())
             .unwrap_or_else(|| layout.inline_comma().to_string())
     } else {
-        format!(",{}{indent}", layout.newline)
+        concat(&[",", layout.newline, &indent])
     };
     let mut insert = String::new();
     for item in items {
@@ -1709,14 +1941,29 @@ mod tests {
             let element = root.pointer("/materials/1").unwrap();
             let refs: Vec<&Edit> = edits.iter().collect();
             let layout = Layout::detect(text, root);
-            let (_, changed, digest) =
+            let (_, changed, check) =
                 members_set_in_place(text, element, "/materials/1", &refs, &layout)
                     .expect("sets of members of existing objects take the index's way");
             assert!(changed);
+            let ElementCheck::Digest(digest) = check else {
+                panic!("members replaced are checked by digest")
+            };
             let mut whole: Value = serde_json::from_str(text).unwrap();
             super::super::apply(&mut whole, &edits).unwrap();
             assert_eq!(digest, value_digest(&whole["materials"][1]), "{text}");
             let (out, _) = splice_edits_text(text, root, &edits).unwrap().unwrap();
+            assert_eq!(out, spliced(text, &whole), "{text}");
+            assert!(reads_as_written(&out, &whole));
+            // Members only added are checked by reading the inserted text alone, and give the
+            // text the general way gives.
+            let added = &edits[..1];
+            let refs: Vec<&Edit> = added.iter().collect();
+            let (_, _, check) =
+                members_set_in_place(text, element, "/materials/1", &refs, &layout).unwrap();
+            assert!(matches!(check, ElementCheck::Inserted(true)), "{text}");
+            let mut whole: Value = serde_json::from_str(text).unwrap();
+            super::super::apply(&mut whole, added).unwrap();
+            let (out, _) = splice_edits_text(text, root, added).unwrap().unwrap();
             assert_eq!(out, spliced(text, &whole), "{text}");
             assert!(reads_as_written(&out, &whole));
         }
@@ -1982,6 +2229,108 @@ mod tests {
             "0.75"
         );
         assert_eq!(with_written_number("-7.5e-8", str::to_string), "0");
+    }
+
+    /// An inserted text passes only when it reads as exactly the members meant: a comma before
+    /// each, the keys and values (numbers as velvet writes them), nothing after but whitespace,
+    /// and no character JSON forbids.
+    #[test]
+    fn inserted_members_are_checked_by_reading_the_inserted_text() {
+        let value =
+            serde_json::json!({"fuzzFactor": 0.7499999999999999, "fuzzColorFactor": [1, 0.5]});
+        let second = serde_json::json!("b");
+        let members = [("KHR_materials_fuzz", &value), ("name", &second)];
+        let good = ",\n  \"KHR_materials_fuzz\": {\"fuzzFactor\": 0.75, \"fuzzColorFactor\": [1, 0.5]}, \"name\": \"b\"\n";
+        assert!(inserted_members_read_as(good, &members));
+        for bad in [
+            // No comma before the first member.
+            " \"KHR_materials_fuzz\": {\"fuzzFactor\": 0.75, \"fuzzColorFactor\": [1, 0.5]}, \"name\": \"b\"",
+            // Another key.
+            ", \"KHR_materials_fuz\": {\"fuzzFactor\": 0.75, \"fuzzColorFactor\": [1, 0.5]}, \"name\": \"b\"",
+            // Another number, a member missing, a member twice.
+            ", \"KHR_materials_fuzz\": {\"fuzzFactor\": 0.7, \"fuzzColorFactor\": [1, 0.5]}, \"name\": \"b\"",
+            ", \"KHR_materials_fuzz\": {\"fuzzFactor\": 0.75}, \"name\": \"b\"",
+            ", \"KHR_materials_fuzz\": {\"fuzzFactor\": 0.75, \"fuzzFactor\": 0.75}, \"name\": \"b\"",
+            // A number JSON does not allow, a raw control character in a string.
+            ", \"KHR_materials_fuzz\": {\"fuzzFactor\": .75, \"fuzzColorFactor\": [1, 0.5]}, \"name\": \"b\"",
+            ", \"KHR_materials_fuzz\": {\"fuzzFactor\": 0.75, \"fuzzColorFactor\": [01, 0.5]}, \"name\": \"b\"",
+            ", \"KHR_materials_fuzz\": {\"fuzzFactor\": 0.75, \"fuzzColorFactor\": [1, 0.5]}, \"na\tme\": \"b\"",
+            // Something after the members.
+            ", \"KHR_materials_fuzz\": {\"fuzzFactor\": 0.75, \"fuzzColorFactor\": [1, 0.5]}, \"name\": \"b\",",
+        ] {
+            assert!(!inserted_members_read_as(bad, &members), "{bad}");
+        }
+    }
+
+    /// A computed number is written as the general way writes it once made a value: kept,
+    /// rounded or zero, over a sweep of magnitudes, signs and the edges.
+    #[test]
+    fn computed_numbers_are_written_as_their_values_are() {
+        let mut xs = vec![
+            0.0,
+            -0.0,
+            0.5,
+            1.0,
+            0.75,
+            1.0 / 3.0,
+            2.0 / 3.0,
+            0.1 + 0.2,
+            7.5e-8,
+            -7.5e-8,
+            5e-7,
+            4.9e-7,
+            1e-6,
+            1.5e-6,
+            0.1234565,
+            0.12345650000000001,
+            1e9,
+            1e9 - 0.3,
+            123_456_789.123_456_7,
+            -5.5e12,
+            1e300,
+            f64::NAN,
+            f64::INFINITY,
+            f64::MIN_POSITIVE,
+        ];
+        let mut x = 1e-9;
+        while x < 1e12 {
+            xs.extend([x, -x, x * 0.999_999_7]);
+            x *= 1.618;
+        }
+        for x in xs {
+            assert_eq!(
+                written_f64(x).to_string(),
+                written(Value::from(x)).to_string(),
+                "{x}"
+            );
+        }
+    }
+
+    /// The rounded numbers written with integer arithmetic are what `Display` writes, over a
+    /// sweep of magnitudes and signs, at the 10⁹ edge and past it.
+    #[test]
+    fn rounded_numbers_written_from_their_millionths_match_display() {
+        let mut millionths: Vec<f64> = vec![1.0, 5.0, 10.0, 999_999.0, 1_000_000.0, 1_000_001.0];
+        // A multiplicative sweep over every magnitude below 10⁹ (in millionths: below 10¹⁵).
+        let mut k: f64 = 3.0;
+        while k < 1e15 {
+            millionths.push(k.round());
+            k *= 1.37;
+        }
+        millionths.push(999_999_999_999_999.0);
+        millionths.extend((1..2000).map(|i| (i * 7919) as f64));
+        for k in millionths {
+            for x in [k / 1e6, -k / 1e6] {
+                let mut text = StackText::new();
+                write_rounded(x, &mut text);
+                assert_eq!(text.as_str(), format!("{x}"), "{x}");
+            }
+        }
+        for x in [1e9, 123_456_789_012.5, -4.5e15, 1e300] {
+            let mut text = StackText::new();
+            write_rounded(x, &mut text);
+            assert_eq!(text.as_str(), format!("{x}"), "{x}");
+        }
     }
 
     #[test]

@@ -257,9 +257,15 @@ pub fn sheen_for(
         let base = cx
             .material
             .pointer("/pbrMetallicRoughness/baseColorFactor")
-            .and_then(Value::as_array)
+            .and_then(|a| a.as_array())
             .filter(|a| a.len() == 4)
-            .and_then(|a| Some([a[0].as_f64()?, a[1].as_f64()?, a[2].as_f64()?]))
+            .and_then(|a| {
+                Some([
+                    a.get(0)?.as_f64()?,
+                    a.get(1)?.as_f64()?,
+                    a.get(2)?.as_f64()?,
+                ])
+            })
             .unwrap_or([1.0; 3]);
         let (fuzz_max, base_max) = (max3(view.color_factor), max3(base));
         let difference = view.factor * (1.0 - fuzz_max).max(0.0) * base_max;

@@ -31,6 +31,11 @@ const RATIFIED_PROPERTIES: [&str; 4] = [
     "sheenRoughnessTexture",
 ];
 
+/// Whether a sheen object, as loaded, holds any draft property.
+pub fn has_legacy_properties(sheen: crate::asset::tape::Node) -> bool {
+    LEGACY_PROPERTIES.iter().any(|p| sheen.get(*p).is_some())
+}
+
 /// The draft properties present on a sheen object.
 pub fn legacy_properties(sheen: &Value) -> Vec<&'static str> {
     LEGACY_PROPERTIES
@@ -80,7 +85,11 @@ pub fn upgrade(cx: &MaterialCx, sheen: &Value, plan: &mut MaterialPlan) -> Optio
         number_like(original, clamped[i])
     });
 
-    let pbr = cx.material.get("pbrMetallicRoughness");
+    let pbr = cx
+        .material
+        .get("pbrMetallicRoughness")
+        .map(|p| p.to_value());
+    let pbr = pbr.as_ref();
     let roughness_raw = pbr
         .and_then(|p| p.get("roughnessFactor"))
         .filter(|v| v.as_f64().is_some());

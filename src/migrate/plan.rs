@@ -40,13 +40,13 @@ pub(crate) fn notes_json<S: serde::Serializer>(notes: &[Note], s: S) -> Result<S
 }
 
 impl MaterialPlan {
-    fn new(index: usize, material: &Value) -> MaterialPlan {
+    fn new(index: usize, material: Node) -> MaterialPlan {
         MaterialPlan {
             index,
             name: material
                 .get("name")
-                .and_then(Value::as_str)
-                .map(str::to_string),
+                .and_then(|name| name.as_str())
+                .map(|name| name.into_owned()),
             conversions: Vec::new(),
             skipped: None,
             edits: Vec::new(),
@@ -81,7 +81,9 @@ impl MaterialPlan {
 pub struct MaterialCx<'a> {
     pub asset: &'a Asset,
     pub index: usize,
-    pub material: &'a Value,
+    /// The material as loaded, through the index: only the layers a conversion reads are read
+    /// into values.
+    pub material: Node<'a>,
     pub options: &'a Options,
     /// The document's primitives by material, shared by every material's plan.
     pub primitives: &'a Primitives<'a>,
@@ -143,11 +145,19 @@ impl<'a> MaterialCx<'a> {
 
     /// Pointer to `extension` on this material.
     pub fn extension_pointer(&self, extension: &str) -> String {
-        format!("/materials/{}/extensions/{extension}", self.index)
+        use std::fmt::Write;
+        let mut pointer = String::with_capacity(32 + extension.len());
+        // Writing to a String cannot fail; `format!` cost more than the rest of the pointer.
+        let _ = write!(pointer, "/materials/{}/extensions/", self.index);
+        crate::asset::pointer::push_escaped(&mut pointer, extension);
+        pointer
     }
 
     pub fn has_extension(&self, extension: &str) -> bool {
-        layers::extensions(self.material).is_some_and(|e| e.contains_key(extension))
+        self.material
+            .get("extensions")
+            .and_then(|e| e.as_object())
+            .is_some_and(|e| e.get(extension).is_some())
     }
 
     /// A bake of the texture `texture_info` names into slot `texture_key` of `extension` on
@@ -267,24 +277,24 @@ pub fn plan_material(
     options: &Options,
     primitives: &Primitives,
 ) -> Option<MaterialPlan> {
-    // The material alone is read into a value: the document is never built as one.
+    // The material is read through the index: the document is never built as a value, and a
+    // layer object becomes one only where a conversion needs it so (a ratified sheen on its
+    // way to fuzz, by far the most common, is read from the index alone).
     let node = asset.root().get("materials")?.get(index)?;
-    let layer_nodes = node.get("extensions")?;
-    if layer_nodes.get(layers::SHEEN).is_none() && layer_nodes.get(layers::FUZZ).is_none() {
-        return None;
-    }
-    let material = &node.to_value();
-    let exts = layers::extensions(material)?;
-    let (sheen, fuzz) = (exts.get(layers::SHEEN), exts.get(layers::FUZZ));
+    let layer_nodes = node.get("extensions")?.as_object()?;
+    let (sheen, fuzz) = (
+        layer_nodes.get(layers::SHEEN),
+        layer_nodes.get(layers::FUZZ),
+    );
     if sheen.is_none() && fuzz.is_none() {
         return None;
     }
-    let mut plan = MaterialPlan::new(index, material);
+    let mut plan = MaterialPlan::new(index, node);
     for (extension, why) in [
         (layers::UNLIT, Skip::Unlit),
         (layers::SPEC_GLOSS, Skip::SpecularGlossiness),
     ] {
-        if exts.contains_key(extension) {
+        if layer_nodes.get(extension).is_some() {
             plan.skip(
                 why,
                 Note::Excluded {
@@ -294,8 +304,8 @@ pub fn plan_material(
             return Some(plan);
         }
     }
-    for (name, value) in [(layers::SHEEN, sheen), (layers::FUZZ, fuzz)] {
-        if value.is_some_and(|v| !v.is_object()) {
+    for (name, layer) in [(layers::SHEEN, sheen), (layers::FUZZ, fuzz)] {
+        if layer.is_some_and(|v| v.kind() != crate::asset::tape::Kind::Object) {
             plan.skip(
                 Skip::Malformed,
                 Note::Malformed {
@@ -308,21 +318,22 @@ pub fn plan_material(
     let cx = MaterialCx {
         asset,
         index,
-        material,
+        material: node,
         options,
         primitives,
     };
     match (sheen, fuzz) {
         (Some(sheen), None) => {
-            let sheen = match legacy::upgrade(&cx, sheen, &mut plan) {
-                Some(upgraded) => upgraded,
-                None => sheen_to_fuzz::Sheen::read(sheen),
+            let upgraded = match legacy::has_legacy_properties(sheen) {
+                true => legacy::upgrade(&cx, &sheen.to_value(), &mut plan),
+                false => None,
             };
+            let sheen = upgraded.unwrap_or_else(|| sheen_to_fuzz::Sheen::read(sheen));
             sheen_to_fuzz::convert(&cx, &sheen, &mut plan);
         }
-        (None, Some(fuzz)) => fallback::add(&cx, fuzz, &mut plan),
+        (None, Some(fuzz)) => fallback::add(&cx, &fuzz.to_value(), &mut plan),
         (Some(sheen), Some(fuzz)) if options.refresh_fallback => {
-            fallback::refresh(&cx, sheen, fuzz, &mut plan)
+            fallback::refresh(&cx, &sheen.to_value(), &fuzz.to_value(), &mut plan)
         }
         (Some(_), Some(_)) => plan.skip(Skip::BothPresent, Note::BothPresent),
         (None, None) => unreachable!("checked above"),
@@ -333,8 +344,27 @@ pub fn plan_material(
 /// A number for the output: `original` itself (its text kept) when it already has this value,
 /// else the value written anew.
 pub(crate) fn number_like(original: Option<&Value>, value: f64) -> Value {
+    number_like_in(original, value, Value::clone)
+}
+
+/// [`number_like`] as velvet writes it ([`crate::edit::splice::written`]): `original` when it
+/// has this value, else the value, rounded.
+pub(crate) fn written_number_like(original: Option<&Value>, value: f64) -> Value {
     match original {
-        Some(v) if v.as_f64() == Some(value) => v.clone(),
+        Some(v) if v.as_f64() == Some(value) => crate::edit::splice::written(v.clone()),
+        _ => crate::edit::splice::written_f64(value),
+    }
+}
+
+/// [`number_like`] for a number read through `view` (a value or the index), made a value by
+/// `to_value`.
+pub(crate) fn number_like_in<'a, V: crate::asset::tape::JsonView<'a>>(
+    original: Option<V>,
+    value: f64,
+    to_value: impl FnOnce(V) -> Value,
+) -> Value {
+    match original {
+        Some(v) if v.number() == Some(value) => to_value(v),
         _ => Value::from(value),
     }
 }

@@ -17,10 +17,12 @@
 
 use super::measure;
 use super::note::{Conversion, Note, Skip};
-use super::plan::{number_like, MaterialCx, MaterialPlan};
+use super::plan::{number_like_in, written_number_like, MaterialCx, MaterialPlan};
 use super::roughness::{self, Direction, RoughnessMapping};
 use super::textures::{Contents, TextureBake};
+use crate::asset::tape::{JsonView, Node};
 use crate::bake::Channel;
+use crate::edit::splice::written;
 use crate::edit::Edit;
 use crate::layers::{self, max3};
 use crate::shading::layering;
@@ -45,31 +47,57 @@ pub struct Sheen {
 impl Sheen {
     /// Reads a ratified KHR_materials_sheen object, with the spec's defaults (a malformed
     /// value reads as its default: the schema check reports it).
-    pub fn read(ext: &Value) -> Sheen {
+    pub fn read<'a>(ext: impl SheenSource<'a>) -> Sheen {
         let view = layers::SheenView::read(ext).unwrap_or(layers::SheenView {
             color_factor: layers::SHEEN_COLOR_DEFAULT,
             roughness_factor: layers::SHEEN_ROUGHNESS_DEFAULT,
             color_texture: None,
             roughness_texture: None,
         });
-        let raw = ext.get("sheenColorFactor").and_then(Value::as_array);
-        let color_values =
-            std::array::from_fn(|i| number_like(raw.and_then(|a| a.get(i)), view.color_factor[i]));
+        let raw = ext.member("sheenColorFactor");
+        let color_values = std::array::from_fn(|i| {
+            number_like_in(
+                raw.and_then(|a| a.element(i)),
+                view.color_factor[i],
+                SheenSource::value,
+            )
+        });
+        let texture = |key| {
+            ext.member(key)
+                .filter(|v| v.object())
+                .map(SheenSource::value)
+        };
         Sheen {
             color: view.color_factor,
             color_values,
             roughness: view.roughness_factor,
-            roughness_value: number_like(ext.get("sheenRoughnessFactor"), view.roughness_factor),
-            color_texture: ext
-                .get("sheenColorTexture")
-                .filter(|v| v.is_object())
-                .cloned(),
-            roughness_texture: ext
-                .get("sheenRoughnessTexture")
-                .filter(|v| v.is_object())
-                .cloned(),
+            roughness_value: number_like_in(
+                ext.member("sheenRoughnessFactor"),
+                view.roughness_factor,
+                SheenSource::value,
+            ),
+            color_texture: texture("sheenColorTexture"),
+            roughness_texture: texture("sheenRoughnessTexture"),
             roughness_channel: Channel::A,
         }
+    }
+}
+
+/// What a sheen is read from: a value, or the document's index (the values the conversion
+/// keeps, numbers and textureInfos, are then read alone).
+pub trait SheenSource<'a>: JsonView<'a> {
+    fn value(self) -> Value;
+}
+
+impl<'a> SheenSource<'a> for &'a Value {
+    fn value(self) -> Value {
+        self.clone()
+    }
+}
+
+impl<'a> SheenSource<'a> for Node<'a> {
+    fn value(self) -> Value {
+        self.to_value()
     }
 }
 
@@ -88,17 +116,28 @@ pub fn fuzz_for(
     let strongest = (0..3)
         .find(|i| sheen.color[*i] == w)
         .expect("w is one of the components");
-    let mut fuzz = Map::new();
-    fuzz.insert("fuzzFactor".into(), sheen.color_values[strongest].clone());
+    // Each value is written as the file will hold it (`edit::splice::written`) as it goes in,
+    // and the object is made at its final size: `Edit::set` then keeps it as it is, where
+    // rounding a finished object rebuilt it (a tenth of planning the library's 20,000).
+    let textures = [
+        strength_texture,
+        sheen.color_texture.as_ref(),
+        sheen.roughness_texture.as_ref(),
+    ];
+    let mut fuzz = Map::with_capacity(3 + textures.iter().flatten().count());
+    fuzz.insert(
+        "fuzzFactor".into(),
+        written(sheen.color_values[strongest].clone()),
+    );
     if let Some(texture) = strength_texture {
-        fuzz.insert("fuzzTexture".into(), texture.clone());
+        fuzz.insert("fuzzTexture".into(), written(texture.clone()));
     }
     let color: Vec<Value> = (0..3)
-        .map(|i| number_like(Some(&sheen.color_values[i]), sheen.color[i] / w))
+        .map(|i| written_number_like(Some(&sheen.color_values[i]), sheen.color[i] / w))
         .collect();
     fuzz.insert("fuzzColorFactor".into(), Value::Array(color));
     if let Some(texture) = &sheen.color_texture {
-        fuzz.insert("fuzzColorTexture".into(), texture.clone());
+        fuzz.insert("fuzzColorTexture".into(), written(texture.clone()));
     }
     let r = roughness::written(roughness::map(
         sheen.roughness,
@@ -107,10 +146,10 @@ pub fn fuzz_for(
     ));
     fuzz.insert(
         "fuzzRoughnessFactor".into(),
-        number_like(Some(&sheen.roughness_value), r),
+        written_number_like(Some(&sheen.roughness_value), r),
     );
     if let Some(texture) = &sheen.roughness_texture {
-        fuzz.insert("fuzzRoughnessTexture".into(), texture.clone());
+        fuzz.insert("fuzzRoughnessTexture".into(), written(texture.clone()));
     }
     Some(fuzz)
 }
@@ -353,10 +392,9 @@ mod tests {
             for i in 0..3 {
                 let colour = fuzz["fuzzColorFactor"][i].as_f64().unwrap();
                 assert!(colour <= 1.0);
-                assert!(
-                    (colour * w - c[i]).abs() <= 1e-15 * c[i].max(1e-300),
-                    "{c:?}"
-                );
+                // Both numbers are written to six decimals (`edit::splice::DECIMALS`), each
+                // off by at most 5e-7, and neither above 1.
+                assert!((colour * w - c[i]).abs() <= 1e-6, "{c:?}");
             }
         }
     }
