@@ -137,7 +137,11 @@ fn number<'a>(obj: impl JsonView<'a>, key: &str) -> Option<f64> {
 }
 
 fn rgb<'a>(obj: impl JsonView<'a>, key: &str) -> Option<[f64; 3]> {
-    let arr = obj.member(key)?;
+    rgb_of(obj.member(key)?)
+}
+
+/// Three numbers, as a colour factor holds them.
+pub fn rgb_of<'a>(arr: impl JsonView<'a>) -> Option<[f64; 3]> {
     if arr.length()? != 3 {
         return None;
     }

@@ -24,12 +24,12 @@ pub fn push_escaped(out: &mut String, segment: &str) {
     out.push_str(rest);
 }
 
-/// Undoes `escape`.
-pub fn unescape(token: &str) -> String {
+/// Undoes `escape`; borrowed when there is nothing to undo.
+pub fn unescape(token: &str) -> std::borrow::Cow<'_, str> {
     if !token.contains('~') {
-        return token.to_string();
+        return std::borrow::Cow::Borrowed(token);
     }
-    token.replace("~1", "/").replace("~0", "~")
+    std::borrow::Cow::Owned(token.replace("~1", "/").replace("~0", "~"))
 }
 
 /// `base` followed by one more segment.
@@ -65,7 +65,10 @@ pub fn tokens(pointer: &str) -> Vec<String> {
     if pointer.is_empty() {
         return Vec::new();
     }
-    pointer[1..].split('/').map(unescape).collect()
+    pointer[1..]
+        .split('/')
+        .map(|token| unescape(token).into_owned())
+        .collect()
 }
 
 /// The value a pointer names, if any.

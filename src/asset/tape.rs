@@ -713,6 +713,16 @@ impl<'a> Node<'a> {
 
     /// The value as a `serde_json::Value`, for the few places that need one (error reports,
     /// comparisons of whole values).
+    /// This number as a value, given the `f64` it reads as: serde_json's own writing of `x`
+    /// where it spells the number as the text does (as it does most numbers an exporter
+    /// writes), which is cheaper than reading the text into a number again.
+    pub fn number_value(&self, x: f64) -> Value {
+        match serde_json::Number::from_f64(x) {
+            Some(n) if self.kind() == Kind::Number && n.as_str() == self.raw() => Value::Number(n),
+            _ => self.to_value(),
+        }
+    }
+
     pub fn to_value(&self) -> Value {
         match self.kind() {
             // A scalar is made directly (a number keeps its text, as serde_json reads it).

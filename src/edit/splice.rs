@@ -127,7 +127,8 @@ pub fn splice_edits<'t, 'e>(
         };
         let element = second
             .filter(|_| within_element)
-            .and_then(|t| crate::asset::pointer::array_index(&crate::asset::pointer::unescape(t)))
+            // An escape (`~0`, `~1`) never reads as a digit: the token is read as it stands.
+            .and_then(crate::asset::pointer::array_index)
             .filter(|i| members[m].len.is_some_and(|len| *i < len));
         if element.is_none() {
             members[m].whole = true;
@@ -923,26 +924,49 @@ impl Scanner<'_> {
                 if self.open(b'}')? {
                     return Some(map.is_empty());
                 }
-                // Each key once. The keys read are kept in a list for a small object (a layer
-                // object, checked by the ten thousand), in a set for a large one.
+                // Members are compared in the map's order while the text follows it, as the
+                // text velvet writes does: distinct keys, none looked up. From the first key
+                // out of that order, each key is looked up and the keys read are tracked, so
+                // that none is read twice: in a list for a small object, in a set for a large.
                 let small = map.len() <= 16;
-                let mut seen_list = Vec::with_capacity(if small { map.len() } else { 0 });
+                let mut in_order = map.iter();
+                let mut ordered = true;
+                let mut seen_list: Vec<std::borrow::Cow<str>> = Vec::new();
                 let mut seen_set = std::collections::HashSet::new();
                 let mut count = 0;
                 loop {
                     let key = key_at(self.text, self.key()?)?;
-                    let Some(member) = map.get(key.as_ref()) else {
-                        return Some(false);
-                    };
-                    let first = if small {
-                        !seen_list.contains(&key) && {
-                            seen_list.push(key);
-                            true
+                    let next_in_order = in_order.next().filter(|(k, _)| ordered && **k == *key);
+                    let member = match next_in_order {
+                        Some((_, member)) => member,
+                        None => {
+                            if ordered {
+                                ordered = false;
+                                let read = map.keys().take(count).map(|k| k.as_str().into());
+                                if small {
+                                    seen_list.extend(read);
+                                } else {
+                                    seen_set.extend(read);
+                                }
+                            }
+                            let Some(member) = map.get(key.as_ref()) else {
+                                return Some(false);
+                            };
+                            let first = if small {
+                                !seen_list.contains(&key) && {
+                                    seen_list.push(key);
+                                    true
+                                }
+                            } else {
+                                seen_set.insert(key)
+                            };
+                            if !first {
+                                return Some(false);
+                            }
+                            member
                         }
-                    } else {
-                        seen_set.insert(key)
                     };
-                    if !first || !self.holds(member)? {
+                    if !self.holds(member)? {
                         return Some(false);
                     }
                     count += 1;
@@ -1106,14 +1130,24 @@ impl<'t> Layout<'t> {
     /// This layout with the indent unit the container at `container_start` uses for its
     /// member at `member_start`, where the file mixes units (tabs in one place, spaces in
     /// another).
-    fn local(&self, text: &str, container_start: usize, member_start: usize) -> Layout<'t> {
+    /// Borrowed where the unit is the file's own (a layout is not copied for every insertion).
+    fn local(
+        &self,
+        text: &str,
+        container_start: usize,
+        member_start: usize,
+    ) -> std::borrow::Cow<'_, Layout<'t>> {
         let outer = self.line_indent(text, container_start);
         let inner = self.line_indent(text, member_start);
-        let mut layout = self.clone();
         if self.unit.is_some() && inner.len() > outer.len() && inner.starts_with(outer) {
-            layout.unit = Some(inner[outer.len()..].to_string());
+            let unit = &inner[outer.len()..];
+            if self.unit.as_deref() != Some(unit) {
+                let mut layout = self.clone();
+                layout.unit = Some(unit.to_string());
+                return std::borrow::Cow::Owned(layout);
+            }
         }
-        layout
+        std::borrow::Cow::Borrowed(self)
     }
 
     /// Renders `value` whose first line starts at indentation `indent`; `inline` keeps it on
@@ -1310,15 +1344,17 @@ fn write_rounded(x: f64, out: &mut StackText) {
         if millionths < 0.0 {
             out.push(b'-');
         }
-        let (int, mut fraction) = (whole / 1_000_000, whole % 1_000_000);
-        let _ = write!(out, "{int}");
+        // Digit by digit: the formatting machinery cost more than the rest of the number.
+        let (int, fraction) = (whole / 1_000_000, whole % 1_000_000);
+        out.push_digits(int, 1);
         if fraction != 0 {
-            let mut digits = 6;
-            while fraction % 10 == 0 {
-                fraction /= 10;
+            out.push(b'.');
+            let (mut digits, mut trimmed) = (6, fraction);
+            while trimmed % 10 == 0 {
+                trimmed /= 10;
                 digits -= 1;
             }
-            let _ = write!(out, ".{fraction:0digits$}");
+            out.push_digits(trimmed, digits);
         }
         return;
     }
@@ -1350,6 +1386,18 @@ impl StackText {
             *room = byte;
             self.len += 1;
         }
+    }
+
+    /// Appends `n` in decimal, padded with leading zeros to at least `width` digits.
+    fn push_digits(&mut self, mut n: u64, width: usize) {
+        let mut digits = [b'0'; 20];
+        let mut at = digits.len();
+        while n > 0 || digits.len() - at < width {
+            at -= 1;
+            digits[at] = b'0' + (n % 10) as u8;
+            n /= 10;
+        }
+        digits[at..].iter().for_each(|&d| self.push(d));
     }
 
     fn as_str(&self) -> &str {
@@ -2242,6 +2290,9 @@ mod tests {
         let members = [("KHR_materials_fuzz", &value), ("name", &second)];
         let good = ",\n  \"KHR_materials_fuzz\": {\"fuzzFactor\": 0.75, \"fuzzColorFactor\": [1, 0.5]}, \"name\": \"b\"\n";
         assert!(inserted_members_read_as(good, &members));
+        // The members of an object in another order read as the same object.
+        let reordered = ", \"KHR_materials_fuzz\": {\"fuzzColorFactor\": [1, 0.5], \"fuzzFactor\": 0.75}, \"name\": \"b\"";
+        assert!(inserted_members_read_as(reordered, &members));
         for bad in [
             // No comma before the first member.
             " \"KHR_materials_fuzz\": {\"fuzzFactor\": 0.75, \"fuzzColorFactor\": [1, 0.5]}, \"name\": \"b\"",

@@ -344,27 +344,28 @@ pub fn plan_material(
 /// A number for the output: `original` itself (its text kept) when it already has this value,
 /// else the value written anew.
 pub(crate) fn number_like(original: Option<&Value>, value: f64) -> Value {
-    number_like_in(original, value, Value::clone)
+    number_like_in(original, value, |v, _| v.clone())
 }
 
-/// [`number_like`] as velvet writes it ([`crate::edit::splice::written`]): `original` when it
-/// has this value, else the value, rounded.
-pub(crate) fn written_number_like(original: Option<&Value>, value: f64) -> Value {
-    match original {
-        Some(v) if v.as_f64() == Some(value) => crate::edit::splice::written(v.clone()),
-        _ => crate::edit::splice::written_f64(value),
+/// [`number_like`] as velvet writes it ([`crate::edit::splice::written`]), for an `original`
+/// known to read as `reads_as`: `original` when that is the value, else the value, rounded.
+pub(crate) fn written_number_like(original: &Value, reads_as: f64, value: f64) -> Value {
+    if reads_as == value {
+        crate::edit::splice::written(original.clone())
+    } else {
+        crate::edit::splice::written_f64(value)
     }
 }
 
 /// [`number_like`] for a number read through `view` (a value or the index), made a value by
-/// `to_value`.
+/// `to_value` (given the number it reads as).
 pub(crate) fn number_like_in<'a, V: crate::asset::tape::JsonView<'a>>(
     original: Option<V>,
     value: f64,
-    to_value: impl FnOnce(V) -> Value,
+    to_value: impl FnOnce(V, f64) -> Value,
 ) -> Value {
     match original {
-        Some(v) if v.number() == Some(value) => to_value(v),
+        Some(v) if v.number() == Some(value) => to_value(v, value),
         _ => Value::from(value),
     }
 }

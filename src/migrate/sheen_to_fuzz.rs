@@ -33,8 +33,10 @@ use serde_json::{Map, Value};
 #[derive(Debug, Clone, PartialEq)]
 pub struct Sheen {
     pub color: [f64; 3],
+    /// The colour as written: each reads as its component of `color`.
     pub color_values: [Value; 3],
     pub roughness: f64,
+    /// The roughness as written: it reads as `roughness`.
     pub roughness_value: Value,
     pub color_texture: Option<Value>,
     pub roughness_texture: Option<Value>,
@@ -48,18 +50,22 @@ impl Sheen {
     /// Reads a ratified KHR_materials_sheen object, with the spec's defaults (a malformed
     /// value reads as its default: the schema check reports it).
     pub fn read<'a>(ext: impl SheenSource<'a>) -> Sheen {
-        let view = layers::SheenView::read(ext).unwrap_or(layers::SheenView {
-            color_factor: layers::SHEEN_COLOR_DEFAULT,
-            roughness_factor: layers::SHEEN_ROUGHNESS_DEFAULT,
-            color_texture: None,
-            roughness_texture: None,
-        });
-        let raw = ext.member("sheenColorFactor");
+        // Each member is looked up once (a layer read through the index pays for every
+        // lookup), with what `layers::SheenView::read` would read from it.
+        let member = |key| ext.object().then(|| ext.member(key)).flatten();
+        let raw = member("sheenColorFactor");
+        let color = raw
+            .and_then(layers::rgb_of)
+            .unwrap_or(layers::SHEEN_COLOR_DEFAULT);
+        let roughness_raw = member("sheenRoughnessFactor");
+        let roughness = roughness_raw
+            .and_then(JsonView::number)
+            .unwrap_or(layers::SHEEN_ROUGHNESS_DEFAULT);
         let color_values = std::array::from_fn(|i| {
             number_like_in(
                 raw.and_then(|a| a.element(i)),
-                view.color_factor[i],
-                SheenSource::value,
+                color[i],
+                SheenSource::number_value,
             )
         });
         let texture = |key| {
@@ -68,14 +74,10 @@ impl Sheen {
                 .map(SheenSource::value)
         };
         Sheen {
-            color: view.color_factor,
+            color,
             color_values,
-            roughness: view.roughness_factor,
-            roughness_value: number_like_in(
-                ext.member("sheenRoughnessFactor"),
-                view.roughness_factor,
-                SheenSource::value,
-            ),
+            roughness,
+            roughness_value: number_like_in(roughness_raw, roughness, SheenSource::number_value),
             color_texture: texture("sheenColorTexture"),
             roughness_texture: texture("sheenRoughnessTexture"),
             roughness_channel: Channel::A,
@@ -87,10 +89,15 @@ impl Sheen {
 /// keeps, numbers and textureInfos, are then read alone).
 pub trait SheenSource<'a>: JsonView<'a> {
     fn value(self) -> Value;
+    /// A number as a value, given what it reads as.
+    fn number_value(self, x: f64) -> Value;
 }
 
 impl<'a> SheenSource<'a> for &'a Value {
     fn value(self) -> Value {
+        self.clone()
+    }
+    fn number_value(self, _: f64) -> Value {
         self.clone()
     }
 }
@@ -98,6 +105,9 @@ impl<'a> SheenSource<'a> for &'a Value {
 impl<'a> SheenSource<'a> for Node<'a> {
     fn value(self) -> Value {
         self.to_value()
+    }
+    fn number_value(self, x: f64) -> Value {
+        Node::number_value(&self, x)
     }
 }
 
@@ -133,7 +143,7 @@ pub fn fuzz_for(
         fuzz.insert("fuzzTexture".into(), written(texture.clone()));
     }
     let color: Vec<Value> = (0..3)
-        .map(|i| written_number_like(Some(&sheen.color_values[i]), sheen.color[i] / w))
+        .map(|i| written_number_like(&sheen.color_values[i], sheen.color[i], sheen.color[i] / w))
         .collect();
     fuzz.insert("fuzzColorFactor".into(), Value::Array(color));
     if let Some(texture) = &sheen.color_texture {
@@ -146,7 +156,7 @@ pub fn fuzz_for(
     ));
     fuzz.insert(
         "fuzzRoughnessFactor".into(),
-        written_number_like(Some(&sheen.roughness_value), r),
+        written_number_like(&sheen.roughness_value, sheen.roughness, r),
     );
     if let Some(texture) = &sheen.roughness_texture {
         fuzz.insert("fuzzRoughnessTexture".into(), written(texture.clone()));
