@@ -1815,13 +1815,16 @@ fn insert_members(
         }
     }
     if !leading.is_empty() {
+        leading.shrink_to_fit();
         out.push(Splice {
             start: first.0,
             end: first.0,
             text: leading,
         });
     }
-    for (i, insert) in after_member {
+    for (i, mut insert) in after_member {
+        // Kept to the end of the write, by the twenty thousand: cut to its length.
+        insert.shrink_to_fit();
         let end = members[i].1.span().end;
         out.push(Splice {
             start: end,

@@ -146,8 +146,12 @@ impl<'a> MaterialCx<'a> {
     /// Pointer to `extension` on this material.
     pub fn extension_pointer(&self, extension: &str) -> String {
         use std::fmt::Write;
-        let mut pointer = String::with_capacity(32 + extension.len());
-        // Writing to a String cannot fail; `format!` cost more than the rest of the pointer.
+        // Made at its length (a plan keeps it to the end of the run, by the twenty thousand);
+        // `format!` cost more than the rest of the pointer.
+        const PARTS: usize = "/materials//extensions/".len();
+        let digits = self.index.checked_ilog10().unwrap_or(0) as usize + 1;
+        let mut pointer = String::with_capacity(PARTS + digits + extension.len());
+        // Writing to a String cannot fail.
         let _ = write!(pointer, "/materials/{}/extensions/", self.index);
         crate::asset::pointer::push_escaped(&mut pointer, extension);
         pointer
