@@ -20,8 +20,9 @@
 //! decimals (copied from the input, or integers) keep their spelling.
 //!
 //! [`splice_edits`] takes a plan's edits instead of a whole edited document: only the parts
-//! they touch are read, each part's new text is read back alone, and the result is a
-//! [`Spliced`] text, written to its file piece by piece rather than joined.
+//! they touch are read, each part's new text is checked alone (where the edits only add
+//! members, by reading the inserted text; otherwise by reading the part's new text back), and
+//! the result is a [`Spliced`] text, written to its file piece by piece rather than joined.
 //!
 //! The spans come from the document's index ([`crate::asset::tape`]), built when it was loaded:
 //! the source is not read a second time. No maintained crate offers format-preserving edits of
@@ -154,7 +155,8 @@ pub fn splice_edits<'t, 'e>(
                     member: member.name.clone(),
                     element,
                 },
-                Vec::new(),
+                // A unit has one edit, most often.
+                Vec::with_capacity(1),
             ));
             units.len() - 1
         });
@@ -451,7 +453,9 @@ fn members_set_in_place(
             }
         }
     }
-    let mut splices = Vec::new();
+    // Most elements take one splice (their new members, inserted at one place); the list is
+    // kept to the end of the write, by the twenty thousand.
+    let mut splices = Vec::with_capacity(1);
     let mut changed = false;
     // Whether some edit sets a member the element holds already.
     let mut replaced = false;
