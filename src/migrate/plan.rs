@@ -239,7 +239,10 @@ pub fn plan_document(asset: &Asset, options: &Options) -> DocumentPlan {
     };
     let mut materials: Vec<MaterialPlan> = if options.fast {
         use rayon::prelude::*;
-        (0..count).into_par_iter().filter_map(plan).collect()
+        // Collected by index, each plan written into its place: a filtered parallel collect
+        // gathers lists per worker and copies them together.
+        let planned: Vec<Option<MaterialPlan>> = (0..count).into_par_iter().map(plan).collect();
+        planned.into_iter().flatten().collect()
     } else {
         (0..count).filter_map(plan).collect()
     };
