@@ -42,6 +42,21 @@ impl Edit {
         }
     }
 
+    /// Sets `value`, made as velvet writes it and at its size (as a conversion makes a layer
+    /// object): kept as it is where every number in it is written, otherwise written as
+    /// [`Edit::set`] writes it. [`Edit::set`] rebuilds every container, which also cuts
+    /// containers read from the document to their size; a value made here needs neither.
+    pub fn set_made(pointer: impl Into<String>, value: Value) -> Edit {
+        if splice::is_written(&value) {
+            Edit::Set {
+                pointer: pointer.into(),
+                value,
+            }
+        } else {
+            Edit::set(pointer, value)
+        }
+    }
+
     /// The same edit at `pointer`: an edit of a part of the document, given from the part's
     /// own root. A declaration, which has no pointer, is itself.
     pub fn at(&self, pointer: &str) -> Edit {

@@ -1455,7 +1455,7 @@ fn rounded_number(x: f64) -> Option<serde_json::Number> {
 }
 
 /// Whether every number in `value` is already as velvet writes it (see [`written`]).
-fn is_written(value: &Value) -> bool {
+pub(crate) fn is_written(value: &Value) -> bool {
     match value {
         Value::Number(n) => matches!(raw_number_text(n.as_str()), std::borrow::Cow::Borrowed(_)),
         Value::Array(items) => items.iter().all(is_written),
@@ -1467,10 +1467,6 @@ fn is_written(value: &Value) -> bool {
 /// `value` with every number as velvet writes it (see [`number_text`]): edits store what the
 /// file will hold, so that planning again compares like with like.
 pub fn written(value: Value) -> Value {
-    if matches!(value, Value::Array(_) | Value::Object(_)) && is_written(&value) {
-        // Kept as it is: a container of written numbers is not rebuilt.
-        return value;
-    }
     match value {
         Value::Number(n) => match written_number(n.as_str()) {
             WrittenNumber::Kept(_) => Value::Number(n),

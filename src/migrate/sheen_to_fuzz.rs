@@ -127,7 +127,7 @@ pub fn fuzz_for(
         .find(|i| sheen.color[*i] == w)
         .expect("w is one of the components");
     // Each value is written as the file will hold it (`edit::splice::written`) as it goes in,
-    // and the object is made at its final size: `Edit::set` then keeps it as it is, where
+    // and the object is made at its final size: `Edit::set_made` then keeps it as it is, where
     // rounding a finished object rebuilt it (a tenth of planning the library's 20,000).
     let textures = [
         strength_texture,
@@ -255,7 +255,7 @@ pub fn convert(cx: &MaterialCx, sheen: &Sheen, plan: &mut MaterialPlan) {
         plan.skip(Skip::SheenOff, Note::SheenOff);
         return;
     };
-    plan.edits.push(Edit::set(
+    plan.edits.push(Edit::set_made(
         cx.extension_pointer(layers::FUZZ),
         Value::Object(fuzz),
     ));
