@@ -301,6 +301,25 @@ mod tests {
         serde_json::to_string(v).unwrap()
     }
 
+    /// A value made with written numbers is kept as it is; any other is written as `Edit::set`
+    /// writes it.
+    #[test]
+    fn set_made_keeps_a_written_value_and_writes_any_other() {
+        let Edit::Set { value, .. } = Edit::set_made("/a", json!({"fuzzFactor": 0.5})) else {
+            panic!("a set");
+        };
+        assert_eq!(value.to_string(), r#"{"fuzzFactor":0.5}"#);
+        let rounded = Edit::set_made("/a", json!({"fuzzFactor": 0.7499999999999999}));
+        assert_eq!(
+            rounded,
+            Edit::set("/a", json!({"fuzzFactor": 0.7499999999999999}))
+        );
+        let Edit::Set { value, .. } = rounded else {
+            panic!("a set");
+        };
+        assert_eq!(value.to_string(), r#"{"fuzzFactor":0.75}"#);
+    }
+
     #[test]
     fn set_replaces_in_place_appends_new_keys_and_creates_objects() {
         let mut v = doc(r#"{"a":1,"b":{"x":0.50},"c":[1,2]}"#);
