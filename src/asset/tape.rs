@@ -711,18 +711,16 @@ impl<'a> Node<'a> {
         })
     }
 
-    /// The value as a `serde_json::Value`, for the few places that need one (error reports,
-    /// comparisons of whole values).
-    /// This number as a value, given the `f64` it reads as: serde_json's own writing of `x`
-    /// where it spells the number as the text does (as it does most numbers an exporter
-    /// writes), which is cheaper than reading the text into a number again.
+    /// This number as a value, given the `f64` it reads as ([`number_spelled`]).
     pub fn number_value(&self, x: f64) -> Value {
-        match serde_json::Number::from_f64(x) {
-            Some(n) if self.kind() == Kind::Number && n.as_str() == self.raw() => Value::Number(n),
+        match self.kind() {
+            Kind::Number => number_spelled(self.raw(), x).map_or(Value::Null, Value::Number),
             _ => self.to_value(),
         }
     }
 
+    /// The value as a `serde_json::Value`, for the few places that need one (error reports,
+    /// comparisons of whole values).
     pub fn to_value(&self) -> Value {
         match self.kind() {
             // A scalar is made directly (a number keeps its text, as serde_json reads it).
@@ -737,6 +735,15 @@ impl<'a> Node<'a> {
                 .map_or(Value::Null, |s| Value::String(s.into_owned())),
             Kind::Array | Kind::Object => serde_json::from_str(self.raw()).unwrap_or(Value::Null),
         }
+    }
+}
+
+/// The number written `text`, which reads as `x`. serde_json makes a number of a given text
+/// only by reading it; its own writing of `x` is taken where it is that text, which is cheaper.
+pub fn number_spelled(text: &str, x: f64) -> Option<serde_json::Number> {
+    match serde_json::Number::from_f64(x) {
+        Some(n) if n.as_str() == text => Some(n),
+        _ => text.parse().ok(),
     }
 }
 

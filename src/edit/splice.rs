@@ -1308,15 +1308,34 @@ fn written_number(text: &str) -> WrittenNumber<'_> {
     let Some(x) = text.parse::<f64>().ok().filter(|x| x.is_finite()) else {
         return WrittenNumber::Kept(text);
     };
+    match rounding(x) {
+        // Already at that precision (`5E-1`): the spelling stays.
+        Rounding::Same => WrittenNumber::Kept(text),
+        Rounding::Zero => WrittenNumber::Zero,
+        Rounding::To(rounded) => WrittenNumber::Rounded(rounded),
+    }
+}
+
+/// What rounding a finite `x` to [`DECIMALS`] places does to it.
+enum Rounding {
+    /// Nothing: it is at that precision already.
+    Same,
+    /// Rounds it to nothing.
+    Zero,
+    /// Rounds it to this value.
+    To(f64),
+}
+
+fn rounding(x: f64) -> Rounding {
     let scale = 10f64.powi(DECIMALS);
     let rounded = (x * scale).round() / scale;
     if rounded == x {
-        return WrittenNumber::Kept(text); // already at that precision (`5E-1`): the spelling stays
+        Rounding::Same
+    } else if rounded == 0.0 {
+        Rounding::Zero
+    } else {
+        Rounding::To(rounded)
     }
-    if rounded == 0.0 {
-        return WrittenNumber::Zero;
-    }
-    WrittenNumber::Rounded(rounded)
 }
 
 /// Calls `f` with the text [`raw_number_text`] gives, written on the stack when it is rounded:
@@ -1430,28 +1449,21 @@ pub fn written_f64(x: f64) -> Value {
     if !x.is_finite() || x.abs() >= 1e9 {
         return written(Value::from(x)); // not finite, or large: the general way
     }
-    let scale = 10f64.powi(DECIMALS);
-    let rounded = (x * scale).round() / scale;
-    if rounded == x {
-        // Already at that precision: `Value::from` writes the shortest decimal that reads back.
-        Value::from(x)
-    } else if rounded == 0.0 {
-        Value::from(0u8)
-    } else {
-        rounded_number(rounded).map_or_else(|| written(Value::from(x)), Value::Number)
+    match rounding(x) {
+        // `Value::from` writes the shortest decimal that reads back.
+        Rounding::Same => Value::from(x),
+        Rounding::Zero => Value::from(0u8),
+        Rounding::To(rounded) => {
+            rounded_number(rounded).map_or_else(|| written(Value::from(x)), Value::Number)
+        }
     }
 }
 
-/// The number written as [`write_rounded`] writes the rounded `x`. serde_json makes a number
-/// of a given text only by reading it; its own writing of `x` is taken where it gives the same
-/// text, which is cheaper.
+/// The number written as [`write_rounded`] writes the rounded `x`.
 fn rounded_number(x: f64) -> Option<serde_json::Number> {
     let mut text = StackText::new();
     write_rounded(x, &mut text);
-    match serde_json::Number::from_f64(x) {
-        Some(n) if n.as_str() == text.as_str() => Some(n),
-        _ => text.as_str().parse().ok(),
-    }
+    crate::asset::tape::number_spelled(text.as_str(), x)
 }
 
 /// Whether every number in `value` is already as velvet writes it (see [`written`]).
