@@ -931,40 +931,25 @@ impl Scanner<'_> {
                 // Members are compared in the map's order while the text follows it, as the
                 // text velvet writes does: distinct keys, none looked up. From the first key
                 // out of that order, each key is looked up and the keys read are tracked, so
-                // that none is read twice: in a list for a small object, in a set for a large.
-                let small = map.len() <= 16;
+                // that none is read twice.
                 let mut in_order = map.iter();
-                let mut ordered = true;
-                let mut seen_list: Vec<std::borrow::Cow<str>> = Vec::new();
-                let mut seen_set = std::collections::HashSet::new();
+                let mut seen: Option<std::collections::HashSet<std::borrow::Cow<str>>> = None;
                 let mut count = 0;
                 loop {
                     let key = key_at(self.text, self.key()?)?;
-                    let next_in_order = in_order.next().filter(|(k, _)| ordered && **k == *key);
+                    let next_in_order = in_order
+                        .next()
+                        .filter(|(k, _)| seen.is_none() && **k == *key);
                     let member = match next_in_order {
                         Some((_, member)) => member,
                         None => {
-                            if ordered {
-                                ordered = false;
-                                let read = map.keys().take(count).map(|k| k.as_str().into());
-                                if small {
-                                    seen_list.extend(read);
-                                } else {
-                                    seen_set.extend(read);
-                                }
-                            }
+                            let seen = seen.get_or_insert_with(|| {
+                                map.keys().take(count).map(|k| k.as_str().into()).collect()
+                            });
                             let Some(member) = map.get(key.as_ref()) else {
                                 return Some(false);
                             };
-                            let first = if small {
-                                !seen_list.contains(&key) && {
-                                    seen_list.push(key);
-                                    true
-                                }
-                            } else {
-                                seen_set.insert(key)
-                            };
-                            if !first {
+                            if !seen.insert(key) {
                                 return Some(false);
                             }
                             member
