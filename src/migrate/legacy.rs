@@ -31,16 +31,11 @@ const RATIFIED_PROPERTIES: [&str; 4] = [
     "sheenRoughnessTexture",
 ];
 
-/// Whether a sheen object, as loaded, holds any draft property.
-pub fn has_legacy_properties(sheen: crate::asset::tape::Node) -> bool {
-    LEGACY_PROPERTIES.iter().any(|p| sheen.get(*p).is_some())
-}
-
-/// The draft properties present on a sheen object.
-pub fn legacy_properties(sheen: &Value) -> Vec<&'static str> {
+/// The draft properties present on a sheen object, read as a value or through the index.
+pub fn legacy_properties<'a>(sheen: impl crate::asset::tape::JsonView<'a>) -> Vec<&'static str> {
     LEGACY_PROPERTIES
         .into_iter()
-        .filter(|p| sheen.get(p).is_some())
+        .filter(|p| sheen.member(p).is_some())
         .collect()
 }
 

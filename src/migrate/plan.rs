@@ -331,9 +331,10 @@ pub fn plan_material(
     };
     match (sheen, fuzz) {
         (Some(sheen), None) => {
-            let upgraded = match legacy::has_legacy_properties(sheen) {
-                true => legacy::upgrade(&cx, &sheen.to_value(), &mut plan),
-                false => None,
+            // An empty list is made without allocating: the draft is looked for in the index.
+            let upgraded = match legacy::legacy_properties(sheen).is_empty() {
+                true => None,
+                false => legacy::upgrade(&cx, &sheen.to_value(), &mut plan),
             };
             let sheen = upgraded.unwrap_or_else(|| sheen_to_fuzz::Sheen::read(sheen));
             sheen_to_fuzz::convert(&cx, &sheen, &mut plan);
