@@ -51,13 +51,13 @@ impl Sheen {
     /// value reads as its default: the schema check reports it).
     pub fn read<'a>(ext: impl SheenSource<'a>) -> Sheen {
         // Each member is looked up once (a layer read through the index pays for every
-        // lookup), with what `layers::SheenView::read` would read from it.
-        let member = |key| ext.object().then(|| ext.member(key)).flatten();
-        let raw = member("sheenColorFactor");
+        // lookup), with what `layers::SheenView::read` would read from it. A value that is not
+        // an object has no members: every one reads as its default.
+        let raw = ext.member("sheenColorFactor");
         let color = raw
             .and_then(layers::rgb_of)
             .unwrap_or(layers::SHEEN_COLOR_DEFAULT);
-        let roughness_raw = member("sheenRoughnessFactor");
+        let roughness_raw = ext.member("sheenRoughnessFactor");
         let roughness = roughness_raw
             .and_then(JsonView::number)
             .unwrap_or(layers::SHEEN_ROUGHNESS_DEFAULT);
