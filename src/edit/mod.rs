@@ -301,14 +301,24 @@ mod tests {
         serde_json::to_string(v).unwrap()
     }
 
-    /// A value made with written numbers is kept as it is; any other is written as `Edit::set`
-    /// writes it.
+    /// A value made with written numbers is kept as it is (its members where they were, not
+    /// rebuilt as `Edit::set` rebuilds them); any other is written as `Edit::set` writes it.
     #[test]
     fn set_made_keeps_a_written_value_and_writes_any_other() {
-        let Edit::Set { value, .. } = Edit::set_made("/a", json!({"fuzzFactor": 0.5})) else {
+        let made = json!({"fuzzFactor": 0.5});
+        let member_at = |v: &Value| v.as_object().unwrap().values().next().unwrap() as *const Value;
+        let before = member_at(&made);
+        let Edit::Set { value, .. } = Edit::set_made("/a", made) else {
             panic!("a set");
         };
+        assert_eq!(member_at(&value), before, "the object is not rebuilt");
         assert_eq!(value.to_string(), r#"{"fuzzFactor":0.5}"#);
+        let made = json!({"fuzzFactor": 0.5});
+        let before = member_at(&made);
+        let Edit::Set { value, .. } = Edit::set("/a", made) else {
+            panic!("a set");
+        };
+        assert_ne!(member_at(&value), before, "Edit::set rebuilds the object");
         let rounded = Edit::set_made("/a", json!({"fuzzFactor": 0.7499999999999999}));
         assert_eq!(
             rounded,
