@@ -130,6 +130,13 @@ pub fn load_bytes(path: &Path, bytes: &[u8]) -> Loaded {
 /// Parses bytes read from `path`, keeping them as the JSON text without a copy when the file is
 /// a .gltf in plain UTF-8 (a copy of a large document costs as much as indexing it).
 fn load_owned(path: &Path, bytes: Vec<u8>, options: &LoadOptions) -> Loaded {
+    load_read(path, bytes, options).0
+}
+
+/// [`load_owned`], giving the bytes back when the asset did not take them as its text (a GLB,
+/// a byte-order mark, a document over the limit, text that is not UTF-8). When it took them,
+/// [`Asset::file_bytes`] reads them.
+pub fn load_read(path: &Path, bytes: Vec<u8>, options: &LoadOptions) -> (Loaded, Option<Vec<u8>>) {
     let plain = !bytes.starts_with(b"glTF")
         && !bytes.starts_with(b"\xEF\xBB\xBF")
         && !path
@@ -137,11 +144,17 @@ fn load_owned(path: &Path, bytes: Vec<u8>, options: &LoadOptions) -> Loaded {
             .is_some_and(|e| e.eq_ignore_ascii_case("glb"))
         && bytes.len() as u64 <= options.max_document_bytes;
     if !plain {
-        return load_bytes_with(path, &bytes, options);
+        return (load_bytes_with(path, &bytes, options), Some(bytes));
     }
     match String::from_utf8(bytes) {
-        Ok(text) => load_text(path, text, Container::Gltf, 0, None, Vec::new(), options),
-        Err(e) => load_bytes_with(path, e.as_bytes(), options),
+        Ok(text) => (
+            load_text(path, text, Container::Gltf, 0, None, Vec::new(), options),
+            None,
+        ),
+        Err(e) => (
+            load_bytes_with(path, e.as_bytes(), options),
+            Some(e.into_bytes()),
+        ),
     }
 }
 
@@ -408,6 +421,13 @@ fn strip_position(message: &str) -> &str {
 }
 
 impl Asset {
+    /// The file's bytes, where its JSON text is the whole file (a .gltf without a byte-order
+    /// mark); a GLB's are not kept.
+    pub fn file_bytes(&self) -> Option<&[u8]> {
+        (self.container == Container::Gltf && self.json_offset == 0)
+            .then_some(self.json_text.as_bytes())
+    }
+
     /// The document as read from the file, through its index.
     pub fn root(&self) -> tape::Node<'_> {
         self.tape.root(&self.json_text)

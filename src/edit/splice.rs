@@ -30,7 +30,7 @@
 //! before it is written reads that new text with a small streaming scanner, written here for the
 //! same reason.
 
-use super::{Edit, EditError};
+use super::{Edit, EditError, SetValue};
 use crate::asset::json_text::push_quoted;
 use crate::asset::tape::{Kind, Node};
 use rayon::prelude::*;
@@ -406,7 +406,42 @@ fn feed_node(d: &mut Digest, node: Node) {
 /// given).
 struct MemberSet<'e> {
     tokens: Vec<String>,
-    value: std::borrow::Cow<'e, Value>,
+    value: SetTo<'e>,
+}
+
+/// What a member is set to: a value, or compact text as [`write_compact`] writes it.
+enum SetTo<'e> {
+    Value(std::borrow::Cow<'e, Value>),
+    Text(&'e str),
+}
+
+impl SetTo<'_> {
+    fn meant(&self) -> Meant<'_> {
+        match self {
+            SetTo::Value(value) => Meant::Value(value),
+            SetTo::Text(text) => Meant::Text(text),
+        }
+    }
+
+    /// The value (a text read: only where it replaces a member, which a conversion's text
+    /// does not).
+    fn value(&self) -> std::borrow::Cow<'_, Value> {
+        match self {
+            SetTo::Value(value) => std::borrow::Cow::Borrowed(value.as_ref()),
+            SetTo::Text(text) => {
+                std::borrow::Cow::Owned(serde_json::from_str(text).unwrap_or_default())
+            }
+        }
+    }
+}
+
+/// A value a new member is meant to hold, as given to the writer and to the check of what it
+/// wrote.
+#[derive(Clone, Copy)]
+enum Meant<'v> {
+    Value(&'v Value),
+    /// Compact text as [`write_compact`] writes it.
+    Text(&'v str),
 }
 
 /// The splices of an element unit whose edits each set or replace a member of an object the
@@ -431,9 +466,19 @@ fn members_set_in_place(
     for edit in edits {
         let (pointer, value) = match edit {
             // Borrowed unless a number is rounded: a plan's values are not copied.
-            Edit::Set { pointer, value } if is_written(value) => (pointer, Cow::Borrowed(value)),
-            Edit::Set { pointer, value } => (pointer, Cow::Owned(written(value.clone()))),
-            Edit::Replace { pointer, value } => (pointer, Cow::Borrowed(value)),
+            Edit::Set {
+                pointer,
+                value: SetValue::Text(text),
+            } => (pointer, SetTo::Text(text)),
+            Edit::Set {
+                pointer,
+                value: SetValue::Value(value),
+            } if is_written(value) => (pointer, SetTo::Value(Cow::Borrowed(value))),
+            Edit::Set {
+                pointer,
+                value: SetValue::Value(value),
+            } => (pointer, SetTo::Value(Cow::Owned(written(value.clone())))),
+            Edit::Replace { pointer, value } => (pointer, SetTo::Value(Cow::Borrowed(value))),
             _ => return None,
         };
         let within = pointer
@@ -460,7 +505,7 @@ fn members_set_in_place(
     // Whether some edit sets a member the element holds already.
     let mut replaced = false;
     // New members by the object that receives them, in the order the edits add them.
-    let mut inserts: Vec<(Node, Vec<(&str, &Value)>)> = Vec::new();
+    let mut inserts: Vec<(Node, Vec<(&str, Meant)>)> = Vec::new();
     for set in &sets {
         let (key, path) = set.tokens.split_last()?;
         let mut parent = element;
@@ -473,15 +518,16 @@ fn members_set_in_place(
         match object.get(key) {
             Some(old) => {
                 replaced = true;
-                changed |= !matches(old, &set.value, Compare::Exact);
-                diff(text, old, &set.value, layout, &mut splices);
+                let value = set.value.value();
+                changed |= !matches(old, &value, Compare::Exact);
+                diff(text, old, &value, layout, &mut splices);
             }
             None => {
                 changed = true;
                 let at = parent.span().start;
                 match inserts.iter_mut().find(|(p, _)| p.span().start == at) {
-                    Some((_, new)) => new.push((key, &set.value)),
-                    None => inserts.push((parent, vec![(key.as_str(), &set.value)])),
+                    Some((_, new)) => new.push((key, set.value.meant())),
+                    None => inserts.push((parent, vec![(key.as_str(), set.value.meant())])),
                 }
             }
         }
@@ -495,7 +541,7 @@ fn members_set_in_place(
             .collect();
         // A new key goes last, as the edit applier puts it: after the last member.
         let last = Some(members.len() - 1);
-        let placed: Vec<(Option<usize>, &str, &Value)> = new
+        let placed: Vec<(Option<usize>, &str, Meant)> = new
             .iter()
             .map(|(key, value)| (last, *key, *value))
             .collect();
@@ -514,9 +560,11 @@ fn members_set_in_place(
         return Some((splices, changed, ElementCheck::Inserted(reads_back)));
     }
     let mut d = Digest::new();
+    let values: Vec<std::borrow::Cow<Value>> = sets.iter().map(|s| s.value.value()).collect();
     let sets: Vec<(&[String], &Value)> = sets
         .iter()
-        .map(|s| (s.tokens.as_slice(), s.value.as_ref()))
+        .zip(&values)
+        .map(|(s, value)| (s.tokens.as_slice(), value.as_ref()))
         .collect();
     feed_edited(&mut d, element, &sets);
     Some((splices, changed, ElementCheck::Digest(d.finish())))
@@ -534,7 +582,7 @@ enum ElementCheck {
 /// after it: for each, a comma, its key, a colon and its value as velvet writes it; then
 /// nothing but whitespace. The scan validates what it reads (a key's characters and escapes,
 /// each scalar parsed), so the object stays JSON with exactly these members added.
-fn inserted_members_read_as(inserted: &str, members: &[(&str, &Value)]) -> bool {
+fn inserted_members_read_as(inserted: &str, members: &[(&str, Meant)]) -> bool {
     let mut scanner = Scanner {
         text: inserted,
         at: 0,
@@ -546,7 +594,20 @@ fn inserted_members_read_as(inserted: &str, members: &[(&str, &Value)]) -> bool 
         let Some(at) = scanner.key() else {
             return false;
         };
-        if key_at(inserted, at).as_deref() != Some(*key) || scanner.holds(value) != Some(true) {
+        if key_at(inserted, at).as_deref() != Some(*key) {
+            return false;
+        }
+        let holds = match value {
+            Meant::Value(value) => scanner.holds(value),
+            Meant::Text(text) => {
+                scanner.skip_ws();
+                reads_as_compact(&inserted[scanner.at..], text).map(|len| {
+                    scanner.at += len;
+                    true
+                })
+            }
+        };
+        if holds != Some(true) {
             return false;
         }
     }
@@ -737,7 +798,7 @@ fn splice_unit(
                 };
                 match edit {
                     Edit::Set { value: new, .. } if within.is_empty() => {
-                        let new = written(new.clone());
+                        let new = written(new.to_value().into_owned());
                         changed |= value != new;
                         value = new;
                     }
@@ -803,7 +864,7 @@ fn splice_unit(
                         text,
                         root,
                         members,
-                        &[(anchor, &unit.member[..], new)],
+                        &[(anchor, &unit.member[..], Meant::Value(new))],
                         layout,
                         &mut splices,
                     );
@@ -1020,8 +1081,9 @@ struct Layout<'t> {
     newline: &'static str,
     /// Between a key and its value (`": "` or `":"`, from the first member in the file).
     colon: String,
-    /// The document, for what is read on first use.
-    root: Node<'t>,
+    /// The document, for what is read on first use; `None` for [`Layout::compact`], which
+    /// reads nothing.
+    root: Option<Node<'t>>,
     /// Between the elements of a one-line container (`", "` or `","`), from the first such
     /// container in the file.
     inline_comma: std::sync::Arc<std::sync::OnceLock<String>>,
@@ -1062,7 +1124,7 @@ impl<'t> Layout<'t> {
             unit,
             newline,
             colon,
-            root,
+            root: Some(root),
             inline_comma: Default::default(),
             inline_number_arrays: Default::default(),
             line_breaks: Default::default(),
@@ -1072,9 +1134,12 @@ impl<'t> Layout<'t> {
     /// Between the elements of a one-line container.
     fn inline_comma(&self) -> &str {
         self.inline_comma.get_or_init(|| {
-            let text = self.root.text();
             let mut comma = ",".to_string();
-            visit(self.root, &mut |node| {
+            let Some(root) = self.root else {
+                return comma;
+            };
+            let text = root.text();
+            visit(root, &mut |node| {
                 // The first object with two members or array with two elements on one line.
                 let pair = match node.kind() {
                     Kind::Object => node.as_object().and_then(|o| {
@@ -1105,15 +1170,33 @@ impl<'t> Layout<'t> {
     fn inline_number_arrays(&self) -> bool {
         *self.inline_number_arrays.get_or_init(|| {
             let mut inline = false;
-            visit(self.root, &mut |node| match node.as_array() {
+            let Some(root) = self.root else {
+                return inline;
+            };
+            visit(root, &mut |node| match node.as_array() {
                 Some(items) if items.len() >= 2 && items.iter().all(|i| i.is_number()) => {
-                    inline = one_line(self.root.text(), node);
+                    inline = one_line(root.text(), node);
                     false
                 }
                 _ => true,
             });
             inline
         })
+    }
+
+    /// The layout of compact text: one line, `:` and `,` with no space.
+    fn compact() -> &'static Layout<'static> {
+        static COMPACT: std::sync::LazyLock<Layout<'static>> =
+            std::sync::LazyLock::new(|| Layout {
+                unit: None,
+                newline: "\n",
+                colon: ":".to_string(),
+                root: None,
+                inline_comma: std::sync::Arc::new(std::sync::OnceLock::from(",".to_string())),
+                inline_number_arrays: Default::default(),
+                line_breaks: Default::default(),
+            });
+        &COMPACT
     }
 
     /// This layout with the indent unit the container at `container_start` uses for its
@@ -1184,6 +1267,80 @@ impl<'t> Layout<'t> {
         }
     }
 
+    /// Writes the value `compact` holds (as [`write_compact`] writes it) as [`Layout::write`]
+    /// writes that value, byte for byte, in one pass over the text: a layer object a
+    /// conversion wrote as text is laid out without being read into a value. What is not such
+    /// text is written as it comes (the check of the written text then refuses it).
+    fn write_text(&self, compact: &str, indent: &str, inline: bool, out: &mut String) {
+        let bytes = compact.as_bytes();
+        // The indentation of the current line, grown by a unit at each multi-line container.
+        let mut line_indent = String::with_capacity(indent.len() + 16);
+        line_indent.push_str(indent);
+        let unit = self.unit.as_deref().unwrap_or("");
+        // Whether each open container is written on one line.
+        let mut inline_levels: Vec<bool> = Vec::with_capacity(4);
+        let mut at = 0;
+        while let Some(&byte) = bytes.get(at) {
+            let here_inline = inline_levels.last().copied().unwrap_or(inline);
+            match byte {
+                b'{' | b'[' => {
+                    let close = if byte == b'{' { b'}' } else { b']' };
+                    if bytes.get(at + 1) == Some(&close) {
+                        out.push_str(&compact[at..at + 2]);
+                        at += 2;
+                        continue;
+                    }
+                    let one_line = here_inline
+                        || (byte == b'['
+                            && only_numbers_follow(&compact[at + 1..])
+                            && self.inline_number_arrays());
+                    inline_levels.push(one_line);
+                    out.push(char::from(byte));
+                    if !one_line {
+                        line_indent.push_str(unit);
+                        out.push_str(self.newline);
+                        out.push_str(&line_indent);
+                    }
+                    at += 1;
+                }
+                b'}' | b']' => {
+                    if !inline_levels.pop().unwrap_or(true) {
+                        line_indent.truncate(line_indent.len().saturating_sub(unit.len()));
+                        out.push_str(self.newline);
+                        out.push_str(&line_indent);
+                    }
+                    out.push(char::from(byte));
+                    at += 1;
+                }
+                b',' => {
+                    if here_inline {
+                        out.push_str(self.inline_comma());
+                    } else {
+                        out.push(',');
+                        out.push_str(self.newline);
+                        out.push_str(&line_indent);
+                    }
+                    at += 1;
+                }
+                b':' => {
+                    out.push_str(&self.colon);
+                    at += 1;
+                }
+                b'"' => {
+                    // Quoted as velvet quotes, as `write` quotes the string it holds.
+                    let end = string_end(bytes, at).unwrap_or(bytes.len());
+                    out.push_str(&compact[at..end]);
+                    at = end;
+                }
+                _ => {
+                    let end = scalar_end(bytes, at);
+                    with_written_number(&compact[at..end], |text| out.push_str(text));
+                    at = end.max(at + 1);
+                }
+            }
+        }
+    }
+
     fn write_object(&self, map: &Map<String, Value>, indent: &str, inline: bool, out: &mut String) {
         if inline {
             out.push('{');
@@ -1214,6 +1371,28 @@ impl<'t> Layout<'t> {
         out.push_str(indent);
         out.push('}');
     }
+}
+
+/// Whether the elements of a compact array, from its first element to its `]`, are all
+/// numbers (each starts with a digit or a sign, and a number holds no `,` or `]`).
+fn only_numbers_follow(elements: &str) -> bool {
+    let mut rest = elements.as_bytes();
+    loop {
+        if !matches!(rest.first(), Some(b'-' | b'0'..=b'9')) {
+            return false;
+        }
+        match rest.iter().position(|&b| b == b',' || b == b']') {
+            Some(at) if rest[at] == b',' => rest = &rest[at + 1..],
+            Some(_) => return true,
+            None => return false,
+        }
+    }
+}
+
+/// Writes `value` as compact JSON text (no whitespace), its numbers as velvet writes them
+/// and its strings quoted as velvet quotes them: the text of an [`super::SetValue::Text`].
+pub fn write_compact(value: &Value, out: &mut String) {
+    Layout::compact().write(value, "", true, out);
 }
 
 /// Calls `f` on `node` and everything inside it, depth first, until `f` returns false; false
@@ -1627,6 +1806,93 @@ fn scalar_matches(raw: &str, value: &Value, compare: Compare) -> bool {
     }
 }
 
+/// Whether `written`, from its start, is the value `compact` holds (as [`write_compact`]
+/// writes it) laid out: the same tokens in the same order, each number as
+/// [`with_written_number`] writes the compact one, with whitespace only between tokens (next
+/// to a bracket, brace, comma or colon, never inside a string or splitting a number); the
+/// length of `written` it spans. One pass over both texts, as [`Layout::write_text`] writes
+/// them. Every token is checked as JSON: strings without raw control characters and with
+/// valid escapes, numbers JSON allows, the three literals. The compact text's own structure
+/// is what [`write_compact`] made of a value.
+fn reads_as_compact(written: &str, compact: &str) -> Option<usize> {
+    let (w, c) = (written.as_bytes(), compact.as_bytes());
+    let structural = |b: Option<&u8>| matches!(b, Some(b'{' | b'}' | b'[' | b']' | b',' | b':'));
+    let (mut i, mut j) = (0, 0);
+    while j < c.len() {
+        let byte = *w.get(i)?;
+        if matches!(byte, b' ' | b'\t' | b'\n' | b'\r') {
+            // Between tokens only: a structural byte before or after.
+            if !(structural(c.get(j)) || structural(j.checked_sub(1).and_then(|k| c.get(k)))) {
+                return None;
+            }
+            i += 1;
+            continue;
+        }
+        match c[j] {
+            b'"' => {
+                let end = string_end(c, j)?;
+                let token = &compact[j..end];
+                if written.get(i..i + token.len())? != token
+                    || token.bytes().any(|b| b < 0x20)
+                    || (token.contains('\\') && serde_json::from_str::<String>(token).is_err())
+                {
+                    return None;
+                }
+                i += token.len();
+                j = end;
+            }
+            b'{' | b'}' | b'[' | b']' | b',' | b':' => {
+                if byte != c[j] {
+                    return None;
+                }
+                i += 1;
+                j += 1;
+            }
+            _ => {
+                let end = scalar_end(c, j);
+                let meant = &compact[j..end];
+                let written_end = scalar_end(w, i);
+                let raw = &written[i..written_end];
+                let literal = matches!(raw, "true" | "false" | "null");
+                let same = if literal {
+                    raw == meant
+                } else {
+                    (raw == meant || with_written_number(meant, |text| text == raw))
+                        && (is_plain_number(raw)
+                            || serde_json::from_str::<serde_json::Number>(raw).is_ok())
+                };
+                if !same || end == j {
+                    return None;
+                }
+                i = written_end;
+                j = end;
+            }
+        }
+    }
+    Some(i)
+}
+
+/// Where the string whose opening quote stands at `at` ends (past its closing quote).
+fn string_end(bytes: &[u8], at: usize) -> Option<usize> {
+    let mut i = at + 1;
+    loop {
+        match *bytes.get(i)? {
+            b'"' => return Some(i + 1),
+            b'\\' => i += 2,
+            _ => i += 1,
+        }
+    }
+}
+
+/// Where the number or literal starting at `at` ends: at the next comma, bracket, brace or
+/// whitespace.
+fn scalar_end(bytes: &[u8], at: usize) -> usize {
+    bytes[at..]
+        .iter()
+        .position(|b| matches!(b, b',' | b'}' | b']' | b' ' | b'\t' | b'\n' | b'\r' | b':'))
+        .map_or(bytes.len(), |n| at + n)
+}
+
 /// Whether `raw` is a JSON number without an exponent: `-?(0|[1-9][0-9]*)(\.[0-9]+)?`.
 fn is_plain_number(raw: &str) -> bool {
     let digits = raw.strip_prefix('-').unwrap_or(raw).as_bytes();
@@ -1731,11 +1997,11 @@ fn diff_object(
         .map(|(i, k)| (k.as_ref(), i))
         .collect();
     let mut anchor: Option<usize> = None;
-    let mut placed: Vec<(Option<usize>, &str, &Value)> = Vec::new();
+    let mut placed: Vec<(Option<usize>, &str, Meant)> = Vec::new();
     for (key, value) in after {
         match position.get(key.as_str()) {
             Some(i) => anchor = Some(*i),
-            None => placed.push((anchor, key, value)),
+            None => placed.push((anchor, key, Meant::Value(value))),
         }
     }
     insert_members(text, span, &members, &placed, layout, out);
@@ -1765,7 +2031,7 @@ fn insert_members(
     text: &str,
     span: Node,
     members: &[(usize, Node)],
-    placed: &[(Option<usize>, &str, &Value)],
+    placed: &[(Option<usize>, &str, Meant)],
     layout: &Layout,
     out: &mut Vec<Splice>,
 ) {
@@ -1783,10 +2049,14 @@ fn insert_members(
     } else {
         concat(&[",", layout.newline, &indent])
     };
-    let push_member = |text: &mut String, key: &str, value: &Value| {
+    let push_member = |text: &mut String, key: &str, value: Meant| {
         push_quoted(text, key);
         text.push_str(&layout.colon);
-        layout.write(value, &indent, inline || layout.unit.is_none(), text);
+        let inline = inline || layout.unit.is_none();
+        match value {
+            Meant::Value(value) => layout.write(value, &indent, inline, text),
+            Meant::Text(compact) => layout.write_text(compact, &indent, inline, text),
+        }
     };
     // Room for a layer object of a few members, so that writing one grows a string once at
     // most.
@@ -2287,7 +2557,10 @@ mod tests {
         let value =
             serde_json::json!({"fuzzFactor": 0.7499999999999999, "fuzzColorFactor": [1, 0.5]});
         let second = serde_json::json!("b");
-        let members = [("KHR_materials_fuzz", &value), ("name", &second)];
+        let members = [
+            ("KHR_materials_fuzz", Meant::Value(&value)),
+            ("name", Meant::Value(&second)),
+        ];
         let good = ",\n  \"KHR_materials_fuzz\": {\"fuzzFactor\": 0.75, \"fuzzColorFactor\": [1, 0.5]}, \"name\": \"b\"\n";
         assert!(inserted_members_read_as(good, &members));
         // The members of an object in another order read as the same object.
@@ -2311,6 +2584,124 @@ mod tests {
         ] {
             assert!(!inserted_members_read_as(bad, &members), "{bad}");
         }
+    }
+
+    /// Documents in the layouts a file may have: two spaces with number arrays on one line,
+    /// tabs with CRLF, four spaces with one-line objects, minified.
+    const LAYOUTS: [&str; 4] = [
+        "{\n  \"asset\": {\"version\": \"2.0\"},\n  \"materials\": [\n    {\n      \"extensions\": {\n        \"KHR_materials_sheen\": {\n          \"sheenColorFactor\": [1, 0.5, 0]\n        }\n      }\n    }\n  ]\n}\n",
+        "{\r\n\t\"asset\": {\r\n\t\t\"version\": \"2.0\"\r\n\t},\r\n\t\"materials\": [\r\n\t\t{\r\n\t\t\t\"extensions\": {\r\n\t\t\t\t\"KHR_materials_sheen\": {\r\n\t\t\t\t\t\"sheenColorFactor\": [\r\n\t\t\t\t\t\t1,\r\n\t\t\t\t\t\t0.5\r\n\t\t\t\t\t]\r\n\t\t\t\t}\r\n\t\t\t}\r\n\t\t}\r\n\t]\r\n}",
+        "{\n    \"asset\": { \"version\": \"2.0\", \"generator\": \"x\" },\n    \"materials\": [\n        { \"extensions\": { \"KHR_materials_sheen\": { \"sheenColorFactor\": [1, 0.5, 0] } } }\n    ]\n}\n",
+        "{\"asset\":{\"version\":\"2.0\"},\"materials\":[{\"extensions\":{\"KHR_materials_sheen\":{\"sheenColorFactor\":[1,0.5,0]}}}]}",
+    ];
+
+    /// Values a layer object may hold: nested objects and arrays, empty ones, escaped and
+    /// non-ASCII strings, the literals, numbers spelled with exponents and with more decimals
+    /// than velvet writes.
+    fn layer_values() -> Vec<Value> {
+        vec![
+            serde_json::json!({"fuzzFactor": 0.9, "fuzzColorFactor": [1.0, 0.5, 0], "fuzzRoughnessFactor": 0.3089, "fuzzRoughnessTexture": {"index": 0}}),
+            serde_json::json!({"t": {"index": 2, "texCoord": 1, "extensions": {"KHR_texture_transform": {"scale": [30.0, -30.0], "offset": []}}, "extras": {}}}),
+            serde_json::from_str(r#"{"s": "a \"quoted\" \\ tab\t é \u0001", "b": [true, false, null], "n": [1E-1, -2.5e3, 0.12345678, 7.5e-8], "mixed": [1, "x", {"k": [2]}]}"#).unwrap(),
+            serde_json::json!([]),
+            serde_json::json!({}),
+            serde_json::json!("plain"),
+            serde_json::json!(0.7499999999999999),
+        ]
+    }
+
+    /// Compact text written in a file's layout is, byte for byte, what the value it holds
+    /// gives, on one line and over lines, at any indentation; and it reads back as that text.
+    #[test]
+    fn compact_text_is_laid_out_as_its_value_is() {
+        for text in LAYOUTS {
+            let tape = crate::asset::tape::Tape::build(text).unwrap();
+            let layout = Layout::detect(text, tape.root(text));
+            for value in layer_values() {
+                let mut compact = String::new();
+                write_compact(&value, &mut compact);
+                let reread: Value = serde_json::from_str(&compact).unwrap();
+                assert_eq!(reread, written(value.clone()), "{compact}");
+                for (indent, inline) in [("", false), ("\t\t", false), ("    ", true), ("", true)] {
+                    let mut from_value = String::new();
+                    layout.write(&value, indent, inline, &mut from_value);
+                    let mut from_text = String::new();
+                    layout.write_text(&compact, indent, inline, &mut from_text);
+                    assert_eq!(from_text, from_value, "{text:?} {compact}");
+                    assert_eq!(
+                        reads_as_compact(&from_text, &compact),
+                        Some(from_text.len()),
+                        "{from_text}"
+                    );
+                }
+            }
+        }
+    }
+
+    /// A layer object set as text is spliced as the same object set as a value is, in every
+    /// layout, and both read back alone.
+    #[test]
+    fn a_layer_set_as_text_is_spliced_as_the_value_is() {
+        let pointer = "/materials/0/extensions/KHR_materials_fuzz";
+        for text in LAYOUTS {
+            let tape = crate::asset::tape::Tape::build(text).unwrap();
+            for value in layer_values() {
+                let mut compact = String::new();
+                write_compact(&value, &mut compact);
+                let as_value = [Edit::set(pointer, value.clone())];
+                let as_text = [Edit::set_text(pointer, compact)];
+                let spliced = splice_edits_text(text, tape.root(text), &as_value)
+                    .unwrap()
+                    .unwrap();
+                assert_eq!(
+                    splice_edits_text(text, tape.root(text), &as_text)
+                        .unwrap()
+                        .unwrap(),
+                    spliced
+                );
+                let mut whole: Value = serde_json::from_str(text).unwrap();
+                super::super::apply(&mut whole, &as_value).unwrap();
+                assert!(reads_as_written(&spliced.0, &whole));
+            }
+        }
+    }
+
+    /// The check of a laid-out text against compact text refuses any other token, whitespace
+    /// inside a token, a string with a raw control character or a bad escape, and a text that
+    /// ends early; it accepts whitespace between tokens and numbers written as velvet writes
+    /// the compact ones.
+    #[test]
+    fn laid_out_text_is_checked_against_its_compact_text_token_by_token() {
+        let compact = r#"{"a":[1,0.5,true],"b":"x y","c":{}}"#;
+        let good = "{\n  \"a\": [1, 0.5, true],\r\n  \"b\" : \"x y\",\t\"c\": {}\n}";
+        assert_eq!(reads_as_compact(good, compact), Some(good.len()));
+        let followed = format!("{compact} ,");
+        assert_eq!(reads_as_compact(&followed, compact), Some(compact.len()));
+        assert_eq!(
+            reads_as_compact("0.75", "0.7499999999999999"),
+            Some(4),
+            "a number as velvet writes it"
+        );
+        for bad in [
+            r#"{"a":[1,0. 5,true],"b":"x y","c":{}}"#,
+            r#"{"a":[1,0.5,tr ue],"b":"x y","c":{}}"#,
+            r#"{"a":[1,0.5,true],"b":"x  y","c":{}}"#,
+            r#"{"a":[1,0.25,true],"b":"x y","c":{}}"#,
+            r#"{"a":[1,0.5,true],"B":"x y","c":{}}"#,
+            r#"{"a":[1,0.5,true] "b":"x y","c":{}}"#,
+            r#"{"a":[1,0.5,true],"b":"x y","c":{}"#,
+            r#"{"a":[1,0.5,1],"b":"x y","c":{}}"#,
+            r#"{"a":[1,.5,true],"b":"x y","c":{}}"#,
+        ] {
+            assert_eq!(reads_as_compact(bad, compact), None, "{bad}");
+        }
+        assert_eq!(reads_as_compact("\"a\tb\"", "\"a\tb\""), None, "a raw tab");
+        assert_eq!(
+            reads_as_compact(r#""a\qb""#, r#""a\qb""#),
+            None,
+            "a bad escape"
+        );
+        assert_eq!(reads_as_compact("tru", "tru"), None, "not a literal");
     }
 
     /// A computed number is written as the general way writes it once made a value: kept,

@@ -241,8 +241,11 @@ pub fn plan_document(asset: &Asset, options: &Options) -> DocumentPlan {
         use rayon::prelude::*;
         // Collected by index, each plan written into its place: a filtered parallel collect
         // gathers lists per worker and copies them together.
+        // The list is then filtered where it lies: `filter_map` on a vector's own iterator
+        // collects into its allocation, where `flatten` makes a second list, grown by doubling.
         let planned: Vec<Option<MaterialPlan>> = (0..count).into_par_iter().map(plan).collect();
-        planned.into_iter().flatten().collect()
+        #[allow(clippy::filter_map_identity)]
+        planned.into_iter().filter_map(|plan| plan).collect()
     } else {
         (0..count).filter_map(plan).collect()
     };

@@ -20,13 +20,14 @@ use super::note::{Conversion, Note, Skip};
 use super::plan::{number_like_in, written_number_like, MaterialCx, MaterialPlan};
 use super::roughness::{self, Direction, RoughnessMapping};
 use super::textures::{Contents, TextureBake};
+use crate::asset::json_text::push_quoted;
 use crate::asset::tape::{JsonView, Node};
 use crate::bake::Channel;
-use crate::edit::splice::written;
+use crate::edit::splice::write_compact;
 use crate::edit::Edit;
 use crate::layers::{self, max3};
 use crate::shading::layering;
-use serde_json::{Map, Value};
+use serde_json::Value;
 
 /// A ratified sheen as the conversion needs it: values with the JSON text they came in (so
 /// that unchanged numbers keep it), and the textureInfo objects as they are.
@@ -111,14 +112,15 @@ impl<'a> SheenSource<'a> for Node<'a> {
     }
 }
 
-/// The KHR_materials_fuzz object that stands for `sheen`, or `None` when the sheen is off.
-/// Keys follow the draft's parameter table. With `strength_texture`, the fuzzTexture slot
-/// reads it (the exact mode, whose bake fills it).
+/// The KHR_materials_fuzz object that stands for `sheen`, as compact text
+/// ([`write_compact`]), or `None` when the sheen is off. Keys follow the draft's parameter
+/// table. With `strength_texture`, the fuzzTexture slot reads it (the exact mode, whose bake
+/// fills it).
 pub fn fuzz_for(
     sheen: &Sheen,
     strength_texture: Option<&Value>,
     mapping: RoughnessMapping,
-) -> Option<Map<String, Value>> {
+) -> Option<String> {
     let w = max3(sheen.color);
     if !w.is_finite() || w <= 0.0 {
         return None;
@@ -126,41 +128,43 @@ pub fn fuzz_for(
     let strongest = (0..3)
         .find(|i| sheen.color[*i] == w)
         .expect("w is one of the components");
-    // Each value is written as the file will hold it (`edit::splice::written`) as it goes in,
-    // and the object is made at its final size: `Edit::set_made` then keeps it as it is, where
-    // rounding a finished object rebuilt it (a tenth of planning the library's 20,000).
-    let textures = [
-        strength_texture,
-        sheen.color_texture.as_ref(),
-        sheen.roughness_texture.as_ref(),
-    ];
-    let mut fuzz = Map::with_capacity(3 + textures.iter().flatten().count());
-    fuzz.insert(
-        "fuzzFactor".into(),
-        written(sheen.color_values[strongest].clone()),
-    );
+    // Written as text as it is made: no object is built, and a plan keeps the text (a
+    // library's 20,000 fuzz objects as values took a third of its migration's memory).
+    let mut fuzz = String::with_capacity(192);
+    let mut member = |key: &str, value: &Value| {
+        fuzz.push(if fuzz.is_empty() { '{' } else { ',' });
+        push_quoted(&mut fuzz, key);
+        fuzz.push(':');
+        write_compact(value, &mut fuzz);
+    };
+    member("fuzzFactor", &sheen.color_values[strongest]);
     if let Some(texture) = strength_texture {
-        fuzz.insert("fuzzTexture".into(), written(texture.clone()));
+        member("fuzzTexture", texture);
     }
-    let color: Vec<Value> = (0..3)
-        .map(|i| written_number_like(&sheen.color_values[i], sheen.color[i], sheen.color[i] / w))
-        .collect();
-    fuzz.insert("fuzzColorFactor".into(), Value::Array(color));
+    let color = Value::Array(
+        (0..3)
+            .map(|i| {
+                written_number_like(&sheen.color_values[i], sheen.color[i], sheen.color[i] / w)
+            })
+            .collect(),
+    );
+    member("fuzzColorFactor", &color);
     if let Some(texture) = &sheen.color_texture {
-        fuzz.insert("fuzzColorTexture".into(), written(texture.clone()));
+        member("fuzzColorTexture", texture);
     }
     let r = roughness::written(roughness::map(
         sheen.roughness,
         Direction::SheenToFuzz,
         mapping,
     ));
-    fuzz.insert(
-        "fuzzRoughnessFactor".into(),
-        written_number_like(&sheen.roughness_value, sheen.roughness, r),
+    member(
+        "fuzzRoughnessFactor",
+        &written_number_like(&sheen.roughness_value, sheen.roughness, r),
     );
     if let Some(texture) = &sheen.roughness_texture {
-        fuzz.insert("fuzzRoughnessTexture".into(), written(texture.clone()));
+        member("fuzzRoughnessTexture", texture);
     }
+    fuzz.push('}');
     Some(fuzz)
 }
 
@@ -255,10 +259,8 @@ pub fn convert(cx: &MaterialCx, sheen: &Sheen, plan: &mut MaterialPlan) {
         plan.skip(Skip::SheenOff, Note::SheenOff);
         return;
     };
-    plan.edits.push(Edit::set_made(
-        cx.extension_pointer(layers::FUZZ),
-        Value::Object(fuzz),
-    ));
+    plan.edits
+        .push(Edit::set_text(cx.extension_pointer(layers::FUZZ), fuzz));
     plan.conversions.push(Conversion::SheenToFuzz);
     if cx.has_extension(layers::CLEARCOAT) {
         plan.notes.push(Note::ClearcoatOrder { fallback: false });
@@ -328,7 +330,12 @@ mod tests {
 
     fn fuzz_text(sheen: Value) -> Option<String> {
         fuzz_for(&Sheen::read(&sheen), None, RoughnessMapping::Identity)
-            .map(|m| serde_json::to_string(&Value::Object(m)).unwrap())
+    }
+
+    /// The fuzz object's text, read.
+    fn fuzz_value(sheen: &Value) -> Value {
+        let text = fuzz_for(&Sheen::read(sheen), None, RoughnessMapping::Identity).unwrap();
+        serde_json::from_str(&text).unwrap()
     }
 
     #[test]
@@ -369,11 +376,11 @@ mod tests {
     fn textures_are_carried_with_their_extensions() {
         let tex = json!({"index": 2, "texCoord": 1, "extensions": {"KHR_texture_transform": {"scale": [30.0, -30.0]}}});
         let sheen = json!({"sheenColorFactor": [0.5, 0.5, 0.5], "sheenColorTexture": tex, "sheenRoughnessTexture": tex});
-        let fuzz = fuzz_for(&Sheen::read(&sheen), None, RoughnessMapping::Identity).unwrap();
+        let fuzz = fuzz_value(&sheen);
         assert_eq!(fuzz["fuzzColorTexture"], tex);
         assert_eq!(fuzz["fuzzRoughnessTexture"], tex);
         assert_eq!(
-            fuzz.keys().collect::<Vec<_>>(),
+            fuzz.as_object().unwrap().keys().collect::<Vec<_>>(),
             [
                 "fuzzFactor",
                 "fuzzColorFactor",
@@ -392,12 +399,7 @@ mod tests {
             [1e-6, 0.0, 3e-7],
             [0.12, 0.12, 0.13],
         ] {
-            let fuzz = fuzz_for(
-                &Sheen::read(&json!({ "sheenColorFactor": c })),
-                None,
-                RoughnessMapping::Identity,
-            )
-            .unwrap();
+            let fuzz = fuzz_value(&json!({ "sheenColorFactor": c }));
             let w = fuzz["fuzzFactor"].as_f64().unwrap();
             for i in 0..3 {
                 let colour = fuzz["fuzzColorFactor"][i].as_f64().unwrap();

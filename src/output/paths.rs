@@ -372,7 +372,7 @@ pub fn relocate(asset: &Asset, output: &Path, rewrite_uris: bool) -> Result<Relo
     }
     if rewritten > 0 {
         let leaves_folder = relocation.edits.iter().any(
-            |e| matches!(e, Edit::Set { value: Value::String(u), .. } if u.starts_with("../")),
+            |e| matches!(e, Edit::Set { value, .. } if value.to_value().as_str().is_some_and(|u| u.starts_with("../"))),
         );
         relocation.notes.push(RelocationNote::UrisRewritten {
             count: rewritten,
