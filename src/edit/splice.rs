@@ -1623,6 +1623,42 @@ pub fn written_f64(x: f64) -> Value {
     }
 }
 
+/// Writes the text of [`written_f64`]`(x)` as [`write_compact`] writes it, with no value
+/// made: the numbers a conversion computes (a sheen's fuzz colour, three by the twenty
+/// thousand in a library) go straight into its layer object's text.
+pub fn push_written_f64(x: f64, out: &mut String) {
+    if !x.is_finite() || x.abs() >= 1e9 {
+        return write_compact(&written_f64(x), out); // not finite, or large: the general way
+    }
+    match rounding(x) {
+        // What `Value::from` holds: serde_json's own writing of an f64.
+        Rounding::Same => push_serde_f64(x, out),
+        Rounding::Zero => out.push('0'),
+        Rounding::To(rounded) => {
+            let mut text = StackText::new();
+            write_rounded(rounded, &mut text);
+            out.push_str(text.as_str());
+        }
+    }
+}
+
+/// serde_json's writing of a finite `x` (the text `Value::from(x)` holds), made on the stack
+/// by its own formatter.
+fn push_serde_f64(x: f64, out: &mut String) {
+    use serde_json::ser::Formatter;
+    const ROOM: usize = 40;
+    let mut buffer = [0u8; ROOM];
+    let mut rest: &mut [u8] = &mut buffer;
+    let formatted = serde_json::ser::CompactFormatter
+        .write_f64(&mut rest, x)
+        .is_ok();
+    let len = ROOM - rest.len();
+    match std::str::from_utf8(&buffer[..len]) {
+        Ok(text) if formatted => out.push_str(text),
+        _ => out.push_str(&Value::from(x).to_string()),
+    }
+}
+
 /// The number written as [`write_rounded`] writes the rounded `x`.
 fn rounded_number(x: f64) -> Option<serde_json::Number> {
     let mut text = StackText::new();
@@ -2740,11 +2776,11 @@ mod tests {
             x *= 1.618;
         }
         for x in xs {
-            assert_eq!(
-                written_f64(x).to_string(),
-                written(Value::from(x)).to_string(),
-                "{x}"
-            );
+            let general = written(Value::from(x)).to_string();
+            assert_eq!(written_f64(x).to_string(), general, "{x}");
+            let mut pushed = String::new();
+            push_written_f64(x, &mut pushed);
+            assert_eq!(pushed, general, "{x}");
         }
     }
 

@@ -358,13 +358,14 @@ pub(crate) fn number_like(original: Option<&Value>, value: f64) -> Value {
     number_like_in(original, value, |v, _| v.clone())
 }
 
-/// [`number_like`] as velvet writes it ([`crate::edit::splice::written`]), for an `original`
-/// known to read as `reads_as`: `original` when that is the value, else the value, rounded.
-pub(crate) fn written_number_like(original: &Value, reads_as: f64, value: f64) -> Value {
+/// [`number_like`] as velvet writes it, written as compact text
+/// ([`crate::edit::splice::write_compact`]), for an `original` known to read as `reads_as`:
+/// `original` when that is the value, else the value, rounded.
+pub(crate) fn push_number_like(original: &Value, reads_as: f64, value: f64, out: &mut String) {
     if reads_as == value {
-        crate::edit::splice::written(original.clone())
+        crate::edit::splice::write_compact(original, out);
     } else {
-        crate::edit::splice::written_f64(value)
+        crate::edit::splice::push_written_f64(value, out);
     }
 }
 

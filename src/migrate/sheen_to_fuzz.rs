@@ -17,7 +17,7 @@
 
 use super::measure;
 use super::note::{Conversion, Note, Skip};
-use super::plan::{number_like_in, written_number_like, MaterialCx, MaterialPlan};
+use super::plan::{number_like_in, push_number_like, MaterialCx, MaterialPlan};
 use super::roughness::{self, Direction, RoughnessMapping};
 use super::textures::{Contents, TextureBake};
 use crate::asset::json_text::push_quoted;
@@ -131,38 +131,49 @@ pub fn fuzz_for(
     // Written as text as it is made: no object is built, and a plan keeps the text (a
     // library's 20,000 fuzz objects as values took a third of its migration's memory).
     let mut fuzz = String::with_capacity(192);
-    let mut member = |key: &str, value: &Value| {
-        fuzz.push(if fuzz.is_empty() { '{' } else { ',' });
-        push_quoted(&mut fuzz, key);
+    fuzz.push('{');
+    let key = |fuzz: &mut String, key: &str| {
+        if fuzz.len() > 1 {
+            fuzz.push(',');
+        }
+        push_quoted(fuzz, key);
         fuzz.push(':');
-        write_compact(value, &mut fuzz);
     };
-    member("fuzzFactor", &sheen.color_values[strongest]);
+    key(&mut fuzz, "fuzzFactor");
+    write_compact(&sheen.color_values[strongest], &mut fuzz);
     if let Some(texture) = strength_texture {
-        member("fuzzTexture", texture);
+        key(&mut fuzz, "fuzzTexture");
+        write_compact(texture, &mut fuzz);
     }
-    let color = Value::Array(
-        (0..3)
-            .map(|i| {
-                written_number_like(&sheen.color_values[i], sheen.color[i], sheen.color[i] / w)
-            })
-            .collect(),
-    );
-    member("fuzzColorFactor", &color);
+    key(&mut fuzz, "fuzzColorFactor");
+    fuzz.push('[');
+    for i in 0..3 {
+        if i > 0 {
+            fuzz.push(',');
+        }
+        let normalised = sheen.color[i] / w;
+        push_number_like(
+            &sheen.color_values[i],
+            sheen.color[i],
+            normalised,
+            &mut fuzz,
+        );
+    }
+    fuzz.push(']');
     if let Some(texture) = &sheen.color_texture {
-        member("fuzzColorTexture", texture);
+        key(&mut fuzz, "fuzzColorTexture");
+        write_compact(texture, &mut fuzz);
     }
     let r = roughness::written(roughness::map(
         sheen.roughness,
         Direction::SheenToFuzz,
         mapping,
     ));
-    member(
-        "fuzzRoughnessFactor",
-        &written_number_like(&sheen.roughness_value, sheen.roughness, r),
-    );
+    key(&mut fuzz, "fuzzRoughnessFactor");
+    push_number_like(&sheen.roughness_value, sheen.roughness, r, &mut fuzz);
     if let Some(texture) = &sheen.roughness_texture {
-        member("fuzzRoughnessTexture", texture);
+        key(&mut fuzz, "fuzzRoughnessTexture");
+        write_compact(texture, &mut fuzz);
     }
     fuzz.push('}');
     Some(fuzz)
