@@ -23,6 +23,9 @@
 //! they touch are read, each part's new text is checked alone (where the edits only add
 //! members, by reading the inserted text; otherwise by reading the part's new text back), and
 //! the result is a [`Spliced`] text, written to its file piece by piece rather than joined.
+//! A value an edit holds as compact text ([`write_compact`], as a conversion writes its layer
+//! object) is laid out from that text in one pass, and the inserted text is checked against it
+//! token by token.
 //!
 //! The spans come from the document's index ([`crate::asset::tape`]), built when it was loaded:
 //! the source is not read a second time. No maintained crate offers format-preserving edits of
