@@ -15,7 +15,7 @@
 
 use super::note::{Conversion, Note};
 use super::plan::{number_like, texture_unusable, MaterialCx, MaterialPlan};
-use super::sheen_to_fuzz::Sheen;
+use super::sheen_to_fuzz::{Read, Sheen};
 use super::textures::Contents;
 use crate::asset::pointer;
 use crate::bake::Channel;
@@ -49,7 +49,7 @@ fn rgb(value: Option<&Value>) -> Option<[f64; 3]> {
 /// Upgrades a draft sheen on `cx`'s material: pushes the edits and notes to `plan` and returns
 /// the ratified sheen it becomes. `None` when there is nothing to upgrade (no draft property,
 /// or ratified ones beside them).
-pub fn upgrade(cx: &MaterialCx, sheen: &Value, plan: &mut MaterialPlan) -> Option<Sheen> {
+pub fn upgrade(cx: &MaterialCx, sheen: &Value, plan: &mut MaterialPlan) -> Option<Sheen<'static>> {
     let legacy = legacy_properties(sheen);
     if legacy.is_empty() {
         return None;
@@ -141,20 +141,12 @@ pub fn upgrade(cx: &MaterialCx, sheen: &Value, plan: &mut MaterialPlan) -> Optio
         plan.edits
             .push(Edit::remove(pointer::join(&base, property)));
     }
-    let upgraded = Sheen {
-        color: clamped,
-        color_values,
-        roughness,
-        roughness_value: number_like(roughness_raw, roughness),
-        color_texture,
-        roughness_texture,
-        roughness_channel: Channel::G,
-    };
+    let roughness_value = number_like(roughness_raw, roughness);
     plan.edits.push(Edit::set(
         pointer::join(&base, "sheenColorFactor"),
-        Value::Array(upgraded.color_values.to_vec()),
+        Value::Array(color_values.to_vec()),
     ));
-    if let Some(texture) = &upgraded.color_texture {
+    if let Some(texture) = &color_texture {
         plan.edits.push(Edit::set(
             pointer::join(&base, "sheenColorTexture"),
             texture.clone(),
@@ -162,14 +154,23 @@ pub fn upgrade(cx: &MaterialCx, sheen: &Value, plan: &mut MaterialPlan) -> Optio
     }
     plan.edits.push(Edit::set(
         pointer::join(&base, "sheenRoughnessFactor"),
-        upgraded.roughness_value.clone(),
+        roughness_value.clone(),
     ));
-    if let Some(texture) = &upgraded.roughness_texture {
+    if let Some(texture) = &roughness_texture {
         plan.edits.push(Edit::set(
             pointer::join(&base, "sheenRoughnessTexture"),
             texture.clone(),
         ));
     }
+    let upgraded = Sheen {
+        color: clamped,
+        color_values: color_values.map(Read::Value),
+        roughness,
+        roughness_value: Read::Value(roughness_value),
+        color_texture: color_texture.map(Read::Value),
+        roughness_texture: roughness_texture.map(Read::Value),
+        roughness_channel: Channel::G,
+    };
     plan.conversions.push(Conversion::LegacyUpgrade);
     Some(upgraded)
 }

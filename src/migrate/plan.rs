@@ -358,17 +358,6 @@ pub(crate) fn number_like(original: Option<&Value>, value: f64) -> Value {
     number_like_in(original, value, |v, _| v.clone())
 }
 
-/// [`number_like`] as velvet writes it, written as compact text
-/// ([`crate::edit::splice::write_compact`]), for an `original` known to read as `reads_as`:
-/// `original` when that is the value, else the value, rounded.
-pub(crate) fn push_number_like(original: &Value, reads_as: f64, value: f64, out: &mut String) {
-    if reads_as == value {
-        crate::edit::splice::write_compact(original, out);
-    } else {
-        crate::edit::splice::push_written_f64(value, out);
-    }
-}
-
 /// [`number_like`] for a number read through `view` (a value or the index), made a value by
 /// `to_value` (given the number it reads as).
 pub(crate) fn number_like_in<'a, V: crate::asset::tape::JsonView<'a>>(

@@ -17,40 +17,73 @@
 
 use super::measure;
 use super::note::{Conversion, Note, Skip};
-use super::plan::{number_like_in, push_number_like, MaterialCx, MaterialPlan};
+use super::plan::{MaterialCx, MaterialPlan};
 use super::roughness::{self, Direction, RoughnessMapping};
 use super::textures::{Contents, TextureBake};
 use crate::asset::json_text::push_quoted;
 use crate::asset::tape::{JsonView, Node};
 use crate::bake::Channel;
-use crate::edit::splice::write_compact;
+use crate::edit::splice::{write_compact, write_compact_node};
 use crate::edit::Edit;
 use crate::layers::{self, max3};
 use crate::shading::layering;
 use serde_json::Value;
 
-/// A ratified sheen as the conversion needs it: values with the JSON text they came in (so
-/// that unchanged numbers keep it), and the textureInfo objects as they are.
+/// A ratified sheen as the conversion needs it: numbers with the JSON text they came in (so
+/// that unchanged numbers keep it), and the textureInfo objects as they are. Read through the
+/// document's index, those stay places in its text ([`Read::Node`]) until a conversion needs a
+/// value (a bake, a measurement); the fuzz object is written from them as they are.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Sheen {
+pub struct Sheen<'a> {
     pub color: [f64; 3],
     /// The colour as written: each reads as its component of `color`.
-    pub color_values: [Value; 3],
+    pub color_values: [Read<'a>; 3],
     pub roughness: f64,
     /// The roughness as written: it reads as `roughness`.
-    pub roughness_value: Value,
-    pub color_texture: Option<Value>,
-    pub roughness_texture: Option<Value>,
+    pub roughness_value: Read<'a>,
+    pub color_texture: Option<Read<'a>>,
+    pub roughness_texture: Option<Read<'a>>,
     /// The channel the roughness texture holds roughness in: alpha for a ratified sheen, green
     /// for a draft sheen that followed the material's metallicRoughnessTexture (baked into
     /// alpha on the way).
     pub roughness_channel: Channel,
 }
 
-impl Sheen {
+/// A member of a sheen as read: a value, or its place in the document's index.
+#[derive(Debug, Clone)]
+pub enum Read<'a> {
+    Value(Value),
+    Node(Node<'a>),
+}
+
+impl Read<'_> {
+    /// The value (read from the document's text for a place in it).
+    pub fn to_value(&self) -> std::borrow::Cow<'_, Value> {
+        match self {
+            Read::Value(value) => std::borrow::Cow::Borrowed(value),
+            Read::Node(node) => std::borrow::Cow::Owned(node.to_value()),
+        }
+    }
+
+    /// Writes it as [`write_compact`] writes its value.
+    pub fn write_compact(&self, out: &mut String) {
+        match self {
+            Read::Value(value) => write_compact(value, out),
+            Read::Node(node) => write_compact_node(*node, out),
+        }
+    }
+}
+
+impl PartialEq for Read<'_> {
+    fn eq(&self, other: &Read<'_>) -> bool {
+        self.to_value() == other.to_value()
+    }
+}
+
+impl<'a> Sheen<'a> {
     /// Reads a ratified KHR_materials_sheen object, with the spec's defaults (a malformed
     /// value reads as its default: the schema check reports it).
-    pub fn read<'a>(ext: impl SheenSource<'a>) -> Sheen {
+    pub fn read(ext: impl SheenSource<'a>) -> Sheen<'a> {
         // Each member is looked up once (a layer read through the index pays for every
         // lookup), with what `layers::SheenView::read` would read from it. A value that is not
         // an object has no members: every one reads as its default.
@@ -62,23 +95,18 @@ impl Sheen {
         let roughness = roughness_raw
             .and_then(JsonView::number)
             .unwrap_or(layers::SHEEN_ROUGHNESS_DEFAULT);
-        let color_values = std::array::from_fn(|i| {
-            number_like_in(
-                raw.and_then(|a| a.element(i)),
-                color[i],
-                SheenSource::number_value,
-            )
-        });
+        let color_values =
+            std::array::from_fn(|i| number_read(raw.and_then(|a| a.element(i)), color[i]));
         let texture = |key| {
             ext.member(key)
                 .filter(|v| v.object())
-                .map(SheenSource::value)
+                .map(SheenSource::read)
         };
         Sheen {
             color,
             color_values,
             roughness,
-            roughness_value: number_like_in(roughness_raw, roughness, SheenSource::number_value),
+            roughness_value: number_read(roughness_raw, roughness),
             color_texture: texture("sheenColorTexture"),
             roughness_texture: texture("sheenRoughnessTexture"),
             roughness_channel: Channel::A,
@@ -86,29 +114,29 @@ impl Sheen {
     }
 }
 
-/// What a sheen is read from: a value, or the document's index (the values the conversion
-/// keeps, numbers and textureInfos, are then read alone).
+/// The number `original` as read, when it reads as `value`; else `value` as a value.
+fn number_read<'a, S: SheenSource<'a>>(original: Option<S>, value: f64) -> Read<'a> {
+    match original {
+        Some(v) if v.number() == Some(value) => v.read(),
+        _ => Read::Value(Value::from(value)),
+    }
+}
+
+/// What a sheen is read from: a value, or the document's index (the members the conversion
+/// keeps, numbers and textureInfos, then stay places in the text).
 pub trait SheenSource<'a>: JsonView<'a> {
-    fn value(self) -> Value;
-    /// A number as a value, given what it reads as.
-    fn number_value(self, x: f64) -> Value;
+    fn read(self) -> Read<'a>;
 }
 
 impl<'a> SheenSource<'a> for &'a Value {
-    fn value(self) -> Value {
-        self.clone()
-    }
-    fn number_value(self, _: f64) -> Value {
-        self.clone()
+    fn read(self) -> Read<'a> {
+        Read::Value(self.clone())
     }
 }
 
 impl<'a> SheenSource<'a> for Node<'a> {
-    fn value(self) -> Value {
-        self.to_value()
-    }
-    fn number_value(self, x: f64) -> Value {
-        Node::number_value(&self, x)
+    fn read(self) -> Read<'a> {
+        Read::Node(self)
     }
 }
 
@@ -118,7 +146,7 @@ impl<'a> SheenSource<'a> for Node<'a> {
 /// fills it).
 pub fn fuzz_for(
     sheen: &Sheen,
-    strength_texture: Option<&Value>,
+    strength_texture: Option<&Read>,
     mapping: RoughnessMapping,
 ) -> Option<String> {
     let w = max3(sheen.color);
@@ -140,10 +168,10 @@ pub fn fuzz_for(
         fuzz.push(':');
     };
     key(&mut fuzz, "fuzzFactor");
-    write_compact(&sheen.color_values[strongest], &mut fuzz);
+    sheen.color_values[strongest].write_compact(&mut fuzz);
     if let Some(texture) = strength_texture {
         key(&mut fuzz, "fuzzTexture");
-        write_compact(texture, &mut fuzz);
+        texture.write_compact(&mut fuzz);
     }
     key(&mut fuzz, "fuzzColorFactor");
     fuzz.push('[');
@@ -162,7 +190,7 @@ pub fn fuzz_for(
     fuzz.push(']');
     if let Some(texture) = &sheen.color_texture {
         key(&mut fuzz, "fuzzColorTexture");
-        write_compact(texture, &mut fuzz);
+        texture.write_compact(&mut fuzz);
     }
     let r = roughness::written(roughness::map(
         sheen.roughness,
@@ -173,10 +201,20 @@ pub fn fuzz_for(
     push_number_like(&sheen.roughness_value, sheen.roughness, r, &mut fuzz);
     if let Some(texture) = &sheen.roughness_texture {
         key(&mut fuzz, "fuzzRoughnessTexture");
-        write_compact(texture, &mut fuzz);
+        texture.write_compact(&mut fuzz);
     }
     fuzz.push('}');
     Some(fuzz)
+}
+
+/// Writes, as [`write_compact`] writes it, `original` when it reads as `value` (its text kept,
+/// as velvet writes it), else `value` rounded; `original` reads as `reads_as`.
+fn push_number_like(original: &Read, reads_as: f64, value: f64, out: &mut String) {
+    if reads_as == value {
+        original.write_compact(out);
+    } else {
+        crate::edit::splice::push_written_f64(value, out);
+    }
 }
 
 /// The bakes of the exact mode: fuzzTexture = max3 of the linear sheen colour, fuzzColorTexture
@@ -215,7 +253,7 @@ pub fn convert(cx: &MaterialCx, sheen: &Sheen, plan: &mut MaterialPlan) {
     }
     let mut exact = None;
     if let (true, Some(texture)) = (cx.options.exact, &sheen.color_texture) {
-        match exact_bakes(cx, sheen, texture) {
+        match exact_bakes(cx, sheen, &texture.to_value()) {
             Ok(bakes) => exact = Some(bakes),
             Err(reason) => plan.notes.push(Note::ExactNotBaked { reason }),
         }
@@ -242,7 +280,7 @@ pub fn convert(cx: &MaterialCx, sheen: &Sheen, plan: &mut MaterialPlan) {
                 "fuzzRoughnessTexture",
                 "fuzzRoughnessFactor",
                 vec![sheen.roughness],
-                texture,
+                &texture.to_value(),
                 Contents::Roughness {
                     channel: sheen.roughness_channel,
                     factor: sheen.roughness,
@@ -294,7 +332,7 @@ pub fn convert(cx: &MaterialCx, sheen: &Sheen, plan: &mut MaterialPlan) {
         plan.notes.push(Note::ColorTextureAsIs { w });
         if cx.options.report {
             plan.notes.push(
-                match measure::attenuation(cx.asset, texture, sheen.color, w) {
+                match measure::attenuation(cx.asset, &texture.to_value(), sheen.color, w) {
                     Ok(m) => Note::AttenuationMeasured {
                         image: m.image,
                         texels: m.texels,
