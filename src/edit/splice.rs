@@ -139,8 +139,12 @@ pub fn splice_edits<'t, 'e>(
         }
         placed.push((edit, m, element));
     }
-    let mut units: Vec<(Unit, Vec<&Edit>)> = Vec::new();
-    for (edit, m, element) in placed {
+    // Each edit's unit, in the order units are first named; then the edits are laid out unit
+    // by unit in one list (in their order within each), so that a unit's edits are a slice of
+    // it: a plan names a unit per material, and a list each cost an allocation apiece.
+    let mut units: Vec<(Unit, std::ops::Range<usize>)> = Vec::new();
+    let mut unit_of: Vec<usize> = Vec::with_capacity(placed.len());
+    for &(_, m, element) in &placed {
         let member = &mut members[m];
         let element = element.filter(|_| !member.whole);
         let slot = match element {
@@ -158,13 +162,26 @@ pub fn splice_edits<'t, 'e>(
                     member: member.name.clone(),
                     element,
                 },
-                // A unit has one edit, most often.
-                Vec::with_capacity(1),
+                0..0,
             ));
             units.len() - 1
         });
-        units[at].1.push(edit);
+        units[at].1.end += 1;
+        unit_of.push(at);
     }
+    let mut next = 0;
+    for (_, range) in &mut units {
+        let count = range.end;
+        *range = next..next;
+        next += count;
+    }
+    let mut by_unit: Vec<Option<&Edit>> = vec![None; placed.len()];
+    for ((edit, _, _), at) in placed.iter().zip(unit_of) {
+        let range = &mut units[at].1;
+        by_unit[range.end] = Some(*edit);
+        range.end += 1;
+    }
+    let by_unit: Vec<&Edit> = by_unit.into_iter().flatten().collect();
     let layout = Layout::detect(text, root);
     let entries = object.entries();
     let members: Vec<(usize, Node)> = entries.iter().map(|(k, v)| (k.span().start, *v)).collect();
@@ -176,6 +193,7 @@ pub fn splice_edits<'t, 'e>(
     let done: Vec<Result<Option<UnitSplices>, EditError>> = units
         .par_iter()
         .map(|(unit, edits)| {
+            let edits = &by_unit[edits.clone()];
             splice_unit(text, root, object, &entries, &members, &layout, unit, edits)
         })
         .collect();
@@ -408,7 +426,7 @@ fn feed_node(d: &mut Digest, node: Node) {
 /// value the text will hold (a [`Edit::Set`]'s as velvet writes it, a [`Edit::Replace`]'s as
 /// given).
 struct MemberSet<'e> {
-    tokens: Vec<String>,
+    tokens: Vec<std::borrow::Cow<'e, str>>,
     value: SetTo<'e>,
 }
 
@@ -488,7 +506,11 @@ fn members_set_in_place(
             .strip_prefix(prefix)
             .filter(|w| w.starts_with('/'))?;
         sets.push(MemberSet {
-            tokens: crate::asset::pointer::tokens(within),
+            // Borrowed from the pointer unless a token holds an escape.
+            tokens: within[1..]
+                .split('/')
+                .map(crate::asset::pointer::unescape)
+                .collect(),
             value,
         });
     }
@@ -530,7 +552,7 @@ fn members_set_in_place(
                 let at = parent.span().start;
                 match inserts.iter_mut().find(|(p, _)| p.span().start == at) {
                     Some((_, new)) => new.push((key, set.value.meant())),
-                    None => inserts.push((parent, vec![(key.as_str(), set.value.meant())])),
+                    None => inserts.push((parent, vec![(key.as_ref(), set.value.meant())])),
                 }
             }
         }
@@ -564,7 +586,7 @@ fn members_set_in_place(
     }
     let mut d = Digest::new();
     let values: Vec<std::borrow::Cow<Value>> = sets.iter().map(|s| s.value.value()).collect();
-    let sets: Vec<(&[String], &Value)> = sets
+    let sets: Vec<(&[std::borrow::Cow<str>], &Value)> = sets
         .iter()
         .zip(&values)
         .map(|(s, value)| (s.tokens.as_slice(), value.as_ref()))
@@ -636,13 +658,13 @@ fn member_or_element<'a>(node: Node<'a>, token: &str) -> Option<Node<'a>> {
 /// Feeds `node` as [`feed_node`] does, with each of `sets` (tokens below `node`, value) in its
 /// place: a set member where the member stands, a new one after the object's members, in
 /// order. Every set's path exists in `node` up to its last token (see [`members_set_in_place`]).
-fn feed_edited(d: &mut Digest, node: Node, sets: &[(&[String], &Value)]) {
+fn feed_edited<T: AsRef<str>>(d: &mut Digest, node: Node, sets: &[(&[T], &Value)]) {
     if sets.is_empty() {
         return feed_node(d, node);
     }
-    let below = |token: &str| -> Vec<(&[String], &Value)> {
+    let below = |token: &str| -> Vec<(&[T], &Value)> {
         sets.iter()
-            .filter(|(t, _)| t.len() > 1 && t[0] == token)
+            .filter(|(t, _)| t.len() > 1 && t[0].as_ref() == token)
             .map(|(t, v)| (&t[1..], *v))
             .collect()
     };
@@ -654,14 +676,17 @@ fn feed_edited(d: &mut Digest, node: Node, sets: &[(&[String], &Value)]) {
             d.tag(b'{');
             for (key, member) in object.iter() {
                 d.text(b':', &key);
-                match sets.iter().find(|(t, _)| t.len() == 1 && t[0] == key) {
+                match sets
+                    .iter()
+                    .find(|(t, _)| t.len() == 1 && t[0].as_ref() == key)
+                {
                     Some((_, new)) => feed_value(d, new),
                     None => feed_edited(d, member, &below(&key)),
                 }
             }
             for (tokens, new) in sets {
-                if tokens.len() == 1 && !object.contains_key(&tokens[0]) {
-                    d.text(b':', &tokens[0]);
+                if tokens.len() == 1 && !object.contains_key(tokens[0].as_ref()) {
+                    d.text(b':', tokens[0].as_ref());
                     feed_value(d, new);
                 }
             }
@@ -1276,15 +1301,20 @@ impl<'t> Layout<'t> {
     /// text is written as it comes (the check of the written text then refuses it).
     fn write_text(&self, compact: &str, indent: &str, inline: bool, out: &mut String) {
         let bytes = compact.as_bytes();
-        // The indentation of the current line, grown by a unit at each multi-line container.
-        let mut line_indent = String::with_capacity(indent.len() + 16);
-        line_indent.push_str(indent);
         let unit = self.unit.as_deref().unwrap_or("");
-        // Whether each open container is written on one line.
-        let mut inline_levels: Vec<bool> = Vec::with_capacity(4);
+        // Containers are written over lines from the outermost down to the first written on
+        // one line (whatever is inside a one-line container is on that line too), so the open
+        // containers over lines are the outermost `lines` of the `depth` open: no list of them
+        // is kept, and the indentation is `indent` and `lines` units.
+        let (mut depth, mut lines) = (0usize, 0usize);
+        let new_line = |out: &mut String, lines: usize| {
+            out.push_str(self.newline);
+            out.push_str(indent);
+            (0..lines).for_each(|_| out.push_str(unit));
+        };
         let mut at = 0;
         while let Some(&byte) = bytes.get(at) {
-            let here_inline = inline_levels.last().copied().unwrap_or(inline);
+            let here_inline = if depth == 0 { inline } else { depth > lines };
             match byte {
                 b'{' | b'[' => {
                     let close = if byte == b'{' { b'}' } else { b']' };
@@ -1297,21 +1327,20 @@ impl<'t> Layout<'t> {
                         || (byte == b'['
                             && only_numbers_follow(&compact[at + 1..])
                             && self.inline_number_arrays());
-                    inline_levels.push(one_line);
+                    depth += 1;
                     out.push(char::from(byte));
                     if !one_line {
-                        line_indent.push_str(unit);
-                        out.push_str(self.newline);
-                        out.push_str(&line_indent);
+                        lines += 1;
+                        new_line(out, lines);
                     }
                     at += 1;
                 }
                 b'}' | b']' => {
-                    if !inline_levels.pop().unwrap_or(true) {
-                        line_indent.truncate(line_indent.len().saturating_sub(unit.len()));
-                        out.push_str(self.newline);
-                        out.push_str(&line_indent);
+                    if depth > 0 && depth == lines {
+                        lines -= 1;
+                        new_line(out, lines);
                     }
+                    depth = depth.saturating_sub(1);
                     out.push(char::from(byte));
                     at += 1;
                 }
@@ -1320,8 +1349,7 @@ impl<'t> Layout<'t> {
                         out.push_str(self.inline_comma());
                     } else {
                         out.push(',');
-                        out.push_str(self.newline);
-                        out.push_str(&line_indent);
+                        new_line(out, lines);
                     }
                     at += 1;
                 }
@@ -2124,22 +2152,30 @@ fn insert_members(
     };
     let layout = &layout.local(text, span.span().start, first.0);
     let inline = layout.unit.is_none() || one_line(text, span);
-    let indent = layout.line_indent(text, first.0).to_string();
-    let separator = if inline {
-        members
-            .get(1)
-            .map(|(k, _)| text[first.1.span().end..*k].to_string())
-            .unwrap_or_else(|| layout.inline_comma().to_string())
-    } else {
-        concat(&[",", layout.newline, &indent])
+    let indent = layout.line_indent(text, first.0);
+    // Between members: what the object's first two members have between them, or a comma
+    // and a line break to the members' indentation.
+    let between = match (inline, members.get(1)) {
+        (true, Some((k, _))) => &text[first.1.span().end..*k],
+        (true, None) => layout.inline_comma(),
+        (false, _) => "",
+    };
+    let push_separator = |text: &mut String| {
+        if inline {
+            text.push_str(between);
+        } else {
+            text.push(',');
+            text.push_str(layout.newline);
+            text.push_str(indent);
+        }
     };
     let push_member = |text: &mut String, key: &str, value: Meant| {
         push_quoted(text, key);
         text.push_str(&layout.colon);
         let inline = inline || layout.unit.is_none();
         match value {
-            Meant::Value(value) => layout.write(value, &indent, inline, text),
-            Meant::Text(compact) => layout.write_text(compact, &indent, inline, text),
+            Meant::Value(value) => layout.write(value, indent, inline, text),
+            Meant::Text(compact) => layout.write_text(compact, indent, inline, text),
         }
     };
     // Room for a layer object of a few members, so that writing one grows a string once at
@@ -2152,14 +2188,14 @@ fn insert_members(
             None => {
                 leading.reserve(ROOM);
                 push_member(&mut leading, key, value);
-                leading.push_str(&separator);
+                push_separator(&mut leading);
             }
             Some(i) => {
                 if !matches!(after_member.last(), Some((at, _)) if *at == i) {
                     after_member.push((i, String::with_capacity(ROOM)));
                 }
                 if let Some((_, insert)) = after_member.last_mut() {
-                    insert.push_str(&separator);
+                    push_separator(insert);
                     push_member(insert, key, value);
                 }
             }

@@ -47,9 +47,11 @@ impl MaterialPlan {
                 .get("name")
                 .and_then(|name| name.as_str())
                 .map(|name| name.into_owned()),
-            conversions: Vec::new(),
+            // A conversion makes one edit, most often: made at that size, the lists are not
+            // grown to four and cut back (`shrink_to_fit`) by the twenty thousand.
+            conversions: Vec::with_capacity(1),
             skipped: None,
-            edits: Vec::new(),
+            edits: Vec::with_capacity(1),
             bakes: Vec::new(),
             notes: Vec::new(),
         }
