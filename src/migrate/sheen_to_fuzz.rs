@@ -88,15 +88,23 @@ impl<'a> Sheen<'a> {
         // lookup), with what `layers::SheenView::read` would read from it. A value that is not
         // an object has no members: every one reads as its default.
         let raw = ext.member("sheenColorFactor");
-        let color = raw
-            .and_then(layers::rgb_of)
-            .unwrap_or(layers::SHEEN_COLOR_DEFAULT);
+        let parsed = raw.and_then(layers::rgb_of);
+        let color = parsed.unwrap_or(layers::SHEEN_COLOR_DEFAULT);
         let roughness_raw = ext.member("sheenRoughnessFactor");
-        let roughness = roughness_raw
-            .and_then(JsonView::number)
-            .unwrap_or(layers::SHEEN_ROUGHNESS_DEFAULT);
-        let color_values =
-            std::array::from_fn(|i| number_read(raw.and_then(|a| a.element(i)), color[i]));
+        let roughness_parsed = roughness_raw.and_then(JsonView::number);
+        let roughness = roughness_parsed.unwrap_or(layers::SHEEN_ROUGHNESS_DEFAULT);
+        // A number just read as its component is kept as it is, without reading it again.
+        let color_values = std::array::from_fn(|i| {
+            let element = raw.and_then(|a| a.element(i));
+            match (parsed, element) {
+                (Some(_), Some(element)) => element.read(),
+                _ => number_read(element, color[i]),
+            }
+        });
+        let roughness_value = match (roughness_parsed, roughness_raw) {
+            (Some(_), Some(raw)) => raw.read(),
+            _ => number_read(roughness_raw, roughness),
+        };
         let texture = |key| {
             ext.member(key)
                 .filter(|v| v.object())
@@ -106,7 +114,7 @@ impl<'a> Sheen<'a> {
             color,
             color_values,
             roughness,
-            roughness_value: number_read(roughness_raw, roughness),
+            roughness_value,
             color_texture: texture("sheenColorTexture"),
             roughness_texture: texture("sheenRoughnessTexture"),
             roughness_channel: Channel::A,
