@@ -133,8 +133,9 @@ fn load_owned(path: &Path, bytes: Vec<u8>, options: &LoadOptions) -> Loaded {
     load_read(path, bytes, options).0
 }
 
-/// [`load_owned`], giving the bytes back when the asset did not take them as its text (a GLB,
-/// a byte-order mark, a document over the limit, text that is not UTF-8). When it took them,
+/// Parses bytes read from `path`, as [`load_with`] does, keeping them as the JSON text without
+/// a copy where it can; gives them back when the asset did not take them as its text (a GLB, a
+/// byte-order mark, a document over the limit, text that is not UTF-8). When it took them,
 /// [`Asset::file_bytes`] reads them.
 pub fn load_read(path: &Path, bytes: Vec<u8>, options: &LoadOptions) -> (Loaded, Option<Vec<u8>>) {
     let plain = !bytes.starts_with(b"glTF")
