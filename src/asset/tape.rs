@@ -711,14 +711,6 @@ impl<'a> Node<'a> {
         })
     }
 
-    /// This number as a value, given the `f64` it reads as ([`number_spelled`]).
-    pub fn number_value(&self, x: f64) -> Value {
-        match self.kind() {
-            Kind::Number => number_spelled(self.raw(), x).map_or(Value::Null, Value::Number),
-            _ => self.to_value(),
-        }
-    }
-
     /// The value as a `serde_json::Value`, for the few places that need one (error reports,
     /// comparisons of whole values).
     pub fn to_value(&self) -> Value {
@@ -735,15 +727,6 @@ impl<'a> Node<'a> {
                 .map_or(Value::Null, |s| Value::String(s.into_owned())),
             Kind::Array | Kind::Object => serde_json::from_str(self.raw()).unwrap_or(Value::Null),
         }
-    }
-}
-
-/// The number written `text`, which reads as `x`. serde_json makes a number of a given text
-/// only by reading it; its own writing of `x` is taken where it is that text, which is cheaper.
-pub fn number_spelled(text: &str, x: f64) -> Option<serde_json::Number> {
-    match serde_json::Number::from_f64(x) {
-        Some(n) if n.as_str() == text => Some(n),
-        _ => text.parse().ok(),
     }
 }
 

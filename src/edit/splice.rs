@@ -1739,7 +1739,16 @@ fn push_serde_f64(x: f64, out: &mut String) {
 fn rounded_number(x: f64) -> Option<serde_json::Number> {
     let mut text = StackText::new();
     write_rounded(x, &mut text);
-    crate::asset::tape::number_spelled(text.as_str(), x)
+    number_spelled(text.as_str(), x)
+}
+
+/// The number written `text`, which reads as `x`. serde_json makes a number of a given text
+/// only by reading it; its own writing of `x` is taken where it is that text, which is cheaper.
+fn number_spelled(text: &str, x: f64) -> Option<serde_json::Number> {
+    match serde_json::Number::from_f64(x) {
+        Some(n) if n.as_str() == text => Some(n),
+        _ => text.parse().ok(),
+    }
 }
 
 /// Whether every number in `value` is already as velvet writes it (see [`written`]).

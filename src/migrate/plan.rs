@@ -357,18 +357,8 @@ pub fn plan_material(
 /// A number for the output: `original` itself (its text kept) when it already has this value,
 /// else the value written anew.
 pub(crate) fn number_like(original: Option<&Value>, value: f64) -> Value {
-    number_like_in(original, value, |v, _| v.clone())
-}
-
-/// [`number_like`] for a number read through `view` (a value or the index), made a value by
-/// `to_value` (given the number it reads as).
-pub(crate) fn number_like_in<'a, V: crate::asset::tape::JsonView<'a>>(
-    original: Option<V>,
-    value: f64,
-    to_value: impl FnOnce(V, f64) -> Value,
-) -> Value {
     match original {
-        Some(v) if v.number() == Some(value) => to_value(v, value),
+        Some(v) if v.as_f64() == Some(value) => v.clone(),
         _ => Value::from(value),
     }
 }
