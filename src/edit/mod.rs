@@ -51,11 +51,15 @@ impl SetValue {
         use std::borrow::Cow;
         match self {
             SetValue::Value(value) => Cow::Borrowed(value),
-            // The text is written by `splice::write_compact`, which writes JSON; a text that
-            // did not read would be a fault of that writer, and reads as null.
-            SetValue::Text(text) => Cow::Owned(serde_json::from_str(text).unwrap_or_default()),
+            SetValue::Text(text) => Cow::Owned(value_of_text(text)),
         }
     }
+}
+
+/// The value a [`SetValue::Text`] holds. The text is written by `splice::write_compact`, which
+/// writes JSON; a text that did not read would be a fault of that writer, and reads as null.
+pub(crate) fn value_of_text(text: &str) -> Value {
+    serde_json::from_str(text).unwrap_or_default()
 }
 
 impl PartialEq for SetValue {

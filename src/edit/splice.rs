@@ -449,9 +449,7 @@ impl SetTo<'_> {
     fn value(&self) -> std::borrow::Cow<'_, Value> {
         match self {
             SetTo::Value(value) => std::borrow::Cow::Borrowed(value.as_ref()),
-            SetTo::Text(text) => {
-                std::borrow::Cow::Owned(serde_json::from_str(text).unwrap_or_default())
-            }
+            SetTo::Text(text) => std::borrow::Cow::Owned(super::value_of_text(text)),
         }
     }
 }
