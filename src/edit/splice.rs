@@ -948,21 +948,10 @@ impl Scanner<'_> {
         (self.peek()? == byte).then(|| self.at += 1)
     }
 
-    /// Steps over the string at the cursor; `None` where it holds a control character, which
-    /// JSON allows only escaped (escapes are read where the string is decoded).
+    /// Steps over the string at the cursor ([`string_end`]).
     fn string(&mut self) -> Option<()> {
-        self.at += 1; // the opening quote
-        loop {
-            match self.peek()? {
-                b'"' => {
-                    self.at += 1;
-                    return Some(());
-                }
-                b'\\' => self.at += 2,
-                0..=0x1f => return None,
-                _ => self.at += 1,
-            }
-        }
+        self.at = string_end(self.text.as_bytes(), self.at)?;
+        Some(())
     }
 
     /// Steps over the opening `{` or `[` at the cursor; true when `close` follows at once (an
@@ -1087,10 +1076,7 @@ impl Scanner<'_> {
         if self.peek()? == b'"' {
             self.string()?;
         } else {
-            while matches!(self.peek(), Some(b) if !matches!(b, b',' | b'}' | b']' | b' ' | b'\t' | b'\n' | b'\r'))
-            {
-                self.at += 1;
-            }
+            self.at = scalar_end(self.text.as_bytes(), start);
         }
         (self.at > start).then_some((start, self.at))
     }
@@ -1952,7 +1938,6 @@ fn reads_as_compact(written: &str, compact: &str) -> Option<usize> {
                 let end = string_end(c, j)?;
                 let token = &compact[j..end];
                 if written.get(i..i + token.len())? != token
-                    || token.bytes().any(|b| b < 0x20)
                     || (token.contains('\\') && serde_json::from_str::<String>(token).is_err())
                 {
                     return None;
@@ -1991,20 +1976,23 @@ fn reads_as_compact(written: &str, compact: &str) -> Option<usize> {
     Some(i)
 }
 
-/// Where the string whose opening quote stands at `at` ends (past its closing quote).
+/// Where the string whose opening quote stands at `at` ends (past its closing quote); `None`
+/// where it has no end or holds a control character, which JSON allows only escaped (escapes
+/// are read where the string is decoded).
 fn string_end(bytes: &[u8], at: usize) -> Option<usize> {
     let mut i = at + 1;
     loop {
         match *bytes.get(i)? {
             b'"' => return Some(i + 1),
             b'\\' => i += 2,
+            0..=0x1f => return None,
             _ => i += 1,
         }
     }
 }
 
-/// Where the number or literal starting at `at` ends: at the next comma, bracket, brace or
-/// whitespace.
+/// Where the number or literal starting at `at` ends: at the next comma, colon, bracket, brace
+/// or whitespace.
 fn scalar_end(bytes: &[u8], at: usize) -> usize {
     bytes[at..]
         .iter()
