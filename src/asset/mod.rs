@@ -9,6 +9,7 @@
 pub mod discover;
 pub mod glb;
 pub mod json_text;
+mod key_table;
 pub mod limits;
 pub mod pages;
 pub mod pointer;

@@ -14,8 +14,11 @@
 //!
 //! Object members keep their order and their duplicates; lookups give the last duplicate and
 //! iteration gives each key once at its first place with its last value, as serde_json's
-//! order-preserving map does.
+//! order-preserving map does. Each key entry holds the key's number in the document's table of
+//! distinct keys ([`super::key_table`]): a lookup finds the number of the key it wants once,
+//! then compares numbers, and a key the document never writes is answered without a scan.
 
+use super::key_table::KeyTable;
 use serde_json::Value;
 use std::borrow::Cow;
 
@@ -39,7 +42,7 @@ const KEY: u32 = 1 << (KIND_BITS + 1);
 const DUPLICATES: u32 = 1 << (KIND_BITS + 2);
 const COUNT_SHIFT: u32 = KIND_BITS + 3;
 /// The largest number the word shared with the kind holds: an object's member count, where
-/// an array's run starts in `Tape::elements`, or an unescaped key's [`key_print`].
+/// an array's run starts in `Tape::elements`, or a key's number in [`Tape::keys`].
 const MAX_AUX: u32 = (1 << (32 - COUNT_SHIFT)) - 1;
 
 /// One value (or one object key) in the index.
@@ -51,8 +54,8 @@ struct Entry {
     /// Index of the entry after this value and everything inside it.
     next: u32,
     /// Kind (3 bits), the flags above (3 bits), and for an object its member count, for an
-    /// array where its run starts in `Tape::elements`, for an unescaped key its
-    /// [`key_print`].
+    /// array where its run starts in `Tape::elements`, for a key its number in
+    /// [`Tape::keys`].
     meta: u32,
 }
 
@@ -70,19 +73,6 @@ impl Entry {
 
     fn aux(&self) -> usize {
         (self.meta >> COUNT_SHIFT) as usize
-    }
-}
-
-/// A key's length, first and last byte in 26 bits: a lookup compares it with the entry before
-/// it reads the key's text, so that the keys a lookup passes over cost no read of the text
-/// (scattered through a large document, those reads are what lookups spent their time on).
-fn key_print(key: &[u8]) -> u32 {
-    match key {
-        [] => 0,
-        [first, ..] => {
-            let last = key[key.len() - 1];
-            ((key.len() as u32 & 0x3FF) << 16) | (u32::from(*first) << 8) | u32::from(last)
-        }
     }
 }
 
@@ -104,7 +94,16 @@ pub struct Tape {
     entries: Vec<Entry>,
     /// One run per array: its element count, then its elements' entry indices.
     elements: Vec<u32>,
+    /// The distinct keys, whose numbers the key entries hold: a lookup by key compares
+    /// numbers and reads no text.
+    keys: KeyTable,
 }
+
+/// A key's number in the table of keys of one document ([`Node::key_id`]). A lookup by number
+/// ([`Object::get_id`]) compares numbers only; a rule that looks the same key up in thousands
+/// of objects finds its number once. Meaningful only for the document it came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct KeyId(u32);
 
 /// Why a text has no index: it is not JSON as serde_json reads it, or it is too large to index.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -134,8 +133,9 @@ struct Builder<'t> {
     elements: Vec<u32>,
     /// Element indices of the arrays still open, innermost last.
     scratch: Vec<u32>,
-    /// Key entries of the object being closed.
-    keys: Vec<u32>,
+    /// The numbers of the keys of the object being closed.
+    member_keys: Vec<u32>,
+    keys: KeyTable,
 }
 
 impl Tape {
@@ -162,12 +162,14 @@ impl Tape {
             },
             elements: Vec::new(),
             scratch: Vec::new(),
-            keys: Vec::new(),
+            member_keys: Vec::new(),
+            keys: KeyTable::default(),
         };
         builder.document()?;
         Ok(Tape {
             entries: builder.entries,
             elements: builder.elements,
+            keys: builder.keys,
         })
     }
 
@@ -352,45 +354,23 @@ impl Builder<'_> {
     }
 
     /// Whether the object just closed at `object` writes a key twice. Checked once here so
-    /// that reading its members needs no check.
+    /// that reading its members needs no check. Keys are compared by their numbers.
     fn has_duplicate_keys(&mut self, object: u32) -> bool {
         let end = self.entries.len() as u32;
-        let mut keys = std::mem::take(&mut self.keys);
+        let mut keys = std::mem::take(&mut self.member_keys);
         keys.clear();
         let mut at = object + 1;
         while at < end {
-            keys.push(at);
+            keys.push(self.entries[at as usize].aux() as u32);
             at = self.entries[at as usize + 1].next;
         }
-        let text = |k: u32| -> Cow<'_, [u8]> {
-            let e = &self.entries[k as usize];
-            let raw = &self.bytes[e.start as usize..e.end as usize];
-            if e.meta & ESCAPED == 0 {
-                Cow::Borrowed(&raw[1..raw.len() - 1])
-            } else {
-                let raw = std::str::from_utf8(raw).unwrap_or_default();
-                Cow::Owned(
-                    serde_json::from_str::<String>(raw)
-                        .unwrap_or_default()
-                        .into_bytes(),
-                )
-            }
-        };
-        // Two unescaped keys whose prints differ differ: most pairs are told apart without
-        // reading their text.
-        let may_match = |a: u32, b: u32| {
-            let (a, b) = (&self.entries[a as usize], &self.entries[b as usize]);
-            (a.meta | b.meta) & ESCAPED != 0 || a.aux() == b.aux()
-        };
         let found = if keys.len() <= 16 {
-            (1..keys.len()).any(|i| {
-                (0..i).any(|j| may_match(keys[i], keys[j]) && text(keys[i]) == text(keys[j]))
-            })
+            (1..keys.len()).any(|i| keys[..i].contains(&keys[i]))
         } else {
-            let mut seen = std::collections::HashSet::with_capacity(keys.len());
-            !keys.iter().all(|&k| seen.insert(text(k)))
+            keys.sort_unstable();
+            keys.windows(2).any(|pair| pair[0] == pair[1])
         };
-        self.keys = keys;
+        self.member_keys = keys;
         found
     }
 
@@ -401,12 +381,20 @@ impl Builder<'_> {
         }
         let start = self.at;
         let escaped = self.string()?;
-        let meta = if escaped {
-            KEY | ESCAPED
+        let key = &self.bytes[start + 1..self.at - 1];
+        let id = if escaped {
+            // Numbered by what it spells, as the same key written without escapes is.
+            let raw = std::str::from_utf8(&self.bytes[start..self.at]).unwrap_or_default();
+            let key: String = serde_json::from_str(raw).unwrap_or_default();
+            self.keys.intern(key.as_bytes())
         } else {
-            KEY | key_print(&self.bytes[start + 1..self.at - 1]) << COUNT_SHIFT
+            self.keys.intern(key)
         };
-        self.push(Kind::String, start, meta);
+        if id > MAX_AUX {
+            return Err(TapeError::TooLarge);
+        }
+        let flags = if escaped { KEY | ESCAPED } else { KEY };
+        self.push(Kind::String, start, flags | id << COUNT_SHIFT);
         self.skip_whitespace();
         if self.bytes.get(self.at) != Some(&b':') {
             return self.fail();
@@ -551,16 +539,9 @@ impl<'a> Node<'a> {
         self.entry().kind()
     }
 
-    /// Whether this key entry spells `key`, whose [`key_print`] is `print`. An unescaped key
-    /// whose print differs is told apart without reading the text.
-    fn key_is(&self, key: &str, print: u32) -> bool {
-        let e = self.entry();
-        if e.meta & ESCAPED == 0 {
-            e.aux() as u32 == print
-                && &self.text.as_bytes()[e.start as usize + 1..e.end as usize - 1] == key.as_bytes()
-        } else {
-            self.as_str().is_some_and(|s| s == key)
-        }
+    /// Whether this key entry is the key numbered `id` in [`Tape::keys`].
+    fn key_is(&self, id: u32) -> bool {
+        self.entry().aux() as u32 == id
     }
 
     /// The whole text the index was built from, of which this value is a span.
@@ -691,6 +672,11 @@ impl<'a> Node<'a> {
         Some(node)
     }
 
+    /// The number of `key` in this document, if any of its objects has that key.
+    pub fn key_id(&self, key: &str) -> Option<KeyId> {
+        self.tape.keys.id(key.as_bytes()).map(KeyId)
+    }
+
     /// The value of every object member named `key` anywhere inside this value, in text order,
     /// found by one scan of the index rather than a walk. Rules use it to rule out a finding
     /// cheaply before walking for its path.
@@ -701,14 +687,15 @@ impl<'a> Node<'a> {
         let node = *self;
         let entries = &self.tape.entries[self.at as usize + 1..self.entry().next as usize];
         let first = self.at + 1;
-        let print = key_print(key.as_bytes());
-        entries.iter().enumerate().filter_map(move |(i, e)| {
-            if e.meta & KEY == 0 {
-                return None;
-            }
-            let at = first + i as u32;
-            node.node(at).key_is(key, print).then(|| node.node(at + 1))
-        })
+        // A key the text does not have is the key of no member.
+        let id = self.tape.keys.id(key.as_bytes());
+        let entries = if id.is_some() { entries } else { &[] };
+        let id = id.unwrap_or_default();
+        entries
+            .iter()
+            .enumerate()
+            .filter(move |(_, e)| e.meta & KEY != 0 && e.aux() as u32 == id)
+            .map(move |(i, _)| node.node(first + i as u32 + 1))
     }
 
     /// The value as a `serde_json::Value`, for the few places that need one (error reports,
@@ -772,10 +759,21 @@ impl<'a> Object<'a> {
 
     /// The value of `key`: the last one, if the key is written more than once.
     pub fn get(&self, key: &str) -> Option<Node<'a>> {
-        let print = key_print(key.as_bytes());
+        // A key the text does not have is the key of no member.
+        self.get_key(self.node.tape.keys.id(key.as_bytes())?)
+    }
+
+    /// The value of the key numbered `key` (from [`Node::key_id`] on the same document), as
+    /// [`Object::get`] gives it.
+    pub fn get_id(&self, key: KeyId) -> Option<Node<'a>> {
+        self.get_key(key.0)
+    }
+
+    /// The value of the key numbered `id`: the last one, if the key is written more than once.
+    fn get_key(&self, id: u32) -> Option<Node<'a>> {
         let mut found = None;
         for (k, v) in self.raw_members() {
-            if self.node.node(k).key_is(key, print) {
+            if self.node.node(k).key_is(id) {
                 found = Some(v);
                 if !self.has_duplicates() {
                     break;
@@ -798,9 +796,10 @@ impl<'a> Object<'a> {
     }
 
     pub fn contains_key(&self, key: &str) -> bool {
-        let print = key_print(key.as_bytes());
-        self.raw_members()
-            .any(|(k, _)| self.node.node(k).key_is(key, print))
+        self.node.tape.keys.id(key.as_bytes()).is_some_and(|id| {
+            self.raw_members()
+                .any(|(k, _)| self.node.node(k).key_is(id))
+        })
     }
 
     /// Distinct keys.
@@ -875,18 +874,16 @@ impl<'a> Iterator for Members<'a> {
                 return Some((key, node.node(v)));
             }
             // A key seen before was given at its first place; a first one takes its last value.
-            let earlier = RawMembers {
+            let id = node.node(k).entry().aux() as u32;
+            let mut earlier = RawMembers {
                 node,
                 at: node.at + 1,
                 end: k,
             };
-            if earlier
-                .clone()
-                .any(|(e, _)| node.node(e).as_str().unwrap_or_default() == key)
-            {
+            if earlier.any(|(e, _)| node.node(e).key_is(id)) {
                 continue;
             }
-            let value = self.object.get(&key).unwrap_or(node.node(v));
+            let value = self.object.get_key(id).unwrap_or(node.node(v));
             return Some((key, value));
         }
     }
@@ -1124,6 +1121,49 @@ mod tests {
         assert_eq!(obj.len(), 2);
         let keys: Vec<_> = obj.keys().collect();
         assert_eq!(keys, ["a", "b"]);
+    }
+
+    #[test]
+    fn a_key_written_with_escapes_is_the_key_it_spells() {
+        let text = r#"{"\u0061":1,"b":2,"a":3,"\"q\"":{"x":4},"none\/":5}"#;
+        let tape = Tape::build(text).unwrap();
+        let value: Value = serde_json::from_str(text).unwrap();
+        let obj = tape.root(text).as_object().unwrap();
+        assert!(obj.has_duplicate_keys());
+        assert_eq!(obj.get("a").unwrap().as_u64(), Some(3));
+        assert_eq!(obj.get("\"q\"").unwrap().to_value(), value["\"q\""]);
+        assert_eq!(obj.get("none/").unwrap().as_u64(), Some(5));
+        assert!(obj.get("\\u0061").is_none() && obj.get("none\\/").is_none());
+        assert!(obj.get("x").is_none(), "a key of another object");
+        assert!(obj.get("c").is_none() && !obj.contains_key("c"));
+        let keys: Vec<_> = obj.keys().collect();
+        assert_eq!(keys, ["a", "b", "\"q\"", "none/"]);
+        assert_eq!(obj.len(), 4);
+        let named: Vec<u64> = tape
+            .root(text)
+            .members_named("a")
+            .filter_map(|n| n.as_u64())
+            .collect();
+        assert_eq!(named, [1, 3]);
+        assert_eq!(tape.root(text).members_named("zz").count(), 0);
+    }
+
+    #[test]
+    fn a_duplicate_among_many_keys_is_found() {
+        let members = |last: &str| {
+            let mut text: String = (0..40).map(|i| format!("\"k{i}\":{i},")).collect();
+            text.push_str(last);
+            format!("{{{text}}}")
+        };
+        for (last, duplicates, k7) in [(r#""k40":40"#, false, 7), (r#""k\u0037":70"#, true, 70)] {
+            let text = members(last);
+            let tape = Tape::build(&text).unwrap();
+            let obj = tape.root(&text).as_object().unwrap();
+            assert_eq!(obj.has_duplicate_keys(), duplicates, "{last}");
+            assert_eq!(obj.get("k7").unwrap().as_u64(), Some(k7));
+            let value: Value = serde_json::from_str(&text).unwrap();
+            assert_eq!(obj.len(), value.as_object().unwrap().len());
+        }
     }
 
     #[test]

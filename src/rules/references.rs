@@ -11,7 +11,7 @@
 
 use super::{as_index, Context, Rule};
 use crate::asset::pointer;
-use crate::asset::tape::{Kind, Node};
+use crate::asset::tape::{KeyId, Node};
 use crate::diagnostics::{codes, Code, Diagnostic};
 use std::borrow::Cow;
 
@@ -115,8 +115,12 @@ impl Rule for References {
             .iter()
             .map(|(_, target)| (!target.contains("{0}")).then(|| array_len(target)))
             .collect();
+        let steps = steps();
+        // The document's number for each key the patterns name, found once: the walk then
+        // compares numbers.
+        let ids: Vec<Option<KeyId>> = steps.keys.iter().map(|key| json.key_id(key)).collect();
         let mut found: Vec<(usize, Diagnostic)> = Vec::new();
-        walk(json, steps(), &mut Vec::new(), &mut |link, path, value| {
+        let mut found_at = |link: usize, path: &[Token], value: Node| {
             let Some(index) = as_index(value) else {
                 return; // not an index: the schema check reports the type
             };
@@ -148,7 +152,8 @@ impl Rule for References {
                 let message = unresolved_message(&at, index, &target, len);
                 found.push((link, Diagnostic::new(&UNRESOLVED_REFERENCE, at, message)));
             }
-        });
+        };
+        walk(json, &steps.root, &ids, &mut Vec::new(), &mut found_at);
         // Reported link by link, in the table's order, each in document order.
         found.sort_by_key(|(link, _)| *link);
         out.extend(found.into_iter().map(|(_, d)| d));
@@ -196,37 +201,59 @@ impl Token<'_> {
     }
 }
 
+/// What one segment of a pattern in [`LINKS`] matches.
+enum Segment {
+    /// This key; the number is its place in [`Steps::keys`].
+    Key(&'static str, usize),
+    /// Any array index or object key (`*`).
+    Any,
+    /// Any key that ends so (`*Texture`).
+    Suffix(&'static str),
+}
+
 /// One segment of the patterns in [`LINKS`], with the patterns that continue from it: the
 /// table as a tree, so that one walk of the document serves every pattern.
 struct Step {
-    segment: &'static str,
+    /// The segment as the pattern writes it.
+    text: &'static str,
+    segment: Segment,
     /// The pattern that ends here, by its place in [`LINKS`].
     link: Option<usize>,
     next: Vec<Step>,
 }
 
-impl Step {
-    fn matches(&self, key: &str) -> bool {
-        match self.segment.strip_prefix('*') {
-            Some(suffix) => key.ends_with(suffix),
-            None => self.segment == key,
-        }
-    }
+/// [`LINKS`] as a tree, with the keys its segments name.
+struct Steps {
+    root: Vec<Step>,
+    keys: Vec<&'static str>,
 }
 
 /// [`LINKS`] as a tree of steps, built once.
-fn steps() -> &'static [Step] {
-    static STEPS: std::sync::OnceLock<Vec<Step>> = std::sync::OnceLock::new();
+fn steps() -> &'static Steps {
+    static STEPS: std::sync::OnceLock<Steps> = std::sync::OnceLock::new();
     STEPS.get_or_init(|| {
         let mut root: Vec<Step> = Vec::new();
+        let mut keys: Vec<&'static str> = Vec::new();
         for (link, (pattern, _)) in LINKS.iter().enumerate() {
             let mut level = &mut root;
             let segments: Vec<&'static str> = pattern.split('/').skip(1).collect();
-            for (i, segment) in segments.iter().enumerate() {
-                let at = match level.iter().position(|s| s.segment == *segment) {
+            for (i, &text) in segments.iter().enumerate() {
+                let segment = match text.strip_prefix('*') {
+                    Some("") => Segment::Any,
+                    Some(suffix) => Segment::Suffix(suffix),
+                    None => Segment::Key(
+                        text,
+                        keys.iter().position(|k| *k == text).unwrap_or_else(|| {
+                            keys.push(text);
+                            keys.len() - 1
+                        }),
+                    ),
+                };
+                let at = match level.iter().position(|s| s.text == text) {
                     Some(at) => at,
                     None => {
                         level.push(Step {
+                            text,
                             segment,
                             link: None,
                             next: Vec::new(),
@@ -240,15 +267,17 @@ fn steps() -> &'static [Step] {
                 level = &mut level[at].next;
             }
         }
-        root
+        Steps { root, keys }
     })
 }
 
 /// Calls `found` with the pattern, path and value of every match of `steps` under `value`.
-/// The path is kept as tokens and turned into a pointer only for what is reported.
+/// `ids` holds the document's number for each of [`Steps::keys`]. The path is kept as tokens
+/// and turned into a pointer only for what is reported.
 fn walk<'a>(
     value: Node<'a>,
     steps: &'static [Step],
+    ids: &[Option<KeyId>],
     path: &mut Vec<Token<'a>>,
     found: &mut dyn FnMut(usize, &[Token<'a>], Node<'a>),
 ) {
@@ -259,31 +288,40 @@ fn walk<'a>(
                 found(link, path, child);
             }
             if !step.next.is_empty() {
-                walk(child, &step.next, path, found);
+                walk(child, &step.next, ids, path, found);
             }
             path.pop();
         };
-    match value.kind() {
-        Kind::Array => {
-            for step in steps.iter().filter(|s| s.segment == "*") {
-                for (i, child) in value
-                    .as_array()
-                    .into_iter()
-                    .flat_map(|a| a.iter())
-                    .enumerate()
-                {
-                    visit(step, Token::Index(i), child, path);
+    // Each pattern reports in document order; the patterns are put in the table's order
+    // after the walk, so the steps of one level may be taken one after another.
+    if let Some(array) = value.as_array() {
+        for step in steps.iter().filter(|s| matches!(s.segment, Segment::Any)) {
+            for (i, child) in array.iter().enumerate() {
+                visit(step, Token::Index(i), child, path);
+            }
+        }
+    } else if let Some(object) = value.as_object() {
+        for step in steps {
+            match step.segment {
+                Segment::Key(key, i) => {
+                    if let Some(child) = ids[i].and_then(|id| object.get_id(id)) {
+                        visit(step, Token::Key(Cow::Borrowed(key)), child, path);
+                    }
+                }
+                Segment::Any => {
+                    for (key, child) in object.iter() {
+                        visit(step, Token::Key(key), child, path);
+                    }
+                }
+                Segment::Suffix(suffix) => {
+                    for (key, child) in object.iter() {
+                        if key.ends_with(suffix) {
+                            visit(step, Token::Key(key), child, path);
+                        }
+                    }
                 }
             }
         }
-        Kind::Object => {
-            for (key, child) in value.as_object().into_iter().flat_map(|o| o.iter()) {
-                for step in steps.iter().filter(|s| s.matches(&key)) {
-                    visit(step, Token::Key(key.clone()), child, path);
-                }
-            }
-        }
-        _ => {}
     }
 }
 
