@@ -64,6 +64,13 @@ fn message_shape(f: &crate::validate::Finding) -> MessageShape<'_> {
 }
 
 fn shape(report: &FileReport) -> ReportShape<'_> {
+    let mut shape = outline(report);
+    shape.issues.messages = report.findings.iter().map(message_shape).collect();
+    shape
+}
+
+/// The report's shape with an empty list of messages.
+fn outline(report: &FileReport) -> ReportShape<'_> {
     let c = report.counts;
     ReportShape {
         uri: display_path(&report.path),
@@ -74,7 +81,7 @@ fn shape(report: &FileReport) -> ReportShape<'_> {
             num_warnings: c.warnings,
             num_infos: c.infos,
             num_hints: c.hints,
-            messages: report.findings.iter().map(message_shape).collect(),
+            messages: Vec::new(),
             truncated: report.truncated(),
         },
         info: report.info.as_ref().map(|info: &AssetInfo| InfoShape {
@@ -105,9 +112,7 @@ const RUNS_IN_HAND: usize = 8;
 /// is written around them.
 pub fn write_pretty(out: &mut impl std::io::Write, report: &FileReport) -> std::io::Result<()> {
     use rayon::prelude::*;
-    let mut outline = shape(report);
-    outline.issues.messages.clear();
-    let outline = serde_json::to_string_pretty(&outline)?;
+    let outline = serde_json::to_string_pretty(&outline(report))?;
     // An empty list is written `[]`; no string value holds this text, as its quotes would be
     // escaped there.
     const EMPTY: &str = "\n    \"messages\": [],";
@@ -118,31 +123,36 @@ pub fn write_pretty(out: &mut impl std::io::Write, report: &FileReport) -> std::
             return out.write_all(b"\n");
         }
     };
-    let write_run = |run: &[crate::validate::Finding]| {
-        // A message takes some 300 bytes; the run grows past that once at most.
-        let mut text = String::with_capacity(run.len() * 320);
+    let write_run = |(text, run): (&mut String, &[crate::validate::Finding])| {
+        text.clear();
         for (i, finding) in run.iter().enumerate() {
             if i > 0 {
                 text.push_str(",\n      ");
             }
-            push_message(&mut text, &message_shape(finding));
+            push_message(text, &message_shape(finding));
         }
-        text
     };
     // Up to the list's opening bracket, the messages, then from the comma after the list on.
     out.write_all(&outline.as_bytes()[..at + EMPTY.len() - 2])?;
     out.write_all(b"\n      ")?;
-    // A few runs at a time, so that the text in hand stays small and its memory is reused.
+    // A few runs at a time, each written into a text of its own that every window reuses, so
+    // that the text in hand stays small and no window asks for fresh memory. A message takes
+    // some 300 bytes; a text grows past that once at most.
+    let findings = report.findings.len();
+    let mut runs: Vec<String> = (0..findings.div_ceil(MESSAGES_PER_TASK).min(RUNS_IN_HAND))
+        .map(|_| String::with_capacity(findings.min(MESSAGES_PER_TASK) * 320))
+        .collect();
     for (w, window) in report
         .findings
         .chunks(MESSAGES_PER_TASK * RUNS_IN_HAND)
         .enumerate()
     {
-        let runs: Vec<String> = window
-            .par_chunks(MESSAGES_PER_TASK)
-            .map(write_run)
-            .collect();
-        for (i, run) in runs.iter().enumerate() {
+        let tasks = window.len().div_ceil(MESSAGES_PER_TASK);
+        runs[..tasks]
+            .par_iter_mut()
+            .zip(window.par_chunks(MESSAGES_PER_TASK))
+            .for_each(write_run);
+        for (i, run) in runs[..tasks].iter().enumerate() {
             if w > 0 || i > 0 {
                 out.write_all(b",\n      ")?;
             }

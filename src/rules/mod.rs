@@ -56,8 +56,10 @@ impl<'a> Context<'a> {
     /// same objects many times over.
     pub fn layers(&self) -> &[Layer<'a>] {
         self.layers.get_or_init(|| {
-            // Counted first, so that the list is allocated once at its size.
+            // Counted first, so that the list is allocated once at its size (on a large
+            // document, megabytes: backed by huge pages where the system has them).
             let mut layers = Vec::with_capacity(layer_objects(self.json()).count());
+            crate::asset::pages::advise_huge(&mut layers);
             layers.extend(layer_objects(self.json()).map(|object| Layer {
                 view: match object.extension {
                     layers::SHEEN => SheenView::read(object.value).map(View::Sheen),
@@ -246,11 +248,16 @@ pub struct SlotUse<J> {
 impl<J> SlotUse<J> {
     /// Pointer to the textureInfo.
     pub fn pointer(&self) -> String {
-        format!(
-            "/materials/{}/extensions/{}/{}",
-            self.material, self.slot.extension, self.slot.texture
-        )
+        slot_pointer(self.material, self.slot)
     }
+}
+
+/// Pointer to the textureInfo of `slot` on material `material`.
+pub fn slot_pointer(material: usize, slot: &Slot) -> String {
+    format!(
+        "/materials/{material}/extensions/{}/{}",
+        slot.extension, slot.texture
+    )
 }
 
 /// The texture slots a layer object fills.

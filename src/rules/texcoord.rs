@@ -2,9 +2,9 @@
 //! KHR_texture_transform substitutes) needs every mesh primitive drawn with that material to
 //! carry TEXCOORD_N, or loaders sample garbage or refuse the mesh.
 
-use super::{effective_tex_coord, slot_uses, Context, Rule, SlotUse};
-use crate::asset::tape::Node;
+use super::{effective_tex_coord, slot_pointer, slot_uses, Context, Rule};
 use crate::diagnostics::{Code, Diagnostic, Severity};
+use crate::layers::Slot;
 use std::borrow::Cow;
 
 pub const MESH_PRIMITIVE_TOO_FEW_TEXCOORDS: Code = Code::new(
@@ -30,11 +30,12 @@ impl Rule for TexCoords {
         // Each sheen/fuzz texture slot with the TEXCOORD set it reads, in material order (the
         // order the layers come in), so that a primitive's material finds its slots by a
         // binary search: a large document has a material per primitive.
-        let needs: Vec<(usize, u64, SlotUse<Node>)> = cx
-            .layer_objects()
-            .flat_map(|layer| slot_uses(&layer))
-            .map(|slot| (slot.material, effective_tex_coord(slot.value), slot))
-            .collect();
+        let mut needs: Vec<(usize, u64, &'static Slot)> = Vec::with_capacity(cx.layers().len());
+        needs.extend(
+            cx.layer_objects()
+                .flat_map(|layer| slot_uses(&layer))
+                .map(|slot| (slot.material, effective_tex_coord(slot.value), slot.slot)),
+        );
         if needs.is_empty() {
             return;
         }
@@ -61,7 +62,7 @@ impl Rule for TexCoords {
                             format!("/meshes/{m}/primitives/{p}/material"),
                             format!(
                                 "material {material}'s {} reads {attribute}, which this primitive does not have",
-                                slot.pointer()
+                                slot_pointer(material, slot)
                             ),
                         ));
                     }
