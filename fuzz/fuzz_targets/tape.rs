@@ -1,6 +1,7 @@
 //! Arbitrary text, indexed by velvet's read model and parsed by serde_json: both accept the
 //! same texts, and read the same values from them (keys in the same order, duplicates as
-//! serde_json's map keeps them, numbers as serde_json reads them).
+//! serde_json's map keeps them, numbers as serde_json reads them); a lookup by key finds what
+//! iteration gives for it.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
@@ -23,6 +24,11 @@ fn read(node: Node) -> Value {
         Kind::Array => Value::Array(node.as_array().expect("an array").iter().map(read).collect()),
         Kind::Object => {
             let object = node.as_object().expect("an object");
+            // A lookup by key finds the value iteration gives that key.
+            for (key, value) in object.iter() {
+                assert_eq!(object.get(&key).map(|v| v.span()), Some(value.span()));
+                assert!(object.contains_key(&key));
+            }
             let members: serde_json::Map<String, Value> =
                 object.iter().map(|(k, v)| (k.into_owned(), read(v))).collect();
             assert_eq!(object.len(), members.len());
