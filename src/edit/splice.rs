@@ -1926,11 +1926,15 @@ fn reads_as_compact(written: &str, compact: &str) -> Option<usize> {
     while j < c.len() {
         let byte = *w.get(i)?;
         if matches!(byte, b' ' | b'\t' | b'\n' | b'\r') {
-            // Between tokens only: a structural byte before or after.
+            // Between tokens only: a structural byte before or after. The run of whitespace
+            // (a line break and its indentation) stands in one place, so it is passed whole.
             if !(structural(c.get(j)) || structural(j.checked_sub(1).and_then(|k| c.get(k)))) {
                 return None;
             }
-            i += 1;
+            i += 1 + w[i + 1..]
+                .iter()
+                .take_while(|b| matches!(b, b' ' | b'\t' | b'\n' | b'\r'))
+                .count();
             continue;
         }
         match c[j] {
@@ -1982,11 +1986,12 @@ fn reads_as_compact(written: &str, compact: &str) -> Option<usize> {
 fn string_end(bytes: &[u8], at: usize) -> Option<usize> {
     let mut i = at + 1;
     loop {
-        match *bytes.get(i)? {
+        // Plain text is passed eight bytes at a time, as the index passes it.
+        i += crate::asset::json_text::string_stop(bytes.get(i..)?)?;
+        match bytes[i] {
             b'"' => return Some(i + 1),
             b'\\' => i += 2,
-            0..=0x1f => return None,
-            _ => i += 1,
+            _ => return None,
         }
     }
 }
