@@ -15,7 +15,7 @@
 //! Object members keep their order and their duplicates; lookups give the last duplicate and
 //! iteration gives each key once at its first place with its last value, as serde_json's
 //! order-preserving map does. Each key entry holds the key's number in the document's table of
-//! distinct keys ([`super::key_table`]): a lookup finds the number of the key it wants once,
+//! distinct keys (`asset/key_table.rs`): a lookup finds the number of the key it wants once,
 //! then compares numbers, and a key the document never writes is answered without a scan.
 
 use super::key_table::KeyTable;
