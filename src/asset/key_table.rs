@@ -44,13 +44,12 @@ impl Default for KeyTable {
 /// The slot of `key`: its length and up to eight bytes from each end, mixed by one multiply.
 fn slot_of(key: &[u8]) -> usize {
     let n = key.len();
-    let (head, tail) = match (key.get(..8), n.checked_sub(8).map(|from| &key[from..])) {
-        (Some(head), Some(tail)) => (word(head), word(tail)),
-        _ => {
-            let mut short = [0u8; 8];
-            short[..n].copy_from_slice(key);
-            (u64::from_le_bytes(short), 0)
-        }
+    let (head, tail) = if n >= 8 {
+        (word(&key[..8]), word(&key[n - 8..]))
+    } else {
+        let mut short = [0u8; 8];
+        short[..n].copy_from_slice(key);
+        (u64::from_le_bytes(short), 0)
     };
     let mixed = (head ^ tail.rotate_left(29) ^ n as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
     (mixed >> (64 - SLOT_BITS)) as usize

@@ -687,15 +687,15 @@ impl<'a> Node<'a> {
         let node = *self;
         let entries = &self.tape.entries[self.at as usize + 1..self.entry().next as usize];
         let first = self.at + 1;
-        // A key the text does not have is the key of no member.
+        // A key the text does not have is the key of no member: no scan.
         let id = self.tape.keys.id(key.as_bytes());
-        let entries = if id.is_some() { entries } else { &[] };
-        let id = id.unwrap_or_default();
-        entries
-            .iter()
-            .enumerate()
-            .filter(move |(_, e)| e.meta & KEY != 0 && e.aux() as u32 == id)
-            .map(move |(i, _)| node.node(first + i as u32 + 1))
+        id.into_iter().flat_map(move |id| {
+            entries
+                .iter()
+                .enumerate()
+                .filter(move |(_, e)| e.meta & KEY != 0 && e.aux() as u32 == id)
+                .map(move |(i, _)| node.node(first + i as u32 + 1))
+        })
     }
 
     /// The value as a `serde_json::Value`, for the few places that need one (error reports,

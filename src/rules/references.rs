@@ -203,8 +203,8 @@ impl Token<'_> {
 
 /// What one segment of a pattern in [`LINKS`] matches.
 enum Segment {
-    /// This key; the number is its place in [`Steps::keys`].
-    Key(&'static str, usize),
+    /// The step's text, as a key; the number is its place in [`Steps::keys`].
+    Key(usize),
     /// Any array index or object key (`*`).
     Any,
     /// Any key that ends so (`*Texture`).
@@ -241,13 +241,12 @@ fn steps() -> &'static Steps {
                 let segment = match text.strip_prefix('*') {
                     Some("") => Segment::Any,
                     Some(suffix) => Segment::Suffix(suffix),
-                    None => Segment::Key(
-                        text,
-                        keys.iter().position(|k| *k == text).unwrap_or_else(|| {
+                    None => {
+                        Segment::Key(keys.iter().position(|k| *k == text).unwrap_or_else(|| {
                             keys.push(text);
                             keys.len() - 1
-                        }),
-                    ),
+                        }))
+                    }
                 };
                 let at = match level.iter().position(|s| s.text == text) {
                     Some(at) => at,
@@ -303,9 +302,9 @@ fn walk<'a>(
     } else if let Some(object) = value.as_object() {
         for step in steps {
             match step.segment {
-                Segment::Key(key, i) => {
+                Segment::Key(i) => {
                     if let Some(child) = ids[i].and_then(|id| object.get_id(id)) {
-                        visit(step, Token::Key(Cow::Borrowed(key)), child, path);
+                        visit(step, Token::Key(Cow::Borrowed(step.text)), child, path);
                     }
                 }
                 Segment::Any => {

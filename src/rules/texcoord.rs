@@ -30,12 +30,11 @@ impl Rule for TexCoords {
         // Each sheen/fuzz texture slot with the TEXCOORD set it reads, in material order (the
         // order the layers come in), so that a primitive's material finds its slots by a
         // binary search: a large document has a material per primitive.
-        let mut needs: Vec<(usize, u64, &'static Slot)> = Vec::with_capacity(cx.layers().len());
-        needs.extend(
-            cx.layer_objects()
-                .flat_map(|layer| slot_uses(&layer))
-                .map(|slot| (slot.material, effective_tex_coord(slot.value), slot.slot)),
-        );
+        let needs: Vec<(usize, u64, &'static Slot)> = cx
+            .layer_objects()
+            .flat_map(|layer| slot_uses(&layer))
+            .map(|slot| (slot.material, effective_tex_coord(slot.value), slot.slot))
+            .collect();
         if needs.is_empty() {
             return;
         }
