@@ -1,14 +1,19 @@
 #!/bin/sh
 # Times velvet against the tools it is compared with, on generated libraries: the Khronos
 # glTF-Validator and glTF-Transform (npm, versions pinned in benches/anchors/package.json).
-# Run on a machine with nothing else running; each command runs RUNS times (default 5) and the
-# median wall time and largest peak memory are printed.
+# Run on a machine with nothing else running. The commands run in rounds: each round runs every
+# command once, a velvet command next to the one it is compared with, so that both meet the
+# same conditions; RUNS rounds (default 7). For each command the median wall time, the fastest
+# and slowest run and the largest peak memory are printed, then each comparison's ratio of
+# medians, then the share of the processor time the rounds asked for that the host held back
+# ("steal" in /proc/stat: on a virtual machine, the time its processors waited for the host's;
+# near 0 on a quiet host).
 #
 #   sh benches/anchors.sh [WORK_DIR]
 set -eu
 root=$(cd "$(dirname "$0")/.." && pwd)
 work=${1:-/tmp/velvet-anchors}
-runs=${RUNS:-5}
+runs=${RUNS:-7}
 velvet="$root/target/release/velvet"
 corpus="$root/target/release/examples/corpus"
 anchors="$root/benches/anchors"
@@ -21,43 +26,105 @@ for n in 5000 20000 80000; do
 done
 [ -f "$work/lib/library.gltf" ] || "$corpus" --library "$work/lib" > /dev/null
 
-# measure LABEL COMMAND...: median wall seconds and largest peak KiB over $runs runs. The wall
-# time is read with nanosecond clocks around the command (time(1) prints hundredths only, a
-# sixth of a 60 ms run); the peak memory comes from time(1).
-measure() {
-    label=$1
-    shift
-    i=0
-    : > "$work/times"
-    while [ $i -lt "$runs" ]; do
-        rm -rf "$work/out" && mkdir -p "$work/out"
-        # velvet validate exits 1 when it finds errors (the generated files have some); any
-        # other failure means the figure would not measure the job, so the run stops.
-        status=0
-        start=$(date +%s%N)
-        /usr/bin/time -f "%M" -o "$work/time1" "$@" > /dev/null 2> "$work/stderr" || status=$?
-        end=$(date +%s%N)
-        if [ "$status" -gt 1 ]; then
-            echo "$label: exit status $status" >&2
-            cat "$work/stderr" >&2
-            exit 1
-        fi
-        echo "$(( (end - start) / 1000 )) $(tail -n 1 "$work/time1")" >> "$work/times"
-        i=$((i + 1))
-    done
-    sort -n "$work/times" | awk -v label="$label" '
-        { wall[NR] = $1 / 1e6; if ($2 > mem) mem = $2 }
-        END { printf "| %s | %.3f s | %d MiB |\n", label, wall[int((NR + 1) / 2)], mem / 1024 }'
+# The commands, by number: label, then the command line.
+count=9
+command_of() {
+    case $1 in
+    1) echo "velvet validate, 5000 materials" ;;
+    2) echo "velvet validate, 20000 materials" ;;
+    3) echo "Khronos validator, 20000 materials" ;;
+    4) echo "velvet validate, 80000 materials" ;;
+    5) echo "velvet validate, 500 small files" ;;
+    6) echo "Khronos validator, 500 small files" ;;
+    7) echo "velvet migrate --fast, library" ;;
+    8) echo "gltf-transform copy, library" ;;
+    9) echo "velvet migrate, library" ;;
+    esac
+}
+# timed COMMAND...: runs it under time(1), which writes its peak memory (KiB) to time1.
+timed() {
+    /usr/bin/time -f "%M" -o "$work/time1" "$@"
+}
+run_command() {
+    case $1 in
+    1) timed "$velvet" validate --format json "$work/m5000/large.gltf" ;;
+    2) timed "$velvet" validate --format json "$work/m20000/large.gltf" ;;
+    3) timed node "$anchors/validate.js" "$work/m20000/large.gltf" ;;
+    4) timed "$velvet" validate --format json "$work/m80000/large.gltf" ;;
+    5) timed "$velvet" validate --format json "$work/m20000/small" ;;
+    6) timed node "$anchors/validate.js" "$work/m20000/small" ;;
+    7) timed "$velvet" migrate -q --fast "$work/lib/library.gltf" --out-dir "$work/out" ;;
+    8) timed "$anchors/node_modules/.bin/gltf-transform" copy "$work/lib/library.gltf" "$work/out/library.gltf" ;;
+    9) timed "$velvet" migrate -q "$work/lib/library.gltf" --out-dir "$work/out" ;;
+    esac
 }
 
-echo "| command | median wall | peak memory |"
-echo "|---|---|---|"
-for n in 5000 20000 80000; do
-    measure "velvet validate, $n materials" "$velvet" validate --format json "$work/m$n/large.gltf"
+# measure N: runs command N once and adds its wall time (microseconds, read with nanosecond
+# clocks around the command: time(1) prints hundredths, a sixth of a 60 ms run) and its peak
+# memory to the command's record.
+measure() {
+    rm -rf "$work/out" && mkdir -p "$work/out"
+    # velvet validate exits 1 when it finds errors (the generated files have some); any other
+    # failure means the figure would not measure the job, so the run stops.
+    status=0
+    start=$(date +%s%N)
+    run_command "$1" > /dev/null 2> "$work/stderr" || status=$?
+    end=$(date +%s%N)
+    if [ "$status" -gt 1 ]; then
+        echo "$(command_of "$1"): exit status $status" >&2
+        cat "$work/stderr" >&2
+        exit 1
+    fi
+    echo "$(( (end - start) / 1000 )) $(tail -n 1 "$work/time1")" >> "$work/times.$1"
+}
+
+# The processor time the host took (steal) and the time the processors wanted (busy: steal
+# included, idle and waiting for the disk not), so far, in ticks.
+cpu_ticks() {
+    awk '/^cpu / { print $9, $2 + $3 + $4 + $7 + $8 + $9 }' /proc/stat
+}
+
+i=1
+while [ $i -le $count ]; do
+    : > "$work/times.$i"
+    i=$((i + 1))
 done
-measure "Khronos validator, 20000 materials" node "$anchors/validate.js" "$work/m20000/large.gltf"
-measure "velvet validate, 500 small files" "$velvet" validate --format json "$work/m20000/small"
-measure "Khronos validator, 500 small files" node "$anchors/validate.js" "$work/m20000/small"
-measure "velvet migrate --fast, library" "$velvet" migrate -q --fast "$work/lib/library.gltf" --out-dir "$work/out"
-measure "velvet migrate, library" "$velvet" migrate -q "$work/lib/library.gltf" --out-dir "$work/out"
-measure "gltf-transform copy, library" "$anchors/node_modules/.bin/gltf-transform" copy "$work/lib/library.gltf" "$work/out/library.gltf"
+set -- $(cpu_ticks)
+steal_before=$1 busy_before=$2
+round=0
+while [ $round -lt "$runs" ]; do
+    i=1
+    while [ $i -le $count ]; do
+        measure $i
+        i=$((i + 1))
+    done
+    round=$((round + 1))
+done
+set -- $(cpu_ticks)
+steal_ticks=$(($1 - steal_before)) busy_ticks=$(($2 - busy_before))
+
+# median N: the median wall time (seconds) of command N.
+median() {
+    sort -n "$work/times.$1" | awk '{ wall[NR] = $1 / 1e6 } END { printf "%.3f", wall[int((NR + 1) / 2)] }'
+}
+
+echo "| command | median wall | fastest – slowest | peak memory |"
+echo "|---|---|---|---|"
+i=1
+while [ $i -le $count ]; do
+    sort -n "$work/times.$i" | awk -v label="$(command_of $i)" -v wall="$(median $i)" '
+        { if (NR == 1) low = $1 / 1e6; high = $1 / 1e6; if ($2 > mem) mem = $2 }
+        END { printf "| %s | %s s | %.3f – %.3f s | %d MiB |\n", label, wall, low, high, mem / 1024 }'
+    i=$((i + 1))
+done
+echo
+echo "| comparison | velvet | the other tool | velvet is faster by |"
+echo "|---|---|---|---|"
+for pair in "2 3" "5 6" "7 8"; do
+    set -- $pair
+    awk -v label="$(command_of "$1") / $(command_of "$2")" -v a="$(median "$1")" -v b="$(median "$2")" \
+        'BEGIN { printf "| %s | %s s | %s s | %.1f× |\n", label, a, b, b / a }'
+done
+echo
+awk -v s="$steal_ticks" -v t="$busy_ticks" -v rounds="$runs" \
+    'BEGIN { printf "%d rounds; the host held back %.1f %% of the processor time they asked for (steal)\n", rounds, (t > 0 ? 100 * s / t : 0) }'
