@@ -289,6 +289,7 @@ fn emit(text: &[u8]) {
 
 fn main() -> ExitCode {
     velvet::asset::pages::limit_heaps();
+    velvet::asset::source::enable_mapping();
     let cli = Cli::parse();
     match cli.command {
         Command::Validate(args) => validate(args, cli.color, cli.quiet),

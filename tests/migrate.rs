@@ -1920,3 +1920,54 @@ fn a_migration_with_bakes_leaves_every_other_part_of_the_text_as_it_was() {
     // The mesh names no accessors (the scene is cut short): that finding, and no other.
     assert_eq!(errors(&output), errors(&input));
 }
+
+/// A document of `materials` sheen materials (each with a name of `pad` bytes), in two-space
+/// layout: large enough for the command to map the file rather than read it.
+fn large_sheen_document(materials: usize, pad: usize) -> String {
+    let mut text = String::from(
+        "{\n  \"asset\": {\n    \"version\": \"2.0\"\n  },\n  \"extensionsUsed\": [\n    \"KHR_materials_sheen\"\n  ],\n  \"materials\": [",
+    );
+    for i in 0..materials {
+        if i > 0 {
+            text.push(',');
+        }
+        text.push_str(&format!(
+            "\n    {{\n      \"name\": \"m{i} {}\",\n      \"extensions\": {{\n        \"KHR_materials_sheen\": {{\n          \"sheenColorFactor\": [0.5, 0.25, 1.0],\n          \"sheenRoughnessFactor\": 0.75\n        }}\n      }}\n    }}",
+            "x".repeat(pad)
+        ));
+    }
+    text.push_str("\n  ]\n}\n");
+    text
+}
+
+#[test]
+fn a_large_file_is_migrated_in_place_as_the_library_migrates_its_bytes() {
+    let text = large_sheen_document(800, 4000);
+    assert!(text.len() as u64 > 2 * velvet::asset::source::MAPPED_FROM);
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("large.gltf");
+    std::fs::write(&input, &text).unwrap();
+    // The reference: the library migrating the same bytes, never mapped (the library maps
+    // only once the command enables it).
+    let reference_dir = tempfile::tempdir().unwrap();
+    let reference = reference_dir.path().join("large.gltf");
+    std::fs::write(&reference, &text).unwrap();
+    let report = migrate::run(&request(
+        vec![reference.clone()],
+        Destination::InPlace,
+        Options::default(),
+    ))
+    .unwrap();
+    assert_eq!(report.files.len(), 1);
+    let expected = std::fs::read(&reference).unwrap();
+    assert_ne!(expected, text.as_bytes());
+
+    let (status, _, stderr) = velvet(&["migrate", "-q", "--in-place", input.to_str().unwrap()]);
+    assert_eq!(status, 0, "{stderr}");
+    assert_file(&input, &expected);
+    // Nothing but the output is left in the folder.
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    // Every input byte is still there, in order.
+    let mut rest = expected.iter();
+    assert!(text.bytes().all(|b| rest.any(|&c| c == b)));
+}

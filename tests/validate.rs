@@ -648,3 +648,40 @@ fn invalid_json_is_placed_at_its_line_and_column() {
         "{out}"
     );
 }
+
+/// A file large enough for the command to map it rather than read it is reported as a read
+/// one is: the finding in its last material, at its line and column.
+#[test]
+fn a_large_file_reports_its_last_material_at_its_line_and_column() {
+    let materials = 600;
+    let mut text = String::from(
+        "{\n  \"asset\": {\"version\": \"2.0\"},\n  \"extensionsUsed\": [\"KHR_materials_sheen\"],\n  \"materials\": [",
+    );
+    for i in 0..materials {
+        let roughness = if i + 1 == materials { "1.5" } else { "0.75" };
+        text.push_str(&format!(
+            "{}\n    {{\"name\": \"m{i} {}\", \"extensions\": {{\"KHR_materials_sheen\": {{\"sheenColorFactor\": [0.5, 0.25, 1.0], \"sheenRoughnessFactor\": {roughness}}}}}}}",
+            if i > 0 { "," } else { "" },
+            "x".repeat(4000)
+        ));
+    }
+    text.push_str("\n  ]\n}\n");
+    assert!(text.len() as u64 > 2 * velvet::asset::source::MAPPED_FROM);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("large.gltf");
+    std::fs::write(&path, &text).unwrap();
+    let at = text.rfind("1.5").unwrap();
+    let line = text[..at].matches('\n').count() + 1;
+    let column = at - text[..at].rfind('\n').unwrap();
+    let (status, out, _) = velvet(&["validate", "-q", path.to_str().unwrap()]);
+    assert_eq!(status, 1);
+    assert_eq!(
+        out,
+        format!(
+            "{}:{line}:{column}: error VALUE_NOT_IN_RANGE: 1.5 is greater than the maximum of \
+             1.0\n    at /materials/{}/extensions/KHR_materials_sheen/sheenRoughnessFactor\n",
+            path.display(),
+            materials - 1
+        )
+    );
+}

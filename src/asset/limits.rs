@@ -10,6 +10,7 @@
 //! walked recursively (schema checks, rules, parsing values, dropping them), and a decoded
 //! image takes up to eight bytes per pixel however small its file is.
 
+use super::source::FileBytes;
 use std::io::Read;
 use std::path::Path;
 
@@ -141,14 +142,18 @@ pub fn find_too_deep(text: &str, max_depth: usize) -> Option<TooDeep> {
 }
 
 /// Reads a file that is to be parsed as an asset. A regular file is read whole (its size is
-/// what the user stored); anything else — a pipe, a device — is read up to what the limits
+/// what the user stored), or mapped when it is large and mapping is enabled (see
+/// [`super::source`]); anything else — a pipe, a device — is read up to what the limits
 /// allow, so that `/dev/zero` named as an input costs an error, not all memory. A GLB stream
 /// is read up to the length its header declares (at most 4 GiB), anything else up to the
 /// document limit; one byte more is read so that a longer stream is seen to be longer.
-pub fn read_asset_file(path: &Path, options: &LoadOptions) -> std::io::Result<Vec<u8>> {
+pub fn read_asset_file(path: &Path, options: &LoadOptions) -> std::io::Result<FileBytes> {
     let mut file = std::fs::File::open(path)?;
     let metadata = file.metadata()?;
     if metadata.is_file() {
+        if let Some(mapped) = FileBytes::map(&file, path, metadata.len()) {
+            return Ok(mapped);
+        }
         // Sized to the file (and one byte more, to see that it ends there) before it is read,
         // so that a large one can be advised huge pages (see super::pages).
         let size = usize::try_from(metadata.len()).unwrap_or(0);
@@ -157,7 +162,7 @@ pub fn read_asset_file(path: &Path, options: &LoadOptions) -> std::io::Result<Ve
             super::pages::advise_huge(&mut bytes);
         }
         file.read_to_end(&mut bytes)?;
-        return Ok(bytes);
+        return Ok(FileBytes::from_vec(bytes));
     }
     let mut head = Vec::with_capacity(12);
     (&mut file).take(12).read_to_end(&mut head)?;
@@ -170,7 +175,7 @@ pub fn read_asset_file(path: &Path, options: &LoadOptions) -> std::io::Result<Ve
     let mut bytes = head;
     file.take(cap.saturating_sub(bytes.len() as u64).saturating_add(1))
         .read_to_end(&mut bytes)?;
-    Ok(bytes)
+    Ok(FileBytes::from_vec(bytes))
 }
 
 #[cfg(test)]

@@ -15,6 +15,7 @@ pub mod pages;
 pub mod pointer;
 pub mod position;
 pub mod resource;
+pub mod source;
 pub mod tape;
 pub mod tape_schema;
 pub mod write;
@@ -23,6 +24,7 @@ use crate::diagnostics::{codes, Diagnostic};
 pub use limits::LoadOptions;
 use resource::{ImageHeader, Location};
 use serde_json::Value;
+pub use source::{FileBytes, SourceText};
 use std::borrow::Cow;
 use std::collections::HashMap;
 use std::io::{BufReader, Cursor};
@@ -53,7 +55,7 @@ pub struct Asset {
     pub path: PathBuf,
     pub container: Container,
     json: OnceLock<Value>,
-    pub json_text: String,
+    pub json_text: SourceText,
     /// The index of `json_text` that the rules read.
     pub tape: tape::Tape,
     /// Byte offset of `json_text` in the file (20 in a GLB, 3 after a byte-order mark).
@@ -94,7 +96,7 @@ pub fn load_with(path: &Path, options: &LoadOptions) -> Loaded {
 
 /// Reads the bytes of an asset file (see [`limits::read_asset_file`]). A .gltf larger than
 /// the document limit is refused from its size alone, without being read.
-pub fn read(path: &Path, options: &LoadOptions) -> Result<Vec<u8>, Diagnostic> {
+pub fn read(path: &Path, options: &LoadOptions) -> Result<FileBytes, Diagnostic> {
     let io_error = |e: std::io::Error| {
         Diagnostic::new(
             &codes::IO_ERROR,
@@ -130,7 +132,7 @@ pub fn load_bytes(path: &Path, bytes: &[u8]) -> Loaded {
 
 /// Parses bytes read from `path`, keeping them as the JSON text without a copy when the file is
 /// a .gltf in plain UTF-8 (a copy of a large document costs as much as indexing it).
-fn load_owned(path: &Path, bytes: Vec<u8>, options: &LoadOptions) -> Loaded {
+fn load_owned(path: &Path, bytes: FileBytes, options: &LoadOptions) -> Loaded {
     load_read(path, bytes, options).0
 }
 
@@ -138,7 +140,11 @@ fn load_owned(path: &Path, bytes: Vec<u8>, options: &LoadOptions) -> Loaded {
 /// a copy where it can; gives them back when the asset did not take them as its text (a GLB, a
 /// byte-order mark, a document over the limit, text that is not UTF-8). When it took them,
 /// [`Asset::file_bytes`] reads them.
-pub fn load_read(path: &Path, bytes: Vec<u8>, options: &LoadOptions) -> (Loaded, Option<Vec<u8>>) {
+pub fn load_read(
+    path: &Path,
+    bytes: FileBytes,
+    options: &LoadOptions,
+) -> (Loaded, Option<FileBytes>) {
     let plain = !bytes.starts_with(b"glTF")
         && !bytes.starts_with(b"\xEF\xBB\xBF")
         && !path
@@ -148,15 +154,12 @@ pub fn load_read(path: &Path, bytes: Vec<u8>, options: &LoadOptions) -> (Loaded,
     if !plain {
         return (load_bytes_with(path, &bytes, options), Some(bytes));
     }
-    match String::from_utf8(bytes) {
+    match SourceText::from_bytes(bytes) {
         Ok(text) => (
             load_text(path, text, Container::Gltf, 0, None, Vec::new(), options),
             None,
         ),
-        Err(e) => (
-            load_bytes_with(path, e.as_bytes(), options),
-            Some(e.into_bytes()),
-        ),
+        Err((bytes, _)) => (load_bytes_with(path, &bytes, options), Some(bytes)),
     }
 }
 
@@ -213,7 +216,7 @@ pub fn load_bytes_with(path: &Path, bytes: &[u8], options: &LoadOptions) -> Load
         None => (json_bytes, json_offset),
     };
     let json_text = match std::str::from_utf8(json_bytes) {
-        Ok(text) => text.to_string(),
+        Ok(text) => SourceText::from(text.to_string()),
         Err(e) => {
             let at = e.valid_up_to();
             let line = json_bytes[..at].iter().filter(|b| **b == b'\n').count() + 1;
@@ -260,7 +263,7 @@ pub fn load_bytes_with(path: &Path, bytes: &[u8], options: &LoadOptions) -> Load
 /// Indexes a document's JSON text and makes the asset.
 fn load_text(
     path: &Path,
-    json_text: String,
+    json_text: SourceText,
     container: Container,
     json_offset: usize,
     bin: Option<Vec<u8>>,

@@ -209,11 +209,11 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
         copy_resources(&relocation, asset.json())?;
         create_parent(output)?;
         let out_bytes = if relocation.edits.is_empty() {
-            bytes
+            std::borrow::Cow::Borrowed(&bytes[..])
         } else {
             let mut json = asset.take_json();
             crate::edit::apply(&mut json, &relocation.edits).map_err(|e| e.to_string())?;
-            write::to_bytes(&asset, &json, asset.bin.as_deref())
+            std::borrow::Cow::Owned(write::to_bytes(&asset, &json, asset.bin.as_deref()))
         };
         write::write_atomic(output, &out_bytes)
             .map_err(|e| format!("cannot write {}: {e}", output.display()))?;

@@ -13,7 +13,7 @@ use super::plan::{plan_document, DocumentPlan};
 use super::textures;
 use super::Options;
 use crate::asset::write::Output;
-use crate::asset::{self, write, Asset};
+use crate::asset::{self, write, Asset, FileBytes};
 use crate::bake::apply::{apply as bake_apply, ApplyOptions, OutputReport};
 use crate::bake::{bake_into, BakeOptions, KernelOptions};
 use crate::diagnostics::Severity;
@@ -31,7 +31,7 @@ pub struct FilePlan {
     pub input: PathBuf,
     pub output: Option<PathBuf>,
     /// The input's bytes, kept when the plan changes nothing (then written as they are).
-    pub bytes: Vec<u8>,
+    pub bytes: Option<FileBytes>,
     pub asset: Asset,
     pub document: DocumentPlan,
     pub relocation: Relocation,
@@ -102,8 +102,8 @@ pub fn plan_file(job: &Job, options: &Options) -> Result<FilePlan, String> {
     // The input's bytes are written as they are only when the plan changes nothing; a large
     // document that changes does not keep them. A .gltf's are the asset's text.
     let bytes = match bytes {
-        Some(bytes) if document.is_empty() && relocation.edits.is_empty() => bytes,
-        _ => Vec::new(),
+        Some(bytes) if document.is_empty() && relocation.edits.is_empty() => Some(bytes),
+        _ => None,
     };
     Ok(FilePlan {
         input: job.input.clone(),
@@ -256,7 +256,7 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
     }
     if changed {
         // The input's bytes are written only when nothing changed.
-        plan.bytes = Vec::new();
+        plan.bytes = None;
     }
     create_parent(&output)?;
     let bytes = if bake_plan.is_empty() {
@@ -305,15 +305,15 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
 /// are the asset's text; a GLB's are kept from loading when the plan changes nothing, else
 /// read again.
 fn input_bytes(plan: &mut FilePlan) -> Result<Cow<'_, [u8]>, String> {
-    if !plan.bytes.is_empty() {
-        return Ok(Cow::Owned(std::mem::take(&mut plan.bytes)));
+    if plan.bytes.is_none() && plan.asset.file_bytes().is_none() {
+        let read = asset::read(&plan.input, &plan.asset.options)
+            .map_err(|d| format!("cannot read {}: {}", plan.input.display(), d.message))?;
+        plan.bytes = Some(read);
     }
-    if let Some(bytes) = plan.asset.file_bytes() {
-        return Ok(Cow::Borrowed(bytes));
-    }
-    asset::read(&plan.input, &plan.asset.options)
-        .map(Cow::Owned)
-        .map_err(|d| format!("cannot read {}: {}", plan.input.display(), d.message))
+    Ok(Cow::Borrowed(match &plan.bytes {
+        Some(bytes) => bytes,
+        None => plan.asset.file_bytes().unwrap_or_default(),
+    }))
 }
 
 /// What [`baked_by_part`] wrote: the output, whether it differs from the input, and what became

@@ -1,0 +1,399 @@
+//! A file's bytes as velvet holds them, and the JSON text made of them: read into memory, or,
+//! for a large regular file, mapped from the system's file cache.
+//!
+//! Why map: on a virtual machine whose host takes back the memory its guest frees (balloon
+//! free-page reporting, as on the machines velvet is measured on), the first touch of fresh
+//! memory a few seconds after other programs freed it costs the host a fault per page: reading
+//! a 10.7 MB document into a new buffer took 43–55 ms there, where mapping the file, whose
+//! pages the file cache holds already, took 3 ms (and 3–4 ms against 1.5 when the memory was
+//! warm). The bytes are the same either way.
+//!
+//! A mapping reads the file as it is on disk while velvet runs. Another program that shortens
+//! the file meanwhile makes a read past its new end fault (SIGBUS); [`enable_mapping`]
+//! installs a handler that names the file, says what happened and ends the process with status
+//! 1, where the default would be a crash. Files are mapped only once that handler is in place,
+//! and only where it can name them (up to [`MAPPED_AT_ONCE`] at once; the rest are read).
+//! velvet's own writes never change a file it maps: every output is a new file renamed into
+//! place.
+
+use std::fmt;
+use std::fs::File;
+use std::ops::Deref;
+use std::path::Path;
+
+/// Regular files from this size (bytes) are mapped once [`enable_mapping`] was called; smaller
+/// ones are read (a mapping costs two system calls more than a read, and a small file little
+/// fresh memory).
+pub const MAPPED_FROM: u64 = 1 << 20;
+
+/// How many files can be mapped at the same time; a file beyond that is read.
+pub const MAPPED_AT_ONCE: usize = 64;
+
+/// A file's bytes: read into memory, or mapped.
+pub struct FileBytes(Held);
+
+enum Held {
+    Read(Vec<u8>),
+    Mapped(Mapped),
+}
+
+impl FileBytes {
+    /// Bytes already in memory.
+    pub fn from_vec(bytes: Vec<u8>) -> FileBytes {
+        FileBytes(Held::Read(bytes))
+    }
+
+    /// Whether the bytes are a mapping of the file (see the module comment).
+    pub fn is_mapped(&self) -> bool {
+        matches!(self.0, Held::Mapped(_))
+    }
+
+    /// Maps `file`, which `path` names, when mapping is enabled, the file is a regular file of
+    /// at least [`MAPPED_FROM`] bytes, and a slot is free to name it should it shrink; `None`
+    /// otherwise (the caller reads it).
+    pub fn map(file: &File, path: &Path, size: u64) -> Option<FileBytes> {
+        if size < MAPPED_FROM || !mapping::enabled() {
+            return None;
+        }
+        mapping::map(file, path).map(|m| FileBytes(Held::Mapped(m)))
+    }
+}
+
+impl Deref for FileBytes {
+    type Target = [u8];
+    fn deref(&self) -> &[u8] {
+        match &self.0 {
+            Held::Read(bytes) => bytes,
+            Held::Mapped(mapped) => mapped.bytes(),
+        }
+    }
+}
+
+impl fmt::Debug for FileBytes {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let how = if self.is_mapped() { "mapped" } else { "read" };
+        write!(f, "FileBytes({} bytes, {how})", self.len())
+    }
+}
+
+/// A document's JSON text: UTF-8, held as a `String` or as the bytes of its file.
+pub struct SourceText(FileBytes);
+
+impl SourceText {
+    /// The bytes as text when they are UTF-8; otherwise the bytes back, and where they stop
+    /// being UTF-8.
+    pub fn from_bytes(bytes: FileBytes) -> Result<SourceText, (FileBytes, std::str::Utf8Error)> {
+        match std::str::from_utf8(&bytes) {
+            Ok(_) => Ok(SourceText(bytes)),
+            Err(e) => Err((bytes, e)),
+        }
+    }
+
+    pub fn as_str(&self) -> &str {
+        // SAFETY: every SourceText was checked to be UTF-8 when it was made (from_bytes, or a
+        // String). A mapped file's bytes could change after the check only if another program
+        // rewrote the file while velvet ran (see the module comment).
+        unsafe { std::str::from_utf8_unchecked(&self.0) }
+    }
+
+    /// Whether the text is a mapping of its file.
+    pub fn is_mapped(&self) -> bool {
+        self.0.is_mapped()
+    }
+}
+
+impl From<String> for SourceText {
+    fn from(text: String) -> SourceText {
+        SourceText(FileBytes::from_vec(text.into_bytes()))
+    }
+}
+
+impl Deref for SourceText {
+    type Target = str;
+    fn deref(&self) -> &str {
+        self.as_str()
+    }
+}
+
+impl fmt::Debug for SourceText {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        fmt::Debug::fmt(self.as_str(), f)
+    }
+}
+
+/// Allows large input files to be mapped (see the module comment), installing the handler that
+/// reports a mapped file shortened while it is read. The command-line tool calls it first
+/// thing; a program that uses the library and has its own SIGBUS handling need not. Does
+/// nothing where there is no SIGBUS (not Unix).
+pub fn enable_mapping() {
+    mapping::enable();
+}
+
+#[cfg(unix)]
+mod mapping {
+    //! The mappings and the SIGBUS handler. The handler may run on any thread at any moment,
+    //! so what it reads is a fixed table of atomics (no lock, no allocation): each slot holds
+    //! a mapping's address range and a pointer to its file's name, which the mapping owns.
+
+    use std::fs::File;
+    use std::path::Path;
+    use std::sync::atomic::{AtomicBool, AtomicPtr, AtomicUsize, Ordering};
+    use std::sync::Once;
+
+    static ENABLED: AtomicBool = AtomicBool::new(false);
+    static INSTALL: Once = Once::new();
+
+    struct Slot {
+        taken: AtomicBool,
+        /// The mapping's first address, 0 while the slot names none.
+        start: AtomicUsize,
+        len: AtomicUsize,
+        name: AtomicPtr<u8>,
+        name_len: AtomicUsize,
+    }
+
+    #[allow(clippy::declare_interior_mutable_const)]
+    const FREE: Slot = Slot {
+        taken: AtomicBool::new(false),
+        start: AtomicUsize::new(0),
+        len: AtomicUsize::new(0),
+        name: AtomicPtr::new(std::ptr::null_mut()),
+        name_len: AtomicUsize::new(0),
+    };
+
+    static SLOTS: [Slot; super::MAPPED_AT_ONCE] = [FREE; super::MAPPED_AT_ONCE];
+
+    pub fn enabled() -> bool {
+        ENABLED.load(Ordering::Acquire)
+    }
+
+    pub fn enable() {
+        INSTALL.call_once(|| {
+            // SAFETY: sigaction with a zeroed struct, an empty mask and a handler of the
+            // SA_SIGINFO shape; the handler only reads atomics, writes to stderr and exits.
+            let installed = unsafe {
+                let mut action: libc::sigaction = std::mem::zeroed();
+                action.sa_sigaction = on_sigbus as *const () as libc::sighandler_t;
+                action.sa_flags = libc::SA_SIGINFO;
+                libc::sigemptyset(&mut action.sa_mask);
+                libc::sigaction(libc::SIGBUS, &action, std::ptr::null_mut()) == 0
+            };
+            ENABLED.store(installed, Ordering::Release);
+        });
+    }
+
+    /// A mapped file, named in its slot until it is dropped.
+    pub struct Mapped {
+        map: memmap2::Mmap,
+        slot: usize,
+        // Pointed to by the slot; kept here so that it lives as long as the mapping.
+        _name: Box<[u8]>,
+    }
+
+    impl Mapped {
+        pub fn bytes(&self) -> &[u8] {
+            &self.map
+        }
+    }
+
+    pub fn map(file: &File, path: &Path) -> Option<Mapped> {
+        let slot = SLOTS.iter().position(|s| {
+            s.taken
+                .compare_exchange(false, true, Ordering::AcqRel, Ordering::Acquire)
+                .is_ok()
+        })?;
+        // SAFETY: a read-only private mapping of a file velvet does not write. Another program
+        // changing the file while it is mapped is the risk the module comment describes: its
+        // bytes may change under velvet, and a read past a new, shorter end faults, which the
+        // handler reports.
+        let map = match unsafe { memmap2::MmapOptions::new().populate().map(file) } {
+            Ok(map) => map,
+            Err(_) => {
+                SLOTS[slot].taken.store(false, Ordering::Release);
+                return None;
+            }
+        };
+        let mut name: Box<[u8]> = path.display().to_string().into_bytes().into_boxed_slice();
+        let s = &SLOTS[slot];
+        s.name.store(name.as_mut_ptr(), Ordering::Relaxed);
+        s.name_len.store(name.len(), Ordering::Relaxed);
+        s.len.store(map.len(), Ordering::Relaxed);
+        s.start.store(map.as_ptr() as usize, Ordering::Release);
+        Some(Mapped {
+            map,
+            slot,
+            _name: name,
+        })
+    }
+
+    impl Drop for Mapped {
+        fn drop(&mut self) {
+            let s = &SLOTS[self.slot];
+            s.start.store(0, Ordering::Release);
+            s.taken.store(false, Ordering::Release);
+        }
+    }
+
+    fn write_stderr(bytes: &[u8]) {
+        // SAFETY: write(2) is async-signal-safe; the bytes are valid for their length.
+        unsafe {
+            libc::write(2, bytes.as_ptr().cast(), bytes.len());
+        }
+    }
+
+    extern "C" fn on_sigbus(_: libc::c_int, info: *mut libc::siginfo_t, _: *mut libc::c_void) {
+        // SAFETY: the kernel passes a valid siginfo_t to an SA_SIGINFO handler.
+        let address = unsafe { (*info).si_addr() } as usize;
+        for s in &SLOTS {
+            let start = s.start.load(Ordering::Acquire);
+            if start == 0 || address < start || address >= start + s.len.load(Ordering::Relaxed) {
+                continue;
+            }
+            let name = s.name.load(Ordering::Relaxed);
+            let name_len = s.name_len.load(Ordering::Relaxed);
+            write_stderr(b"velvet: ");
+            // SAFETY: the slot's mapping is alive (this thread was reading it), and with it
+            // the name it points to.
+            write_stderr(unsafe { std::slice::from_raw_parts(name, name_len) });
+            write_stderr(
+                b": the file became shorter while velvet read it (another program changed it); \
+                  velvet stopped\n",
+            );
+            // SAFETY: _exit ends the process without running anything else; it is
+            // async-signal-safe.
+            unsafe { libc::_exit(1) };
+        }
+        // Not a mapped file: the fault is velvet's own, and takes its default course (the
+        // instruction runs again and the process ends on the signal).
+        // SAFETY: signal(2) with SIG_DFL is async-signal-safe.
+        unsafe {
+            libc::signal(libc::SIGBUS, libc::SIG_DFL);
+        }
+    }
+}
+
+#[cfg(not(unix))]
+mod mapping {
+    use std::fs::File;
+    use std::path::Path;
+
+    pub struct Mapped(std::convert::Infallible);
+
+    impl Mapped {
+        pub fn bytes(&self) -> &[u8] {
+            match self.0 {}
+        }
+    }
+
+    pub fn enabled() -> bool {
+        false
+    }
+
+    pub fn enable() {}
+
+    pub fn map(_: &File, _: &Path) -> Option<Mapped> {
+        None
+    }
+}
+
+use mapping::Mapped;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::io::Write;
+
+    #[test]
+    fn small_files_and_files_before_enabling_are_read() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("small.gltf");
+        std::fs::write(&path, b"{}").unwrap();
+        let file = File::open(&path).unwrap();
+        enable_mapping();
+        assert!(FileBytes::map(&file, &path, 2).is_none());
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_large_file_is_mapped_with_its_bytes_and_frees_its_slot() {
+        enable_mapping();
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("large.gltf");
+        let mut text = String::from("{\"asset\":{\"version\":\"2.0\"},\"extras\":\"");
+        text.push_str(&"é".repeat(MAPPED_FROM as usize));
+        text.push_str("\"}");
+        std::fs::File::create(&path)
+            .unwrap()
+            .write_all(text.as_bytes())
+            .unwrap();
+        let file = File::open(&path).unwrap();
+        let size = file.metadata().unwrap().len();
+        let bytes = FileBytes::map(&file, &path, size).expect("mapped");
+        assert!(bytes.is_mapped());
+        assert_eq!(&bytes[..], text.as_bytes());
+        let source = SourceText::from_bytes(bytes).unwrap();
+        assert!(source.is_mapped());
+        assert_eq!(source.as_str(), text);
+        drop(source);
+        // Slots are given back: more mappings than there are slots, one after another.
+        for _ in 0..MAPPED_AT_ONCE + 4 {
+            assert!(FileBytes::map(&file, &path, size).is_some());
+        }
+    }
+
+    /// A mapped file that another program shortens while velvet reads it ends the process
+    /// with status 1 and a message naming the file, not a crash. The test runs itself again
+    /// as a child process that maps, shortens and reads the file.
+    #[cfg(unix)]
+    #[test]
+    fn a_mapped_file_shortened_while_read_is_reported_by_name() {
+        const CHILD: &str = "VELVET_SHORTENED_FILE";
+        if let Some(path) = std::env::var_os(CHILD) {
+            let path = std::path::PathBuf::from(path);
+            enable_mapping();
+            let file = File::open(&path).unwrap();
+            let size = file.metadata().unwrap().len();
+            let bytes = FileBytes::map(&file, &path, size).expect("mapped");
+            std::fs::OpenOptions::new()
+                .write(true)
+                .open(&path)
+                .unwrap()
+                .set_len(0)
+                .unwrap();
+            let sum: u64 = bytes.iter().map(|&b| u64::from(b)).sum();
+            panic!("read {sum} past the end without a fault");
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("shrinks.gltf");
+        std::fs::write(&path, vec![b' '; 2 * MAPPED_FROM as usize]).unwrap();
+        let out = std::process::Command::new(std::env::current_exe().unwrap())
+            .args([
+                "--exact",
+                "asset::source::tests::a_mapped_file_shortened_while_read_is_reported_by_name",
+                "--nocapture",
+                "--test-threads=1",
+            ])
+            .env(CHILD, &path)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{stderr}");
+        assert!(
+            stderr.contains(&format!(
+                "velvet: {}: the file became shorter while velvet read it (another program \
+                 changed it); velvet stopped\n",
+                path.display()
+            )),
+            "{stderr}"
+        );
+    }
+
+    #[test]
+    fn bytes_that_are_not_utf8_come_back_with_where_they_stop() {
+        let (bytes, e) = SourceText::from_bytes(FileBytes::from_vec(b"{\"a\":\"\xff\"}".to_vec()))
+            .err()
+            .unwrap();
+        assert_eq!(&bytes[..], b"{\"a\":\"\xff\"}");
+        assert_eq!(e.valid_up_to(), 6);
+    }
+}
