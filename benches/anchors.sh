@@ -1,19 +1,29 @@
 #!/bin/sh
 # Times velvet against the tools it is compared with, on generated libraries: the Khronos
 # glTF-Validator and glTF-Transform (npm, versions pinned in benches/anchors/package.json).
-# Run on a machine with nothing else running. The commands run in rounds: each round runs every
-# command once, a velvet command next to the one it is compared with, so that both meet the
-# same conditions; RUNS rounds (default 7). For each command the median wall time, the fastest
-# and slowest run and the largest peak memory are printed, then each comparison's ratio of
-# medians, then the share of the processor time the rounds asked for that the host held back
-# ("steal" in /proc/stat: on a virtual machine, the time its processors waited for the host's;
-# near 0 on a quiet host).
+# Run on a machine with nothing else running. Each command runs once to warm up (not counted),
+# then RUNS times in a row (default 7), as hyperfine does; with ORDER=rounds the commands run
+# in rounds instead, each round running every command once, each velvet command right before
+# the one it is compared with. For each command the median wall time, the fastest and slowest
+# run and the largest peak memory are printed, then each comparison's ratio of medians, then
+# the share of the processor time the runs asked for that the host held back ("steal" in
+# /proc/stat: on a virtual machine, the time its processors waited for the host's; near 0 on
+# a quiet host).
 #
 #   sh benches/anchors.sh [WORK_DIR]
+#   ORDER=rounds RUNS=9 sh benches/anchors.sh [WORK_DIR]
 set -eu
 root=$(cd "$(dirname "$0")/.." && pwd)
 work=${1:-/tmp/velvet-anchors}
 runs=${RUNS:-7}
+order=${ORDER:-repeat}
+case $order in
+repeat | rounds) ;;
+*)
+    echo "ORDER is repeat or rounds, not $order" >&2
+    exit 2
+    ;;
+esac
 velvet="$root/target/release/velvet"
 corpus="$root/target/release/examples/corpus"
 anchors="$root/benches/anchors"
@@ -59,9 +69,9 @@ run_command() {
     esac
 }
 
-# measure N: runs command N once and adds its wall time (microseconds, read with nanosecond
-# clocks around the command: time(1) prints hundredths, a sixth of a 60 ms run) and its peak
-# memory to the command's record.
+# measure N [RECORD]: runs command N once and adds its wall time (microseconds, read with
+# nanosecond clocks around the command: time(1) prints hundredths, a sixth of a 60 ms run) and
+# its peak memory to RECORD (default: the command's record).
 measure() {
     rm -rf "$work/out" && mkdir -p "$work/out"
     # velvet validate exits 1 when it finds errors (the generated files have some); any other
@@ -75,7 +85,7 @@ measure() {
         cat "$work/stderr" >&2
         exit 1
     fi
-    echo "$(( (end - start) / 1000 )) $(tail -n 1 "$work/time1")" >> "$work/times.$1"
+    echo "$(( (end - start) / 1000 )) $(tail -n 1 "$work/time1")" >> "${2:-$work/times.$1}"
 }
 
 # The processor time the host took (steal) and the time the processors wanted (busy: steal
@@ -91,15 +101,28 @@ while [ $i -le $count ]; do
 done
 set -- $(cpu_ticks)
 steal_before=$1 busy_before=$2
-round=0
-while [ $round -lt "$runs" ]; do
+if [ "$order" = rounds ]; then
+    round=0
+    while [ $round -lt "$runs" ]; do
+        i=1
+        while [ $i -le $count ]; do
+            measure $i
+            i=$((i + 1))
+        done
+        round=$((round + 1))
+    done
+else
     i=1
     while [ $i -le $count ]; do
-        measure $i
+        measure $i "$work/warm-up"
+        round=0
+        while [ $round -lt "$runs" ]; do
+            measure $i
+            round=$((round + 1))
+        done
         i=$((i + 1))
     done
-    round=$((round + 1))
-done
+fi
 set -- $(cpu_ticks)
 steal_ticks=$(($1 - steal_before)) busy_ticks=$(($2 - busy_before))
 
@@ -127,4 +150,5 @@ for pair in "2 3" "5 6" "7 8"; do
 done
 echo
 awk -v s="$steal_ticks" -v t="$busy_ticks" -v rounds="$runs" \
-    'BEGIN { printf "%d rounds; the host held back %.1f %% of the processor time they asked for (steal)\n", rounds, (t > 0 ? 100 * s / t : 0) }'
+    -v order="$order" \
+    'BEGIN { printf "%d runs a command (order: %s); the host held back %.1f %% of the processor time they asked for (steal)\n", rounds, order, (t > 0 ? 100 * s / t : 0) }'
