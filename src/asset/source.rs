@@ -304,7 +304,7 @@ mod tests {
     use std::io::Write;
 
     #[test]
-    fn small_files_and_files_before_enabling_are_read() {
+    fn small_files_are_read_not_mapped() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("small.gltf");
         std::fs::write(&path, b"{}").unwrap();
