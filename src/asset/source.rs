@@ -48,9 +48,9 @@ impl FileBytes {
         matches!(self.0, Held::Mapped(_))
     }
 
-    /// Maps `file`, which `path` names, when mapping is enabled, the file is a regular file of
-    /// at least [`MAPPED_FROM`] bytes, and a slot is free to name it should it shrink; `None`
-    /// otherwise (the caller reads it).
+    /// Maps `file`, a regular file that `path` names and whose length is `size`, when mapping
+    /// is enabled, `size` is at least [`MAPPED_FROM`] and a slot is free to name the file
+    /// should it shrink; `None` otherwise (the caller reads it).
     pub fn map(file: &File, path: &Path, size: u64) -> Option<FileBytes> {
         if size < MAPPED_FROM || !mapping::enabled() {
             return None;
