@@ -167,16 +167,29 @@ mod mapping {
         ENABLED.load(Ordering::Acquire)
     }
 
+    /// The SIGBUS handler there was before velvet's (the Rust runtime's, which reports a
+    /// stack overflow where a system signals one with SIGBUS), and its flags: a fault outside
+    /// the mapped files is passed on to it.
+    static PREVIOUS_HANDLER: AtomicUsize = AtomicUsize::new(libc::SIG_DFL);
+    static PREVIOUS_FLAGS: AtomicUsize = AtomicUsize::new(0);
+
     pub fn enable() {
         INSTALL.call_once(|| {
             // SAFETY: sigaction with a zeroed struct, an empty mask and a handler of the
-            // SA_SIGINFO shape; the handler only reads atomics, writes to stderr and exits.
+            // SA_SIGINFO shape; the handler reads atomics, writes to stderr and exits, or
+            // passes the fault on. The previous action is written to a zeroed struct.
             let installed = unsafe {
                 let mut action: libc::sigaction = std::mem::zeroed();
+                let mut previous: libc::sigaction = std::mem::zeroed();
                 action.sa_sigaction = on_sigbus as *const () as libc::sighandler_t;
                 action.sa_flags = libc::SA_SIGINFO;
                 libc::sigemptyset(&mut action.sa_mask);
-                libc::sigaction(libc::SIGBUS, &action, std::ptr::null_mut()) == 0
+                let installed = libc::sigaction(libc::SIGBUS, &action, &mut previous) == 0;
+                if installed {
+                    PREVIOUS_HANDLER.store(previous.sa_sigaction, Ordering::Release);
+                    PREVIOUS_FLAGS.store(previous.sa_flags as usize, Ordering::Release);
+                }
+                installed
             };
             ENABLED.store(installed, Ordering::Release);
         });
@@ -241,7 +254,11 @@ mod mapping {
         }
     }
 
-    extern "C" fn on_sigbus(_: libc::c_int, info: *mut libc::siginfo_t, _: *mut libc::c_void) {
+    extern "C" fn on_sigbus(
+        signal: libc::c_int,
+        info: *mut libc::siginfo_t,
+        context: *mut libc::c_void,
+    ) {
         // SAFETY: the kernel passes a valid siginfo_t to an SA_SIGINFO handler.
         let address = unsafe { (*info).si_addr() } as usize;
         for s in &SLOTS {
@@ -263,8 +280,28 @@ mod mapping {
             // async-signal-safe.
             unsafe { libc::_exit(1) };
         }
-        // Not a mapped file: the fault is velvet's own, and takes its default course (the
-        // instruction runs again and the process ends on the signal).
+        // Not a mapped file: the fault goes to the handler there was before, or, where there
+        // was none, takes its default course (the instruction runs again and the process ends
+        // on the signal).
+        let previous = PREVIOUS_HANDLER.load(Ordering::Acquire);
+        if previous != libc::SIG_DFL && previous != libc::SIG_IGN {
+            // SAFETY: `previous` is the handler sigaction reported, of the shape its flags
+            // say; it is called as the kernel would have called it.
+            unsafe {
+                if PREVIOUS_FLAGS.load(Ordering::Acquire) & libc::SA_SIGINFO as usize != 0 {
+                    let handler: extern "C" fn(
+                        libc::c_int,
+                        *mut libc::siginfo_t,
+                        *mut libc::c_void,
+                    ) = std::mem::transmute(previous);
+                    handler(signal, info, context);
+                } else {
+                    let handler: extern "C" fn(libc::c_int) = std::mem::transmute(previous);
+                    handler(signal);
+                }
+            }
+            return;
+        }
         // SAFETY: signal(2) with SIG_DFL is async-signal-safe.
         unsafe {
             libc::signal(libc::SIGBUS, libc::SIG_DFL);
@@ -386,6 +423,57 @@ mod tests {
             )),
             "{stderr}"
         );
+    }
+
+    /// A SIGBUS outside the mapped files goes to the handler there was before velvet's. The
+    /// test runs itself again as a child process that installs a handler, enables mapping and
+    /// raises the signal.
+    #[cfg(unix)]
+    #[test]
+    fn a_fault_outside_the_mapped_files_goes_to_the_handler_there_was_before() {
+        const CHILD: &str = "VELVET_PREVIOUS_HANDLER";
+        extern "C" fn previous(_: libc::c_int) {
+            let text = b"the previous handler ran\n";
+            // SAFETY: write(2) and _exit(2) are async-signal-safe.
+            unsafe {
+                libc::write(2, text.as_ptr().cast(), text.len());
+                libc::_exit(3);
+            }
+        }
+        if std::env::var_os(CHILD).is_some() {
+            let installed = |handler: &mut libc::sigaction| {
+                // SAFETY: reads the current action into a zeroed struct.
+                unsafe { libc::sigaction(libc::SIGBUS, std::ptr::null(), handler) };
+                handler.sa_sigaction
+            };
+            // SAFETY: a zeroed sigaction is a valid struct to read an action into; the handler
+            // installed writes and exits.
+            let mut action: libc::sigaction = unsafe { std::mem::zeroed() };
+            unsafe { libc::signal(libc::SIGBUS, previous as *const () as libc::sighandler_t) };
+            let before = installed(&mut action);
+            enable_mapping();
+            assert_ne!(
+                installed(&mut action),
+                before,
+                "velvet's handler is installed"
+            );
+            // SAFETY: raises the signal, which the handlers end the process on.
+            unsafe { libc::raise(libc::SIGBUS) };
+            panic!("the signal came back");
+        }
+        let out = std::process::Command::new(std::env::current_exe().unwrap())
+            .args([
+                "--exact",
+                "asset::source::tests::a_fault_outside_the_mapped_files_goes_to_the_handler_there_was_before",
+                "--nocapture",
+                "--test-threads=1",
+            ])
+            .env(CHILD, "1")
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(3), "{stderr}");
+        assert!(stderr.contains("the previous handler ran\n"), "{stderr}");
     }
 
     #[test]
