@@ -1,12 +1,12 @@
 //! A file's bytes as velvet holds them, and the JSON text made of them: read into memory, or,
 //! for a large regular file, mapped from the system's file cache.
 //!
-//! Why map: on a virtual machine whose host takes back the memory its guest frees (balloon
-//! free-page reporting, as on the machines velvet is measured on), the first touch of fresh
-//! memory a few seconds after other programs freed it costs the host a fault per page: reading
-//! a 10.7 MB document into a new buffer took 43–55 ms there, where mapping the file, whose
-//! pages the file cache holds already, took 3 ms (and 3–4 ms against 1.5 when the memory was
-//! warm). The bytes are the same either way.
+//! Why map: on the virtual machines velvet is measured on, the first touch of fresh memory a
+//! few seconds after other programs freed it is slow, as where the host takes back the memory
+//! its guest frees (a balloon driver's free-page reporting) and faults it in again page by
+//! page: reading a 10.7 MB document into a new buffer took 43–55 ms there, where mapping the
+//! file, whose pages the file cache holds already, took 3 ms (and 3–4 ms against 1.5 when the
+//! memory was warm). The bytes are the same either way.
 //!
 //! A mapping reads the file as it is on disk while velvet runs. Another program that shortens
 //! the file meanwhile makes a read past its new end fault (SIGBUS); [`enable_mapping`]
