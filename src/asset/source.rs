@@ -338,7 +338,26 @@ use mapping::Mapped;
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::io::Write;
+
+    /// Runs the test named `test` again in a child process with `var` set to `value`: how a
+    /// test checks what ends the process. The child's exit status and standard error.
+    #[cfg(unix)]
+    fn run_as_child(test: &str, var: &str, value: &std::ffi::OsStr) -> (Option<i32>, String) {
+        let out = std::process::Command::new(std::env::current_exe().unwrap())
+            .args([
+                "--exact",
+                &format!("asset::source::tests::{test}"),
+                "--nocapture",
+                "--test-threads=1",
+            ])
+            .env(var, value)
+            .output()
+            .unwrap();
+        (
+            out.status.code(),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        )
+    }
 
     #[test]
     fn small_files_are_read_not_mapped() {
@@ -359,10 +378,7 @@ mod tests {
         let mut text = String::from("{\"asset\":{\"version\":\"2.0\"},\"extras\":\"");
         text.push_str(&"é".repeat(MAPPED_FROM as usize));
         text.push_str("\"}");
-        std::fs::File::create(&path)
-            .unwrap()
-            .write_all(text.as_bytes())
-            .unwrap();
+        std::fs::write(&path, &text).unwrap();
         let file = File::open(&path).unwrap();
         let size = file.metadata().unwrap().len();
         let bytes = FileBytes::map(&file, &path, size).expect("mapped");
@@ -403,18 +419,12 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("shrinks.gltf");
         std::fs::write(&path, vec![b' '; 2 * MAPPED_FROM as usize]).unwrap();
-        let out = std::process::Command::new(std::env::current_exe().unwrap())
-            .args([
-                "--exact",
-                "asset::source::tests::a_mapped_file_shortened_while_read_is_reported_by_name",
-                "--nocapture",
-                "--test-threads=1",
-            ])
-            .env(CHILD, &path)
-            .output()
-            .unwrap();
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(1), "{stderr}");
+        let (status, stderr) = run_as_child(
+            "a_mapped_file_shortened_while_read_is_reported_by_name",
+            CHILD,
+            path.as_os_str(),
+        );
+        assert_eq!(status, Some(1), "{stderr}");
         assert!(
             stderr.contains(&format!(
                 "velvet: {}: the file became shorter while velvet read it (another program \
@@ -461,18 +471,12 @@ mod tests {
             unsafe { libc::raise(libc::SIGBUS) };
             panic!("the signal came back");
         }
-        let out = std::process::Command::new(std::env::current_exe().unwrap())
-            .args([
-                "--exact",
-                "asset::source::tests::a_fault_outside_the_mapped_files_goes_to_the_handler_there_was_before",
-                "--nocapture",
-                "--test-threads=1",
-            ])
-            .env(CHILD, "1")
-            .output()
-            .unwrap();
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(3), "{stderr}");
+        let (status, stderr) = run_as_child(
+            "a_fault_outside_the_mapped_files_goes_to_the_handler_there_was_before",
+            CHILD,
+            "1".as_ref(),
+        );
+        assert_eq!(status, Some(3), "{stderr}");
         assert!(stderr.contains("the previous handler ran\n"), "{stderr}");
     }
 

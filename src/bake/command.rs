@@ -7,6 +7,7 @@
 //! unless `--in-place` is asked, and a file with nothing to bake is copied byte for byte (or,
 //! in place, not written at all). A file the loader reports errors for is not baked.
 
+use std::borrow::Cow;
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
@@ -165,7 +166,9 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
     let options = request.options;
     let bytes = asset::read(input, &options.load)
         .map_err(|d| format!("cannot be baked: {} ({})", d.message, d.code))?;
-    let loaded = asset::load_bytes_with(input, &bytes, &options.load);
+    // A .gltf's bytes become the asset's text as they are (a mapped file's stay mapped); a
+    // GLB's come back, for copying one with nothing to bake.
+    let (loaded, bytes) = asset::load_read(input, bytes, &options.load);
     let errors: Vec<String> = loaded
         .diagnostics
         .iter()
@@ -209,11 +212,14 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
         copy_resources(&relocation, asset.json())?;
         create_parent(output)?;
         let out_bytes = if relocation.edits.is_empty() {
-            std::borrow::Cow::Borrowed(&bytes[..])
+            Cow::Borrowed(match &bytes {
+                Some(bytes) => &bytes[..],
+                None => asset.file_bytes().unwrap_or_default(),
+            })
         } else {
             let mut json = asset.take_json();
             crate::edit::apply(&mut json, &relocation.edits).map_err(|e| e.to_string())?;
-            std::borrow::Cow::Owned(write::to_bytes(&asset, &json, asset.bin.as_deref()))
+            Cow::Owned(write::to_bytes(&asset, &json, asset.bin.as_deref()))
         };
         write::write_atomic(output, &out_bytes)
             .map_err(|e| format!("cannot write {}: {e}", output.display()))?;
