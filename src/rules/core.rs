@@ -262,7 +262,7 @@ pub struct CoreStructure;
 impl Rule for CoreStructure {
     /// Among the dearest rules on a large document: the whole document against the official schemas.
     fn cost(&self) -> u32 {
-        7
+        5
     }
 
     fn codes(&self) -> &'static [&'static Code] {

@@ -146,8 +146,11 @@ pub trait Rule: Sync {
     /// Checks the asset, pushing what it finds.
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>);
     /// How long the rule takes on a large document, relative to the others (1: a walk of the
-    /// layers, or less). Rules run side by side start with the dearest, so that the cores
-    /// finish together.
+    /// layers, or less), as timed one rule at a time on the 20,000-material benchmark document.
+    /// Rules run side by side start with the dearest, so that the cores finish together, and
+    /// so that the rules that read the layers do not wait while the first of them reads them
+    /// (see [`Context::layers`]): the layer schema check reads them first, and the core
+    /// schema check, which does not read them, starts beside it.
     fn cost(&self) -> u32 {
         1
     }

@@ -96,7 +96,7 @@ pub struct References;
 impl Rule for References {
     /// Among the dearest rules on a large document: it walks every value of the document.
     fn cost(&self) -> u32 {
-        10
+        4
     }
 
     fn codes(&self) -> &'static [&'static Code] {

@@ -18,7 +18,7 @@ pub struct TexCoords;
 impl Rule for TexCoords {
     /// Among the dearest rules on a large document: every primitive of every mesh.
     fn cost(&self) -> u32 {
-        10
+        2
     }
 
     fn codes(&self) -> &'static [&'static Code] {
