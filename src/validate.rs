@@ -10,6 +10,7 @@ use crate::rules::{self, schema::Schemas, Context};
 use rayon::prelude::*;
 use std::borrow::Cow;
 use std::path::{Path, PathBuf};
+use std::sync::{Arc, OnceLock};
 
 /// Documents from this size (bytes of JSON text) up run their rules in parallel; below it the
 /// files of a run are the parallel unit and splitting a small file only adds overhead.
@@ -102,18 +103,20 @@ pub struct Validator {
     pub positions: bool,
 }
 
-/// The schemas of a run: at hand, or compiling on a thread of their own while the first file
-/// is read (compiling the core schemas takes about as long as reading a large file).
+/// The schemas of a run: at hand, or compiling on a worker of the thread pool while the first
+/// file is read (compiling the core schemas takes about as long as reading a large file).
 enum Compiled {
     Ready(Schemas),
-    Compiling(std::sync::LazyLock<Schemas, Box<dyn FnOnce() -> Schemas + Send>>),
+    /// Filled by the worker, or by whoever needs the schemas before that worker has started on
+    /// them (a pool of one thread, busy with the file): no one waits on work that cannot run.
+    Compiling(Arc<OnceLock<Schemas>>),
 }
 
 impl Compiled {
     fn get(&self) -> &Schemas {
         match self {
             Compiled::Ready(schemas) => schemas,
-            Compiled::Compiling(schemas) => schemas,
+            Compiled::Compiling(schemas) => schemas.get_or_init(Schemas::builtin),
         }
     }
 }
@@ -124,20 +127,21 @@ impl Validator {
     }
 
     /// A validator with the built-in schemas, which compile in the background until the first
-    /// file's rules need them.
+    /// file's rules need them. They compile on a worker of the pool rather than on a thread of
+    /// their own: while one worker reads the first file the other is idle, and a third thread
+    /// would share the two cores with it.
     pub fn builtin(settings: Settings) -> Validator {
-        let thread = std::thread::spawn(Schemas::builtin);
-        // The built-in schemas are tested to compile; a panic there is a bug, raised again
-        // where the schemas are first needed rather than hidden.
-        let joined: Box<dyn FnOnce() -> Schemas + Send> = Box::new(move || {
-            thread
-                .join()
-                .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+        let schemas = Arc::new(OnceLock::new());
+        let job = Arc::clone(&schemas);
+        rayon::spawn(move || {
+            // The built-in schemas are tested to compile; should they panic here, the OnceLock
+            // stays empty and the panic is raised again where the schemas are first needed,
+            // rather than ending the process from the pool.
+            let _ = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                job.get_or_init(Schemas::builtin);
+            }));
         });
-        Validator::with_compiled(
-            Compiled::Compiling(std::sync::LazyLock::new(joined)),
-            settings,
-        )
+        Validator::with_compiled(Compiled::Compiling(schemas), settings)
     }
 
     fn with_compiled(schemas: Compiled, settings: Settings) -> Validator {
@@ -401,6 +405,41 @@ mod tests {
             r#"{{"asset":{{"version":"2.0"}},"extensionsUsed":["KHR_materials_sheen","KHR_materials_fuzz"],"materials":[{}]}}"#,
             list.join(",")
         )
+    }
+
+    #[test]
+    fn a_pool_of_one_thread_compiles_the_schemas_itself_rather_than_wait_for_them() {
+        // The one worker validates the file; the compile job queued behind it cannot run
+        // until it is done, so the validation compiles the schemas where it needs them.
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        let text = many_faults(5);
+        let codes: Vec<&str> = pool.install(|| {
+            let validator = Validator::builtin(Settings::default());
+            let loaded = asset::load_bytes_with(
+                Path::new("faults.gltf"),
+                text.as_bytes(),
+                &asset::LoadOptions::default(),
+            );
+            let report = validator.validate_loaded(Path::new("faults.gltf"), loaded);
+            report.findings.iter().map(|f| f.diagnostic.code).collect()
+        });
+        let reference = Validator::new(Schemas::builtin(), Settings::default());
+        let loaded = asset::load_bytes_with(
+            Path::new("faults.gltf"),
+            text.as_bytes(),
+            &asset::LoadOptions::default(),
+        );
+        let expected: Vec<&str> = reference
+            .validate_loaded(Path::new("faults.gltf"), loaded)
+            .findings
+            .iter()
+            .map(|f| f.diagnostic.code)
+            .collect();
+        assert!(codes.contains(&"TYPE_MISMATCH"), "{codes:?}");
+        assert_eq!(codes, expected);
     }
 
     #[test]
