@@ -95,7 +95,11 @@ impl FileReport {
 /// A validator for one run: schemas compiled once, settings applied to every file, every file
 /// loaded under the same limits.
 pub struct Validator {
-    schemas: Compiled,
+    /// The schemas of a run: given, or compiling on a worker of the thread pool while the
+    /// first file is read (compiling the core schemas takes about as long as reading a large
+    /// file). Filled by that worker, or by whoever needs them before the worker has started on
+    /// them (a pool of one thread, busy with the file): no one waits on work that cannot run.
+    schemas: Arc<OnceLock<Schemas>>,
     pub settings: Settings,
     pub load: asset::LoadOptions,
     /// Whether findings are placed in the source text (line and column); a report format that
@@ -103,27 +107,9 @@ pub struct Validator {
     pub positions: bool,
 }
 
-/// The schemas of a run: at hand, or compiling on a worker of the thread pool while the first
-/// file is read (compiling the core schemas takes about as long as reading a large file).
-enum Compiled {
-    Ready(Schemas),
-    /// Filled by the worker, or by whoever needs the schemas before that worker has started on
-    /// them (a pool of one thread, busy with the file): no one waits on work that cannot run.
-    Compiling(Arc<OnceLock<Schemas>>),
-}
-
-impl Compiled {
-    fn get(&self) -> &Schemas {
-        match self {
-            Compiled::Ready(schemas) => schemas,
-            Compiled::Compiling(schemas) => schemas.get_or_init(Schemas::builtin),
-        }
-    }
-}
-
 impl Validator {
     pub fn new(schemas: Schemas, settings: Settings) -> Validator {
-        Validator::with_compiled(Compiled::Ready(schemas), settings)
+        Validator::with_compiled(Arc::new(OnceLock::from(schemas)), settings)
     }
 
     /// A validator with the built-in schemas, which compile in the background until the first
@@ -141,10 +127,10 @@ impl Validator {
                 job.get_or_init(Schemas::builtin);
             }));
         });
-        Validator::with_compiled(Compiled::Compiling(schemas), settings)
+        Validator::with_compiled(schemas, settings)
     }
 
-    fn with_compiled(schemas: Compiled, settings: Settings) -> Validator {
+    fn with_compiled(schemas: Arc<OnceLock<Schemas>>, settings: Settings) -> Validator {
         Validator {
             schemas,
             settings,
@@ -228,7 +214,7 @@ impl Validator {
                 None,
             );
         };
-        let cx = Context::new(&asset, self.schemas.get());
+        let cx = Context::new(&asset, self.schemas.get_or_init(Schemas::builtin));
         let parallel = asset.json_text.len() >= PARALLEL_RULES_FROM;
         let (found, info) = if parallel {
             rayon::join(|| run_rules(&cx, true), || asset_info(asset.root()))
