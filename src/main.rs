@@ -287,13 +287,21 @@ fn emit(text: &[u8]) {
     let _ = std::io::stdout().lock().write_all(text);
 }
 
+/// Runs `job` on a worker of the thread pool, the calling thread asleep until it is done. A run
+/// on the calling thread would be a third thread beside the pool's two on a two-core machine,
+/// and the workers that wait for work between its parallel steps yield in a loop for a while
+/// before they sleep, taking turns on the cores with it.
+fn in_pool<T: Send>(job: impl FnOnce() -> T + Send) -> T {
+    rayon::scope(|_| job())
+}
+
 fn main() -> ExitCode {
     velvet::asset::pages::limit_heaps();
     velvet::asset::source::enable_mapping();
     let cli = Cli::parse();
     match cli.command {
-        Command::Validate(args) => validate(args, cli.color, cli.quiet),
-        Command::Migrate(args) => migrate(args, cli.quiet),
+        Command::Validate(args) => in_pool(|| validate(args, cli.color, cli.quiet)),
+        Command::Migrate(args) => in_pool(|| migrate(args, cli.quiet)),
         Command::Config { path, settings } => show_config(path, settings),
         Command::Bake(args) => bake(args, cli.quiet),
         Command::Preview(args) => preview(args, cli.quiet),
