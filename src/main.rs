@@ -287,10 +287,10 @@ fn emit(text: &[u8]) {
     let _ = std::io::stdout().lock().write_all(text);
 }
 
-/// Runs `job` on a worker of the thread pool, the calling thread asleep until it is done. A run
-/// on the calling thread would be a third thread beside the pool's two on a two-core machine,
-/// and the workers that wait for work between its parallel steps yield in a loop for a while
-/// before they sleep, taking turns on the cores with it.
+/// Runs `job` on a worker of the thread pool, the calling thread asleep until it is done. On the
+/// calling thread it would be one thread more than the pool's, which has one a core, and the
+/// workers that wait for work between its parallel steps yield in a loop for a while before
+/// they sleep, taking turns on the cores with it.
 fn in_pool<T: Send>(job: impl FnOnce() -> T + Send) -> T {
     rayon::scope(|_| job())
 }
