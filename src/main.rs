@@ -288,7 +288,7 @@ fn emit(text: &[u8]) {
 }
 
 /// Runs `job` on a worker of the thread pool, the calling thread asleep until it is done. On the
-/// calling thread it would be a thread beside the pool.s workers (one per core), and the
+/// calling thread it would be a thread beside the pool's workers (one per core), and the
 /// workers that wait for work between its parallel steps yield in a loop for a while before
 /// they sleep, taking turns on the cores with it.
 fn in_pool<T: Send>(job: impl FnOnce() -> T + Send) -> T {

@@ -115,7 +115,7 @@ impl Validator {
     /// A validator with the built-in schemas, which compile in the background until the first
     /// file's rules need them. They compile on a worker of the pool rather than on a thread of
     /// their own: while one worker reads the first file another is idle, and a thread beside
-    /// the pool.s workers (one per core) would share the cores with them.
+    /// the pool's workers (one per core) would share the cores with them.
     pub fn builtin(settings: Settings) -> Validator {
         let schemas = Arc::new(OnceLock::new());
         let job = Arc::clone(&schemas);
