@@ -214,7 +214,7 @@ fn has_sheen_below_floor(case: &Path) -> bool {
         sheen.is_object()
             && sheen["sheenRoughnessFactor"]
                 .as_f64()
-                .map_or(true, |r| r < roughness::ROUGHNESS_FLOOR)
+                .is_none_or(|r| r < roughness::ROUGHNESS_FLOOR)
     })
 }
 

@@ -105,7 +105,7 @@ pub fn split<'a>(bytes: &'a [u8], out: &mut Vec<Diagnostic>) -> Option<GlbParts<
         let length = u32_at(bytes, at) as usize;
         let kind = u32_at(bytes, at + 4);
         let data = at + CHUNK_HEADER_LEN;
-        if length % 4 != 0 {
+        if !length.is_multiple_of(4) {
             out.push(Diagnostic::new(
                 &codes::GLB_CHUNK_LENGTH_UNALIGNED,
                 "",

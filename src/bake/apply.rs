@@ -426,7 +426,7 @@ fn bin_usable(json: &Value, container: Container) -> bool {
     container == Container::Glb
         && json
             .pointer("/buffers/0")
-            .map_or(true, |b| b.get("uri").is_none())
+            .is_none_or(|b| b.get("uri").is_none())
 }
 
 /// Adds one encoded image to a document and returns its index in `images` and where its bytes
@@ -449,7 +449,7 @@ pub fn add_image(
     let glb = container == Container::Glb;
     let (entry, stored) = if bin_usable(json, container) {
         let data = bin.get_or_insert_with(Vec::new);
-        while data.len() % 4 != 0 {
+        while !data.len().is_multiple_of(4) {
             data.push(0);
         }
         let offset = data.len();

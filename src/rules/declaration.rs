@@ -76,9 +76,8 @@ fn undeclared(json: Node, declared: &BTreeSet<String>, out: &mut Vec<Diagnostic>
     // Every name in every `extensions` object (extras included, so a superset of what the walk
     // visits): when all are declared there is nothing to report, and no walk to do.
     let all_declared = json.members_named("extensions").all(|exts| {
-        exts.as_object().map_or(true, |o| {
-            o.keys().all(|name| declared.contains(name.as_ref()))
-        })
+        exts.as_object()
+            .is_none_or(|o| o.keys().all(|name| declared.contains(name.as_ref())))
     });
     if all_declared {
         return;
