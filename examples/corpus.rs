@@ -4,11 +4,13 @@
 //!
 //!     cargo run --release --example corpus -- OUT_DIR [MATERIALS] [FILES]
 //!     cargo run --release --example corpus -- --library OUT_DIR [LOWEST_ALPHA]
+//!     cargo run --release --example corpus -- --minified-library OUT_DIR [LOWEST_ALPHA]
 //!
 //! `--library` writes OUT_DIR/library.gltf (about 10 MB: 20,000 ratified sheen materials, every
 //! factor different, the odd ones with a sheen roughness texture drawn from 4 shared 256² PNGs,
 //! OUT_DIR/fabric0.png … fabric3.png, whose alpha holds every code from LOWEST_ALPHA, default
-//! 0, to 255) and its mesh buffer.
+//! 0, to 255) and its mesh buffer. `--minified-library` writes the same library with its JSON on
+//! one line (about 5 MB), the layout in which a finding's column is counted along the whole text.
 //!
 //! writes OUT_DIR/large.gltf (MATERIALS materials, default 20000) and OUT_DIR/small/ (FILES
 //! files, default 500). The materials cycle through the shapes real assets have: ratified sheen
@@ -155,13 +157,26 @@ pub fn fabric_png(k: usize, lowest: u8) -> Vec<u8> {
     bytes
 }
 
-/// Writes the library (`materials` materials) into `dir`.
+/// Writes the library (`materials` materials) into `dir`, pretty-printed.
 pub fn write_library(dir: &Path, materials: usize, lowest_alpha: u8) -> std::io::Result<()> {
+    write_library_laid_out(dir, materials, lowest_alpha, false)
+}
+
+/// Writes the library (`materials` materials) into `dir`, pretty-printed or on one line.
+pub fn write_library_laid_out(
+    dir: &Path,
+    materials: usize,
+    lowest_alpha: u8,
+    minified: bool,
+) -> std::io::Result<()> {
     std::fs::create_dir_all(dir)?;
-    std::fs::write(
-        dir.join("library.gltf"),
-        serde_json::to_vec_pretty(&library_document(materials))?,
-    )?;
+    let document = library_document(materials);
+    let text = if minified {
+        serde_json::to_vec(&document)?
+    } else {
+        serde_json::to_vec_pretty(&document)?
+    };
+    std::fs::write(dir.join("library.gltf"), text)?;
     std::fs::write(dir.join("mesh.bin"), [0u8; 60])?;
     for k in 0..LIBRARY_TEXTURES {
         std::fs::write(
@@ -174,13 +189,14 @@ pub fn write_library(dir: &Path, materials: usize, lowest_alpha: u8) -> std::io:
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    if args.first().map(String::as_str) == Some("--library") {
+    if let Some(mode @ ("--library" | "--minified-library")) = args.first().map(String::as_str) {
         let Some(dir) = args.get(1) else {
-            eprintln!("usage: corpus --library OUT_DIR");
+            eprintln!("usage: corpus {mode} OUT_DIR [LOWEST_ALPHA]");
             std::process::exit(2);
         };
         let lowest = args.get(2).and_then(|a| a.parse().ok()).unwrap_or(0);
-        if let Err(e) = write_library(Path::new(dir), 20_000, lowest) {
+        let minified = mode == "--minified-library";
+        if let Err(e) = write_library_laid_out(Path::new(dir), 20_000, lowest, minified) {
             eprintln!("corpus: cannot write {dir}: {e}");
             std::process::exit(1);
         }

@@ -9,24 +9,6 @@ use super::tape::Node;
 
 pub use crate::diagnostics::Position;
 
-/// The position of byte `offset` in `text` (1-based line, character column).
-pub fn at_offset(text: &str, offset: usize) -> Position {
-    let offset = offset.min(text.len());
-    let before = &text.as_bytes()[..offset];
-    let line_start = before
-        .iter()
-        .rposition(|b| *b == b'\n')
-        .map_or(0, |p| p + 1);
-    Position {
-        line: before.iter().filter(|b| **b == b'\n').count() + 1,
-        column: String::from_utf8_lossy(&before[line_start..])
-            .chars()
-            .count()
-            + 1,
-        offset,
-    }
-}
-
 /// The byte offset of 1-based `line` and character `column` in `text`.
 pub fn offset_of(text: &str, line: usize, column: usize) -> usize {
     let line_start = if line <= 1 {
@@ -43,39 +25,73 @@ pub fn offset_of(text: &str, line: usize, column: usize) -> usize {
 }
 
 /// Locates the values named by `pointers` in `text`, whose index `root` is: one entry per
-/// pointer, in the order given, `None` where a pointer names nothing. Each value's place comes
-/// from its span in the index; lines are found by a binary search over the line starts.
+/// pointer, in the order given, `None` where a pointer names nothing. Each value's offset
+/// comes from its span in the index; the offsets are then sorted and the text read once, front
+/// to back, counting lines and characters up to each in turn. Counting each column from the
+/// start of its line instead costs the line's length per finding, which on a one-line
+/// (minified) document is the whole text per finding.
 pub fn locate<'p>(
     text: &str,
     root: Node<'_>,
     pointers: impl IntoIterator<Item = &'p str>,
 ) -> Vec<Option<Position>> {
-    let mut line_starts: Option<Vec<usize>> = None;
-    pointers
+    let offsets: Vec<Option<usize>> = pointers
         .into_iter()
-        .map(|p| {
-            let offset = root.pointer(p)?.span().start;
-            let starts = line_starts.get_or_insert_with(|| self::line_starts(text));
-            let line = starts.partition_point(|&s| s <= offset);
-            let start = starts[line - 1];
-            Some(Position {
-                line,
-                column: text[start..offset].chars().count() + 1,
-                offset,
-            })
-        })
-        .collect()
+        .map(|p| Some(root.pointer(p)?.span().start))
+        .collect();
+    let mut order: Vec<(usize, usize)> = offsets
+        .iter()
+        .enumerate()
+        .filter_map(|(i, offset)| Some(((*offset)?, i)))
+        .collect();
+    order.sort_unstable();
+    let mut positions = vec![None; offsets.len()];
+    let mut cursor = Cursor::new(text);
+    for (offset, i) in order {
+        positions[i] = Some(cursor.advance_to(offset));
+    }
+    positions
 }
 
-fn line_starts(text: &str) -> Vec<usize> {
-    std::iter::once(0)
-        .chain(
-            text.bytes()
-                .enumerate()
-                .filter(|(_, b)| *b == b'\n')
-                .map(|(i, _)| i + 1),
-        )
-        .collect()
+/// A place in a text that only moves forward, knowing its line and column.
+struct Cursor<'a> {
+    bytes: &'a [u8],
+    at: Position,
+}
+
+impl<'a> Cursor<'a> {
+    fn new(text: &'a str) -> Cursor<'a> {
+        Cursor {
+            bytes: text.as_bytes(),
+            at: Position {
+                line: 1,
+                column: 1,
+                offset: 0,
+            },
+        }
+    }
+
+    /// The position of byte `offset` (at or after the cursor's, on a character boundary),
+    /// where the cursor then stands.
+    fn advance_to(&mut self, offset: usize) -> Position {
+        debug_assert!(offset >= self.at.offset, "the cursor only moves forward");
+        for &b in &self.bytes[self.at.offset..offset] {
+            if b == b'\n' {
+                self.at.line += 1;
+                self.at.column = 1;
+            } else if !is_continuation(b) {
+                // A character is counted at its first byte.
+                self.at.column += 1;
+            }
+        }
+        self.at.offset = offset;
+        self.at
+    }
+}
+
+/// True for the second to fourth byte of a UTF-8 character (0b10xx_xxxx).
+fn is_continuation(b: u8) -> bool {
+    b & 0xC0 == 0x80
 }
 
 #[cfg(test)]
@@ -164,6 +180,59 @@ mod tests {
         assert_eq!(at(text, "/v"), Some((2, 21)));
         let p = "/v";
         assert_eq!(&text[find(text, p).unwrap().offset..][..3], "1.5");
+    }
+
+    /// The position of byte `offset`, counted from the text's start on its own.
+    fn counted_alone(text: &str, offset: usize) -> (usize, usize) {
+        let before = &text[..offset];
+        let line_start = before.rfind('\n').map_or(0, |p| p + 1);
+        (
+            before.matches('\n').count() + 1,
+            before[line_start..].chars().count() + 1,
+        )
+    }
+
+    #[test]
+    fn positions_found_in_one_pass_equal_each_counted_alone_in_any_pointer_order() {
+        // Minified and pretty-printed layouts, multibyte characters before values on the same
+        // line, pointers given out of text order, repeated, and naming nothing.
+        let values: Vec<String> = (0..40)
+            .map(|i| format!(r#"{{"näme":"ü{i}","v":[{i},"日本",{{"x":{i}}}]}}"#))
+            .collect();
+        let minified = format!(r#"{{"m":[{}],"ß":true}}"#, values.join(","));
+        let value: serde_json::Value = serde_json::from_str(&minified).unwrap();
+        let pretty = serde_json::to_string_pretty(&value).unwrap();
+        let pointers: Vec<String> = (0..40)
+            .rev()
+            .flat_map(|i| {
+                [
+                    format!("/m/{i}/v/2/x"),
+                    format!("/m/{i}/näme"),
+                    format!("/m/{}/v/1", (i * 7) % 40),
+                    "/ß".to_string(),
+                    format!("/m/{i}/absent"),
+                ]
+            })
+            .collect();
+        for text in [minified.as_str(), pretty.as_str()] {
+            let tape = crate::asset::tape::Tape::build(text).unwrap();
+            let found = locate(text, tape.root(text), pointers.iter().map(String::as_str));
+            assert_eq!(found.len(), pointers.len());
+            for (pointer, position) in pointers.iter().zip(found) {
+                if pointer.ends_with("/absent") {
+                    assert_eq!(position, None, "{pointer}");
+                    continue;
+                }
+                let position = position.unwrap_or_else(|| panic!("{pointer} is found"));
+                let offset = tape.root(text).pointer(pointer).unwrap().span().start;
+                assert_eq!(position.offset, offset, "{pointer}");
+                assert_eq!(
+                    (position.line, position.column),
+                    counted_alone(text, offset),
+                    "{pointer}"
+                );
+            }
+        }
     }
 
     #[test]
