@@ -1276,14 +1276,17 @@ fn bench_is_not_in_the_users_help_but_still_runs() {
 // ---------------------------------------------------------------- folded, ordered text output
 
 #[test]
-fn text_output_folds_a_repeated_code_and_lists_findings_in_file_order() {
+fn text_output_folds_a_repeated_finding_and_lists_findings_in_file_order() {
     let dir = tempfile::tempdir().unwrap();
-    // Eight unknown properties in one sheen object, a legacy draft property, and an
+    // The same unexpected property in eight sheen objects, one other unexpected property (the
+    // same code, another message: not folded with them), a legacy draft property, and an
     // out-of-range roughness before them in the file.
-    let odd: Vec<String> = (0..8).map(|i| format!("\"odd{i}\": {i}")).collect();
+    let others: Vec<String> = (1..8)
+        .map(|i| format!("{{\"extensions\": {{\"KHR_materials_sheen\": {{\"odd\": {i}}}}}}}"))
+        .collect();
     let text = format!(
-        "{{\n\"asset\": {{\"version\": \"2.0\"}},\n\"extensionsUsed\": [\"KHR_materials_sheen\"],\n\"materials\": [{{\"extensions\": {{\"KHR_materials_sheen\": {{\n\"sheenRoughnessFactor\": 3,\n\"sheenFactor\": 1,\n{}\n}}}}}}]\n}}\n",
-        odd.join(",\n")
+        "{{\n\"asset\": {{\"version\": \"2.0\"}},\n\"extensionsUsed\": [\"KHR_materials_sheen\"],\n\"materials\": [{{\"extensions\": {{\"KHR_materials_sheen\": {{\n\"sheenRoughnessFactor\": 3,\n\"sheenFactor\": 1,\n\"odd\": 0,\n\"strange\": 0\n}}}}}},\n{}\n]\n}}\n",
+        others.join(",\n")
     );
     std::fs::write(dir.path().join("many.gltf"), text).unwrap();
     let o = velvet_in(dir.path(), &["validate", "--color", "never", "many.gltf"]);
@@ -1294,9 +1297,10 @@ fn text_output_folds_a_repeated_code_and_lists_findings_in_file_order() {
         format!(
             "many.gltf:5:25: error VALUE_NOT_IN_RANGE: 3 is greater than the maximum of 1.0\n    at {p}/sheenRoughnessFactor\n\
              many.gltf:6:16: warning KHR_MATERIALS_SHEEN_LEGACY_DRAFT: sheenFactor belongs to the pre-ratification KHR_materials_sheen draft and is ignored by ratified loaders; `velvet migrate` upgrades it\n    at {p}/sheenFactor\n\
-             many.gltf:7:9: warning UNEXPECTED_PROPERTY: unexpected property 'odd0'\n    at {p}/odd0\n\
-             \x20   and 7 more at 8:9, 9:9, 10:9, 11:9, 12:9, … (8 in all; --no-fold prints each)\n\
-             1 file checked: 1 error, 9 warnings, 0 info, 0 hints\n"
+             many.gltf:7:8: warning UNEXPECTED_PROPERTY: unexpected property 'odd'\n    at {p}/odd\n\
+             \x20   and 7 more at 10:48, 11:48, 12:48, 13:48, 14:48, … (8 in all; --no-fold prints each)\n\
+             many.gltf:8:12: warning UNEXPECTED_PROPERTY: unexpected property 'strange'\n    at {p}/strange\n\
+             1 file checked: 1 error, 10 warnings, 0 info, 0 hints\n"
         )
     );
     let o = velvet_in(
@@ -1311,9 +1315,11 @@ fn text_output_folds_a_repeated_code_and_lists_findings_in_file_order() {
     let mut expected = vec![
         "many.gltf:5:25: error VALUE_NOT_IN_RANGE".to_string(),
         "many.gltf:6:16: warning KHR_MATERIALS_SHEEN_LEGACY_DRAFT".to_string(),
+        "many.gltf:7:8: warning UNEXPECTED_PROPERTY".to_string(),
+        "many.gltf:8:12: warning UNEXPECTED_PROPERTY".to_string(),
     ];
-    expected.extend((7..15).map(|l| format!("many.gltf:{l}:9: warning UNEXPECTED_PROPERTY")));
-    expected.push("1 file checked: 1 error, 9 warnings, 0 info, 0 hints".to_string());
+    expected.extend((10..17).map(|l| format!("many.gltf:{l}:48: warning UNEXPECTED_PROPERTY")));
+    expected.push("1 file checked: 1 error, 10 warnings, 0 info, 0 hints".to_string());
     assert_eq!(lines, expected);
 }
 

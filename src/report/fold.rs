@@ -4,9 +4,11 @@
 //! (about the whole file, or naming a value that is absent) first, then by byte offset in the
 //! JSON text, which is line and column order in a .gltf and byte order in a .glb. Findings at
 //! one place keep the order the rules gave them. [`fold`] then groups the findings of each
-//! code, so that a code repeated a thousand times in one file is one entry with its count and
-//! its first positions instead of a thousand lines; each group stands where its first finding
-//! stands. Both take findings and return references in a new order: reports are not changed,
+//! code whose messages are the same (they differ only in where they stand), so that a finding
+//! repeated a thousand times in one file is one entry with its count and its first positions
+//! instead of a thousand lines; each group stands where its first finding stands. Findings of
+//! one code with different messages (two undeclared extensions, a missing buffer and a missing
+//! image) call for different fixes and stay apart. Both take findings and return references in a new order: reports are not changed,
 //! so other formats and the report's counts see every finding as the rules produced it.
 
 use crate::validate::Finding;
@@ -18,7 +20,7 @@ pub fn by_position(findings: &[Finding]) -> Vec<&Finding> {
     sorted
 }
 
-/// The findings of one code in one file, in file order.
+/// The findings of one code and message in one file, in file order.
 #[derive(Debug, PartialEq)]
 pub struct Group<'a> {
     /// The first finding, shown in full.
@@ -27,15 +29,18 @@ pub struct Group<'a> {
     pub rest: Vec<&'a Finding>,
 }
 
-/// Groups findings (in file order) by code, each group at its first finding's place.
+/// Groups findings (in file order) by code and message, each group at its first finding's
+/// place.
 pub fn fold<'a>(sorted: &[&'a Finding]) -> Vec<Group<'a>> {
     let mut groups: Vec<Group<'a>> = Vec::new();
-    let mut index: std::collections::HashMap<&str, usize> = std::collections::HashMap::new();
+    let mut index: std::collections::HashMap<(&str, &str), usize> =
+        std::collections::HashMap::new();
     for f in sorted {
-        match index.get(f.diagnostic.code) {
+        let key = (f.diagnostic.code, f.diagnostic.message.as_str());
+        match index.get(&key) {
             Some(&i) => groups[i].rest.push(f),
             None => {
-                index.insert(f.diagnostic.code, groups.len());
+                index.insert(key, groups.len());
                 groups.push(Group {
                     first: f,
                     rest: Vec::new(),
@@ -53,10 +58,14 @@ mod tests {
     use crate::diagnostics::{Diagnostic, Severity};
 
     fn finding(code: &'static str, offset: Option<usize>) -> Finding {
+        said(code, &format!("{code} is found"), offset)
+    }
+
+    fn said(code: &'static str, message: &str, offset: Option<usize>) -> Finding {
         Finding {
             diagnostic: Diagnostic {
                 code,
-                message: format!("{code} at {offset:?}"),
+                message: message.to_string(),
                 severity: Severity::Warning,
                 pointer: String::new(),
                 position: None,
@@ -113,5 +122,33 @@ mod tests {
         assert_eq!(offsets(&[groups[1].first]), [("Y", Some(20))]);
         assert!(groups[1].rest.is_empty());
         assert!(fold(&[]).is_empty());
+    }
+
+    #[test]
+    fn findings_of_one_code_with_different_messages_are_not_folded_together() {
+        let sheen = "KHR_materials_sheen is used but not declared in extensionsUsed";
+        let specular = "KHR_materials_specular is used but not declared in extensionsUsed";
+        let findings = [
+            said("UNDECLARED_EXTENSION", sheen, Some(10)),
+            said("UNDECLARED_EXTENSION", specular, Some(20)),
+            said("UNDECLARED_EXTENSION", sheen, Some(30)),
+        ];
+        let sorted = by_position(&findings);
+        let groups = fold(&sorted);
+        let shown: Vec<(&str, Vec<Option<usize>>)> = groups
+            .iter()
+            .map(|g| {
+                let mut offsets = vec![g.first.position.map(|p| p.offset)];
+                offsets.extend(g.rest.iter().map(|f| f.position.map(|p| p.offset)));
+                (g.first.diagnostic.message.as_str(), offsets)
+            })
+            .collect();
+        assert_eq!(
+            shown,
+            [
+                (sheen, vec![Some(10), Some(30)]),
+                (specular, vec![Some(20)])
+            ]
+        );
     }
 }

@@ -79,7 +79,7 @@ pub struct Options {
     pub color: bool,
     /// Findings only: no summary line (text output; machine formats are always complete).
     pub quiet: bool,
-    /// Text output: every finding on its own, instead of one entry per code and file.
+    /// Text output: every finding on its own, instead of one entry per code, message and file.
     pub no_fold: bool,
 }
 

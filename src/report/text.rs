@@ -1,9 +1,9 @@
 //! Human-readable report: one line per finding, `file:line:column: severity CODE message`,
 //! then the pointer; a summary line at the end. Colour (ANSI, via anstyle) only when asked.
 //!
-//! A file's findings are printed in file order, and a code found more than once in a file is
-//! printed once, followed by a line with how many more there are and where the first
-//! [`SHOWN`] of them stand (see [`fold`]); `--no-fold` prints each one.
+//! A file's findings are printed in file order, and a finding (code and message) found more
+//! than once in a file is printed once, followed by a line with how many more there are and
+//! where the first [`SHOWN`] of them stand (see [`fold`]); `--no-fold` prints each one.
 
 use super::{display_path, fold, Options};
 use crate::asset::Container;
@@ -154,7 +154,7 @@ mod tests {
         Finding {
             diagnostic: Diagnostic {
                 code,
-                message: format!("{code} {pointer}"),
+                message: format!("{code} found"),
                 severity: Severity::Warning,
                 pointer: pointer.to_string(),
                 position: None,
@@ -191,9 +191,9 @@ mod tests {
         let text = render(&[report(Container::Glb, findings)]);
         assert_eq!(
             text,
-            "x/a.glb: warning A: A /absent\n    at /absent\n\
+            "x/a.glb: warning A: A found\n    at /absent\n\
              \x20   and 7 more at byte 60, byte 70, byte 80, byte 90, byte 100, … (8 in all; --no-fold prints each)\n\
-             x/a.glb: warning B: B \n\
+             x/a.glb: warning B: B found\n\
              1 file checked: 0 errors, 9 warnings, 0 info, 0 hints\n"
         );
         let short = vec![
@@ -203,7 +203,7 @@ mod tests {
         let text = render(&[report(Container::Gltf, short)]);
         assert_eq!(
             text,
-            "x/a.glb:2:5: warning A: A /p/0\n    at /p/0\n    and 1 more at 3:4 (2 in all; --no-fold prints each)\n\
+            "x/a.glb:2:5: warning A: A found\n    at /p/0\n    and 1 more at 3:4 (2 in all; --no-fold prints each)\n\
              1 file checked: 0 errors, 2 warnings, 0 info, 0 hints\n"
         );
     }
