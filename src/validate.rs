@@ -57,6 +57,17 @@ pub struct AssetInfo {
     pub fuzz_material_count: usize,
 }
 
+/// The resource files a document names and those of them that do not exist, for the report
+/// formats that list a file's FILE_NOT_FOUND findings as one entry (text, GitHub, SARIF).
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct MissingResources {
+    /// How many distinct files the buffer and image URIs name (data: URIs and URLs aside).
+    pub named: usize,
+    /// The distinct URIs of the FILE_NOT_FOUND findings, in the order the rules found them
+    /// (the findings' own, before a `--max-issues` cap; none when the code is ignored).
+    pub uris: Vec<String>,
+}
+
 /// The report for one file.
 #[derive(Debug, Clone)]
 pub struct FileReport {
@@ -69,6 +80,7 @@ pub struct FileReport {
     /// How many findings `--max-issues` left out of the listing (they are counted all the same).
     pub omitted: usize,
     pub info: Option<AssetInfo>,
+    pub missing: MissingResources,
 }
 
 impl FileReport {
@@ -225,6 +237,7 @@ impl Validator {
         drop(cx);
         let mut groups = found;
         groups.insert(0, diagnostics);
+        let missing = missing_resources(asset.root(), &groups, settings);
         let mut report = self.finish(
             settings,
             path.to_path_buf(),
@@ -233,6 +246,7 @@ impl Validator {
             groups,
             Some(info),
         );
+        report.missing = missing;
         if self.positions && !report.findings.is_empty() {
             let positions = asset::position::locate(
                 &asset.json_text,
@@ -296,7 +310,36 @@ impl Validator {
             counts,
             omitted,
             info,
+            missing: MissingResources::default(),
         }
+    }
+}
+
+/// The files `json` names and the URIs of the FILE_NOT_FOUND findings among `groups`, unless
+/// `settings` ignore the code.
+fn missing_resources(
+    json: Node,
+    groups: &[Vec<Diagnostic>],
+    settings: &Settings,
+) -> MissingResources {
+    let code = rules::resources::FILE_NOT_FOUND.name;
+    if settings.ignore.contains(code) {
+        return MissingResources::default();
+    }
+    let mut uris: Vec<String> = Vec::new();
+    for d in groups.iter().flatten().filter(|d| d.code == code) {
+        if let Some(uri) = json.pointer(&d.pointer).and_then(|u| u.as_str()) {
+            if !uris.iter().any(|u| *u == uri) {
+                uris.push(uri.into_owned());
+            }
+        }
+    }
+    if uris.is_empty() {
+        return MissingResources::default();
+    }
+    MissingResources {
+        named: rules::resources::file_uris(json).len(),
+        uris,
     }
 }
 

@@ -1717,3 +1717,198 @@ fn ci_docs_shard_recipes_cover_the_library_once_as_written() {
     )));
     assert_eq!(sorted_lines(&merged), absolute);
 }
+
+// ---------------------------------------------------------------- missing resources
+
+/// A folder of two assets whose resources are partly missing: a.gltf names three files (one by
+/// two images) and a data: URI, two of the files missing, and has a warning besides; b.gltf
+/// names one missing image and has an error besides.
+fn missing_resources_project() -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("a.gltf"),
+        "{\n\"asset\": {\"version\": \"2.0\"},\n\"extensionsUsed\": [\"KHR_materials_sheen\"],\n\
+         \"buffers\": [{\"uri\": \"Chair.bin\", \"byteLength\": 4}, {\"uri\": \"present.bin\", \"byteLength\": 4}, {\"uri\": \"data:application/octet-stream;base64,AAAAAA==\", \"byteLength\": 4}],\n\
+         \"images\": [{\"uri\": \"Chair_base.png\"}, {\"uri\": \"Chair_base.png\"}],\n\
+         \"materials\": [{\"extensions\": {\"KHR_materials_sheen\": {\"odd\": 1}}}]\n}\n",
+    )
+    .unwrap();
+    std::fs::write(dir.path().join("present.bin"), [0u8; 4]).unwrap();
+    std::fs::write(
+        dir.path().join("b.gltf"),
+        "{\n\"asset\": {\"version\": \"2.0\"},\n\"scene\": 0,\n\"images\": [{\"uri\": \"gone.png\"}]\n}\n",
+    )
+    .unwrap();
+    dir
+}
+
+const A_MISSING: &str = "2 of 3 resources are missing: Chair.bin, Chair_base.png — a checkout without Git LFS? fetch them, or `--ignore FILE_NOT_FOUND`";
+const B_MISSING: &str = "1 of 1 resource is missing: gone.png — a checkout without Git LFS? fetch it, or `--ignore FILE_NOT_FOUND`";
+
+#[test]
+fn missing_resources_are_one_text_entry_per_file_after_its_other_findings() {
+    let dir = missing_resources_project();
+    let o = velvet_in(
+        dir.path(),
+        &["validate", "--color", "never", "a.gltf", "b.gltf"],
+    );
+    assert_eq!(o.status.code(), Some(1));
+    assert_eq!(
+        stdout(&o),
+        format!(
+            "a.gltf:6:62: warning UNEXPECTED_PROPERTY: unexpected property 'odd'\n\
+             \x20   at /materials/0/extensions/KHR_materials_sheen/odd\n\
+             a.gltf:4:21: error FILE_NOT_FOUND: {A_MISSING}\n\
+             b.gltf: error UNSATISFIED_DEPENDENCY: 'scenes' must be defined here (a property present depends on it)\n\
+             b.gltf:3:10: error UNRESOLVED_REFERENCE: scene names scene 0, but the asset has 0 scenes\n\
+             \x20   at /scene\n\
+             b.gltf:4:20: error FILE_NOT_FOUND: {B_MISSING}\n\
+             2 files checked: 6 errors, 1 warning, 0 info, 0 hints\n"
+        )
+    );
+}
+
+#[test]
+fn github_and_sarif_list_every_other_finding_before_the_missing_resources() {
+    let dir = missing_resources_project();
+    let o = velvet_in(
+        dir.path(),
+        &["validate", "--format", "github", "a.gltf", "b.gltf"],
+    );
+    assert_eq!(o.status.code(), Some(1));
+    let titles: Vec<String> = stdout(&o)
+        .lines()
+        .map(|l| {
+            let (head, message) = l.split_once("::").unwrap().1.split_once("::").unwrap();
+            let file = head
+                .split(',')
+                .next()
+                .unwrap()
+                .trim_start_matches(|c| c != ' ');
+            let title = head.rsplit("title=").next().unwrap();
+            format!("{} {title}: {message}", file.trim())
+        })
+        .collect();
+    assert_eq!(
+        titles,
+        [
+            "file=a.gltf UNEXPECTED_PROPERTY: unexpected property 'odd' (at /materials/0/extensions/KHR_materials_sheen/odd)".to_string(),
+            "file=b.gltf UNSATISFIED_DEPENDENCY: 'scenes' must be defined here (a property present depends on it)".to_string(),
+            "file=b.gltf UNRESOLVED_REFERENCE: scene names scene 0, but the asset has 0 scenes (at /scene)".to_string(),
+            format!("file=a.gltf FILE_NOT_FOUND: {A_MISSING}"),
+            format!("file=b.gltf FILE_NOT_FOUND: {B_MISSING}"),
+        ]
+    );
+    let o = velvet_in(
+        dir.path(),
+        &["validate", "--format", "sarif", "a.gltf", "b.gltf"],
+    );
+    assert_eq!(o.status.code(), Some(1));
+    let log: Value = serde_json::from_slice(&o.stdout).unwrap();
+    let results: Vec<(String, String, Option<u64>)> = log["runs"][0]["results"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| {
+            let location = &r["locations"][0]["physicalLocation"];
+            (
+                location["artifactLocation"]["uri"]
+                    .as_str()
+                    .unwrap()
+                    .to_string(),
+                r["ruleId"].as_str().unwrap().to_string(),
+                location["region"]["startLine"].as_u64(),
+            )
+        })
+        .collect();
+    let row =
+        |file: &str, code: &str, line: Option<u64>| (file.to_string(), code.to_string(), line);
+    assert_eq!(
+        results,
+        [
+            row("a.gltf", "UNEXPECTED_PROPERTY", Some(6)),
+            row("b.gltf", "UNSATISFIED_DEPENDENCY", None),
+            row("b.gltf", "UNRESOLVED_REFERENCE", Some(3)),
+            row("a.gltf", "FILE_NOT_FOUND", Some(4)),
+            row("b.gltf", "FILE_NOT_FOUND", Some(4)),
+        ]
+    );
+    assert_eq!(
+        log["runs"][0]["results"][3]["message"]["text"].as_str(),
+        Some(A_MISSING)
+    );
+}
+
+#[test]
+fn the_json_report_keeps_one_message_per_missing_file_with_its_pointer() {
+    let dir = missing_resources_project();
+    let o = velvet_in(
+        dir.path(),
+        &["validate", "--format", "json", "a.gltf", "b.gltf"],
+    );
+    assert_eq!(o.status.code(), Some(1));
+    let reports: Value = serde_json::from_slice(&o.stdout).unwrap();
+    let missing: Vec<&str> = reports[0]["issues"]["messages"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|m| m["code"] == "FILE_NOT_FOUND")
+        .map(|m| m["pointer"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        missing,
+        ["/buffers/0/uri", "/images/0/uri", "/images/1/uri"]
+    );
+    assert_eq!(reports[0]["issues"]["numErrors"], 3);
+}
+
+#[test]
+fn ignoring_file_not_found_leaves_the_other_findings_and_their_exit_status() {
+    let dir = missing_resources_project();
+    let o = velvet_in(
+        dir.path(),
+        &[
+            "validate",
+            "--color",
+            "never",
+            "--ignore",
+            "FILE_NOT_FOUND",
+            "a.gltf",
+        ],
+    );
+    assert_eq!(o.status.code(), Some(0), "a warning alone does not fail");
+    assert_eq!(
+        stdout(&o),
+        "a.gltf:6:62: warning UNEXPECTED_PROPERTY: unexpected property 'odd'\n\
+         \x20   at /materials/0/extensions/KHR_materials_sheen/odd\n\
+         1 file checked: 0 errors, 1 warning, 0 info, 0 hints\n"
+    );
+    for format in ["github", "sarif", "json"] {
+        let o = velvet_in(
+            dir.path(),
+            &[
+                "validate",
+                "--format",
+                format,
+                "--ignore",
+                "FILE_NOT_FOUND",
+                "a.gltf",
+                "b.gltf",
+            ],
+        );
+        assert_eq!(
+            o.status.code(),
+            Some(1),
+            "{format}: b.gltf's error fails the run"
+        );
+        let listed = if format == "sarif" {
+            let log: Value = serde_json::from_slice(&o.stdout).unwrap();
+            serde_json::to_string(&log["runs"][0]["results"]).unwrap()
+        } else {
+            stdout(&o)
+        };
+        assert!(listed.contains("UNRESOLVED_REFERENCE"), "{format}");
+        assert!(!listed.contains("FILE_NOT_FOUND"), "{format}");
+        assert!(!listed.contains("missing"), "{format}");
+    }
+}

@@ -15,7 +15,12 @@ use crate::validate::Finding;
 
 /// `findings` in file order: without a position first, then by byte offset (stable).
 pub fn by_position(findings: &[Finding]) -> Vec<&Finding> {
-    let mut sorted: Vec<&Finding> = findings.iter().collect();
+    by_position_of(&findings.iter().collect::<Vec<_>>())
+}
+
+/// [`by_position`] for findings already borrowed.
+pub fn by_position_of<'a>(findings: &[&'a Finding]) -> Vec<&'a Finding> {
+    let mut sorted = findings.to_vec();
     sorted.sort_by_key(|f| f.position.map(|p| p.offset));
     sorted
 }

@@ -5,11 +5,15 @@
 //! and `col` are given for a .gltf finding whose pointer names a value (a .glb has no lines:
 //! its byte offset goes into the message instead). Properties and message are escaped as the
 //! runner unescapes them: `%`, CR and LF everywhere, and `:` and `,` in properties too.
+//!
+//! Each file's missing resources are one annotation (see [`super::Listing`]), and these come
+//! after every other finding of the run: GitHub shows only a step's first ten error
+//! annotations, and they go to the findings a checkout with every resource would still have.
 
 use super::display_path;
 use crate::asset::Container;
 use crate::diagnostics::Severity;
-use crate::validate::FileReport;
+use crate::validate::{FileReport, Finding};
 use std::fmt::Write;
 
 /// Escapes a command's message.
@@ -32,50 +36,71 @@ fn command(severity: Severity) -> &'static str {
     }
 }
 
-/// One workflow command per finding, and a notice for each file whose findings were capped.
+/// One workflow command per finding, and a notice for each file whose findings were capped;
+/// the entries for missing resources last.
 pub fn render(reports: &[FileReport]) -> String {
     let mut out = String::new();
+    let mut missing = String::new();
     for report in reports {
-        let file = escape_property(&display_path(&report.path));
-        for f in &report.findings {
-            let d = &f.diagnostic;
-            let mut properties = format!("file={file}");
-            let mut message = d.message.clone();
-            match (f.position, report.container) {
-                (Some(p), Some(Container::Glb)) => {
-                    let _ = write!(
-                        message,
-                        " (at {}, byte {})",
-                        d.pointer,
-                        report.json_offset + p.offset
-                    );
-                }
-                (Some(p), _) => {
-                    let _ = write!(properties, ",line={},col={}", p.line, p.column);
-                    let _ = write!(message, " (at {})", d.pointer);
-                }
-                (None, _) if !d.pointer.is_empty() => {
-                    let _ = write!(message, " (at {})", d.pointer);
-                }
-                (None, _) => {}
-            }
-            let _ = writeln!(
-                out,
-                "::{} {properties},title={}::{}",
-                command(d.severity),
-                escape_property(d.code),
-                escape_data(&message)
-            );
-        }
-        if report.truncated() {
-            let _ = writeln!(
-                out,
-                "::notice file={file},title=velvet::{}",
-                super::omitted_note(report.omitted)
-            );
-        }
+        let (file, last) = render_file(report);
+        out += &file;
+        missing += &last;
     }
-    out
+    out + &missing
+}
+
+/// One file's workflow commands: those of its findings but the missing resources, and the
+/// one for its missing resources (empty when none is missing), which the run lists last.
+pub fn render_file(report: &FileReport) -> (String, String) {
+    let listing = super::listing(report);
+    let file = escape_property(&display_path(&report.path));
+    let mut out = String::new();
+    for f in listing.others {
+        command_line(&mut out, &file, report, f);
+    }
+    if report.truncated() {
+        let _ = writeln!(
+            out,
+            "::notice file={file},title=velvet::{}",
+            super::omitted_note(report.omitted)
+        );
+    }
+    let mut missing = String::new();
+    if let Some(f) = &listing.missing {
+        command_line(&mut missing, &file, report, f);
+    }
+    (out, missing)
+}
+
+/// The workflow command of one finding: a .gltf finding's line and column as properties, a
+/// .glb finding's byte offset and the pointer in the message.
+fn command_line(out: &mut String, file: &str, report: &FileReport, f: &Finding) {
+    let d = &f.diagnostic;
+    let mut properties = format!("file={file}");
+    let mut message = d.message.clone();
+    let mut at: Vec<String> = Vec::new();
+    if !d.pointer.is_empty() {
+        at.push(d.pointer.clone());
+    }
+    match (f.position, report.container) {
+        (Some(p), Some(Container::Glb)) => {
+            at.push(format!("byte {}", report.json_offset + p.offset))
+        }
+        (Some(p), _) => {
+            let _ = write!(properties, ",line={},col={}", p.line, p.column);
+        }
+        (None, _) => {}
+    }
+    if !at.is_empty() {
+        let _ = write!(message, " (at {})", at.join(", "));
+    }
+    let _ = writeln!(
+        out,
+        "::{} {properties},title={}::{}",
+        command(d.severity),
+        escape_property(d.code),
+        escape_data(&message)
+    );
 }
 
 #[cfg(test)]

@@ -249,6 +249,7 @@ mod tests {
                 sheen_material_count: 1,
                 fuzz_material_count: 0,
             }),
+            missing: Default::default(),
         }
     }
 

@@ -9,7 +9,7 @@ pub mod json;
 pub mod sarif;
 pub mod text;
 
-use crate::validate::FileReport;
+use crate::validate::{FileReport, Finding, MissingResources};
 use std::io::IsTerminal;
 
 pub use crate::asset::discover::display_path;
@@ -19,6 +19,73 @@ pub fn omitted_note(omitted: usize) -> String {
     format!(
         "{omitted} more issue{} not shown (--max-issues)",
         if omitted == 1 { "" } else { "s" }
+    )
+}
+
+/// A file's findings as the text, GitHub and SARIF reports list them: its FILE_NOT_FOUND
+/// findings as one entry, after the others. A checkout without its binaries (Git LFS not
+/// fetched, generated files not generated) has one such finding per buffer and image, and
+/// listed one by one they bury the file's other findings (GitHub shows a step's first ten
+/// error annotations). The JSON reports, in the Khronos validator's shape, keep one message per
+/// missing file with its pointer, as that validator does; the counts and the exit status come
+/// from every finding in every format.
+pub struct Listing<'a> {
+    /// The other findings, in the report's order.
+    pub others: Vec<&'a Finding>,
+    /// The entry for the missing files, when any FILE_NOT_FOUND finding is listed.
+    pub missing: Option<Finding>,
+}
+
+/// How many missing files the entry names before it ends in `…`.
+pub const MISSING_NAMED: usize = 5;
+
+/// `report`'s findings, its FILE_NOT_FOUND findings gathered into one.
+pub fn listing(report: &FileReport) -> Listing<'_> {
+    let code = crate::rules::resources::FILE_NOT_FOUND.name;
+    let first = report.findings.iter().find(|f| f.diagnostic.code == code);
+    let Some(first) = first.filter(|_| !report.missing.uris.is_empty()) else {
+        return Listing {
+            others: report.findings.iter().collect(),
+            missing: None,
+        };
+    };
+    let mut diagnostic = first.diagnostic.clone();
+    diagnostic.message = missing_message(&report.missing);
+    // The entry speaks of every missing file: it stands where the first is named, but names
+    // no one value.
+    diagnostic.pointer = String::new();
+    Listing {
+        others: report
+            .findings
+            .iter()
+            .filter(|f| f.diagnostic.code != code)
+            .collect(),
+        missing: Some(Finding {
+            diagnostic,
+            position: first.position,
+        }),
+    }
+}
+
+/// "9 of 12 resources are missing: Chair.bin, … — a checkout without Git LFS? …"
+fn missing_message(missing: &MissingResources) -> String {
+    let count = missing.uris.len();
+    let named = missing.named.max(count);
+    let mut names = missing
+        .uris
+        .iter()
+        .take(MISSING_NAMED)
+        .map(String::as_str)
+        .collect::<Vec<_>>()
+        .join(", ");
+    if count > MISSING_NAMED {
+        names += &format!(", … ({} more)", count - MISSING_NAMED);
+    }
+    format!(
+        "{count} of {named} resource{} {} missing: {names} — a checkout without Git LFS? fetch {}, or `--ignore FILE_NOT_FOUND`",
+        if named == 1 { "" } else { "s" },
+        if count == 1 { "is" } else { "are" },
+        if count == 1 { "it" } else { "them" },
     )
 }
 
@@ -108,6 +175,8 @@ pub struct Stream<W: std::io::Write> {
     files: usize,
     totals: [usize; 4],
     json_array: bool,
+    /// GitHub output: the missing-resource annotations, written after every other one.
+    deferred: String,
 }
 
 /// A JSON report as an element of the pretty-printed array of several: every line indented.
@@ -134,6 +203,7 @@ impl<W: std::io::Write> Stream<W> {
             files: 0,
             totals: [0; 4],
             json_array: true,
+            deferred: String::new(),
         }
     }
 
@@ -164,7 +234,11 @@ impl<W: std::io::Write> Stream<W> {
                 },
             ),
             Format::Jsonl => json::render_lines(one),
-            Format::Github => github::render(one),
+            Format::Github => {
+                let (text, missing) = github::render_file(&report);
+                self.deferred += &missing;
+                text
+            }
             Format::Json if !self.json_array => {
                 self.kept.push(report);
                 return;
@@ -198,6 +272,7 @@ impl<W: std::io::Write> Stream<W> {
             Format::Json if self.json_array && self.files == 0 => "[]\n".to_string(),
             Format::Json if self.json_array => "\n]\n".to_string(),
             Format::Json | Format::Sarif => render(self.format, &self.kept, &self.options),
+            Format::Github => std::mem::take(&mut self.deferred),
             _ => String::new(),
         };
         let _ = self.out.write_all(text.as_bytes());
@@ -247,7 +322,7 @@ mod tests {
             .map(|i| {
                 let path = std::path::PathBuf::from(format!("memory/{i}.gltf"));
                 let text = format!(
-                    r#"{{"asset":{{"version":"2.0"}},"extensionsUsed":["KHR_materials_fuzz"],"extras":{{"n":{i},"s":"a\nb"}}}}"#
+                    r#"{{"asset":{{"version":"2.0"}},"extensionsUsed":["KHR_materials_fuzz"],"buffers":[{{"uri":"gone{i}.bin","byteLength":1}}],"extras":{{"n":{i},"s":"a\nb"}}}}"#
                 );
                 let loaded = crate::asset::load_bytes(&path, text.as_bytes());
                 validator.validate_loaded(&path, loaded)
@@ -287,6 +362,51 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn the_missing_resources_entry_names_the_first_five_and_counts_the_rest() {
+        let missing = |uris: &[&str], named| MissingResources {
+            named,
+            uris: uris.iter().map(|u| u.to_string()).collect(),
+        };
+        assert_eq!(
+            missing_message(&missing(&["a.bin", "b.png", "c.png", "d.png", "e.png", "f.png", "g.png"], 12)),
+            "7 of 12 resources are missing: a.bin, b.png, c.png, d.png, e.png, … (2 more) — a checkout without Git LFS? fetch them, or `--ignore FILE_NOT_FOUND`"
+        );
+        assert_eq!(
+            missing_message(&missing(&["a.bin"], 3)),
+            "1 of 3 resources is missing: a.bin — a checkout without Git LFS? fetch it, or `--ignore FILE_NOT_FOUND`"
+        );
+    }
+
+    #[test]
+    fn streamed_github_output_lists_every_missing_resource_entry_after_the_other_findings() {
+        let mut out = Vec::new();
+        let mut stream = Stream::new(Format::Github, Options::default(), &mut out);
+        for r in reports(3) {
+            stream.push(r);
+        }
+        stream.finish();
+        let codes: Vec<&str> = std::str::from_utf8(&out)
+            .unwrap()
+            .lines()
+            .map(|l| {
+                l.rsplit_once("title=")
+                    .unwrap()
+                    .1
+                    .split("::")
+                    .next()
+                    .unwrap()
+            })
+            .collect();
+        let missing = codes.iter().position(|c| *c == "FILE_NOT_FOUND").unwrap();
+        assert_eq!(missing, codes.len() - 3, "{codes:?}");
+        assert!(
+            codes[missing..].iter().all(|c| *c == "FILE_NOT_FOUND"),
+            "{codes:?}"
+        );
+        assert!(missing > 0, "{codes:?}");
     }
 
     #[test]

@@ -9,10 +9,13 @@
 //! binary, so its region is the `byteOffset` of the value in the file instead, with
 //! `startLine` 1 because GitHub code scanning requires a line on every result. The JSON pointer
 //! goes in each result's `properties.pointer`.
+//!
+//! Each file's missing resources are one result (see [`super::Listing`]), at the place of the
+//! first, and these results follow every other result of the run.
 
 use crate::asset::Container;
 use crate::diagnostics::Severity;
-use crate::validate::FileReport;
+use crate::validate::{FileReport, Finding};
 use percent_encoding::{utf8_percent_encode, AsciiSet, NON_ALPHANUMERIC};
 use serde::Serialize;
 use serde_json::Value;
@@ -203,7 +206,52 @@ fn artifact_location(path: &Path) -> ArtifactLocation {
     }
 }
 
-fn log<'a>(reports: &'a [FileReport], artifacts: &'a [ArtifactLocation]) -> Log<'a> {
+/// The result of one finding of `report`.
+fn result<'a>(
+    report: &FileReport,
+    artifact: &'a ArtifactLocation,
+    f: &'a Finding,
+    index: &HashMap<&str, usize>,
+) -> SarifResult<'a> {
+    let d = &f.diagnostic;
+    let region = f.position.map(|p| match report.container {
+        Some(Container::Glb) => Region::Binary {
+            start_line: 1,
+            byte_offset: report.json_offset + p.offset,
+        },
+        _ => Region::Text {
+            start_line: p.line,
+            start_column: p.column,
+        },
+    });
+    SarifResult {
+        rule_id: d.code,
+        // Every emitted code is registered; -1 is SARIF's "not in the rules array".
+        rule_index: index.get(d.code).map_or(-1, |&i| i as i64),
+        level: level(d.severity),
+        message: Text { text: &d.message },
+        locations: [Location {
+            physical_location: PhysicalLocation {
+                artifact_location: artifact,
+                region,
+            },
+        }],
+        properties: Properties {
+            pointer: &d.pointer,
+        },
+    }
+}
+
+/// Each report's entry for its missing resources, if it has one.
+fn missing_entries(reports: &[FileReport]) -> Vec<Option<Finding>> {
+    reports.iter().map(|r| super::listing(r).missing).collect()
+}
+
+fn log<'a>(
+    reports: &'a [FileReport],
+    artifacts: &'a [ArtifactLocation],
+    missing: &'a [Option<Finding>],
+) -> Log<'a> {
     let codes = crate::rules::all_codes();
     let index: HashMap<&str, usize> = codes.iter().enumerate().map(|(i, c)| (c.name, i)).collect();
     let rules = codes
@@ -219,34 +267,8 @@ fn log<'a>(reports: &'a [FileReport], artifacts: &'a [ArtifactLocation]) -> Log<
     let mut results = Vec::new();
     let mut notifications = Vec::new();
     for (report, artifact) in reports.iter().zip(artifacts) {
-        for f in &report.findings {
-            let d = &f.diagnostic;
-            let region = f.position.map(|p| match report.container {
-                Some(Container::Glb) => Region::Binary {
-                    start_line: 1,
-                    byte_offset: report.json_offset + p.offset,
-                },
-                _ => Region::Text {
-                    start_line: p.line,
-                    start_column: p.column,
-                },
-            });
-            results.push(SarifResult {
-                rule_id: d.code,
-                // Every emitted code is registered; -1 is SARIF's "not in the rules array".
-                rule_index: index.get(d.code).map_or(-1, |&i| i as i64),
-                level: level(d.severity),
-                message: Text { text: &d.message },
-                locations: [Location {
-                    physical_location: PhysicalLocation {
-                        artifact_location: artifact,
-                        region,
-                    },
-                }],
-                properties: Properties {
-                    pointer: &d.pointer,
-                },
-            });
+        for f in super::listing(report).others {
+            results.push(result(report, artifact, f, &index));
         }
         if report.truncated() {
             notifications.push(Notification {
@@ -261,6 +283,11 @@ fn log<'a>(reports: &'a [FileReport], artifacts: &'a [ArtifactLocation]) -> Log<
                     },
                 }],
             });
+        }
+    }
+    for ((report, artifact), entry) in reports.iter().zip(artifacts).zip(missing) {
+        if let Some(f) = entry {
+            results.push(result(report, artifact, f, &index));
         }
     }
     Log {
@@ -289,15 +316,17 @@ fn log<'a>(reports: &'a [FileReport], artifacts: &'a [ArtifactLocation]) -> Log<
 pub fn document(reports: &[FileReport]) -> Value {
     let artifacts: Vec<ArtifactLocation> =
         reports.iter().map(|r| artifact_location(&r.path)).collect();
-    serde_json::to_value(log(reports, &artifacts)).expect("a SARIF log serialises")
+    let missing = missing_entries(reports);
+    serde_json::to_value(log(reports, &artifacts, &missing)).expect("a SARIF log serialises")
 }
 
 /// The SARIF log as pretty-printed JSON.
 pub fn render(reports: &[FileReport]) -> String {
     let artifacts: Vec<ArtifactLocation> =
         reports.iter().map(|r| artifact_location(&r.path)).collect();
-    let mut text =
-        serde_json::to_string_pretty(&log(reports, &artifacts)).expect("a SARIF log serialises");
+    let missing = missing_entries(reports);
+    let mut text = serde_json::to_string_pretty(&log(reports, &artifacts, &missing))
+        .expect("a SARIF log serialises");
     text.push('\n');
     text
 }

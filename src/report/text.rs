@@ -3,7 +3,8 @@
 //!
 //! A file's findings are printed in file order, and a finding (code and message) found more
 //! than once in a file is printed once, followed by a line with how many more there are and
-//! where the first [`SHOWN`] of them stand (see [`fold`]); `--no-fold` prints each one.
+//! where the first [`SHOWN`] of them stand (see [`fold`]); `--no-fold` prints each one. A
+//! file's missing resources are one entry after its other findings (see [`super::Listing`]).
 
 use super::{display_path, fold, Options};
 use crate::asset::Container;
@@ -47,8 +48,9 @@ pub fn render_with(reports: &[FileReport], options: &Options) -> String {
             (Some(p), _) => format!("{file}:{}:{}", p.line, p.column),
             (None, _) => file.clone(),
         };
-        let sorted = fold::by_position(&report.findings);
-        let groups = if options.no_fold {
+        let listing = super::listing(report);
+        let sorted = fold::by_position_of(&listing.others);
+        let mut groups = if options.no_fold {
             sorted
                 .iter()
                 .map(|f| fold::Group {
@@ -59,6 +61,11 @@ pub fn render_with(reports: &[FileReport], options: &Options) -> String {
         } else {
             fold::fold(&sorted)
         };
+        // The missing files come last, whatever their place in the file.
+        groups.extend(listing.missing.as_ref().map(|first| fold::Group {
+            first,
+            rest: Vec::new(),
+        }));
         for group in groups {
             let d = &group.first.diagnostic;
             let _ = writeln!(
@@ -179,6 +186,7 @@ mod tests {
             findings,
             omitted: 0,
             info: None,
+            missing: Default::default(),
         }
     }
 

@@ -79,6 +79,18 @@ impl Rule for Resources {
     }
 }
 
+/// The distinct URIs of the buffers and images of `json` that name files: not data: URIs, not
+/// URLs.
+pub fn file_uris(json: Node) -> std::collections::BTreeSet<String> {
+    ["buffers", "images"]
+        .into_iter()
+        .flat_map(|key| array(json, key))
+        .filter_map(|(_, resource)| resource.get("uri")?.as_str())
+        .filter(|uri| !uri.starts_with("data:") && !resource::is_remote(uri))
+        .map(std::borrow::Cow::into_owned)
+        .collect()
+}
+
 fn array<'a>(json: Node<'a>, key: &str) -> impl Iterator<Item = (usize, Node<'a>)> {
     super::elements(json.get(key))
         .enumerate()
