@@ -405,18 +405,29 @@ fn show_config(path: Option<PathBuf>, args: SettingsArgs) -> ExitCode {
 }
 
 fn validate(args: ValidateArgs, color: ColorChoice, quiet: bool) -> ExitCode {
+    // One report object for a run over one file named on the command line; an array for
+    // anything else (folders, several files, a list, a shard), whatever it finds.
+    let one_file = args.input.files_from.is_none()
+        && args.input.shard.is_none()
+        && matches!(args.input.paths.as_slice(), [path] if path.is_file());
+    // A run that cannot start still writes a report in its format, recording why (every
+    // such error comes before the first report is written).
+    let failed = |message: String| {
+        emit(report::failed_run(args.format, &message, !one_file).as_bytes());
+        usage_error(message)
+    };
     let paths = match args.input.resolve() {
         Ok(p) => p,
-        Err(e) => return usage_error(e),
+        Err(e) => return failed(e.to_string()),
     };
     let mut resolver = match resolver(&args.settings) {
         Ok(r) => r,
-        Err(e) => return usage_error(e),
+        Err(e) => return failed(e.to_string()),
     };
     let validator = match &args.schema_dir {
         Some(dir) => match Schemas::with_overrides(dir) {
             Ok(schemas) => Validator::new(schemas, Settings::default()),
-            Err(e) => return usage_error(e),
+            Err(e) => return failed(e.to_string()),
         },
         None => Validator::builtin(Settings::default()),
     };
@@ -431,11 +442,6 @@ fn validate(args: ValidateArgs, color: ColorChoice, quiet: bool) -> ExitCode {
     };
     // Each file's report is written as soon as it is done (see report::Stream).
     let stdout = std::io::BufWriter::new(std::io::stdout().lock());
-    // One report object for a run over one file named on the command line; an array for
-    // anything else (folders, several files, a list, a shard), whatever it finds.
-    let one_file = args.input.files_from.is_none()
-        && args.input.shard.is_none()
-        && matches!(args.input.paths.as_slice(), [path] if path.is_file());
     let mut stream = report::Stream::new(args.format, options, stdout).json_array(!one_file);
     let outcome = match velvet::run::validate_shard_each(
         &validator,
@@ -453,7 +459,12 @@ fn validate(args: ValidateArgs, color: ColorChoice, quiet: bool) -> ExitCode {
         },
     ) {
         Ok(o) => o,
-        Err(e) => return usage_error(e),
+        Err(e) => {
+            // Nothing has been written (configurations are resolved first); the stream holds
+            // standard output, so it goes before the failure's report is written.
+            drop(stream);
+            return failed(e.to_string());
+        }
     };
     stream.finish();
     if outcome.failed {

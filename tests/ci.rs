@@ -1912,3 +1912,79 @@ fn ignoring_file_not_found_leaves_the_other_findings_and_their_exit_status() {
         assert!(!listed.contains("missing"), "{format}");
     }
 }
+
+// ---------------------------------------------------------------- runs that cannot start
+
+#[test]
+fn a_run_that_cannot_start_writes_a_valid_report_recording_why_and_exits_2() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("a.gltf"),
+        r#"{"asset": {"version": "2.0"}}"#,
+    )
+    .unwrap();
+    let schema_path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/ci/sarif-schema-2.1.0.json");
+    let schema: Value = serde_json::from_slice(&std::fs::read(schema_path).unwrap()).unwrap();
+    let sarif_schema = jsonschema::validator_for(&schema).expect("the SARIF schema compiles");
+    // A path that does not exist, and an unknown code (a configuration error).
+    for (args, said) in [
+        (&["typo/"][..], "typo/: no such file or folder"),
+        (&["--ignore", "NO_SUCH_CODE", "."][..], "NO_SUCH_CODE"),
+    ] {
+        let run = |format: &str| {
+            let mut all = vec!["validate", "--format", format];
+            all.extend(args);
+            let o = velvet_in(dir.path(), &all);
+            assert_eq!(o.status.code(), Some(2), "{format} {args:?}");
+            assert!(stderr(&o).contains(said), "{format}: {}", stderr(&o));
+            stdout(&o)
+        };
+        let log: Value = serde_json::from_str(&run("sarif")).expect("SARIF is JSON");
+        let errors: Vec<String> = sarif_schema
+            .iter_errors(&log)
+            .map(|e| format!("{} at {}", e, e.instance_path()))
+            .collect();
+        assert!(errors.is_empty(), "{errors:#?}");
+        let invocation = &log["runs"][0]["invocations"][0];
+        assert_eq!(invocation["executionSuccessful"], false);
+        assert_eq!(invocation["exitCode"], 2);
+        let notification = &invocation["toolExecutionNotifications"][0];
+        assert_eq!(notification["level"], "error");
+        assert!(
+            notification["message"]["text"]
+                .as_str()
+                .unwrap()
+                .contains(said),
+            "{notification}"
+        );
+        assert_eq!(log["runs"][0]["results"], serde_json::json!([]));
+
+        let reports: Value = serde_json::from_str(&run("json")).expect("JSON");
+        let lines: Vec<Value> = run("jsonl")
+            .lines()
+            .map(|l| serde_json::from_str(l).expect("a JSON line"))
+            .collect();
+        assert_eq!(reports.as_array().map(Vec::len), Some(1), "{reports}");
+        assert_eq!(lines, reports.as_array().unwrap().clone());
+        let issues = &reports[0]["issues"];
+        assert_eq!(issues["numErrors"], 1);
+        assert_eq!(issues["messages"][0]["code"], "USAGE_ERROR");
+        assert_eq!(issues["messages"][0]["severity"], 0);
+        assert!(issues["messages"][0]["message"]
+            .as_str()
+            .unwrap()
+            .contains(said));
+
+        let github = run("github");
+        assert!(
+            github.starts_with("::error title=velvet::") && github.lines().count() == 1,
+            "{github}"
+        );
+        assert_eq!(
+            run("text"),
+            "",
+            "text output leaves the message to standard error"
+        );
+    }
+}

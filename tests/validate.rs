@@ -121,8 +121,14 @@ fn every_registered_code_has_a_fixture_folder() {
         .iter()
         .map(|c| c.file_name().unwrap().to_string_lossy().into_owned())
         .collect();
+    // A code about the run rather than a file has no asset to trigger it; tests/ci.rs runs it.
     let missing: Vec<&str> = all_codes()
         .iter()
+        .filter(|c| {
+            !velvet::diagnostics::codes::RUN
+                .iter()
+                .any(|r| r.name == c.name)
+        })
         .map(|c| c.name)
         .filter(|n| !folders.iter().any(|f| f == n))
         .collect();

@@ -130,6 +130,17 @@ pub const IMAGE_TOO_LARGE: Code = Code::new(
     "An image's header declares more pixels than --max-image-pixels allows; it was not decoded.",
 );
 
+/// Not a finding about an asset: the run could not start. The JSON reports of such a run hold
+/// it as their one message, so that a report redirected into a file is never empty.
+pub const USAGE_ERROR: Code = Code::new(
+    "USAGE_ERROR",
+    Error,
+    "The run could not start (a path that does not exist, a bad flag value, an invalid velvet.toml); the JSON reports record it, and the exit status is 2.",
+);
+
+/// The codes about a run rather than a file (no asset triggers them).
+pub const RUN: &[&Code] = &[&USAGE_ERROR];
+
 pub const LOADER: &[&Code] = &[
     &IO_ERROR,
     &DOCUMENT_TOO_LARGE,

@@ -161,6 +161,45 @@ pub fn render(format: Format, reports: &[FileReport], options: &Options) -> Stri
     }
 }
 
+/// What a run that could not start writes to standard output in `format`, besides its
+/// message on standard error: a document that records the failure, so that output redirected
+/// into the file a CI step uploads (`if: always()`) is never empty or cut short. SARIF: a log
+/// whose invocation has `executionSuccessful: false`, exit code 2 and the message, and no
+/// results. JSON and JSON lines: a report in the Khronos shape whose one message is
+/// USAGE_ERROR (an array of it, as a run over anything but one file gives, for `json_array`).
+/// GitHub: an error annotation. Text: nothing.
+pub fn failed_run(format: Format, message: &str, json_array: bool) -> String {
+    let report = || FileReport {
+        path: std::path::PathBuf::new(),
+        container: None,
+        json_offset: 0,
+        findings: vec![Finding {
+            diagnostic: crate::diagnostics::Diagnostic::new(
+                &crate::diagnostics::codes::USAGE_ERROR,
+                "",
+                message,
+            ),
+            position: None,
+        }],
+        counts: crate::validate::Counts {
+            errors: 1,
+            ..Default::default()
+        },
+        omitted: 0,
+        info: None,
+        missing: MissingResources::default(),
+    };
+    match format {
+        Format::Text => String::new(),
+        Format::Github => format!("::error title=velvet::{}\n", github::escape_data(message)),
+        // As the stream writes an array of one report.
+        Format::Json if json_array => format!("[\n{}\n]\n", json_element(&report())),
+        Format::Json => json::render(&[report()]),
+        Format::Jsonl => json::render_lines(&[report()]),
+        Format::Sarif => sarif::render_failed(message),
+    }
+}
+
 /// Writes a run's reports as they come, one file at a time, keeping only the totals: a run over
 /// many files holds one file's report, not all of them. The JSON report's shape is chosen per
 /// invocation, never per count: a run over one file argument gives the report object, any

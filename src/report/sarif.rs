@@ -127,6 +127,8 @@ struct Configuration {
 #[serde(rename_all = "camelCase")]
 struct Invocation<'a> {
     execution_successful: bool,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    exit_code: Option<i32>,
     #[serde(skip_serializing_if = "Vec::is_empty")]
     tool_execution_notifications: Vec<Notification<'a>>,
 }
@@ -140,7 +142,8 @@ struct OwnedText {
 struct Notification<'a> {
     level: &'static str,
     message: OwnedText,
-    locations: [Location<'a>; 1],
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    locations: Vec<Location<'a>>,
 }
 
 #[derive(Serialize)]
@@ -254,16 +257,6 @@ fn log<'a>(
 ) -> Log<'a> {
     let codes = crate::rules::all_codes();
     let index: HashMap<&str, usize> = codes.iter().enumerate().map(|(i, c)| (c.name, i)).collect();
-    let rules = codes
-        .iter()
-        .map(|c| Rule {
-            id: c.name,
-            short_description: Text { text: c.doc },
-            default_configuration: Configuration {
-                level: level(c.severity),
-            },
-        })
-        .collect();
     let mut results = Vec::new();
     let mut notifications = Vec::new();
     for (report, artifact) in reports.iter().zip(artifacts) {
@@ -276,7 +269,7 @@ fn log<'a>(
                 message: OwnedText {
                     text: super::omitted_note(report.omitted),
                 },
-                locations: [Location {
+                locations: vec![Location {
                     physical_location: PhysicalLocation {
                         artifact_location: artifact,
                         region: None,
@@ -294,22 +287,66 @@ fn log<'a>(
         schema: SCHEMA_URI,
         version: "2.1.0",
         runs: [Run {
-            tool: Tool {
-                driver: Driver {
-                    name: "velvet",
-                    version: env!("CARGO_PKG_VERSION"),
-                    semantic_version: env!("CARGO_PKG_VERSION"),
-                    rules,
-                },
-            },
+            tool: tool(),
             invocations: [Invocation {
                 execution_successful: true,
+                exit_code: None,
                 tool_execution_notifications: notifications,
             }],
             column_kind: "unicodeCodePoints",
             results,
         }],
     }
+}
+
+/// The tool: velvet, with every code of the registry as a rule.
+fn tool() -> Tool {
+    let rules = crate::rules::all_codes()
+        .iter()
+        .map(|c| Rule {
+            id: c.name,
+            short_description: Text { text: c.doc },
+            default_configuration: Configuration {
+                level: level(c.severity),
+            },
+        })
+        .collect();
+    Tool {
+        driver: Driver {
+            name: "velvet",
+            version: env!("CARGO_PKG_VERSION"),
+            semantic_version: env!("CARGO_PKG_VERSION"),
+            rules,
+        },
+    }
+}
+
+/// The SARIF log of a run that could not start: its invocation failed with exit code 2 and
+/// `message`, and it has no results.
+pub fn render_failed(message: &str) -> String {
+    let log = Log {
+        schema: SCHEMA_URI,
+        version: "2.1.0",
+        runs: [Run {
+            tool: tool(),
+            invocations: [Invocation {
+                execution_successful: false,
+                exit_code: Some(2),
+                tool_execution_notifications: vec![Notification {
+                    level: "error",
+                    message: OwnedText {
+                        text: message.to_string(),
+                    },
+                    locations: Vec::new(),
+                }],
+            }],
+            column_kind: "unicodeCodePoints",
+            results: Vec::new(),
+        }],
+    };
+    let mut text = serde_json::to_string_pretty(&log).expect("a SARIF log serialises");
+    text.push('\n');
+    text
 }
 
 /// The SARIF log for `reports` as a JSON value.

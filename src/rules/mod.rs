@@ -185,6 +185,7 @@ pub fn all_codes() -> Vec<&'static Code> {
     for code in crate::diagnostics::codes::LOADER
         .iter()
         .chain(crate::diagnostics::codes::SCHEMA)
+        .chain(crate::diagnostics::codes::RUN)
         .copied()
         .chain(REGISTRY.iter().flat_map(|r| r.codes().iter().copied()))
     {
