@@ -498,7 +498,8 @@ fn every_missing_resource_is_one_file_not_found_and_nothing_else() {
         "textures": [{"source": 0}, {"source": 1}],
         "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}},
                        "extensions": {"KHR_materials_sheen": {"sheenColorFactor": [1, 1, 1],
-                           "sheenColorTexture": {"index": 1}, "sheenRoughnessTexture": {"index": 1}}}}],
+                           "sheenColorTexture": {"index": 1}, "sheenRoughnessFactor": 0.5,
+                           "sheenRoughnessTexture": {"index": 1}}}}],
         "extensionsUsed": ["KHR_materials_sheen"]});
     let path = dir.path().join("lfs-less.gltf");
     std::fs::write(&path, serde_json::to_vec_pretty(&doc).unwrap()).unwrap();

@@ -1,5 +1,7 @@
 //! Layer order with a clear coat: sheen lies under KHR_materials_clearcoat, fuzz over it. The
 //! same material converted from one to the other changes its look where the coat is strong.
+//! A clear coat whose clearcoatFactor is 0 (the default) is switched off ("If `clearcoatFactor`
+//! (in the extension) is zero, the whole clearcoat layer is disabled"): it lies over nothing.
 
 use super::{Context, Rule};
 use crate::diagnostics::{Code, Diagnostic, Severity};
@@ -25,7 +27,12 @@ impl Rule for Clearcoat {
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
         for layer in cx.layer_objects() {
-            if layer.extensions.get(layers::CLEARCOAT).is_none() {
+            let coat_factor = layer
+                .extensions
+                .get(layers::CLEARCOAT)
+                .and_then(|coat| coat.get("clearcoatFactor"))
+                .and_then(|f| f.as_f64());
+            if !coat_factor.is_some_and(|f| f > 0.0) {
                 continue;
             }
             let (code, message) = if layer.extension == layers::SHEEN {

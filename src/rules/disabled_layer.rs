@@ -1,7 +1,9 @@
-//! Switched-off layers with textures: sheen is off when sheenColorFactor is `[0, 0, 0]` (its
-//! default) and fuzz when fuzzFactor is 0 (its default). Textures on such a layer have no
-//! effect, which usually means a forgotten factor: exporters often write the texture and rely
-//! on a default that turns the layer off.
+//! Textures without effect. On switched-off layers: sheen is off when sheenColorFactor is
+//! `[0, 0, 0]` (its default) and fuzz when fuzzFactor is 0 (its default). On a sheen layer that
+//! is on, a sheenRoughnessTexture whose sheenRoughnessFactor is 0 (its default): the spec
+//! multiplies the texture's alpha by the factor, so the roughness is 0 wherever it is read.
+//! Either usually means a forgotten factor: exporters often write the texture and rely on a
+//! default that cancels it.
 
 use super::{slot_uses, Context, Rule};
 use crate::diagnostics::{Code, Diagnostic, Severity};
@@ -9,13 +11,15 @@ use crate::diagnostics::{Code, Diagnostic, Severity};
 pub const SHEEN_TEXTURE_WITHOUT_EFFECT: Code = Code::new(
     "KHR_MATERIALS_SHEEN_TEXTURE_WITHOUT_EFFECT",
     Severity::Warning,
-    "A sheen texture on a layer switched off by sheenColorFactor [0,0,0] (the default).",
+    "A sheen texture without effect: on a layer switched off by sheenColorFactor [0,0,0] (the default), or a sheenRoughnessTexture scaled by sheenRoughnessFactor 0 (the default).",
 );
 pub const FUZZ_TEXTURE_WITHOUT_EFFECT: Code = Code::new(
     "KHR_MATERIALS_FUZZ_TEXTURE_WITHOUT_EFFECT",
     Severity::Warning,
     "A fuzz texture on a layer switched off by fuzzFactor 0 (the default).",
 );
+
+const ROUGHNESS_TEXTURE: &str = "sheenRoughnessTexture";
 
 pub struct DisabledLayer;
 
@@ -41,6 +45,21 @@ impl Rule for DisabledLayer {
                 (None, None) => continue,
             };
             if !off {
+                let roughness_cancelled = read.sheen().is_some_and(|s| s.roughness_factor == 0.0);
+                for slot in slot_uses(&layer)
+                    .filter(|s| roughness_cancelled && s.slot.texture == ROUGHNESS_TEXTURE)
+                {
+                    let stated = layer.value.get(slot.slot.factor).is_some();
+                    out.push(Diagnostic::new(
+                        &SHEEN_TEXTURE_WITHOUT_EFFECT,
+                        slot.pointer(),
+                        format!(
+                            "{ROUGHNESS_TEXTURE} has no effect: {} is 0{}, which scales the texture to 0",
+                            slot.slot.factor,
+                            if stated { "" } else { " (the default)" }
+                        ),
+                    ));
+                }
                 continue;
             }
             for slot in slot_uses(&layer) {
