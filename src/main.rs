@@ -26,7 +26,9 @@ struct Cli {
     /// When to colour output: auto colours on a terminal unless NO_COLOR is set.
     #[arg(long, value_enum, global = true, default_value_t = ColorChoice::Auto, value_name = "WHEN")]
     color: ColorChoice,
-    /// Print findings only: no summary line and no progress bar.
+    /// Less output, no summary line and no progress bar: validate prints its findings only,
+    /// migrate and bake only the files that failed, preview nothing (errors still go to
+    /// standard error; JSON output is always complete).
     #[arg(long, short, global = true)]
     quiet: bool,
     #[command(subcommand)]
@@ -58,6 +60,7 @@ enum Command {
     Bake(BakeArgs),
     /// List every code velvet reports, with its severity and description.
     Codes {
+        /// Output format.
         #[arg(long, value_enum, default_value_t = CodesFormat::Text)]
         format: CodesFormat,
     },
@@ -67,6 +70,8 @@ enum Command {
     Completions { shell: clap_complete::Shell },
     /// Print the man page (roff), or write one page per command into DIR.
     Man {
+        /// Write velvet.1 and a page per command (velvet-validate.1, …) into DIR instead of
+        /// printing velvet.1.
         #[arg(long, value_name = "DIR")]
         dir: Option<PathBuf>,
     },
@@ -229,6 +234,7 @@ struct BakeArgs {
     /// that existing scripts run.
     #[arg(long, hide = true, conflicts_with = "rewrite_uris")]
     copy_resources: bool,
+    /// Output format.
     #[arg(long, value_enum, default_value_t = BakeFormat::Text)]
     format: BakeFormat,
     #[command(flatten)]
@@ -259,13 +265,17 @@ enum Compression {
 
 #[derive(Clone, Copy, ValueEnum)]
 enum BakeFormat {
+    /// A line per file, then a summary.
     Text,
+    /// One JSON document: every file with its slots, outputs and notes.
     Json,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
 enum CodesFormat {
+    /// One line per code: name, severity, description.
     Text,
+    /// A Markdown table (docs/codes.md is this output).
     Markdown,
 }
 
@@ -334,7 +344,8 @@ fn man(dir: Option<PathBuf>) -> ExitCode {
                 dir.display()
             )),
         },
-        None => match cli_docs::man_page(Cli::command()) {
+        // The page lists the pages --dir writes: no velvet-help(1), which it does not.
+        None => match cli_docs::man_page(Cli::command().disable_help_subcommand(true)) {
             Ok(page) => {
                 emit(&page);
                 ExitCode::SUCCESS
@@ -496,6 +507,7 @@ struct MigrateArgs {
     /// Write nothing; exit with status 1 when a file would change (for CI and pre-commit).
     #[arg(long, conflicts_with_all = ["output", "out_dir", "in_place"])]
     check: bool,
+    /// Output format.
     #[arg(long, value_enum, default_value_t = MigrateFormat::Text)]
     format: MigrateFormat,
     /// Decode sheen colour textures to measure what the fast conversion changes (and show
@@ -551,7 +563,9 @@ enum RoughnessArg {
 
 #[derive(Clone, Copy, ValueEnum)]
 enum MigrateFormat {
+    /// A line per file, then a summary.
     Text,
+    /// One JSON document: every file with its materials, edits and notes.
     Json,
 }
 

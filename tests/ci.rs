@@ -840,6 +840,19 @@ fn man_page_renders_and_writes_one_page_per_command() {
             "{expected} in {names:?}"
         );
     }
+    // Every page the printed page lists under SUBCOMMANDS is one --dir writes.
+    let listed: Vec<String> = page
+        .lines()
+        .filter_map(|l| l.strip_prefix("velvet\\-")?.strip_suffix("(1)"))
+        .map(|name| format!("velvet-{name}.1"))
+        .collect();
+    assert_eq!(listed.len(), 8, "{listed:?}");
+    for name in &listed {
+        assert!(
+            names.contains(name),
+            "{name} is listed but not written: {names:?}"
+        );
+    }
     let validate_page =
         std::fs::read_to_string(dir.path().join("pages/velvet-validate.1")).unwrap();
     assert!(
