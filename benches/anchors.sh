@@ -6,7 +6,9 @@
 # in rounds instead, each round running every command once, each velvet command right before
 # the one it is compared with. For each command the median wall time, the fastest and slowest
 # run and the largest peak memory are printed, then each comparison's ratio of medians, then
-# the share of the processor time the runs asked for that the host held back ("steal" in
+# the ratio of each output format's median to --format json's on the minified library and on
+# its migrated output (one line of JSON each: every finding's column is counted along the whole
+# text), then the share of the processor time the runs asked for that the host held back ("steal" in
 # /proc/stat: on a virtual machine, the time its processors waited for the host's; near 0 on
 # a quiet host).
 #
@@ -35,9 +37,22 @@ for n in 5000 20000 80000; do
     [ -f "$work/m$n/large.gltf" ] || "$corpus" "$work/m$n" "$n" 500 > /dev/null
 done
 [ -f "$work/lib/library.gltf" ] || "$corpus" --library "$work/lib" > /dev/null
+[ -f "$work/min/library.gltf" ] || "$corpus" --minified-library "$work/min" > /dev/null
+# The minified library migrated (a fuzz and a note on each of its 20,000 materials); migrate
+# keeps the layout, so it is one line too.
+[ -f "$work/min-migrated/library.gltf" ] ||
+    "$velvet" migrate -q --fast "$work/min/library.gltf" --out-dir "$work/min-migrated" > /dev/null
 
 # The commands, by number: label, then the command line.
-count=9
+count=17
+# validate's output formats on the minified library (10-13) and its migrated output (14-17).
+formats="json text github sarif"
+format_of() {
+    n=$(( ($1 - 10) % 4 ))
+    set -- $formats
+    shift "$n"
+    echo "$1"
+}
 command_of() {
     case $1 in
     1) echo "velvet validate, 5000 materials" ;;
@@ -49,6 +64,8 @@ command_of() {
     7) echo "velvet migrate --fast, library" ;;
     8) echo "gltf-transform copy, library" ;;
     9) echo "velvet migrate, library" ;;
+    1[0-3]) echo "velvet validate --format $(format_of "$1"), minified library" ;;
+    1[4-7]) echo "velvet validate --format $(format_of "$1"), minified library migrated" ;;
     esac
 }
 # timed COMMAND...: runs it under time(1), which writes its peak memory (KiB) to time1.
@@ -66,6 +83,8 @@ run_command() {
     7) timed "$velvet" migrate -q --fast "$work/lib/library.gltf" --out-dir "$work/out" ;;
     8) timed "$anchors/node_modules/.bin/gltf-transform" copy "$work/lib/library.gltf" "$work/out/library.gltf" ;;
     9) timed "$velvet" migrate -q "$work/lib/library.gltf" --out-dir "$work/out" ;;
+    1[0-3]) timed "$velvet" validate --format "$(format_of "$1")" "$work/min/library.gltf" ;;
+    1[4-7]) timed "$velvet" validate --format "$(format_of "$1")" "$work/min-migrated/library.gltf" ;;
     esac
 }
 
@@ -147,6 +166,14 @@ for pair in "2 3" "5 6" "7 8"; do
     set -- $pair
     awk -v label="$(command_of "$1") / $(command_of "$2")" -v a="$(median "$1")" -v b="$(median "$2")" \
         'BEGIN { printf "| %s | %s s | %s s | %.1f× |\n", label, a, b, b / a }'
+done
+echo
+echo "| validate output format | minified library | × json | minified library migrated | × json |"
+echo "|---|---|---|---|---|"
+for offset in 0 1 2 3; do
+    a=$((10 + offset)) b=$((14 + offset))
+    awk -v label="$(format_of $a)" -v a="$(median $a)" -v a0="$(median 10)" -v b="$(median $b)" -v b0="$(median 14)" \
+        'BEGIN { printf "| %s | %s s | %.2f× | %s s | %.2f× |\n", label, a, a / a0, b, b / b0 }'
 done
 echo
 awk -v s="$steal_ticks" -v t="$busy_ticks" -v rounds="$runs" \

@@ -306,11 +306,17 @@ impl<W: std::io::Write> Stream<W> {
             self.kept.drain(..).for_each(release);
             return;
         }
+        if self.format == Format::Sarif {
+            let _ = sarif::write(&mut self.out, &self.kept);
+            let _ = self.out.flush();
+            self.kept.drain(..).for_each(release);
+            return;
+        }
         let text = match self.format {
             Format::Text if !self.options.quiet => text::summary(self.files, self.totals),
             Format::Json if self.json_array && self.files == 0 => "[]\n".to_string(),
             Format::Json if self.json_array => "\n]\n".to_string(),
-            Format::Json | Format::Sarif => render(self.format, &self.kept, &self.options),
+            Format::Json => render(self.format, &self.kept, &self.options),
             Format::Github => std::mem::take(&mut self.deferred),
             _ => String::new(),
         };

@@ -359,13 +359,19 @@ pub fn document(reports: &[FileReport]) -> Value {
 
 /// The SARIF log as pretty-printed JSON.
 pub fn render(reports: &[FileReport]) -> String {
+    let mut text = Vec::new();
+    write(&mut text, reports).expect("writing to memory cannot fail");
+    String::from_utf8(text).expect("serde_json writes UTF-8")
+}
+
+/// Writes the SARIF log, pretty-printed and followed by a newline, straight into `out` (a log
+/// of many results is some three times the size of the JSON report, and is not held whole).
+pub fn write(out: &mut impl std::io::Write, reports: &[FileReport]) -> std::io::Result<()> {
     let artifacts: Vec<ArtifactLocation> =
         reports.iter().map(|r| artifact_location(&r.path)).collect();
     let missing = missing_entries(reports);
-    let mut text = serde_json::to_string_pretty(&log(reports, &artifacts, &missing))
-        .expect("a SARIF log serialises");
-    text.push('\n');
-    text
+    serde_json::to_writer_pretty(&mut *out, &log(reports, &artifacts, &missing))?;
+    out.write_all(b"\n")
 }
 
 #[cfg(test)]
