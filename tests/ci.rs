@@ -2001,3 +2001,120 @@ fn a_run_that_cannot_start_writes_a_valid_report_recording_why_and_exits_2() {
         );
     }
 }
+
+// ---------------------------------------------------------------- the README against the binary
+
+/// The flags the README gives a command: on each line, every `--flag` and `-x` after a mention
+/// of `velvet <command>`, up to the next mention, a pipe, a redirect, `;`, `&&` or a `#`
+/// comment; with the command each belongs to.
+fn readme_flags(readme: &str, commands: &[&str]) -> Vec<(String, String)> {
+    let mention = regex::Regex::new(&format!(r"\bvelvet ({})\b", commands.join("|"))).unwrap();
+    let flag = regex::Regex::new(r"(?:^|[\s`(\[])(--[a-z][a-z0-9-]*|-[a-zA-Z])\b").unwrap();
+    let mut found = Vec::new();
+    for line in readme.lines() {
+        let mentions: Vec<_> = mention.captures_iter(line).collect();
+        for (i, m) in mentions.iter().enumerate() {
+            let whole = m.get(0).unwrap();
+            let end = mentions
+                .get(i + 1)
+                .map_or(line.len(), |next| next.get(0).unwrap().start());
+            let segment = &line[whole.end()..end];
+            let segment = segment
+                .find(['|', '>', ';', '#'])
+                .map_or(segment, |cut| &segment[..cut]);
+            let segment = segment.split("&&").next().unwrap();
+            for f in flag.captures_iter(segment) {
+                found.push((m[1].to_string(), f[1].to_string()));
+            }
+        }
+    }
+    found.sort();
+    found.dedup();
+    found
+}
+
+#[test]
+fn every_flag_the_readme_gives_a_command_is_in_that_commands_help() {
+    let commands = [
+        "validate",
+        "migrate",
+        "bake",
+        "preview",
+        "config",
+        "codes",
+        "completions",
+        "man",
+    ];
+    let flags = readme_flags(&readme(), &commands);
+    assert!(
+        flags
+            .iter()
+            .any(|(c, f)| c == "validate" && f == "--format"),
+        "the README's flags are found: {flags:?}"
+    );
+    let mut unknown = Vec::new();
+    for command in commands {
+        let help = stdout(&velvet(&[command, "--help"]));
+        for (_, flag) in flags.iter().filter(|(c, _)| c == command) {
+            // As clap lists them: `  -o, --output <FILE>`, `      --dry-run`.
+            let listed = help.lines().any(|l| {
+                let l = l.trim_start();
+                l.split([',', ' ', '\t'])
+                    .filter(|w| !w.is_empty())
+                    .take_while(|w| w.starts_with('-'))
+                    .any(|w| w == flag)
+            });
+            if !listed {
+                unknown.push(format!("velvet {command} {flag}"));
+            }
+        }
+    }
+    assert!(
+        unknown.is_empty(),
+        "flags in the README that --help does not list: {unknown:?}"
+    );
+}
+
+#[test]
+fn readme_flags_are_read_after_the_command_they_follow_and_not_from_other_tools() {
+    let text = "git diff --name-only -z | velvet validate --files-from -\n\
+                velvet migrate a/ --dry-run --format json   # or --check\n\
+                `velvet bake -o x.gltf` and `velvet validate --shard 2/4` > out; --not-this\n";
+    let found = readme_flags(text, &["validate", "migrate", "bake"]);
+    let as_str: Vec<(&str, &str)> = found
+        .iter()
+        .map(|(c, f)| (c.as_str(), f.as_str()))
+        .collect();
+    assert_eq!(
+        as_str,
+        [
+            ("bake", "-o"),
+            ("migrate", "--dry-run"),
+            ("migrate", "--format"),
+            ("validate", "--files-from"),
+            ("validate", "--shard")
+        ]
+    );
+}
+
+#[test]
+fn the_readme_states_the_rust_version_cargo_toml_declares() {
+    let manifest: toml::Table =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("Cargo.toml"))
+            .unwrap()
+            .parse()
+            .unwrap();
+    let declared = manifest["package"]["rust-version"]
+        .as_str()
+        .expect("Cargo.toml declares rust-version");
+    let stated: Vec<String> = regex::Regex::new(r"\bRust (\d+\.\d+(?:\.\d+)?)")
+        .unwrap()
+        .captures_iter(&readme())
+        .map(|c| c[1].to_string())
+        .collect();
+    assert!(!stated.is_empty(), "the README states a Rust version");
+    assert!(
+        stated.iter().all(|v| v == declared),
+        "Cargo.toml: rust-version {declared}; the README: Rust {stated:?}"
+    );
+}
