@@ -13,12 +13,13 @@ Exit status:
   1  a file has an issue at or above --fail-on (a file that cannot be read or parsed has an error)
   2  usage or configuration error (bad flag, unknown code, invalid velvet.toml, a path that does not exist, a folder without .gltf/.glb files)";
 
-/// The exit statuses common to every command, for `velvet --help`.
+/// The exit statuses of every command that works on files, for `velvet --help`: what each
+/// status means for each command (each command's `--help` gives its own).
 pub const EXIT_STATUS_ALL: &str = "\
 Exit status:
-  0  success: no file has an issue at or above --fail-on (validate); every file done (migrate, bake)
-  1  a file has an issue at or above --fail-on (validate), or a file failed (migrate, bake)
-  2  usage or configuration error (bad flag, unknown code, invalid velvet.toml, a path that does not exist, a folder without .gltf/.glb files)";
+  0  validate: no file has an issue at or above --fail-on; migrate, bake: every file done, or nothing to do; preview: every sheet written
+  1  validate: a file has an issue at or above --fail-on (a file that cannot be read or parsed has an error); migrate: a file failed (the others are still written) or, with --check, a file would change; bake: a file failed (the others are still written); preview: a file could not be previewed or a sheet not written
+  2  usage or configuration error in validate, migrate, bake or preview (bad flag, unknown code, invalid velvet.toml, a path that does not exist, a folder without .gltf/.glb files, a refused output); migrate, bake and preview then write nothing";
 
 const HEADING: &str = "Exit status:\n";
 

@@ -764,7 +764,7 @@ fn help_documents_the_exit_status() {
     let top = stdout(&velvet(&["--help"]));
     assert!(
         top.contains(
-            "Exit status:\n  0  success: no file has an issue at or above --fail-on (validate)"
+            "Exit status:\n  0  validate: no file has an issue at or above --fail-on; migrate, bake: "
         ),
         "{top}"
     );
@@ -816,7 +816,7 @@ fn man_page_renders_and_writes_one_page_per_command() {
         "{page}"
     );
     assert!(
-        page.contains(".SH \"EXIT STATUS\"\n.TP\n\\fB0\\fR\nsuccess: "),
+        page.contains(".SH \"EXIT STATUS\"\n.TP\n\\fB0\\fR\nvalidate: no file has an issue"),
         "{page}"
     );
     let dir = tempfile::tempdir().unwrap();
@@ -2117,4 +2117,24 @@ fn the_readme_states_the_rust_version_cargo_toml_declares() {
         stated.iter().all(|v| v == declared),
         "Cargo.toml: rust-version {declared}; the README: Rust {stated:?}"
     );
+}
+
+#[test]
+fn velvet_help_gives_each_exit_status_for_each_command() {
+    let help = stdout(&velvet(&["--help"]));
+    let table = &help[help.find("Exit status:\n").expect("an exit-status section")..];
+    let rows: Vec<&str> = table.lines().skip(1).collect();
+    assert_eq!(rows.len(), 3, "{table}");
+    for (row, status) in rows.iter().zip(["0", "1", "2"]) {
+        assert!(
+            row.trim_start().starts_with(&format!("{status}  ")),
+            "{row}"
+        );
+        for command in ["validate", "migrate", "bake", "preview"] {
+            assert!(
+                row.contains(command),
+                "status {status} says nothing of {command}: {row}"
+            );
+        }
+    }
 }
