@@ -2685,9 +2685,15 @@ mod tests {
         let tape = crate::asset::tape::Tape::build(minified).unwrap();
         let layout = Layout::detect(minified, tape.root(minified));
         let first = "{\n  \"a\": 1}";
-        assert_eq!(layout.line_indent(first, first.find("\"a\"").unwrap()), "  ");
+        assert_eq!(
+            layout.line_indent(first, first.find("\"a\"").unwrap()),
+            "  "
+        );
         let second = "{\t \"b\": 2}";
-        assert_eq!(layout.line_indent(second, second.find("\"b\"").unwrap()), "");
+        assert_eq!(
+            layout.line_indent(second, second.find("\"b\"").unwrap()),
+            ""
+        );
         // A long line of a pretty document: the table is made then, and used after.
         let long = format!("{{\n  \"x\": [{}1],\n\t\"y\": 2}}", "1, ".repeat(3000));
         let tape = crate::asset::tape::Tape::build(&long).unwrap();
