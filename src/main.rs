@@ -588,7 +588,7 @@ fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
                 .map(|f| f.path)
                 .collect(),
         };
-        velvet::preview::render(&inputs, &request.options.load)
+        velvet::preview::render(&inputs, &request.options)
     });
     // A list that names no asset (a change that touched none) is nothing to do, not an error.
     let report = if request.inputs.is_empty() {
@@ -714,7 +714,13 @@ fn preview(args: PreviewArgs, quiet: bool) -> ExitCode {
     if let Err(e) = discover::check_inputs(&args.paths) {
         return usage_error(e);
     }
-    let previews = velvet::preview::render(&args.paths, &args.load.options());
+    let previews = velvet::preview::render(
+        &args.paths,
+        &migrate::Options {
+            load: args.load.options(),
+            ..migrate::Options::default()
+        },
+    );
     let mut failed = !previews.failures.is_empty();
     for f in &previews.failures {
         eprintln!("velvet: {}: {}", f.file.display(), f.message);
