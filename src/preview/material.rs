@@ -653,7 +653,7 @@ pub fn columns(material: &Material, swatch: &Swatch) -> Vec<Column> {
                     look: look(fuzz_layer(migrated)),
                 },
                 Column {
-                    title: "OTHER MAPPING: FUZZ".into(),
+                    title: format!("IF {}: FUZZ", mapping_word(other(mapping))),
                     detail: format!(
                         "A {} {}",
                         rough(alternative.roughness),
@@ -714,7 +714,7 @@ pub fn columns(material: &Material, swatch: &Swatch) -> Vec<Column> {
                     look: look(sheen_layer(migrated)),
                 });
                 cols.push(Column {
-                    title: "OTHER MAPPING: SHEEN".into(),
+                    title: format!("IF {}: SHEEN", mapping_word(other(mapping))),
                     detail: format!(
                         "R {} {}",
                         rough(alternative.roughness),
