@@ -12,12 +12,12 @@ pub mod core;
 pub mod declaration;
 pub mod disabled_layer;
 pub mod exclusions;
+pub mod extensions;
 pub mod fallback;
 pub mod fuzz_roughness_default;
 pub mod fuzz_roughness_mapping;
 pub mod image_size;
 pub mod legacy_sheen;
-pub mod placement;
 pub mod references;
 pub mod resources;
 pub mod roughness_alpha;
@@ -162,7 +162,7 @@ pub static REGISTRY: &[&dyn Rule] = &[
     &schema::SchemaCheck,
     &asset_version::AssetVersion,
     &declaration::Declaration,
-    &placement::Placement,
+    &extensions::ExtensionObjects,
     &exclusions::Exclusions,
     &references::References,
     &attributes::Attributes,
