@@ -1076,3 +1076,66 @@ fn a_number_past_the_range_of_f64_is_out_of_range_where_a_number_is_asked_and_no
     expected_sorted.sort();
     assert_eq!(sorted, expected_sorted, "{found:?}");
 }
+
+/// The code and pointer of every finding on `doc`, written as chair.gltf in a fresh folder.
+fn codes_and_pointers_of(doc: &Value) -> Vec<(String, String)> {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("chair.gltf");
+    std::fs::write(&path, doc.to_string()).unwrap();
+    Validator::new(Schemas::builtin(), Settings::default())
+        .validate_file(&path)
+        .findings
+        .iter()
+        .map(|f| (f.diagnostic.code.to_string(), f.diagnostic.pointer.clone()))
+        .collect()
+}
+
+#[test]
+fn every_texture_of_a_material_needs_its_texcoord_set_as_texture_transform_says() {
+    // A primitive with TEXCOORD_0 only, drawn with material 0, whose textures read: the base
+    // colour set 1 (missing), the normal texture set 1 but KHR_texture_transform's texCoord 0
+    // (present), a clearcoat texture set 0 but KHR_texture_transform's texCoord 2 (missing).
+    let doc = json!({
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_materials_clearcoat", "KHR_texture_transform"],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1, "TANGENT": 2, "TEXCOORD_0": 3}, "material": 0}]}],
+        "materials": [{
+            "pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": 1}},
+            "normalTexture": {"index": 0, "texCoord": 1, "extensions": {"KHR_texture_transform": {"texCoord": 0}}},
+            "extensions": {"KHR_materials_clearcoat": {"clearcoatFactor": 1,
+                "clearcoatTexture": {"index": 0, "extensions": {"KHR_texture_transform": {"texCoord": 2}}}}}
+        }],
+        "textures": [{"source": 0}],
+        "images": [{"uri": "data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR4nGNgYGD4DwABBAEAWB0S5wAAAABJRU5ErkJggg=="}],
+        "accessors": [
+            {"componentType": 5126, "count": 1, "type": "VEC3", "min": [0, 0, 0], "max": [0, 0, 0]},
+            {"componentType": 5126, "count": 1, "type": "VEC3"},
+            {"componentType": 5126, "count": 1, "type": "VEC4"},
+            {"componentType": 5126, "count": 1, "type": "VEC2"}
+        ]
+    });
+    let at = "/meshes/0/primitives/0/material".to_string();
+    assert_eq!(
+        codes_and_pointers_of(&doc),
+        [
+            ("MESH_PRIMITIVE_TOO_FEW_TEXCOORDS".to_string(), at.clone()),
+            ("MESH_PRIMITIVE_TOO_FEW_TEXCOORDS".to_string(), at)
+        ]
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("chair.gltf");
+    std::fs::write(&path, doc.to_string()).unwrap();
+    let messages: Vec<String> = Validator::new(Schemas::builtin(), Settings::default())
+        .validate_file(&path)
+        .findings
+        .iter()
+        .map(|f| f.diagnostic.message.clone())
+        .collect();
+    assert_eq!(
+        messages,
+        [
+            "material 0's /materials/0/pbrMetallicRoughness/baseColorTexture reads TEXCOORD_1, which this primitive does not have",
+            "material 0's /materials/0/extensions/KHR_materials_clearcoat/clearcoatTexture reads TEXCOORD_2, which this primitive does not have",
+        ]
+    );
+}

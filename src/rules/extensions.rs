@@ -609,6 +609,8 @@ struct Shape {
 struct Shapes {
     shapes: Vec<Shape>,
     root: usize,
+    /// The kind of a material.
+    material: usize,
     /// The kind of each placement's object, by index into [`PLACEMENTS`].
     placed: Vec<usize>,
     /// The placements of each extension, by name.
@@ -712,6 +714,9 @@ static SHAPES: LazyLock<Shapes> = LazyLock::new(|| {
     let root = builder
         .shape(&[], "glTF.schema.json")
         .expect("the core schemas describe the root");
+    let material = builder
+        .shape(&[], "material.schema.json")
+        .expect("the core schemas describe a material");
     let mut by_extension: HashMap<&'static str, Vec<usize>> = HashMap::new();
     let placed = PLACEMENTS
         .iter()
@@ -726,6 +731,7 @@ static SHAPES: LazyLock<Shapes> = LazyLock::new(|| {
     Shapes {
         shapes: builder.shapes,
         root,
+        material,
         placed,
         by_extension,
     }
@@ -739,6 +745,11 @@ impl Shapes {
             is.iter()
                 .any(|file| file.strip_suffix(".schema.json") == Some(*kind))
         })
+    }
+
+    /// Whether a kind is (or extends) the schema file `file`.
+    fn is(&self, shape: usize, file: &str) -> bool {
+        self.shapes[shape].is.iter().any(|f| f == file)
     }
 
     /// A kind's name as messages give it: its schema file's name without `.schema.json`.
@@ -963,6 +974,101 @@ impl<'a> Walk<'_, 'a> {
             pointer: [at, d.pointer.as_str()].concat(),
             position: d.position,
         }));
+    }
+}
+
+/// A texture a material reads: a textureInfo of the core or of one of the material's
+/// extensions that has a schema (sheen and fuzz included).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct MaterialTexture {
+    /// Its pointer below the material (`/normalTexture`,
+    /// `/extensions/KHR_materials_clearcoat/clearcoatNormalTexture`).
+    pub pointer: String,
+    /// The TEXCOORD set it reads (KHR_texture_transform's `texCoord` overrides its own).
+    pub set: u64,
+    /// Whether it is a normal texture (a `material.normalTextureInfo`), which needs a tangent
+    /// space.
+    pub normal: bool,
+}
+
+/// Every texture `material` reads, in the order its schemas walk them: the core's properties,
+/// then its extensions'.
+pub fn material_textures(material: Node) -> Vec<MaterialTexture> {
+    let shapes = &*SHAPES;
+    let mut out = Vec::new();
+    let mut path = String::new();
+    textures_in(shapes, material, shapes.material, &mut path, 0, &mut out);
+    out
+}
+
+fn textures_in(
+    shapes: &Shapes,
+    value: Node,
+    shape: usize,
+    path: &mut String,
+    depth: usize,
+    out: &mut Vec<MaterialTexture>,
+) {
+    let Some(object) = value.as_object() else {
+        return;
+    };
+    if depth > MAX_DEPTH {
+        return;
+    }
+    if shapes.is(shape, "textureInfo.schema.json") {
+        out.push(MaterialTexture {
+            pointer: path.clone(),
+            set: super::effective_tex_coord(value),
+            normal: shapes.is(shape, "material.normalTextureInfo.schema.json"),
+        });
+    }
+    for (property, child, array) in &shapes.shapes[shape].children {
+        let Some(member) = object.get(property) else {
+            continue;
+        };
+        let len = path.len();
+        path.push('/');
+        path.push_str(&pointer::escape(property));
+        if *array {
+            for (i, element) in member
+                .as_array()
+                .into_iter()
+                .flat_map(|a| a.iter())
+                .enumerate()
+            {
+                let len = path.len();
+                path.push('/');
+                path.push_str(&i.to_string());
+                textures_in(shapes, element, *child, path, depth + 1, out);
+                path.truncate(len);
+            }
+        } else {
+            textures_in(shapes, member, *child, path, depth + 1, out);
+        }
+        path.truncate(len);
+    }
+    if let Some(extensions) = object.get("extensions").and_then(|e| e.as_object()) {
+        for (name, extension) in extensions.iter() {
+            let Some(placement) = shapes
+                .by_extension
+                .get(name.as_ref())
+                .and_then(|ps| ps.iter().find(|p| shapes.fits(**p, shape)))
+            else {
+                continue;
+            };
+            let len = path.len();
+            path.push_str("/extensions/");
+            path.push_str(&pointer::escape(&name));
+            textures_in(
+                shapes,
+                extension,
+                shapes.placed[*placement],
+                path,
+                depth + 1,
+                out,
+            );
+            path.truncate(len);
+        }
     }
 }
 
