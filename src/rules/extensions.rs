@@ -1080,3 +1080,106 @@ fn kinds(placements: &[usize]) -> String {
         .collect();
     names.join(" or ")
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The placements whose kind is not the first part of their schema file's name, each with
+    /// the reason the table gives.
+    const RENAMED: &[&str] = &[
+        "glTF.EXT_mesh_gpu_instancing.schema.json",
+        "primitive.EXT_mesh_primitive_edge_visibility.schema.json",
+        "EXT_mesh_primitive_restart.schema.json",
+        "glTF.EXT_texture_webp.schema.json",
+        "KHR_xmp_json_ld.schema.json",
+    ];
+
+    #[test]
+    fn the_table_places_every_extension_schema_file_where_its_name_says_but_the_named_exceptions() {
+        for (extension, files) in EXTENSION_FILES {
+            // Every file named `<kind>.<extension>.schema.json` is a placement.
+            for (file, _) in files.iter() {
+                if file.contains(&format!(".{extension}.")) || file.starts_with(extension) {
+                    let placement = PLACEMENTS
+                        .iter()
+                        .find(|p| p.schema == *file)
+                        .unwrap_or_else(|| panic!("{file} is in no placement"));
+                    assert_eq!(placement.extension, *extension);
+                    if !RENAMED.contains(file) {
+                        let kind = file.strip_suffix(&format!(".{extension}.schema.json"));
+                        assert_eq!(placement.on, [kind.unwrap()], "{file}");
+                    }
+                }
+            }
+        }
+        for placement in PLACEMENTS {
+            // Each kind named is a core object (the root included).
+            for kind in placement.on {
+                assert!(
+                    super::super::core::CORE_SCHEMAS
+                        .iter()
+                        .any(|(file, _)| *file == format!("{kind}.schema.json")),
+                    "{}: {kind}",
+                    placement.extension
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn every_placement_compiles_and_finds_its_kind() {
+        let schemas = ExtensionSchemas::default();
+        for (i, placement) in PLACEMENTS.iter().enumerate() {
+            if !judged_as_layer(placement.extension) {
+                schemas.validator(i);
+            }
+            assert!(
+                SHAPES.fits(i, shape_named(placement.on[0])),
+                "{}",
+                placement.schema
+            );
+        }
+    }
+
+    fn shape_named(kind: &str) -> usize {
+        let file = format!("{kind}.schema.json");
+        (0..SHAPES.shapes.len())
+            .find(|s| SHAPES.shapes[*s].is[0] == file)
+            .unwrap_or_else(|| panic!("no kind {kind}"))
+    }
+
+    #[test]
+    fn a_material_reads_the_textures_of_the_core_and_of_its_extensions() {
+        let text = r#"{"pbrMetallicRoughness":{"baseColorTexture":{"index":0,"texCoord":1}},
+            "normalTexture":{"index":1},
+            "extensions":{
+                "KHR_materials_clearcoat":{"clearcoatNormalTexture":{"index":2,
+                    "extensions":{"KHR_texture_transform":{"texCoord":3}}}},
+                "KHR_materials_sheen":{"sheenColorTexture":{"index":0}},
+                "VENDOR_unknown":{"someTexture":{"index":0}}}}"#;
+        let tape = crate::asset::tape::Tape::build(text).unwrap();
+        let found: Vec<(String, u64, bool)> = material_textures(tape.root(text))
+            .into_iter()
+            .map(|t| (t.pointer, t.set, t.normal))
+            .collect();
+        let texture = |p: &str, set, normal| (p.to_string(), set, normal);
+        assert_eq!(
+            found,
+            [
+                texture("/pbrMetallicRoughness/baseColorTexture", 1, false),
+                texture("/normalTexture", 0, true),
+                texture(
+                    "/extensions/KHR_materials_clearcoat/clearcoatNormalTexture",
+                    3,
+                    true
+                ),
+                texture(
+                    "/extensions/KHR_materials_sheen/sheenColorTexture",
+                    0,
+                    false
+                ),
+            ]
+        );
+    }
+}

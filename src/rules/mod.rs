@@ -18,6 +18,7 @@ pub mod fuzz_roughness_default;
 pub mod fuzz_roughness_mapping;
 pub mod image_size;
 pub mod legacy_sheen;
+pub mod lights;
 pub mod references;
 pub mod resources;
 pub mod roughness_alpha;
@@ -192,6 +193,7 @@ pub static REGISTRY: &[&dyn Rule] = &[
     &asset_version::AssetVersion,
     &declaration::Declaration,
     &extensions::ExtensionObjects,
+    &lights::Lights,
     &exclusions::Exclusions,
     &references::References,
     &attributes::Attributes,
