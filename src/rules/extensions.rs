@@ -828,12 +828,10 @@ impl Rule for ExtensionObjects {
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
         let json = cx.json();
-        // Where every `extensions` object starts: the walk enters only values that hold one.
-        let holders: Vec<usize> = json
-            .members_named("extensions")
-            .map(|e| e.span().start)
-            .collect();
-        if holders.is_empty() {
+        // Every `extensions` object, found by one scan of the index; the walk enters only
+        // values that hold one.
+        let found: Vec<Node> = json.members_named("extensions").collect();
+        if found.is_empty() {
             return;
         }
         // When the only extensions with a schema are sheen and fuzz, each on a material (the
@@ -841,7 +839,7 @@ impl Rule for ExtensionObjects {
         let shapes = &*SHAPES;
         let mut layer_keys = 0;
         let mut others = false;
-        for extensions in json.members_named("extensions") {
+        for extensions in &found {
             for (name, _) in extensions.as_object().into_iter().flat_map(|o| o.iter()) {
                 if judged_as_layer(&name) {
                     layer_keys += 1;
@@ -853,6 +851,7 @@ impl Rule for ExtensionObjects {
         if !others && layer_keys == cx.layer_objects().count() {
             return;
         }
+        let holders = found.iter().map(|e| e.span().start).collect();
         let mut walk = Walk {
             shapes,
             schemas: &cx.schemas.extensions,
