@@ -1139,3 +1139,44 @@ fn every_texture_of_a_material_needs_its_texcoord_set_as_texture_transform_says(
         ]
     );
 }
+
+#[test]
+fn only_a_glbs_first_buffer_needs_the_bin_chunk() {
+    // Buffer 1 has no uri: nothing reads it (or an extension fills it). Valid in a .gltf and in
+    // a .glb; only buffer 0 of a .glb without a BIN chunk lacks its data.
+    let doc = json!({
+        "asset": {"version": "2.0"},
+        "buffers": [{"byteLength": 4}, {"byteLength": 8}]
+    });
+    let text = doc.to_string();
+    let dir = tempfile::tempdir().unwrap();
+    let validator = Validator::new(Schemas::builtin(), Settings::default());
+    let codes_of = |name: &str, bytes: Vec<u8>| -> Vec<(String, String)> {
+        let path = dir.path().join(name);
+        std::fs::write(&path, bytes).unwrap();
+        validator
+            .validate_file(&path)
+            .findings
+            .iter()
+            .map(|f| (f.diagnostic.code.to_string(), f.diagnostic.pointer.clone()))
+            .collect()
+    };
+    assert_eq!(codes_of("buffers.gltf", text.clone().into_bytes()), []);
+    assert_eq!(
+        codes_of(
+            "with_bin.glb",
+            velvet::asset::glb::join(text.as_bytes(), Some(&[0u8; 4]))
+        ),
+        []
+    );
+    assert_eq!(
+        codes_of(
+            "without_bin.glb",
+            velvet::asset::glb::join(text.as_bytes(), None)
+        ),
+        [(
+            "BUFFER_MISSING_GLB_DATA".to_string(),
+            "/buffers/0".to_string()
+        )]
+    );
+}
