@@ -617,8 +617,8 @@ struct Shapes {
     by_extension: HashMap<&'static str, Vec<usize>>,
 }
 
-/// The schema files that describe no object of their own (indices, the open `extensions` and
-/// `extras`) or only the members every object shares.
+/// The schema files that describe no object to walk into: an index, and the open `extensions`
+/// and `extras` (whose members are walked as extension objects, or not at all).
 fn is_leaf(name: &str) -> bool {
     matches!(
         name,
@@ -736,6 +736,11 @@ static SHAPES: LazyLock<Shapes> = LazyLock::new(|| {
         by_extension,
     }
 });
+
+/// Reads the kinds of objects from the schemas now, if no document has needed them yet.
+pub fn prepare() {
+    LazyLock::force(&SHAPES);
+}
 
 impl Shapes {
     /// Whether placement `placement` may stand on an object of kind `shape`.
