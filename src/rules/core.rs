@@ -289,6 +289,13 @@ fn diagnostic(
             &PATTERN_MISMATCH,
             format!("{} does not match the pattern '{pattern}'", quote(instance)),
         ),
+        K::OneOfNotValid { context } if required_names(context).is_some() => (
+            &ONE_OF_MISMATCH,
+            format!(
+                "exactly one of {} must be defined",
+                required_names(context).unwrap_or_default()
+            ),
+        ),
         K::OneOfNotValid { .. } | K::OneOfMultipleValid { .. } => (
             &ONE_OF_MISMATCH,
             format!("exactly one of {} must be defined", one_of_names(&at)),
@@ -324,6 +331,24 @@ fn type_names(kind: &jsonschema::error::TypeKind) -> String {
             names.join(" or ")
         }
     }
+}
+
+/// The properties a `oneOf` of `required` alternatives names ("'uri' and 'bufferView'"), when
+/// every alternative failed for want of one property.
+fn required_names(context: &[Vec<jsonschema::ValidationError<'static>>]) -> Option<String> {
+    let names: Option<Vec<String>> = context
+        .iter()
+        .map(|branch| match branch.as_slice() {
+            [one] => match one.kind() {
+                ValidationErrorKind::Required { property } => {
+                    Some(format!("'{}'", property_name(property)))
+                }
+                _ => None,
+            },
+            _ => None,
+        })
+        .collect();
+    names.filter(|n| n.len() > 1).map(|n| n.join(" and "))
 }
 
 /// The properties a `oneOf` of `required` names, from where it stands (only an image has one).

@@ -1146,6 +1146,73 @@ mod tests {
         }
     }
 
+    /// The findings of judging `object` by placement `extension` on `kind`, as (code, pointer,
+    /// message), pointers relative to the object.
+    fn judged(extension: &str, kind: &str, object: &str) -> Vec<(&'static str, String, String)> {
+        let placement = (0..PLACEMENTS.len())
+            .find(|p| PLACEMENTS[*p].extension == extension && PLACEMENTS[*p].on.contains(&kind))
+            .unwrap();
+        let tape = crate::asset::tape::Tape::build(object).unwrap();
+        let mut out = Vec::new();
+        super::super::core::diagnostics(
+            ExtensionSchemas::default().validator(placement),
+            tape.root(object),
+            &mut out,
+        );
+        out.into_iter()
+            .map(|d| (d.code, d.pointer, d.message))
+            .collect()
+    }
+
+    #[test]
+    fn extension_schema_errors_get_the_core_codes_with_messages_that_name_the_fault() {
+        let found = |code: &'static str, pointer: &str, message: &str| {
+            (code, pointer.to_string(), message.to_string())
+        };
+        // IOR: 0, or at least 1; 0.5 is in neither range.
+        assert_eq!(
+            judged("KHR_materials_ior", "material", r#"{"ior":0.5}"#),
+            [found(
+                "VALUE_NOT_IN_RANGE",
+                "/ior",
+                "0.5 is outside every range the schema allows"
+            )]
+        );
+        // An IES profile is read from a uri or a bufferView, exactly one.
+        assert_eq!(
+            judged("EXT_lights_ies", "glTF", r#"{"lights":[{"mimeType":"x"}]}"#),
+            [found(
+                "ONE_OF_MISMATCH",
+                "/lights/0",
+                "exactly one of 'uri' and 'bufferView' must be defined"
+            )]
+        );
+        assert_eq!(
+            judged("KHR_lights_punctual", "glTF", r#"{"lights":[]}"#),
+            [found("EMPTY_ENTITY", "/lights", "the array is empty")]
+        );
+        assert_eq!(
+            judged(
+                "KHR_animation_pointer",
+                "animation.channel.target",
+                r#"{"pointer":"nodes/0"}"#
+            ),
+            [found(
+                "PATTERN_MISMATCH",
+                "/pointer",
+                "'nodes/0' is not a valid json-pointer"
+            )]
+        );
+        assert_eq!(
+            judged("KHR_lights_punctual", "node", r#"{"light":1e400}"#),
+            [found(
+                "TYPE_MISMATCH",
+                "/light",
+                "1e+400 is not of type 'integer'"
+            )]
+        );
+    }
+
     fn shape_named(kind: &str) -> usize {
         let file = format!("{kind}.schema.json");
         (0..SHAPES.shapes.len())
