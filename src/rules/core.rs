@@ -136,7 +136,10 @@ pub(crate) fn diagnostics(
     json: Node,
     out: &mut Vec<Diagnostic>,
 ) {
-    let first = out.len();
+    // The (code, pointer) of each finding so far: a document with many faults has many
+    // findings, and comparing each with all the others would take quadratic time.
+    let mut seen: std::collections::HashSet<(&'static str, String)> =
+        std::collections::HashSet::new();
     for error in validator.iter_errors(json) {
         let at = error.instance_path().as_str().to_string();
         let schema_path = error.schema_path().as_str().to_string();
@@ -144,10 +147,7 @@ pub(crate) fn diagnostics(
         let found = diagnostic(error.kind(), &schema_path, &instance, at);
         // A fault is one finding, though the schema may say so twice: a number past f64's
         // range fails both its type and its maximum, a value its own `type` and its base's.
-        if out[first..]
-            .iter()
-            .any(|d| d.code == found.code && d.pointer == found.pointer)
-        {
+        if !seen.insert((found.code, found.pointer.clone())) {
             continue;
         }
         out.push(found);

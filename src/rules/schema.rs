@@ -310,6 +310,9 @@ fn check_layer(schemas: &Schemas, layer: &LayerObject<Node>) -> Vec<Diagnostic> 
     // Most objects are valid, and the yes-or-no check is the cheaper walk.
     let errors = (!schema.validator.is_valid(layer.value))
         .then(|| schema.validator.iter_errors(layer.value));
+    // The pointers of the values found out of range, each reported once (a set: a hostile
+    // object may have many).
+    let mut out_of_range = std::collections::HashSet::new();
     for error in errors.into_iter().flatten() {
         let code = match error.kind() {
             // A number past f64's range fails its type: it is out of range, reported once.
@@ -319,11 +322,7 @@ fn check_layer(schemas: &Schemas, layer: &LayerObject<Node>) -> Vec<Diagnostic> 
             kind => code_for(kind),
         };
         let at = error.instance_path().as_str();
-        if code.name == codes::VALUE_NOT_IN_RANGE.name
-            && out
-                .iter()
-                .any(|d: &Diagnostic| d.code == code.name && d.pointer == at)
-        {
+        if code.name == codes::VALUE_NOT_IN_RANGE.name && !out_of_range.insert(at.to_string()) {
             continue;
         }
         out.push(Diagnostic::new(code, at, error.to_string()));
