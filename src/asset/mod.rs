@@ -599,7 +599,7 @@ impl Asset {
         let pointer = format!("/images/{index}");
         let unreadable = |detail: String| {
             Diagnostic::new(
-                &codes::IMAGE_UNRECOGNIZED_FORMAT,
+                &codes::IMAGE_DATA_INVALID,
                 &pointer,
                 format!("image {index}: {detail}"),
             )
@@ -621,11 +621,18 @@ impl Asset {
             Some(resource::ImageFormat::Jpeg) => image::ImageFormat::Jpeg,
             Some(resource::ImageFormat::Webp) => image::ImageFormat::WebP,
             Some(resource::ImageFormat::Ktx2) => {
-                return Err(unreadable("KTX2 images are not decoded".to_string()))
+                return Err(Diagnostic::new(
+                    &codes::IMAGE_UNRECOGNIZED_FORMAT,
+                    &pointer,
+                    format!("image {index}: velvet does not decode KTX2 images"),
+                ))
             }
+            // read_header has refused it already.
             None => {
-                return Err(unreadable(
-                    "not a PNG, JPEG, WebP or KTX2 image".to_string(),
+                return Err(Diagnostic::new(
+                    &codes::IMAGE_UNRECOGNIZED_FORMAT,
+                    &pointer,
+                    format!("image {index}: not a PNG, JPEG, WebP or KTX2 image"),
                 ))
             }
         };
