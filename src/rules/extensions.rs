@@ -608,6 +608,12 @@ struct Shape {
 /// The kinds of objects of a glTF document and of its extension objects, from the schemas.
 struct Shapes {
     shapes: Vec<Shape>,
+    /// Per kind: whether it is a textureInfo, and a normal texture's, read once here rather
+    /// than by comparing file names at every object of every material.
+    texture_info: Vec<bool>,
+    normal_texture_info: Vec<bool>,
+    /// Per kind, per placement: whether the placement may stand on it ([`Shapes::fits`]).
+    fit: Vec<Vec<bool>>,
     root: usize,
     /// The kind of a material.
     material: usize,
@@ -728,8 +734,35 @@ static SHAPES: LazyLock<Shapes> = LazyLock::new(|| {
                 .unwrap_or_else(|| panic!("{} has no schema file {}", p.extension, p.schema))
         })
         .collect();
+    let shapes = builder.shapes;
+    let is = |shape: &Shape, file: &str| shape.is.iter().any(|f| f == file);
+    let fit = shapes
+        .iter()
+        .map(|shape| {
+            PLACEMENTS
+                .iter()
+                .map(|p| {
+                    p.on.iter().any(|kind| {
+                        shape
+                            .is
+                            .iter()
+                            .any(|file| file.strip_suffix(".schema.json") == Some(*kind))
+                    })
+                })
+                .collect()
+        })
+        .collect();
     Shapes {
-        shapes: builder.shapes,
+        texture_info: shapes
+            .iter()
+            .map(|s| is(s, "textureInfo.schema.json"))
+            .collect(),
+        normal_texture_info: shapes
+            .iter()
+            .map(|s| is(s, "material.normalTextureInfo.schema.json"))
+            .collect(),
+        fit,
+        shapes,
         root,
         material,
         placed,
@@ -745,16 +778,7 @@ pub fn prepare() {
 impl Shapes {
     /// Whether placement `placement` may stand on an object of kind `shape`.
     fn fits(&self, placement: usize, shape: usize) -> bool {
-        let is = &self.shapes[shape].is;
-        PLACEMENTS[placement].on.iter().any(|kind| {
-            is.iter()
-                .any(|file| file.strip_suffix(".schema.json") == Some(*kind))
-        })
-    }
-
-    /// Whether a kind is (or extends) the schema file `file`.
-    fn is(&self, shape: usize, file: &str) -> bool {
-        self.shapes[shape].is.iter().any(|f| f == file)
+        self.fit[shape][placement]
     }
 
     /// A kind's name as messages give it: its schema file's name without `.schema.json`.
@@ -1019,11 +1043,11 @@ fn textures_in(
     if depth > MAX_DEPTH {
         return;
     }
-    if shapes.is(shape, "textureInfo.schema.json") {
+    if shapes.texture_info[shape] {
         out.push(MaterialTexture {
             pointer: path.clone(),
             set: super::effective_tex_coord(value),
-            normal: shapes.is(shape, "material.normalTextureInfo.schema.json"),
+            normal: shapes.normal_texture_info[shape],
         });
     }
     for (property, child, array) in &shapes.shapes[shape].children {
