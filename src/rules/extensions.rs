@@ -25,7 +25,7 @@
 
 use super::{Context, Rule};
 use crate::asset::pointer;
-use crate::asset::tape::Node;
+use crate::asset::tape::{KeyId, Node};
 use crate::asset::tape_schema::TapeJson;
 use crate::diagnostics::{Code, Diagnostic, Severity};
 use crate::layers;
@@ -1019,18 +1019,50 @@ pub struct MaterialTexture {
     pub normal: bool,
 }
 
+/// The keys a walk of the kinds asks objects for, numbered once for one document: a lookup by
+/// number compares numbers, where a lookup by name hashes the name (for every property of
+/// every material, most of the cost of finding a library's textures). `None` for a key the
+/// document does not have, which no object holds.
+pub struct WalkKeys {
+    children: Vec<Vec<Option<KeyId>>>,
+    extensions: Option<KeyId>,
+}
+
+impl WalkKeys {
+    /// The keys of the document `node` belongs to.
+    pub fn of(node: Node) -> WalkKeys {
+        WalkKeys {
+            children: SHAPES
+                .shapes
+                .iter()
+                .map(|s| s.children.iter().map(|(p, _, _)| node.key_id(p)).collect())
+                .collect(),
+            extensions: node.key_id("extensions"),
+        }
+    }
+}
+
 /// Every texture `material` reads, in the order its schemas walk them: the core's properties,
-/// then its extensions'.
-pub fn material_textures(material: Node) -> Vec<MaterialTexture> {
+/// then its extensions'. `keys` are its document's ([`WalkKeys::of`]).
+pub fn material_textures(material: Node, keys: &WalkKeys) -> Vec<MaterialTexture> {
     let shapes = &*SHAPES;
     let mut out = Vec::new();
     let mut path = String::new();
-    textures_in(shapes, material, shapes.material, &mut path, 0, &mut out);
+    textures_in(
+        shapes,
+        keys,
+        material,
+        shapes.material,
+        &mut path,
+        0,
+        &mut out,
+    );
     out
 }
 
 fn textures_in(
     shapes: &Shapes,
+    keys: &WalkKeys,
     value: Node,
     shape: usize,
     path: &mut String,
@@ -1050,8 +1082,12 @@ fn textures_in(
             normal: shapes.normal_texture_info[shape],
         });
     }
-    for (property, child, array) in &shapes.shapes[shape].children {
-        let Some(member) = object.get(property) else {
+    for ((property, child, array), key) in shapes.shapes[shape]
+        .children
+        .iter()
+        .zip(&keys.children[shape])
+    {
+        let Some(member) = key.and_then(|key| object.get_id(key)) else {
             continue;
         };
         let len = path.len();
@@ -1067,15 +1103,16 @@ fn textures_in(
                 let len = path.len();
                 path.push('/');
                 path.push_str(&i.to_string());
-                textures_in(shapes, element, *child, path, depth + 1, out);
+                textures_in(shapes, keys, element, *child, path, depth + 1, out);
                 path.truncate(len);
             }
         } else {
-            textures_in(shapes, member, *child, path, depth + 1, out);
+            textures_in(shapes, keys, member, *child, path, depth + 1, out);
         }
         path.truncate(len);
     }
-    if let Some(extensions) = object.get("extensions").and_then(|e| e.as_object()) {
+    let extensions = keys.extensions.and_then(|key| object.get_id(key));
+    if let Some(extensions) = extensions.and_then(|e| e.as_object()) {
         for (name, extension) in extensions.iter() {
             let Some(placement) = shapes
                 .by_extension
@@ -1089,6 +1126,7 @@ fn textures_in(
             path.push_str(&pointer::escape(&name));
             textures_in(
                 shapes,
+                keys,
                 extension,
                 shapes.placed[*placement],
                 path,
@@ -1254,10 +1292,11 @@ mod tests {
                 "KHR_materials_sheen":{"sheenColorTexture":{"index":0}},
                 "VENDOR_unknown":{"someTexture":{"index":0}}}}"#;
         let tape = crate::asset::tape::Tape::build(text).unwrap();
-        let found: Vec<(String, u64, bool)> = material_textures(tape.root(text))
-            .into_iter()
-            .map(|t| (t.pointer, t.set, t.normal))
-            .collect();
+        let found: Vec<(String, u64, bool)> =
+            material_textures(tape.root(text), &WalkKeys::of(tape.root(text)))
+                .into_iter()
+                .map(|t| (t.pointer, t.set, t.normal))
+                .collect();
         let texture = |p: &str, set, normal| (p.to_string(), set, normal);
         assert_eq!(
             found,

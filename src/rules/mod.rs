@@ -62,12 +62,13 @@ impl<'a> Context<'a> {
                 .members_named("index")
                 .map(|n| n.span().start)
                 .collect();
+            let keys = extensions::WalkKeys::of(json);
             materials(json)
                 .map(|material| {
                     let span = material.span();
                     let first = indices.partition_point(|start| *start < span.start);
                     if indices.get(first).is_some_and(|start| *start < span.end) {
-                        extensions::material_textures(material)
+                        extensions::material_textures(material, &keys)
                     } else {
                         Vec::new()
                     }
