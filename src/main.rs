@@ -297,7 +297,6 @@ fn in_pool<T: Send>(job: impl FnOnce() -> T + Send) -> T {
 
 fn main() -> ExitCode {
     velvet::asset::pages::limit_heaps();
-    velvet::asset::source::enable_mapping();
     let cli = Cli::parse();
     match cli.command {
         Command::Validate(args) => in_pool(|| validate(args, cli.color, cli.quiet)),

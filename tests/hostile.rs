@@ -1095,3 +1095,106 @@ fn bake_leaves_a_document_whose_arrays_are_not_arrays_of_objects() {
         );
     }
 }
+
+// ---------------------------------------------------------------------------------------------
+// Inputs read as a snapshot
+
+/// A sheen document of about 2 MiB (large files were once mapped rather than read), its
+/// materials named `cloth N`.
+fn large_sheen_text() -> String {
+    let mut doc = json!({
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_materials_sheen"],
+        "materials": [],
+    });
+    for i in 0..400 {
+        doc["materials"].as_array_mut().unwrap().push(json!({
+            "name": format!("cloth {i} {}", "x".repeat(5000)),
+            "extensions": {"KHR_materials_sheen": {
+                "sheenColorFactor": [0.5, 0.25, 1.0],
+                "sheenRoughnessFactor": 0.75
+            }}
+        }));
+    }
+    let text = serde_json::to_string_pretty(&doc).unwrap();
+    assert!(text.len() > 2 << 20);
+    text
+}
+
+/// Overwrites `len` bytes of `path` at `at` with `byte`, in place (no new file, same size), as
+/// an editor or a sync client writing into the file would.
+fn rewrite_in_place(path: &Path, at: u64, len: usize, byte: u8) {
+    use std::io::{Seek, SeekFrom, Write};
+    let mut file = std::fs::OpenOptions::new().write(true).open(path).unwrap();
+    file.seek(SeekFrom::Start(at)).unwrap();
+    file.write_all(&vec![byte; len]).unwrap();
+    file.sync_all().unwrap();
+}
+
+/// An input another program rewrites in place between velvet reading it and writing its
+/// migration (here with bytes that are not UTF-8, which once made velvet panic) is not written:
+/// the migration fails naming the file, and the file keeps the other program's bytes.
+#[test]
+fn an_input_rewritten_during_migrate_in_place_fails_naming_it_without_a_write() {
+    use velvet::migrate::apply::{execute, plan_file};
+    use velvet::output::files::Claims;
+    use velvet::output::paths::Job;
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("large.gltf");
+    write(&input, large_sheen_text());
+    let job = Job {
+        input: input.clone(),
+        output: Some(input.clone()),
+    };
+    let mut plan = plan_file(&job, &velvet::migrate::Options::default()).unwrap();
+    assert!(plan.changes());
+    rewrite_in_place(&input, 100_000, 4096, 0xff);
+    let rewritten = std::fs::read(&input).unwrap();
+    let error = execute(&mut plan, &Claims::default()).unwrap_err();
+    assert_eq!(
+        error,
+        format!(
+            "{} changed while velvet worked on it (another program wrote it); nothing was \
+             written for it",
+            input.display()
+        )
+    );
+    assert_eq!(std::fs::read(&input).unwrap(), rewritten);
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+}
+
+/// A file last written long before it was read gets no digest: its times alone tell a later
+/// write, and an output to another folder is not written either.
+#[test]
+fn an_input_rewritten_after_it_was_read_is_caught_by_its_times_alone() {
+    use velvet::migrate::apply::{execute, plan_file};
+    use velvet::output::files::Claims;
+    use velvet::output::paths::Job;
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("old.gltf");
+    write(&input, large_sheen_text());
+    // Last written an hour ago: no digest is taken, the times decide.
+    let hour_ago = std::time::SystemTime::now() - std::time::Duration::from_secs(3600);
+    std::fs::File::options()
+        .write(true)
+        .open(&input)
+        .unwrap()
+        .set_modified(hour_ago)
+        .unwrap();
+    let out = dir.path().join("out");
+    let job = Job {
+        input: input.clone(),
+        output: Some(out.join("old.gltf")),
+    };
+    let mut plan = plan_file(&job, &velvet::migrate::Options::default()).unwrap();
+    rewrite_in_place(&input, 100_000, 16, b' ');
+    let error = execute(&mut plan, &Claims::default()).unwrap_err();
+    assert!(
+        error.starts_with(&format!(
+            "{} changed while velvet worked on it",
+            input.display()
+        )),
+        "{error}"
+    );
+    assert!(!out.join("old.gltf").exists());
+}

@@ -141,19 +141,15 @@ pub fn find_too_deep(text: &str, max_depth: usize) -> Option<TooDeep> {
     None
 }
 
-/// Reads a file that is to be parsed as an asset. A regular file is read whole (its size is
-/// what the user stored), or mapped when it is large and mapping is enabled (see
-/// [`super::source`]); anything else — a pipe, a device — is read up to what the limits
-/// allow, so that `/dev/zero` named as an input costs an error, not all memory. A GLB stream
+/// Reads a file that is to be parsed as an asset. A regular file is read whole into memory
+/// (its size is what the user stored; [`super::source`] says why it is not mapped); anything
+/// else — a pipe, a device — is read up to what the limits allow, so that `/dev/zero` named as an input costs an error, not all memory. A GLB stream
 /// is read up to the length its header declares (at most 4 GiB), anything else up to the
 /// document limit; one byte more is read so that a longer stream is seen to be longer.
 pub fn read_asset_file(path: &Path, options: &LoadOptions) -> std::io::Result<FileBytes> {
     let mut file = std::fs::File::open(path)?;
     let metadata = file.metadata()?;
     if metadata.is_file() {
-        if let Some(mapped) = FileBytes::map(&file, path, metadata.len()) {
-            return Ok(mapped);
-        }
         // Sized to the file (and one byte more, to see that it ends there) before it is read,
         // so that a large one can be advised huge pages (see super::pages).
         let size = usize::try_from(metadata.len()).unwrap_or(0);

@@ -24,7 +24,7 @@ use crate::diagnostics::{codes, Diagnostic};
 pub use limits::LoadOptions;
 use resource::{ImageHeader, Location};
 use serde_json::Value;
-pub use source::{FileBytes, SourceText};
+pub use source::{FileBytes, Snapshot, SourceText};
 use std::borrow::Cow;
 use std::collections::HashMap;
 use std::io::{BufReader, Cursor};
@@ -123,6 +123,26 @@ pub fn read(path: &Path, options: &LoadOptions) -> Result<FileBytes, Diagnostic>
         }
     }
     limits::read_asset_file(path, options).map_err(io_error)
+}
+
+/// Reads an asset file as [`read`] does, for a command that will write something for it: with
+/// the [`Snapshot`] of the file to compare before writing. A file that changed while it was
+/// read (its snapshot before and after differ) is refused, naming it.
+pub fn read_for_writing(
+    path: &Path,
+    options: &LoadOptions,
+) -> Result<(FileBytes, Snapshot), String> {
+    let cannot = |e: std::io::Error| format!("cannot read {}: {e}", path.display());
+    let before = Snapshot::before_reading(path).map_err(cannot)?;
+    let bytes = read(path, options).map_err(|d| format!("{} ({})", d.message, d.code))?;
+    match Snapshot::taken(path, before, &bytes).map_err(cannot)? {
+        Some(snapshot) => Ok((bytes, snapshot)),
+        None => Err(format!(
+            "{} changed while velvet read it (another program wrote it); nothing was written \
+             for it",
+            path.display()
+        )),
+    }
 }
 
 /// Parses the bytes of a file that lives (or would live) at `path` under the default limits.

@@ -164,10 +164,10 @@ fn slot_reports(plan: &BakePlan, names: &[String]) -> Vec<SlotReport> {
 fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult, String> {
     let input = job.input.as_path();
     let options = request.options;
-    let bytes = asset::read(input, &options.load)
-        .map_err(|d| format!("cannot be baked: {} ({})", d.message, d.code))?;
-    // A .gltf's bytes become the asset's text as they are (a mapped file's stay mapped); a
-    // GLB's come back, for copying one with nothing to bake.
+    let (bytes, snapshot) = asset::read_for_writing(input, &options.load)
+        .map_err(|e| format!("cannot be baked: {e}"))?;
+    // A .gltf's bytes become the asset's text as they are; a GLB's come back, for copying one
+    // with nothing to bake.
     let (loaded, bytes) = asset::load_read(input, bytes, &options.load);
     let errors: Vec<String> = loaded
         .diagnostics
@@ -221,6 +221,7 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
             crate::edit::apply(&mut json, &relocation.edits).map_err(|e| e.to_string())?;
             Cow::Owned(write::to_bytes(&asset, &json, asset.bin.as_deref()))
         };
+        snapshot.unchanged(input)?;
         write::write_atomic(output, &out_bytes)
             .map_err(|e| format!("cannot write {}: {e}", output.display()))?;
         result.outcome = Outcome::Copied;
@@ -285,6 +286,7 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
     copy_resources(&relocation, &applied.json)?;
     write_new_files(&out_dir, &applied.files)?;
     let out_bytes = write::to_bytes(&asset, &applied.json, applied.bin.as_deref());
+    snapshot.unchanged(input)?;
     write::write_atomic(output, &out_bytes)
         .map_err(|e| format!("cannot write {}: {e}", output.display()))?;
     let names: Vec<String> = applied.outputs.iter().map(|o| o.name.clone()).collect();

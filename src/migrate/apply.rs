@@ -13,7 +13,7 @@ use super::plan::{plan_document, DocumentPlan};
 use super::textures;
 use super::Options;
 use crate::asset::write::Output;
-use crate::asset::{self, write, Asset, FileBytes};
+use crate::asset::{self, write, Asset, FileBytes, Snapshot};
 use crate::bake::apply::{apply as bake_apply, ApplyOptions, OutputReport};
 use crate::bake::{bake_into, BakeOptions, KernelOptions};
 use crate::diagnostics::Severity;
@@ -29,6 +29,8 @@ use std::sync::Mutex;
 #[derive(Debug)]
 pub struct FilePlan {
     pub input: PathBuf,
+    /// The input as it was read, compared before anything is written for it.
+    pub snapshot: Snapshot,
     pub output: Option<PathBuf>,
     /// The input's bytes, kept when the plan changes nothing (then written as they are).
     pub bytes: Option<FileBytes>,
@@ -65,14 +67,8 @@ pub enum Written {
 
 /// Loads and plans one file. Errors name the file and what is wrong.
 pub fn plan_file(job: &Job, options: &Options) -> Result<FilePlan, String> {
-    let bytes = asset::read(&job.input, &options.load).map_err(|d| {
-        format!(
-            "{} cannot be migrated: {} ({})",
-            job.input.display(),
-            d.message,
-            d.code
-        )
-    })?;
+    let (bytes, snapshot) = asset::read_for_writing(&job.input, &options.load)
+        .map_err(|e| format!("{} cannot be migrated: {e}", job.input.display()))?;
     // A .gltf's bytes become the asset's text as they are: a copy of a large document cost as
     // much as reading it (a page fault per 4 KiB on first touch).
     let (loaded, bytes) = asset::load_read(&job.input, bytes, &options.load);
@@ -107,6 +103,7 @@ pub fn plan_file(job: &Job, options: &Options) -> Result<FilePlan, String> {
     };
     Ok(FilePlan {
         input: job.input.clone(),
+        snapshot,
         output: job.output.clone(),
         bytes,
         asset,
@@ -181,6 +178,7 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
     let mut names = names.into_inner().unwrap_or_else(|e| e.into_inner());
     let names_dir = names.dir().to_path_buf();
     let input = plan.input.clone();
+    let snapshot = plan.snapshot;
     let in_place = plan.in_place();
     let fail = |e: edit::EditError| format!("{}: {e}", input.display());
     // Without bakes the edits are written as splices straight into the loaded text, reading
@@ -228,6 +226,7 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
         } else {
             out
         };
+        snapshot.unchanged(&input)?;
         write::write_output_atomic(&output, &out)
             .map_err(|e| format!("cannot write {}: {e}", output.display()))?;
         plan.baked = outputs;
@@ -292,6 +291,7 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
         plan.baked = applied.outputs;
         bytes
     };
+    snapshot.unchanged(&input)?;
     write::write_atomic(&output, &bytes)
         .map_err(|e| format!("cannot write {}: {e}", output.display()))?;
     Ok(if changed {
