@@ -225,7 +225,7 @@ struct BakeArgs {
     /// lead there) instead of getting its own copies beside it (the default).
     #[arg(long)]
     rewrite_uris: bool,
-    /// Copy (or hard-link) resources beside outputs in another folder: the default, kept so
+    /// Copy resources beside outputs in another folder (never hard links): the default, kept so
     /// that existing scripts run.
     #[arg(long, hide = true, conflicts_with = "rewrite_uris")]
     copy_resources: bool,
@@ -519,7 +519,7 @@ struct MigrateArgs {
     /// lead there) instead of getting its own copies beside it (the default).
     #[arg(long)]
     rewrite_uris: bool,
-    /// Copy (or hard-link) resources beside outputs in another folder: the default, kept so
+    /// Copy resources beside outputs in another folder (never hard links): the default, kept so
     /// that existing scripts run.
     #[arg(long, hide = true, conflicts_with = "rewrite_uris")]
     copy_resources: bool,

@@ -1198,3 +1198,125 @@ fn an_input_rewritten_after_it_was_read_is_caught_by_its_times_alone() {
     );
     assert!(!out.join("old.gltf").exists());
 }
+
+// ---------------------------------------------------------------------------------------------
+// No aliasing
+
+/// A document whose sheen changes and whose buffer and image are files beside it.
+fn document_with_resources(dir: &Path) -> PathBuf {
+    write(&dir.join("geometry.bin"), [7u8; 64]);
+    write(
+        &dir.join("tex.png"),
+        png(4, 4, image::ExtendedColorType::Rgba8),
+    );
+    let doc = json!({
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_materials_sheen"],
+        "buffers": [{"uri": "geometry.bin", "byteLength": 64}],
+        "images": [{"uri": "tex.png"}],
+        "textures": [{"source": 0}],
+        "materials": [{
+            "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}},
+            "extensions": {"KHR_materials_sheen": {
+                "sheenColorFactor": [0.5, 0.25, 1.0],
+                "sheenRoughnessFactor": 0.75
+            }}
+        }]
+    });
+    let path = dir.join("asset.gltf");
+    write(&path, serde_json::to_string_pretty(&doc).unwrap());
+    path
+}
+
+/// The resources an output in another folder needs are files of their own: no output resource
+/// shares an inode with its input, and writing into one in place leaves the input as it was.
+#[cfg(unix)]
+#[test]
+fn an_output_resource_never_shares_an_inode_with_its_input() {
+    use std::io::Write;
+    use std::os::unix::fs::MetadataExt;
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in");
+    document_with_resources(&input);
+    for command in ["migrate", "bake"] {
+        let out = dir.path().join(format!("out-{command}"));
+        let (status, stdout, stderr) = velvet(&[command, s(&input), "--out-dir", s(&out)]);
+        assert_eq!(status, 0, "{stdout}{stderr}");
+        for name in ["geometry.bin", "tex.png"] {
+            let (from, to) = (input.join(name), out.join(name));
+            let before = std::fs::read(&from).unwrap();
+            assert_eq!(std::fs::read(&to).unwrap(), before, "{command} {name}");
+            let meta = |p: &Path| std::fs::metadata(p).unwrap();
+            assert_ne!(
+                (meta(&from).dev(), meta(&from).ino()),
+                (meta(&to).dev(), meta(&to).ino()),
+                "{command} {name}"
+            );
+            assert_eq!(meta(&from).nlink(), 1, "{command} {name}");
+            std::fs::OpenOptions::new()
+                .write(true)
+                .open(&to)
+                .unwrap()
+                .write_all(b"EDITED IN PLACE")
+                .unwrap();
+            assert_eq!(std::fs::read(&from).unwrap(), before, "{command} {name}");
+        }
+    }
+}
+
+/// `--in-place` on a symbolic link migrates the file it leads to and keeps the link; a folder
+/// holding a link and its target migrates the file once; a link leading out of the folder
+/// given is refused before anything is written (exit status 2).
+#[cfg(unix)]
+#[test]
+fn in_place_on_a_link_migrates_its_target_and_keeps_the_link() {
+    let dir = tempfile::tempdir().unwrap();
+    let reference = dir.path().join("reference");
+    let reference_doc = document_with_resources(&reference);
+    let (status, _, stderr) = velvet(&["migrate", "--in-place", s(&reference_doc)]);
+    assert_eq!(status, 0, "{stderr}");
+    let migrated = std::fs::read(&reference_doc).unwrap();
+
+    let tree = dir.path().join("tree");
+    let real = document_with_resources(&tree.join("real"));
+    let original = std::fs::read(&real).unwrap();
+    assert_ne!(original, migrated);
+    let link = tree.join("link.gltf");
+    std::os::unix::fs::symlink("real/asset.gltf", &link).unwrap();
+    let (status, stdout, stderr) = velvet(&["migrate", "--in-place", s(&link)]);
+    // A link named alone leads into its own folder's tree: accepted.
+    assert_eq!(status, 0, "{stdout}{stderr}");
+    assert!(std::fs::symlink_metadata(&link).unwrap().is_symlink());
+    assert_eq!(
+        std::fs::read_link(&link).unwrap(),
+        Path::new("real/asset.gltf")
+    );
+    assert_eq!(std::fs::read(&real).unwrap(), migrated);
+
+    // The folder holding both: the one file is migrated once, no collision is claimed.
+    std::fs::write(&real, &original).unwrap();
+    let (status, stdout, stderr) = velvet(&["migrate", "--in-place", s(&tree)]);
+    assert_eq!(status, 0, "{stdout}{stderr}");
+    assert!(std::fs::symlink_metadata(&link).unwrap().is_symlink());
+    assert_eq!(std::fs::read(&real).unwrap(), migrated);
+
+    // A link out of the folder given: refused, nothing written.
+    let inner = tree.join("real");
+    let outside = dir.path().join("outside");
+    let outside_doc = document_with_resources(&outside);
+    let before = std::fs::read(&outside_doc).unwrap();
+    std::os::unix::fs::symlink(&outside_doc, inner.join("away.gltf")).unwrap();
+    let (status, stdout, stderr) = velvet(&["migrate", "--in-place", s(&inner)]);
+    assert_eq!(status, 2, "{stdout}{stderr}");
+    assert_eq!(
+        stderr,
+        format!(
+            "velvet: --in-place: {} is a symbolic link to {}, outside {}; velvet writes only \
+             inside the folders it is given (name the target itself to migrate it)\n",
+            inner.join("away.gltf").display(),
+            outside_doc.canonicalize().unwrap().display(),
+            inner.display()
+        )
+    );
+    assert_eq!(std::fs::read(&outside_doc).unwrap(), before);
+}

@@ -325,16 +325,7 @@ pub fn write_output_atomic(path: &Path, output: &Output) -> io::Result<()> {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
     };
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(".velvet-").suffix(".tmp");
-    // A temporary file is private (0600) by default; a new output is an ordinary file, so it
-    // asks for 0666 and the umask trims it, as any other program's new file.
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        builder.permissions(std::fs::Permissions::from_mode(0o666));
-    }
-    let tmp = builder.tempfile_in(dir)?;
+    let tmp = temporary_in(dir)?;
     write_temporary(&mut HandedOn::new(tmp.as_file()), output)?;
     tmp.as_file().sync_all()?;
     if let Ok(meta) = std::fs::metadata(path) {
@@ -345,39 +336,71 @@ pub fn write_output_atomic(path: &Path, output: &Output) -> io::Result<()> {
     Ok(())
 }
 
-/// How [`copy_atomic`] placed a file.
+/// How [`copy_atomic`] placed a file. Either way the output is a file of its own (another
+/// inode): a tool that edits an output in place never edits the input.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Placed {
-    /// A hard link to the source (same filesystem): no bytes copied.
-    Linked,
+    /// A copy-on-write clone of the source (a reflink, where the filesystem has them: Btrfs,
+    /// XFS, bcachefs…): no bytes copied, and a write to either file leaves the other as it was.
+    Cloned,
     /// A copy of the bytes.
     Copied,
 }
 
-/// Places a regular file holding `from`'s bytes at `to`, atomically: a hard link made under a
-/// temporary name in `to`'s folder and renamed into place where the filesystem allows it, else
-/// a copy through [`write_atomic`]. `from` should be a resolved path (a link to a link is not
-/// made: `link(2)` does not follow a symbolic link, so the caller passes its target).
+/// Places a regular file holding `from`'s bytes at `to`, atomically: a temporary file in `to`'s
+/// folder gets a copy-on-write clone of `from` where the filesystem can make one, else an
+/// ordinary copy, is flushed to disk and renamed into place. Never a hard link: an output's
+/// resource sharing the input's inode would let an edit of the output change the input.
 pub fn copy_atomic(from: &Path, to: &Path) -> io::Result<Placed> {
-    static LINKS: AtomicUsize = AtomicUsize::new(0);
     let dir = match to.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
     };
-    if injected_fault().is_none() {
-        let n = LINKS.fetch_add(1, Ordering::Relaxed);
-        let tmp = dir.join(format!(".velvet-{}-{n}.link", std::process::id()));
-        if std::fs::hard_link(from, &tmp).is_ok() {
-            let renamed = std::fs::rename(&tmp, to);
-            // rename(2) does nothing when both names are links to one file already (an
-            // earlier run's copy): the temporary name is then still there.
-            let _ = std::fs::remove_file(&tmp);
-            return renamed.map(|()| Placed::Linked);
-        }
+    let mut source = std::fs::File::open(from)?;
+    if injected_fault().is_some() {
+        // The fault seam covers the bytes' write, as it does every other output's.
+        let mut bytes = Vec::new();
+        io::Read::read_to_end(&mut source, &mut bytes)?;
+        write_atomic(to, &bytes)?;
+        return Ok(Placed::Copied);
     }
-    let bytes = std::fs::read(from)?;
-    write_atomic(to, &bytes)?;
-    Ok(Placed::Copied)
+    let tmp = temporary_in(dir)?;
+    let placed = if clone_file(&source, tmp.as_file()) {
+        Placed::Cloned
+    } else {
+        // std's copy between files uses copy_file_range(2) on Linux, in the kernel.
+        io::copy(&mut source, &mut tmp.as_file())?;
+        Placed::Copied
+    };
+    tmp.as_file().sync_all()?;
+    tmp.persist(to).map_err(|e| e.error)?;
+    Ok(placed)
+}
+
+/// A new temporary file in `dir`, named `.velvet-*.tmp`, asking for mode 0666 (the umask trims
+/// it, as it does any program's new file; tempfile's default is 0600).
+fn temporary_in(dir: &Path) -> io::Result<tempfile::NamedTempFile> {
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".velvet-").suffix(".tmp");
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    builder.tempfile_in(dir)
+}
+
+/// Makes `to` a copy-on-write clone of `from` (FICLONE); false where the filesystem cannot.
+#[cfg(target_os = "linux")]
+fn clone_file(from: &std::fs::File, to: &std::fs::File) -> bool {
+    use std::os::fd::AsRawFd;
+    // SAFETY: FICLONE takes the source's descriptor as its argument; both are open files.
+    unsafe { libc::ioctl(to.as_raw_fd(), libc::FICLONE, from.as_raw_fd()) == 0 }
+}
+
+#[cfg(not(target_os = "linux"))]
+fn clone_file(_: &std::fs::File, _: &std::fs::File) -> bool {
+    false
 }
 
 #[cfg(test)]
@@ -472,8 +495,7 @@ mod tests {
         std::fs::write(&from, b"resource").unwrap();
         let to = dir.path().join("to.bin");
         std::fs::write(&to, b"old").unwrap();
-        let placed = copy_atomic(&from, &to).unwrap();
-        assert_eq!(placed, Placed::Linked, "one filesystem allows a hard link");
+        copy_atomic(&from, &to).unwrap();
         assert_eq!(std::fs::read(&to).unwrap(), b"resource");
         assert!(std::fs::symlink_metadata(&to)
             .unwrap()
@@ -485,9 +507,22 @@ mod tests {
             .collect();
         names.sort();
         assert_eq!(names, ["from.bin", "to.bin"], "no temporary name is left");
-        // Again, onto the link made the first time: still no temporary name left.
-        assert_eq!(copy_atomic(&from, &to).unwrap(), Placed::Linked);
+        // Again, onto the copy made the first time: still no temporary name left.
+        copy_atomic(&from, &to).unwrap();
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
+        // A copy is a file of its own: writing into it leaves the source as it was.
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::MetadataExt;
+            let inode = |p: &Path| std::fs::metadata(p).unwrap().ino();
+            assert_ne!(inode(&from), inode(&to));
+        }
+        std::fs::OpenOptions::new()
+            .write(true)
+            .open(&to)
+            .and_then(|mut f| f.write_all(b"EDITED"))
+            .unwrap();
+        assert_eq!(std::fs::read(&from).unwrap(), b"resource");
     }
 
     #[test]

@@ -150,8 +150,8 @@ pub(crate) fn create_parent(path: &Path) -> Result<(), String> {
 }
 
 /// Places a relocation's resource copies that the written document `json` still names (each a
-/// regular file, hard-linked or copied atomically from the resolved source), for migrate and
-/// bake alike.
+/// regular file of its own, cloned or copied atomically from the resolved source), for migrate
+/// and bake alike.
 pub(crate) fn copy_resources<'a>(
     relocation: &Relocation,
     json: impl crate::asset::tape::JsonView<'a>,

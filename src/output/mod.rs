@@ -97,4 +97,10 @@ pub enum UsageError {
     },
     #[error("no inputs given")]
     NoInputs,
+    #[error("--in-place: {link} is a symbolic link to {target}, outside {root}; velvet writes only inside the folders it is given (name the target itself to migrate it)")]
+    LinkOutside {
+        link: String,
+        target: String,
+        root: String,
+    },
 }
