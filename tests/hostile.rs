@@ -1320,3 +1320,76 @@ fn in_place_on_a_link_migrates_its_target_and_keeps_the_link() {
     );
     assert_eq!(std::fs::read(&outside_doc).unwrap(), before);
 }
+
+// ---------------------------------------------------------------------------------------------
+// Output escapes what it did not write
+
+/// An image URI that would start a GitHub workflow command on a line of its own, and a
+/// material name that would retitle a terminal.
+const INJECTED_URI: &str = "x\n::error file=README.md,line=1::INJECTED\n.png";
+const INJECTED_NAME: &str = "\u{1b}]0;owned\u{7}cloth";
+
+fn injecting_document(dir: &Path) -> PathBuf {
+    let mut doc = sheen_document(INJECTED_URI);
+    doc["materials"][0]["name"] = json!(INJECTED_NAME);
+    let path = dir.join("inject.gltf");
+    write(&path, serde_json::to_string_pretty(&doc).unwrap());
+    path
+}
+
+/// Asserts that `output` holds no control character but newlines and that no line of it is a
+/// workflow command other than velvet's own (`allowed` of them, none the injected one).
+fn assert_inert(output: &str, allowed: usize, what: &str) {
+    assert!(
+        !output.chars().any(|c| c.is_control() && c != '\n'),
+        "{what}: {output:?}"
+    );
+    let commands: Vec<&str> = output.lines().filter(|l| l.starts_with("::")).collect();
+    assert_eq!(commands.len(), allowed, "{what}: {output}");
+    assert!(
+        !commands
+            .iter()
+            .any(|l| l.starts_with("::error file=README.md")),
+        "{what}: {output}"
+    );
+}
+
+/// A URI holding a newline and `::error` prints no workflow command, in any format or command,
+/// and a name holding an escape sequence reaches no terminal: both are shown as escapes.
+#[test]
+fn a_uri_with_a_newline_and_error_prints_no_workflow_command() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = injecting_document(dir.path());
+    let shown_uri = "x\\u000a::error file=README.md,line=1::INJECTED\\u000a.png";
+
+    let (status, out, err) = velvet(&["validate", s(&path)]);
+    assert_eq!(status, 1, "{out}{err}");
+    assert_inert(&out, 0, "validate text");
+    assert_inert(&err, 0, "validate text, stderr");
+    assert!(out.contains(shown_uri), "{out}");
+
+    let (status, out, err) = velvet(&["validate", "--format", "github", s(&path)]);
+    assert_eq!(status, 1, "{out}{err}");
+    let findings = out.lines().count();
+    assert!(findings >= 1);
+    assert_inert(&out, findings, "validate github");
+    assert!(out.contains(shown_uri), "{out}");
+
+    for command in ["migrate", "bake"] {
+        let (_, out, err) = velvet(&[command, "-v", "--dry-run", s(&path)]);
+        assert_inert(&out, 0, command);
+        assert_inert(&err, 0, command);
+        let (_, out, err) = velvet(&[
+            command,
+            "-v",
+            "--out-dir",
+            s(&dir.path().join("o")),
+            s(&path),
+        ]);
+        assert_inert(&out, 0, command);
+        assert_inert(&err, 0, command);
+        assert!(out.contains("::error file=README.md"), "{command}: {out}");
+    }
+    let (_, out, _) = velvet(&["migrate", "-v", "--dry-run", s(&path)]);
+    assert!(out.contains("\"\\u001b]0;owned\\u0007cloth\""), "{out}");
+}

@@ -29,6 +29,7 @@ use crate::output::files::{Claims, FileNames};
 use crate::output::paths::{check_links, relocate, Destination, Job, Relocation};
 use crate::output::summary::{added, bytes, files_line, plural, Detail};
 use crate::output::{run_each, Scope, UsageError};
+use crate::report::escape::push_line;
 
 /// What a run does besides where it writes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -438,17 +439,22 @@ pub fn render_text(results: &[FileResult], dry_run: bool, detail: Detail) -> Str
             Outcome::Planned { changes: false } => format!("nothing to bake{warned}"),
             Outcome::Failed { error } => format!("FAILED: {error}"),
         };
-        let _ = writeln!(out, "{}{target}: {status}", r.input.display());
+        push_line(
+            &mut out,
+            &format!("{}{target}: {status}", r.input.display()),
+        );
         if detail != Detail::Verbose {
             continue;
         }
         for s in &r.slots {
-            let _ = writeln!(
-                out,
-                "  {}: factor {:?} -> {}",
-                s.pointer,
-                s.factor,
-                s.outputs.join(", ")
+            push_line(
+                &mut out,
+                &format!(
+                    "  {}: factor {:?} -> {}",
+                    s.pointer,
+                    s.factor,
+                    s.outputs.join(", ")
+                ),
             );
         }
         for o in &r.outputs {
@@ -477,14 +483,16 @@ pub fn render_text(results: &[FileResult], dry_run: bool, detail: Detail) -> Str
                     o.clamped
                 );
             }
-            let _ = writeln!(out, "{line}");
+            push_line(&mut out, &line);
         }
         if !r.dropped_images.is_empty() {
-            let _ = writeln!(
-                out,
-                "  dropped images {:?} ({} cut from the BIN chunk)",
-                r.dropped_images,
-                bytes(r.dropped_bin_bytes)
+            push_line(
+                &mut out,
+                &format!(
+                    "  dropped images {:?} ({} cut from the BIN chunk)",
+                    r.dropped_images,
+                    bytes(r.dropped_bin_bytes)
+                ),
             );
         }
         for n in &r.notes {
@@ -492,7 +500,7 @@ pub fn render_text(results: &[FileResult], dry_run: bool, detail: Detail) -> Str
                 super::plan::Level::Info => "info",
                 super::plan::Level::Warning => "warning",
             };
-            let _ = writeln!(out, "  {level} {}: {}", n.pointer, n.message);
+            push_line(&mut out, &format!("  {level} {}: {}", n.pointer, n.message));
         }
     }
     if detail == Detail::Quiet {
