@@ -38,6 +38,10 @@ pub enum ConfigError {
     Invalid { path: PathBuf, message: String },
     #[error("{0}")]
     CommandLine(String),
+    /// Every file found was excluded: a run that checks nothing fails rather than pass as
+    /// "0 files checked".
+    #[error("no asset left to check: {found} found, all excluded by {by}; a run that checks nothing fails")]
+    AllExcluded { found: usize, by: String },
 }
 
 /// Which codes a run reports.

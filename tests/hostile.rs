@@ -211,13 +211,24 @@ fn a_document_over_the_size_limit_is_refused_naming_the_limit_and_its_flag() {
     assert!(!out.contains("DOCUMENT_TOO_LARGE"), "{status} {out}");
 }
 
+/// The library reads a stream up to the document limit; the command refuses one named as an
+/// input (see `a_fifo_or_device_named_as_input_is_a_usage_error_without_blocking`).
+#[cfg(unix)]
 #[test]
-fn an_endless_stream_named_as_input_stops_at_the_document_limit() {
-    let (status, out, _) = velvet(&["validate", "--max-document-bytes", "100000", "/dev/zero"]);
-    assert_eq!(status, 1, "{out}");
+fn an_endless_stream_loaded_by_the_library_stops_at_the_document_limit() {
+    let options = LoadOptions {
+        max_document_bytes: 100_000,
+        ..LoadOptions::default()
+    };
+    let loaded = asset::load_with(Path::new("/dev/zero"), &options);
+    assert!(loaded.asset.is_none());
+    assert_eq!(codes(&loaded.diagnostics), ["DOCUMENT_TOO_LARGE"]);
     assert!(
-        out.contains("the JSON document is 100004 bytes, over the limit of 100000"),
-        "{out}"
+        loaded.diagnostics[0]
+            .message
+            .contains("the JSON document is 100004 bytes, over the limit of 100000"),
+        "{:?}",
+        loaded.diagnostics
     );
 }
 
@@ -1392,4 +1403,214 @@ fn a_uri_with_a_newline_and_error_prints_no_workflow_command() {
     }
     let (_, out, _) = velvet(&["migrate", "-v", "--dry-run", s(&path)]);
     assert!(out.contains("\"\\u001b]0;owned\\u0007cloth\""), "{out}");
+}
+
+// ---------------------------------------------------------------------------------------------
+// The gate
+
+/// Runs velvet with `args`, killing it after 20 s: (exit status, stdout, stderr), status
+/// `None` when it had to be killed.
+fn velvet_within_20s(args: &[&str]) -> (Option<i32>, String, String) {
+    use std::io::Read;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_velvet"))
+        .args(args)
+        .stdin(std::process::Stdio::null())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    let status = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break status.code();
+        }
+        if start.elapsed() > std::time::Duration::from_secs(20) {
+            child.kill().unwrap();
+            child.wait().unwrap();
+            break None;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    };
+    let (mut out, mut err) = (String::new(), String::new());
+    child
+        .stdout
+        .take()
+        .unwrap()
+        .read_to_string(&mut out)
+        .unwrap();
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut err)
+        .unwrap();
+    (status, out, err)
+}
+
+/// A FIFO or a device named as an input is a usage error (exit status 2) naming it, at once:
+/// nothing waits for a writer that never comes.
+#[cfg(unix)]
+#[test]
+fn a_fifo_or_device_named_as_input_is_a_usage_error_without_blocking() {
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("pipe.gltf");
+    let made = Command::new("mkfifo").arg(&fifo).status().unwrap();
+    assert!(made.success());
+    for command in ["validate", "migrate", "bake"] {
+        let mut args = vec![command, s(&fifo)];
+        if command != "validate" {
+            args.push("--dry-run");
+        }
+        let (status, out, err) = velvet_within_20s(&args);
+        assert_eq!(status, Some(2), "{command}: {out}{err}");
+        assert_eq!(
+            err,
+            format!(
+                "velvet: {}: not a regular file or folder (a FIFO); velvet reads assets from \
+                 files\n",
+                fifo.display()
+            ),
+            "{command}"
+        );
+    }
+    let (status, _, err) = velvet_within_20s(&["validate", "/dev/zero"]);
+    assert_eq!(status, Some(2), "{err}");
+    assert_eq!(
+        err,
+        "velvet: /dev/zero: not a regular file or folder (a character device); velvet reads \
+         assets from files\n"
+    );
+}
+
+/// A velvet.toml that excludes every file found, even one in a folder above the checkout, does
+/// not let a run pass as "0 files checked": exit status 2, saying why.
+#[test]
+fn a_config_that_excludes_every_asset_found_fails_the_run_with_status_2() {
+    let dir = tempfile::tempdir().unwrap();
+    write(&dir.path().join("velvet.toml"), "exclude = [\"**\"]\n");
+    let checkout = dir.path().join("checkout");
+    write(
+        &checkout.join("assets/a.gltf"),
+        r#"{"asset":{"version":"2.0"}}"#,
+    );
+    let (status, out, err) = velvet(&["validate", s(&checkout.join("assets"))]);
+    assert_eq!(status, 2, "{out}{err}");
+    assert_eq!(out, "");
+    assert_eq!(
+        err,
+        format!(
+            "velvet: no asset left to check: 1 found, all excluded by the exclude patterns of \
+             {}; a run that checks nothing fails\n",
+            dir.path().join("velvet.toml").display()
+        )
+    );
+    // Excluding some files is fine: the rest are checked.
+    write(
+        &dir.path().join("velvet.toml"),
+        "exclude = [\"checkout/assets/b.gltf\"]\n",
+    );
+    write(
+        &checkout.join("assets/b.gltf"),
+        r#"{"asset":{"version":"2.0"}}"#,
+    );
+    let (status, out, err) = velvet(&["validate", s(&checkout.join("assets"))]);
+    assert_eq!(status, 0, "{out}{err}");
+    assert!(out.contains("1 file checked"), "{out}");
+}
+
+/// An asset whose path is longer than the system allows (over 4,096 bytes) is reported as an
+/// IO_ERROR finding (exit status 1), not skipped by the folder scan.
+#[cfg(unix)]
+#[test]
+fn an_overlong_path_is_a_finding_not_a_silent_skip() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = dir.path().join("deep");
+    write(&root.join("top.gltf"), r#"{"asset":{"version":"2.0"}}"#);
+    // Made from inside, a folder at a time: no single path handed to the system is too long.
+    let script = format!(
+        "cd '{}' && n=$(printf 'd%.0s' $(seq 200)) && for i in $(seq 22); do mkdir $n && cd -P $n \
+         || exit 1; done && printf '{{}}' > deep.gltf",
+        root.display()
+    );
+    let made = Command::new("sh").args(["-c", &script]).status().unwrap();
+    assert!(made.success());
+    let (status, out, err) = velvet(&["validate", s(&root)]);
+    assert_eq!(status, 1, "{out}{err}");
+    let io_errors: Vec<&str> = out.lines().filter(|l| l.contains("IO_ERROR")).collect();
+    assert_eq!(io_errors.len(), 1, "{out}");
+    assert!(
+        io_errors[0].ends_with("File name too long (os error 36)"),
+        "{}",
+        io_errors[0]
+    );
+    assert!(out.contains("2 files checked"), "{out}");
+}
+
+/// An index beyond 64 bits is judged as the number it is: 2^64 + 1 names no texture
+/// (UNRESOLVED_REFERENCE, as the reference validator says), and migrate refuses to carry it
+/// into a new layer rather than copy it in silence.
+#[test]
+fn an_index_of_two_to_the_64_plus_one_is_an_unresolved_reference() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("huge-index.gltf");
+    let mut doc = sheen_document("tex.png");
+    let text = serde_json::to_string_pretty(&doc).unwrap().replace(
+        "\"sheenColorTexture\": {\n            \"index\": 0",
+        "\"sheenColorTexture\": {\n            \"index\": 18446744073709551617",
+    );
+    assert!(text.contains("18446744073709551617"), "{text}");
+    write(
+        &dir.path().join("tex.png"),
+        png(2, 2, image::ExtendedColorType::Rgba8),
+    );
+    write(&path, &text);
+    let validator = Validator::new(Schemas::builtin(), Settings::default());
+    let report = validator.validate_file(&path);
+    assert_eq!(
+        error_findings(&report),
+        [(
+            "UNRESOLVED_REFERENCE",
+            "/materials/0/extensions/KHR_materials_sheen/sheenColorTexture/index"
+        )]
+    );
+    let unresolved = |report: &velvet::validate::FileReport| {
+        report
+            .findings
+            .iter()
+            .find(|f| f.diagnostic.code == "UNRESOLVED_REFERENCE")
+            .map(|f| f.diagnostic.message.clone())
+    };
+    assert_eq!(
+        unresolved(&report).unwrap(),
+        "sheenColorTexture names texture 18446744073709551617, but the asset has 1 texture"
+    );
+    // The same at 1e30 and at a value just inside u64.
+    for (index, expected) in [
+        ("1e30", "1e30"),
+        ("18446744073709551615", "18446744073709551615"),
+    ] {
+        write(&path, text.replace("18446744073709551617", index));
+        let report = validator.validate_file(&path);
+        assert_eq!(
+            unresolved(&report).unwrap(),
+            format!("sheenColorTexture names texture {expected}, but the asset has 1 texture")
+        );
+    }
+    write(&path, &text);
+    let out_dir = dir.path().join("out");
+    let (status, out, err) = velvet(&["migrate", s(&path), "--out-dir", s(&out_dir)]);
+    assert_eq!(status, 1, "{out}{err}");
+    assert!(
+        out.contains(
+            "cannot be migrated: sheenColorTexture names texture 18446744073709551617, but the \
+             asset has 1 texture (UNRESOLVED_REFERENCE at \
+             /materials/0/extensions/KHR_materials_sheen/sheenColorTexture/index)"
+        ),
+        "{out}"
+    );
+    assert!(!out_dir.join("huge-index.gltf").exists());
+    doc["materials"][0]["extensions"]["KHR_materials_sheen"]["sheenColorTexture"]["index"] =
+        json!(0);
+    write(&path, serde_json::to_string_pretty(&doc).unwrap());
+    assert!(error_findings(&validator.validate_file(&path)).is_empty());
 }

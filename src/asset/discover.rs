@@ -98,8 +98,16 @@ fn walk(dir: &Path, files: &mut Vec<PathBuf>, errors: &mut Vec<WalkError>) {
     let mut paths: Vec<PathBuf> = entries.filter_map(|e| e.ok().map(|e| e.path())).collect();
     paths.sort();
     for path in paths {
-        let Ok(meta) = std::fs::symlink_metadata(&path) else {
-            continue;
+        let meta = match std::fs::symlink_metadata(&path) {
+            Ok(meta) => meta,
+            // Gone between the listing and now: nothing to report.
+            Err(e) if e.kind() == io::ErrorKind::NotFound => continue,
+            // An entry that cannot be looked at (a path longer than the system allows, a
+            // permission): reported, never skipped in silence.
+            Err(e) => {
+                errors.push((path, e));
+                continue;
+            }
         };
         if meta.is_dir() {
             walk(&path, files, errors);
@@ -125,8 +133,11 @@ fn has_asset(dir: &Path) -> bool {
     let mut folders = Vec::new();
     for entry in entries.filter_map(Result::ok) {
         let path = entry.path();
-        let Ok(meta) = std::fs::symlink_metadata(&path) else {
-            continue;
+        let meta = match std::fs::symlink_metadata(&path) {
+            Ok(meta) => meta,
+            Err(e) if e.kind() == io::ErrorKind::NotFound => continue,
+            // Reported by the walk (see `walk`).
+            Err(_) => return true,
         };
         if meta.is_dir() {
             folders.push(path);
@@ -144,6 +155,8 @@ pub enum InputError {
     Missing(PathBuf),
     #[error("{}: no .gltf or .glb file in this folder or below", .0.display())]
     NoAssets(PathBuf),
+    #[error("{}: not a regular file or folder ({kind}); velvet reads assets from files", .path.display())]
+    NotAFile { path: PathBuf, kind: &'static str },
     #[error("--files-from {}: {source}", .list.display())]
     ListUnreadable { list: PathBuf, source: io::Error },
     #[error("--files-from {}: {path} (entry {entry}) does not exist", .list.display())]
@@ -156,8 +169,10 @@ pub enum InputError {
     ListedNotAPath { list: PathBuf, entry: usize },
 }
 
-/// Refuses a path that does not exist and a folder with no asset in it or below. A link named
-/// on the command line is taken even when it dangles: the loader reports that file.
+/// Refuses a path that does not exist, one that is neither a regular file nor a folder (a FIFO
+/// would block the run until something writes to it, a device would be read without end), and
+/// a folder with no asset in it or below. A link named on the command line is taken even when
+/// it dangles: the loader reports that file.
 pub fn check_inputs(inputs: &[PathBuf]) -> Result<(), InputError> {
     for input in inputs {
         match std::fs::symlink_metadata(input) {
@@ -166,11 +181,42 @@ pub fn check_inputs(inputs: &[PathBuf]) -> Result<(), InputError> {
             }
             _ => {}
         }
+        if let Ok(meta) = std::fs::metadata(input) {
+            if !meta.is_file() && !meta.is_dir() {
+                return Err(InputError::NotAFile {
+                    path: input.clone(),
+                    kind: file_kind(&meta),
+                });
+            }
+        }
         if input.is_dir() && !has_asset(input) {
             return Err(InputError::NoAssets(input.clone()));
         }
     }
     Ok(())
+}
+
+/// What a file that is neither a regular file nor a folder is, for messages.
+fn file_kind(meta: &std::fs::Metadata) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        let t = meta.file_type();
+        if t.is_fifo() {
+            return "a FIFO";
+        }
+        if t.is_socket() {
+            return "a socket";
+        }
+        if t.is_char_device() {
+            return "a character device";
+        }
+        if t.is_block_device() {
+            return "a block device";
+        }
+    }
+    let _ = meta;
+    "a special file"
 }
 
 /// The entries of a `--files-from` list: NUL-separated when the bytes hold a NUL, else one per

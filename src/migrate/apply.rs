@@ -90,6 +90,12 @@ pub fn plan_file(job: &Job, options: &Options) -> Result<FilePlan, String> {
     };
     check_links(&asset).map_err(|e| format!("{}: {e}", job.input.display()))?;
     let document = plan_document(&asset, options);
+    if let Some(dangling) = dangling_layer_texture(&asset, &document) {
+        return Err(format!(
+            "{} cannot be migrated: {dangling}",
+            job.input.display()
+        ));
+    }
     let relocation = match &job.output {
         Some(output) if output != &job.input => relocate(&asset, output, options.rewrite_uris)
             .map_err(|e| format!("{}: {e}", job.input.display()))?,
@@ -112,6 +118,52 @@ pub fn plan_file(job: &Job, options: &Options) -> Result<FilePlan, String> {
         embed: options.embed,
         baked: Vec::new(),
     })
+}
+
+/// The first texture reference of a layer the plan converts that names no texture (an index
+/// past the textures, at any size: `18446744073709551617` included), worded as validate's
+/// UNRESOLVED_REFERENCE. A conversion would carry it into the new layer as it is: an output
+/// that repeats the input's dangling reference under another name, with a clean report. A
+/// draft sheen is left out: its upgrade checks its texture and drops one that names nothing,
+/// saying so.
+fn dangling_layer_texture(asset: &Asset, document: &DocumentPlan) -> Option<String> {
+    let root = asset.root();
+    let textures = root
+        .get("textures")
+        .and_then(|t| t.as_array())
+        .map_or(0, |t| t.len());
+    let materials = root.get("materials")?;
+    document
+        .materials
+        .iter()
+        .filter(|m| {
+            !m.conversions.is_empty() && !m.conversions.contains(&super::Conversion::LegacyUpgrade)
+        })
+        .find_map(|m| {
+            let extensions = materials.get(m.index)?.get("extensions")?;
+            ["KHR_materials_sheen", "KHR_materials_fuzz"]
+                .into_iter()
+                .filter_map(|name| Some((name, extensions.get(name)?.as_object()?)))
+                .find_map(|(name, layer)| {
+                    layer.iter().find_map(|(key, info)| {
+                        if !key.ends_with("Texture") {
+                            return None;
+                        }
+                        let index = info.get("index")?;
+                        let i = crate::layers::as_index(index)?;
+                        (i >= textures as u64).then(|| {
+                            format!(
+                                "{key} names texture {}, but the asset has {textures} \
+                                 texture{} (UNRESOLVED_REFERENCE at \
+                                 /materials/{}/extensions/{name}/{key}/index)",
+                                index.raw(),
+                                if textures == 1 { "" } else { "s" },
+                                m.index
+                            )
+                        })
+                    })
+                })
+        })
 }
 
 /// Applies a file's plan and writes its output (and resource copies). On failure the output
