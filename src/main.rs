@@ -282,6 +282,26 @@ fn usage_error(message: impl std::fmt::Display) -> ExitCode {
     ExitCode::from(2)
 }
 
+/// When SIGINT or SIGTERM stopped a migrate or bake run: the one line saying what was finished
+/// (`finished` says it of each file) and the exit status, 128 + the signal. Files that failed
+/// for another reason are counted with those not finished: nothing of either was written.
+fn stopped(finished: impl Iterator<Item = bool>) -> Option<ExitCode> {
+    let signal = velvet::output::interrupt::requested()?;
+    let (mut done, mut total) = (0usize, 0usize);
+    for finished in finished {
+        total += 1;
+        done += usize::from(finished);
+    }
+    eprintln!(
+        "velvet: stopped by {}: {done} of {total} {} finished (their outputs are complete); \
+         nothing was written for the other {}",
+        velvet::output::interrupt::name(signal),
+        if total == 1 { "file" } else { "files" },
+        total - done
+    );
+    Some(ExitCode::from(128 + signal as u8))
+}
+
 /// Writes to standard output; a closed pipe (`velvet … | head`) is not an error.
 fn emit(text: &[u8]) {
     let _ = std::io::stdout().lock().write_all(text);
@@ -597,11 +617,20 @@ fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
             summary: migrate::Summary::default(),
         }
     } else {
+        velvet::output::interrupt::install();
         match migrate::run_shard(&request, args.input.shard) {
             Ok(report) => report,
             Err(e) => return usage_error(e),
         }
     };
+    if let Some(stopped) = stopped(
+        report
+            .files
+            .iter()
+            .map(|f| !matches!(f.outcome, migrate::FileOutcome::Failed { .. })),
+    ) {
+        return stopped;
+    }
     print!(
         "{}",
         match args.format {
@@ -680,11 +709,15 @@ fn bake(args: BakeArgs, quiet: bool) -> ExitCode {
     let results = if request.inputs.is_empty() {
         Vec::new()
     } else {
+        velvet::output::interrupt::install();
         match command::run_shard(&request, args.input.shard) {
             Ok(r) => r,
             Err(e) => return usage_error(e),
         }
     };
+    if let Some(stopped) = stopped(results.iter().map(|r| !r.failed())) {
+        return stopped;
+    }
     match args.format {
         BakeFormat::Text => print!(
             "{}",

@@ -740,12 +740,13 @@ fn an_interrupted_batch_leaves_only_complete_outputs() {
         "the interrupted write was mid-file"
     );
     assert_eq!(tree(&input), inputs_before);
-    // A rerun completes the batch; the leftover temporaries are hidden and never taken for
-    // assets.
+    // A rerun completes the batch and removes the staging files the killed run left (its
+    // process is gone).
     let (status, out, _) = velvet(&["migrate", s(&input), "--out-dir", s(&out_dir)]);
     assert_eq!(status, 0, "{out}");
-    let (outputs, _) = complete_outputs(&out_dir, &expected);
+    let (outputs, temporaries) = complete_outputs(&out_dir, &expected);
     assert_eq!(outputs.len(), 12);
+    assert_eq!(temporaries, Vec::<PathBuf>::new());
 
     // In place: every input is its old bytes or its complete migration.
     let in_place = dir.path().join("in-place");
@@ -1613,4 +1614,211 @@ fn an_index_of_two_to_the_64_plus_one_is_an_unresolved_reference() {
         json!(0);
     write(&path, serde_json::to_string_pretty(&doc).unwrap());
     assert!(error_findings(&validator.validate_file(&path)).is_empty());
+}
+
+// ---------------------------------------------------------------------------------------------
+// Interruption
+
+/// A 64 × 64 RGBA texture whose texels depend on `seed`, so that no two are alike.
+fn seeded_png(seed: usize) -> Vec<u8> {
+    let data: Vec<u8> = (0..64 * 64 * 4)
+        .map(|i| ((i * 31 + seed * 97) % 253) as u8)
+        .collect();
+    let mut out = Vec::new();
+    image::ImageEncoder::write_image(
+        image::codecs::png::PngEncoder::new(&mut out),
+        &data,
+        64,
+        64,
+        image::ExtendedColorType::Rgba8,
+    )
+    .unwrap();
+    out
+}
+
+/// A sheen material whose colour and roughness textures read texture `texture`.
+fn textured_sheen_material(texture: usize, roughness: f64) -> Value {
+    json!({"extensions": {"KHR_materials_sheen": {
+        "sheenColorFactor": [0.5, 0.4, 0.3],
+        "sheenColorTexture": {"index": texture},
+        "sheenRoughnessFactor": roughness,
+        "sheenRoughnessTexture": {"index": texture}
+    }}})
+}
+
+/// A folder of `files` documents, each with its own texture, and one library document of
+/// `materials` materials, each with its own texture: work that bakes a new texture per
+/// material in both commands.
+fn interruptible_inputs(root: &Path, files: usize, materials: usize) -> (PathBuf, PathBuf) {
+    let folder = root.join("folder");
+    for i in 0..files {
+        write(&folder.join(format!("t{i:02}.png")), seeded_png(i));
+        let doc = json!({
+            "asset": {"version": "2.0"},
+            "extensionsUsed": ["KHR_materials_sheen"],
+            "materials": [textured_sheen_material(0, 0.3 + i as f64 / 100.0)],
+            "textures": [{"source": 0}],
+            "images": [{"uri": format!("t{i:02}.png")}]
+        });
+        write(
+            &folder.join(format!("d{i:02}.gltf")),
+            serde_json::to_string_pretty(&doc).unwrap(),
+        );
+    }
+    let library = root.join("library");
+    let mut doc = json!({
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_materials_sheen"],
+        "materials": [], "textures": [], "images": []
+    });
+    for i in 0..materials {
+        write(&library.join(format!("m{i:02}.png")), seeded_png(100 + i));
+        doc["materials"]
+            .as_array_mut()
+            .unwrap()
+            .push(textured_sheen_material(i, 0.2 + i as f64 / 100.0));
+        doc["textures"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!({"source": i}));
+        doc["images"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!({"uri": format!("m{i:02}.png")}));
+    }
+    write(
+        &library.join("library.gltf"),
+        serde_json::to_string_pretty(&doc).unwrap(),
+    );
+    (folder, library)
+}
+
+/// The relative URIs a document names (its buffers' and images').
+fn uris_of(document: &[u8]) -> Vec<String> {
+    let doc: Value = serde_json::from_slice(document).unwrap();
+    ["buffers", "images"]
+        .iter()
+        .flat_map(|kind| doc[*kind].as_array().cloned().unwrap_or_default())
+        .filter_map(|item| item["uri"].as_str().map(str::to_string))
+        .filter(|uri| !uri.starts_with("data:"))
+        .collect()
+}
+
+/// Checks an output folder after a stopped run against the complete run's `expected`: every
+/// file is one of the complete run's, byte for byte; every document there has every file it
+/// names; every other file is named by a document there; no temporary file is left.
+fn assert_only_finished_outputs(out: &Path, expected: &BTreeMap<PathBuf, Vec<u8>>, what: &str) {
+    let found = if out.exists() {
+        tree(out)
+    } else {
+        BTreeMap::new()
+    };
+    let mut named = std::collections::BTreeSet::new();
+    for (path, bytes) in &found {
+        let name = path.to_string_lossy();
+        assert!(!name.contains(".velvet-"), "{what}: {name} left behind");
+        assert_eq!(
+            expected.get(path),
+            Some(bytes),
+            "{what}: {name} is not complete"
+        );
+        if name.ends_with(".gltf") {
+            for uri in uris_of(bytes) {
+                let resource = path.parent().unwrap().join(&uri);
+                assert!(
+                    found.contains_key(&resource),
+                    "{what}: {name} names {uri}, which is missing"
+                );
+                named.insert(resource);
+            }
+        }
+    }
+    for path in found.keys() {
+        if !path.to_string_lossy().ends_with(".gltf") {
+            assert!(
+                named.contains(path),
+                "{what}: {} belongs to no finished document",
+                path.display()
+            );
+        }
+    }
+}
+
+/// SIGINT and SIGTERM at several moments of a migrate and a bake, of a folder of documents and
+/// of one library document, leave only finished outputs, every file they name, and no
+/// temporary file; a stopped run says what it finished on one line and exits 130 or 143.
+#[cfg(unix)]
+#[test]
+fn sigint_and_sigterm_leave_only_finished_outputs_and_no_temporary_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let (folder, library) = interruptible_inputs(dir.path(), 16, 16);
+    let mut stopped = 0;
+    for command in ["migrate", "bake"] {
+        for input in [&folder, &library] {
+            let what = format!("{command} {}", input.display());
+            let reference = dir.path().join("reference");
+            let (status, out, err) = velvet(&[command, s(input), "--out-dir", s(&reference)]);
+            assert_eq!(status, 0, "{what}: {out}{err}");
+            let expected = tree(&reference);
+            std::fs::remove_dir_all(&reference).unwrap();
+            assert!(expected.len() > 16, "{what}: {expected:?}");
+            for (k, (signal, delay_ms)) in [
+                (libc::SIGINT, 20),
+                (libc::SIGTERM, 60),
+                (libc::SIGINT, 150),
+                (libc::SIGTERM, 400),
+            ]
+            .into_iter()
+            .enumerate()
+            {
+                let out_dir = dir.path().join(format!("out-{k}"));
+                let child = Command::new(env!("CARGO_BIN_EXE_velvet"))
+                    .args([command, s(input), "--out-dir", s(&out_dir)])
+                    .stdout(std::process::Stdio::piped())
+                    .stderr(std::process::Stdio::piped())
+                    .spawn()
+                    .unwrap();
+                std::thread::sleep(std::time::Duration::from_millis(delay_ms));
+                // SAFETY: kill(2) on the child's id, which it holds until it is waited for.
+                unsafe { libc::kill(child.id() as libc::pid_t, signal) };
+                let output = child.wait_with_output().unwrap();
+                let err = String::from_utf8_lossy(&output.stderr);
+                let what = format!("{what}, signal {signal} after {delay_ms} ms");
+                match output.status.code() {
+                    Some(0) => assert_eq!(tree(&out_dir), expected, "{what}"),
+                    Some(code) => {
+                        assert_eq!(code, 128 + signal, "{what}: {err}");
+                        let name = if signal == libc::SIGINT {
+                            "SIGINT"
+                        } else {
+                            "SIGTERM"
+                        };
+                        let line = err.lines().last().unwrap_or_default();
+                        assert!(
+                            line.starts_with(&format!("velvet: stopped by {name}: ")),
+                            "{what}: {err}"
+                        );
+                        assert!(
+                            line.contains(
+                                " finished (their outputs are complete); nothing was \
+                                           written for the other "
+                            ),
+                            "{what}: {err}"
+                        );
+                        assert_eq!(err.lines().count(), 1, "{what}: {err}");
+                        assert_only_finished_outputs(&out_dir, &expected, &what);
+                        stopped += 1;
+                    }
+                    None => panic!("{what}: ended by the signal itself: {err}"),
+                }
+                if out_dir.exists() {
+                    std::fs::remove_dir_all(&out_dir).unwrap();
+                }
+            }
+        }
+    }
+    assert!(
+        stopped >= 4,
+        "only {stopped} runs were stopped before they finished"
+    );
 }

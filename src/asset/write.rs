@@ -321,19 +321,55 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
 
 /// Writes `output` to `path` atomically, as [`write_atomic`] writes bytes.
 pub fn write_output_atomic(path: &Path, output: &Output) -> io::Result<()> {
-    let dir = match path.parent() {
+    stage_output(path, output)?.put_in_place()
+}
+
+/// A complete file written under a temporary name in its target's folder, flushed to disk,
+/// waiting to be renamed into place ([`Staged::put_in_place`]). Dropped without that, it is
+/// removed. Its name, `.velvet-PID-*.tmp`, carries the writing process's id, so that the next
+/// run into the folder removes it when that process is gone ([`remove_leftovers`]): a kill
+/// or a power cut leaves nothing that lasts.
+#[derive(Debug)]
+pub struct Staged {
+    tmp: tempfile::NamedTempFile,
+    to: std::path::PathBuf,
+}
+
+impl Staged {
+    /// Where the file goes.
+    pub fn target(&self) -> &Path {
+        &self.to
+    }
+
+    /// Renames the file into place, over whatever was there.
+    pub fn put_in_place(self) -> io::Result<()> {
+        self.tmp.persist(&self.to).map_err(|e| e.error)?;
+        Ok(())
+    }
+}
+
+/// The folder a file at `path` is written in.
+fn folder(path: &Path) -> &Path {
+    match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
-    };
-    let tmp = temporary_in(dir)?;
+    }
+}
+
+/// Writes `output` to a temporary file next to `path`, flushed to disk, with the mode of the
+/// file it will replace (or the umask's), to be put in place later.
+pub fn stage_output(path: &Path, output: &Output) -> io::Result<Staged> {
+    let tmp = temporary_in(folder(path))?;
     write_temporary(&mut HandedOn::new(tmp.as_file()), output)?;
     tmp.as_file().sync_all()?;
     if let Ok(meta) = std::fs::metadata(path) {
         // Keep the permissions of a file being replaced.
         let _ = std::fs::set_permissions(tmp.path(), meta.permissions());
     }
-    tmp.persist(path).map_err(|e| e.error)?;
-    Ok(())
+    Ok(Staged {
+        tmp,
+        to: path.to_path_buf(),
+    })
 }
 
 /// How [`copy_atomic`] placed a file. Either way the output is a file of its own (another
@@ -347,24 +383,27 @@ pub enum Placed {
     Copied,
 }
 
-/// Places a regular file holding `from`'s bytes at `to`, atomically: a temporary file in `to`'s
-/// folder gets a copy-on-write clone of `from` where the filesystem can make one, else an
-/// ordinary copy, is flushed to disk and renamed into place. Never a hard link: an output's
-/// resource sharing the input's inode would let an edit of the output change the input.
+/// Places a regular file holding `from`'s bytes at `to`, atomically: see [`stage_copy`].
 pub fn copy_atomic(from: &Path, to: &Path) -> io::Result<Placed> {
-    let dir = match to.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
+    let (staged, placed) = stage_copy(from, to)?;
+    staged.put_in_place()?;
+    Ok(placed)
+}
+
+/// A copy of `from` staged for `to`: a temporary file in `to`'s folder gets a copy-on-write
+/// clone of `from` where the filesystem can make one, else an ordinary copy, and is flushed to
+/// disk. Never a hard link: an output's resource sharing the input's inode would let an edit
+/// of the output change the input.
+pub fn stage_copy(from: &Path, to: &Path) -> io::Result<(Staged, Placed)> {
     let mut source = std::fs::File::open(from)?;
     if injected_fault().is_some() {
         // The fault seam covers the bytes' write, as it does every other output's.
         let mut bytes = Vec::new();
         io::Read::read_to_end(&mut source, &mut bytes)?;
-        write_atomic(to, &bytes)?;
-        return Ok(Placed::Copied);
+        let staged = stage_output(to, &Output::Bytes(bytes.into()))?;
+        return Ok((staged, Placed::Copied));
     }
-    let tmp = temporary_in(dir)?;
+    let tmp = temporary_in(folder(to))?;
     let placed = if clone_file(&source, tmp.as_file()) {
         Placed::Cloned
     } else {
@@ -373,15 +412,72 @@ pub fn copy_atomic(from: &Path, to: &Path) -> io::Result<Placed> {
         Placed::Copied
     };
     tmp.as_file().sync_all()?;
-    tmp.persist(to).map_err(|e| e.error)?;
-    Ok(placed)
+    Ok((
+        Staged {
+            tmp,
+            to: to.to_path_buf(),
+        },
+        placed,
+    ))
 }
 
-/// A new temporary file in `dir`, named `.velvet-*.tmp`, asking for mode 0666 (the umask trims
+/// The name prefix of this process's temporary files: `.velvet-PID-`.
+fn temporary_prefix() -> String {
+    format!(".velvet-{}-", std::process::id())
+}
+
+/// Removes from `dir` the temporary files (`.velvet-PID-*.tmp`) of velvet processes that are
+/// no longer running: what a killed run, a crash or a power cut left. A file of a process
+/// still running (another run into the same folder) is left alone. Returns how many were
+/// removed.
+pub fn remove_leftovers(dir: &Path) -> usize {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return 0;
+    };
+    let mut removed = 0;
+    for entry in entries.filter_map(Result::ok) {
+        let name = entry.file_name();
+        let Some(pid) = name.to_str().and_then(leftover_pid) else {
+            continue;
+        };
+        if pid != std::process::id() && !process_running(pid) {
+            removed += usize::from(std::fs::remove_file(entry.path()).is_ok());
+        }
+    }
+    removed
+}
+
+/// The process id in a temporary file's name `.velvet-PID-*.tmp`.
+fn leftover_pid(name: &str) -> Option<u32> {
+    let rest = name.strip_prefix(".velvet-")?.strip_suffix(".tmp")?;
+    let (pid, _) = rest.split_once('-')?;
+    pid.parse().ok()
+}
+
+/// Whether a process with id `pid` runs (or may: where that cannot be told, yes).
+fn process_running(pid: u32) -> bool {
+    #[cfg(unix)]
+    {
+        let Ok(pid) = libc::pid_t::try_from(pid) else {
+            return true;
+        };
+        // SAFETY: kill with signal 0 sends nothing; it only checks that the process exists.
+        let alive = unsafe { libc::kill(pid, 0) } == 0;
+        alive || std::io::Error::last_os_error().raw_os_error() != Some(libc::ESRCH)
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = pid;
+        true
+    }
+}
+
+/// A new temporary file in `dir`, named `.velvet-PID-*.tmp`, asking for mode 0666 (the umask trims
 /// it, as it does any program's new file; tempfile's default is 0600).
 fn temporary_in(dir: &Path) -> io::Result<tempfile::NamedTempFile> {
+    let prefix = temporary_prefix();
     let mut builder = tempfile::Builder::new();
-    builder.prefix(".velvet-").suffix(".tmp");
+    builder.prefix(&prefix).suffix(".tmp");
     #[cfg(unix)]
     {
         use std::os::unix::fs::PermissionsExt;
@@ -523,6 +619,48 @@ mod tests {
             .and_then(|mut f| f.write_all(b"EDITED"))
             .unwrap();
         assert_eq!(std::fs::read(&from).unwrap(), b"resource");
+    }
+
+    #[test]
+    fn leftovers_of_processes_gone_are_removed_and_others_kept() {
+        let dir = tempfile::tempdir().unwrap();
+        // A process id no process holds: above the kernel's largest (2^22).
+        let gone = dir.path().join(".velvet-99999999-abc.tmp");
+        let mine = dir
+            .path()
+            .join(format!(".velvet-{}-abc.tmp", std::process::id()));
+        // The parent process (the test harness's caller) runs.
+        #[cfg(unix)]
+        let running = dir.path().join(format!(
+            ".velvet-{}-abc.tmp",
+            std::os::unix::process::parent_id()
+        ));
+        let other = dir.path().join("velvet-99999999-abc.tmp");
+        for path in [&gone, &mine, &other] {
+            std::fs::write(path, b"x").unwrap();
+        }
+        #[cfg(unix)]
+        std::fs::write(&running, b"x").unwrap();
+        assert_eq!(remove_leftovers(dir.path()), 1);
+        assert!(!gone.exists());
+        assert!(mine.exists() && other.exists());
+        #[cfg(unix)]
+        assert!(running.exists());
+    }
+
+    #[test]
+    fn a_staged_file_dropped_before_it_is_put_in_place_is_removed() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("out.png");
+        let staged = stage_output(&target, &Output::Bytes(b"png".as_slice().into())).unwrap();
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+        assert!(!target.exists());
+        drop(staged);
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+        let staged = stage_output(&target, &Output::Bytes(b"png".as_slice().into())).unwrap();
+        staged.put_in_place().unwrap();
+        assert_eq!(std::fs::read(&target).unwrap(), b"png");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
     }
 
     #[test]

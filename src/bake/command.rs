@@ -24,9 +24,11 @@ use super::prune::Dropped;
 use crate::asset::discover::Shard;
 use crate::asset::{self, write};
 use crate::diagnostics::Severity;
-use crate::output::files::{copy_resources, create_parent, file_sink, write_new_files};
+use crate::output::files::{copy_resources, create_parent, file_sink, stage_new_files};
 use crate::output::files::{Claims, FileNames};
+use crate::output::interrupt;
 use crate::output::paths::{check_links, relocate, Destination, Job, Relocation};
+use crate::output::staging::Staging;
 use crate::output::summary::{added, bytes, files_line, plural, Detail};
 use crate::output::{run_each, Scope, UsageError};
 use crate::report::escape::push_line;
@@ -163,6 +165,7 @@ fn slot_reports(plan: &BakePlan, names: &[String]) -> Vec<SlotReport> {
 
 /// Bakes one file; errors name what is wrong (the caller adds the file).
 fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult, String> {
+    interrupt::check()?;
     let input = job.input.as_path();
     let options = request.options;
     let (bytes, snapshot) = asset::read_for_writing(input, &options.load)
@@ -210,7 +213,9 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
         if output == input {
             return Ok(result);
         }
-        copy_resources(&relocation, asset.json())?;
+        interrupt::check()?;
+        let staging = Staging::default();
+        copy_resources(&relocation, asset.json(), &staging)?;
         create_parent(output)?;
         let out_bytes = if relocation.edits.is_empty() {
             Cow::Borrowed(match &bytes {
@@ -222,9 +227,9 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
             crate::edit::apply(&mut json, &relocation.edits).map_err(|e| e.to_string())?;
             Cow::Owned(write::to_bytes(&asset, &json, asset.bin.as_deref()))
         };
+        staging.stage_document(output, &write::Output::Bytes(out_bytes))?;
         snapshot.unchanged(input)?;
-        write::write_atomic(output, &out_bytes)
-            .map_err(|e| format!("cannot write {}: {e}", output.display()))?;
+        staging.commit()?;
         result.outcome = Outcome::Copied;
         return Ok(result);
     }
@@ -245,6 +250,8 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
     // File names next to the output that the document already uses are not free. New image
     // files are written as they are encoded (a .gltf with file images), so a run holds only
     // the images in flight.
+    interrupt::check()?;
+    let staging = Staging::default();
     let names = Mutex::new(FileNames::next_to(
         claims,
         &asset,
@@ -256,7 +263,7 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
     let streamed = asset.container == asset::Container::Gltf && !options.embed;
     let mut baked = Vec::with_capacity(plan.recipes.len());
     let results = {
-        let sink = file_sink(&names, &images, &plan);
+        let sink = file_sink(&names, &images, &plan, &staging);
         bake_into(
             &plan.recipes,
             &asset,
@@ -284,12 +291,12 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
         },
         &mut names,
     );
-    copy_resources(&relocation, &applied.json)?;
-    write_new_files(&out_dir, &applied.files)?;
+    copy_resources(&relocation, &applied.json, &staging)?;
+    stage_new_files(&out_dir, &applied.files, &staging)?;
     let out_bytes = write::to_bytes(&asset, &applied.json, applied.bin.as_deref());
+    staging.stage_document(output, &write::Output::Bytes(out_bytes.into()))?;
     snapshot.unchanged(input)?;
-    write::write_atomic(output, &out_bytes)
-        .map_err(|e| format!("cannot write {}: {e}", output.display()))?;
+    staging.commit()?;
     let names: Vec<String> = applied.outputs.iter().map(|o| o.name.clone()).collect();
     let mut result = FileResult::new(input, Some(output), Outcome::Changed);
     result.slots = slot_reports(&plan, &names);

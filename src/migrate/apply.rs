@@ -18,9 +18,11 @@ use crate::bake::apply::{apply as bake_apply, ApplyOptions, OutputReport};
 use crate::bake::{bake_into, BakeOptions, KernelOptions};
 use crate::diagnostics::Severity;
 use crate::edit;
-use crate::output::files::{copy_resources, create_parent, file_sink, write_new_files};
+use crate::output::files::{copy_resources, create_parent, file_sink, stage_new_files};
 use crate::output::files::{Claims, FileNames};
+use crate::output::interrupt;
 use crate::output::paths::{check_links, relocate, Job, Relocation};
+use crate::output::staging::Staging;
 use std::borrow::Cow;
 use std::path::PathBuf;
 use std::sync::Mutex;
@@ -180,6 +182,10 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
     // Names for new image files, from the document's URIs before they are relocated. In a
     // .gltf whose new images are files, each is written as soon as it is encoded, so the run
     // holds only the images in flight, however many there are.
+    // Every file written for this output is staged and put in place with the document; an
+    // error or a stop drops them all (see output::staging).
+    interrupt::check()?;
+    let staging = Staging::default();
     let names = Mutex::new(FileNames::next_to(
         claims,
         &plan.asset,
@@ -208,7 +214,7 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
             .get("images")
             .map_or(serde_json::Value::Null, |images| images.to_value());
         let results = {
-            let sink = file_sink(&names, &images, &bake_plan);
+            let sink = file_sink(&names, &images, &bake_plan, &staging);
             bake_into(
                 &bake_plan.recipes,
                 &plan.asset,
@@ -257,6 +263,7 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
             &bake_plan,
             &mut baked,
             &mut names,
+            &staging,
         )?
     } else {
         None
@@ -270,7 +277,7 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
             // Without bakes no edit touches a URI that is copied (resources are copied or
             // their URIs rewritten, never both), so the document as loaded names what the
             // output uses.
-            copy_resources(&plan.relocation, plan.asset.root())?;
+            copy_resources(&plan.relocation, plan.asset.root(), &staging)?;
             match changed {
                 true => out,
                 false => Output::Bytes(input_bytes(plan)?),
@@ -278,9 +285,9 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
         } else {
             out
         };
+        staging.stage_document(&output, &out)?;
         snapshot.unchanged(&input)?;
-        write::write_output_atomic(&output, &out)
-            .map_err(|e| format!("cannot write {}: {e}", output.display()))?;
+        staging.commit()?;
         plan.baked = outputs;
         return Ok(if changed {
             Written::Changed
@@ -311,7 +318,7 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
     }
     create_parent(&output)?;
     let bytes = if bake_plan.is_empty() {
-        copy_resources(&plan.relocation, plan.asset.root())?;
+        copy_resources(&plan.relocation, plan.asset.root(), &staging)?;
         match changed {
             true => Cow::Owned(write::to_bytes(
                 &plan.asset,
@@ -331,8 +338,8 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
             ApplyOptions { embed: plan.embed },
             &mut names,
         );
-        copy_resources(&plan.relocation, &applied.json)?;
-        write_new_files(&names_dir, &applied.files)?;
+        copy_resources(&plan.relocation, &applied.json, &staging)?;
+        stage_new_files(&names_dir, &applied.files, &staging)?;
         let bytes = Cow::Owned(write::to_bytes(
             &plan.asset,
             &applied.json,
@@ -343,9 +350,9 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
         plan.baked = applied.outputs;
         bytes
     };
+    staging.stage_document(&output, &Output::Bytes(bytes))?;
     snapshot.unchanged(&input)?;
-    write::write_atomic(&output, &bytes)
-        .map_err(|e| format!("cannot write {}: {e}", output.display()))?;
+    staging.commit()?;
     Ok(if changed {
         Written::Changed
     } else {
@@ -390,6 +397,7 @@ fn baked_by_part<'a>(
     bake_plan: &crate::bake::plan::BakePlan,
     baked: &mut Vec<crate::bake::engine::Baked>,
     names: &mut FileNames,
+    staging: &Staging,
 ) -> Result<Option<PartWritten<'a>>, String> {
     let Some(mut part) = BakePart::new(asset, bake_plan, document) else {
         return Ok(None);
@@ -421,7 +429,7 @@ fn baked_by_part<'a>(
         *baked = as_baked;
         return Ok(None);
     }
-    copy_resources(relocation, &applied.json)?;
+    copy_resources(relocation, &applied.json, staging)?;
     let part_edits = part.into_edits(asset, applied.json);
     let spliced =
         write::spliced_bytes(asset, others.iter().copied().chain(&part_edits)).map_err(fail)?;

@@ -8,8 +8,10 @@ use std::sync::Mutex;
 
 use serde_json::Value;
 
+use super::interrupt;
 use super::paths::{folder_of, identity, relative_uris, Relocation};
-use crate::asset::{self, resource, write};
+use super::staging::Staging;
+use crate::asset::{self, resource};
 use crate::bake::apply::{content_hash, file_candidates, output_name, Names, NewFile};
 use crate::bake::plan::BakePlan;
 use crate::bake::{Baked, OutputId, StoredFile};
@@ -91,15 +93,18 @@ impl Names for FileNames<'_> {
 /// What [`file_sink`] returns: a [`Sink`](crate::bake::Sink) it owns.
 pub(crate) type FileSink<'s> = Box<dyn Fn(OutputId, &mut Baked) -> Result<(), String> + Sync + 's>;
 
-/// A [`Sink`](crate::bake::Sink) that writes each output as a file into `dir` as soon as it is encoded
+/// A [`Sink`](crate::bake::Sink) that stages each output as a file into `dir` as soon as it is encoded
 /// (named from the source image, the slots and a hash of the bytes, claimed through `names`)
 /// and drops its bytes. Only for a .gltf whose new images are files.
 pub(crate) fn file_sink<'s, 'c: 's>(
     names: &'s Mutex<FileNames<'c>>,
     images: &'s Value,
     plan: &'s BakePlan,
+    staging: &'s Staging,
 ) -> FileSink<'s> {
     Box::new(move |id, baked| {
+        // A run asked to stop writes no further texture; what the file staged is dropped.
+        interrupt::check()?;
         let Some((format, bytes)) = baked.encoded.take() else {
             return Ok(());
         };
@@ -111,7 +116,7 @@ pub(crate) fn file_sink<'s, 'c: 's>(
                 .expect("some name is free");
             (names.dir().to_path_buf(), file)
         };
-        write_new_file(&dir, &file, &bytes)?;
+        staging.stage_bytes(&dir, &file, &bytes)?;
         baked.stored = Some(StoredFile {
             name: file,
             format,
@@ -121,23 +126,16 @@ pub(crate) fn file_sink<'s, 'c: 's>(
     })
 }
 
-/// Writes new image files into `dir` (each atomically; one already holding the bytes is left).
-pub(crate) fn write_new_files(dir: &Path, files: &[NewFile]) -> Result<(), String> {
+/// Stages new image files for `dir` (one already holding the bytes is left).
+pub(crate) fn stage_new_files(
+    dir: &Path,
+    files: &[NewFile],
+    staging: &Staging,
+) -> Result<(), String> {
     for file in files {
-        write_new_file(dir, &file.name, &file.bytes)?;
+        staging.stage_bytes(dir, &file.name, &file.bytes)?;
     }
     Ok(())
-}
-
-/// Writes one new file into `dir` atomically, unless it already holds `bytes`.
-pub(crate) fn write_new_file(dir: &Path, name: &str, bytes: &[u8]) -> Result<(), String> {
-    std::fs::create_dir_all(dir)
-        .map_err(|e| format!("cannot create folder {}: {e}", dir.display()))?;
-    let path = dir.join(name);
-    if std::fs::read(&path).is_ok_and(|b| b == bytes) {
-        return Ok(());
-    }
-    write::write_atomic(&path, bytes).map_err(|e| format!("cannot write {}: {e}", path.display()))
 }
 
 /// Creates the folder `path` goes in, if it has one.
@@ -155,6 +153,7 @@ pub(crate) fn create_parent(path: &Path) -> Result<(), String> {
 pub(crate) fn copy_resources<'a>(
     relocation: &Relocation,
     json: impl crate::asset::tape::JsonView<'a>,
+    staging: &Staging,
 ) -> Result<(), String> {
     let used = relative_uris(json);
     for copy in relocation
@@ -167,8 +166,7 @@ pub(crate) fn copy_resources<'a>(
             .canonicalize()
             .map_err(|e| format!("cannot read resource {}: {e}", copy.from.display()))?;
         create_parent(&copy.to)?;
-        write::copy_atomic(&from, &copy.to)
-            .map_err(|e| format!("cannot write resource {}: {e}", copy.to.display()))?;
+        staging.stage_copy(&from, &copy.to)?;
     }
     Ok(())
 }
