@@ -1822,3 +1822,104 @@ fn sigint_and_sigterm_leave_only_finished_outputs_and_no_temporary_file() {
         "only {stopped} runs were stopped before they finished"
     );
 }
+
+// ---------------------------------------------------------------------------------------------
+// Nothing dropped
+
+/// A GLB chunk of a type the spec does not define (here 0x4B4E5558, "XUNK", 12 bytes) survives
+/// migrate and bake byte for byte: it follows the BIN chunk in the output as it stood in the
+/// input, and the header's length counts it.
+#[test]
+fn an_unknown_glb_chunk_survives_migrate_and_bake_byte_for_byte() {
+    let dir = tempfile::tempdir().unwrap();
+    let rgba = png(2, 2, image::ExtendedColorType::Rgba8);
+    let mut doc = sheen_document("unused");
+    doc["images"] = json!([{"bufferView": 0, "mimeType": "image/png"}]);
+    doc["bufferViews"] = json!([{"buffer": 0, "byteLength": rgba.len()}]);
+    doc["buffers"] = json!([{"byteLength": rgba.len()}]);
+    let mut chunk = Vec::new();
+    chunk.extend_from_slice(&12u32.to_le_bytes());
+    chunk.extend_from_slice(b"XUNK");
+    chunk.extend_from_slice(b"kept as is!\x01");
+    let mut bytes = glb::join(doc.to_string().as_bytes(), Some(&rgba));
+    bytes.extend_from_slice(&chunk);
+    let length = bytes.len() as u32;
+    bytes[8..12].copy_from_slice(&length.to_le_bytes());
+    let input = dir.path().join("unknown.glb");
+    write(&input, &bytes);
+    for (command, extra) in [
+        ("migrate", None),
+        ("bake", None),
+        ("migrate", Some("--exact")),
+    ] {
+        let output = dir
+            .path()
+            .join(format!("{command}-{}.glb", extra.is_some()));
+        let mut args = vec![command, s(&input), "-o", s(&output)];
+        args.extend(extra);
+        let (status, out, err) = velvet(&args);
+        assert_eq!(status, 0, "{command}: {out}{err}");
+        let written = std::fs::read(&output).unwrap();
+        assert_ne!(written, bytes, "{command}: the output is a rewrite");
+        assert!(written.ends_with(&chunk), "{command}: {out}");
+        assert_eq!(
+            u32::from_le_bytes(written[8..12].try_into().unwrap()) as usize,
+            written.len()
+        );
+        let mut diagnostics = Vec::new();
+        let parts = glb::split(&written, &mut diagnostics).unwrap();
+        assert_eq!(parts.other, [chunk.as_slice()], "{command}");
+        assert_eq!(codes(&diagnostics), ["GLB_UNKNOWN_CHUNK_TYPE"], "{command}");
+    }
+}
+
+/// Two slots whose bakes come out identical (two source images with the same pixels) get one
+/// new file, named by both images, in bake and in migrate.
+#[test]
+fn identical_baked_images_are_written_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in");
+    let texture = seeded_png(7);
+    write(&input.join("a.png"), &texture);
+    write(&input.join("b.png"), &texture);
+    let doc = json!({
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_materials_sheen"],
+        "materials": [textured_sheen_material(0, 0.5), textured_sheen_material(1, 0.5)],
+        "textures": [{"source": 0}, {"source": 1}],
+        "images": [{"uri": "a.png"}, {"uri": "b.png"}]
+    });
+    write(
+        &input.join("pair.gltf"),
+        serde_json::to_string_pretty(&doc).unwrap(),
+    );
+    for command in ["bake", "migrate"] {
+        let out = dir.path().join(command);
+        let (status, stdout, err) = velvet(&[command, s(&input), "--out-dir", s(&out)]);
+        assert_eq!(status, 0, "{command}: {stdout}{err}");
+        let written = tree(&out);
+        let new: Vec<&PathBuf> = written
+            .keys()
+            .filter(|p| !["pair.gltf", "a.png", "b.png"].contains(&p.to_str().unwrap()))
+            .collect();
+        let output: Value = serde_json::from_slice(&written[Path::new("pair.gltf")]).unwrap();
+        let uris: Vec<&str> = output["images"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter_map(|i| i["uri"].as_str())
+            .filter(|u| *u != "a.png" && *u != "b.png")
+            .collect();
+        assert!(!uris.is_empty(), "{command}: {output}");
+        // Every new image names the one file per distinct content.
+        let distinct: std::collections::BTreeSet<&Vec<u8>> =
+            new.iter().map(|p| &written[*p]).collect();
+        assert_eq!(new.len(), distinct.len(), "{command}: {new:?}");
+        for uri in &uris {
+            assert!(written.contains_key(Path::new(uri)), "{command}: {uri}");
+        }
+        let named: std::collections::BTreeSet<&str> = uris.iter().copied().collect();
+        assert_eq!(named.len(), new.len(), "{command}: {uris:?} {new:?}");
+        assert!(uris.len() > named.len(), "{command}: {uris:?}");
+    }
+}

@@ -62,6 +62,8 @@ pub struct Asset {
     pub json_offset: usize,
     /// The GLB BIN chunk, if any.
     pub bin: Option<Vec<u8>>,
+    /// A GLB's chunks of unknown types, whole, in file order: written back after BIN.
+    pub other_chunks: Vec<Vec<u8>>,
     /// The limits and URI policy it was loaded with; resources are read under them too.
     pub options: LoadOptions,
     image_headers: Mutex<HashMap<usize, Result<ImageHeader, Diagnostic>>>,
@@ -191,14 +193,18 @@ pub fn load_bytes_with(path: &Path, bytes: &[u8], options: &LoadOptions) -> Load
         || path
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("glb"));
+    let mut other_chunks = Vec::new();
     let (container, json_bytes, json_offset, bin) = if is_glb {
         match glb::split(bytes, &mut diagnostics) {
-            Some(parts) => (
-                Container::Glb,
-                parts.json,
-                parts.json_offset,
-                parts.bin.map(<[u8]>::to_vec),
-            ),
+            Some(parts) => {
+                other_chunks = parts.other.iter().map(|c| c.to_vec()).collect();
+                (
+                    Container::Glb,
+                    parts.json,
+                    parts.json_offset,
+                    parts.bin.map(<[u8]>::to_vec),
+                )
+            }
             None => {
                 return Loaded {
                     asset: None,
@@ -269,7 +275,7 @@ pub fn load_bytes_with(path: &Path, bytes: &[u8], options: &LoadOptions) -> Load
             };
         }
     };
-    load_text(
+    let mut loaded = load_text(
         path,
         json_text,
         container,
@@ -277,7 +283,11 @@ pub fn load_bytes_with(path: &Path, bytes: &[u8], options: &LoadOptions) -> Load
         bin,
         diagnostics,
         options,
-    )
+    );
+    if let Some(asset) = &mut loaded.asset {
+        asset.other_chunks = other_chunks;
+    }
+    loaded
 }
 
 /// Indexes a document's JSON text and makes the asset.
@@ -383,6 +393,7 @@ fn load_text(
             json_text,
             json_offset,
             bin,
+            other_chunks: Vec::new(),
             options: *options,
             image_headers: Mutex::new(HashMap::new()),
             real_base: OnceLock::new(),

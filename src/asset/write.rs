@@ -252,7 +252,7 @@ fn source(asset: &Asset) -> &str {
 fn in_container(asset: &Asset, text: Vec<u8>, bin: Option<&[u8]>) -> Vec<u8> {
     match asset.container {
         Container::Gltf => text,
-        Container::Glb => glb::join(&text, bin),
+        Container::Glb => glb::join_with(&text, bin, &asset.other_chunks),
     }
 }
 
@@ -271,9 +271,14 @@ pub fn spliced_bytes<'a, 'e>(
     };
     let output = match asset.container {
         Container::Gltf => Output::Spliced(spliced),
-        Container::Glb => {
-            Output::Bytes(glb::join(spliced.to_text().as_bytes(), asset.bin.as_deref()).into())
-        }
+        Container::Glb => Output::Bytes(
+            glb::join_with(
+                spliced.to_text().as_bytes(),
+                asset.bin.as_deref(),
+                &asset.other_chunks,
+            )
+            .into(),
+        ),
     };
     Ok(Some((output, changed)))
 }

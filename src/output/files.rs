@@ -30,6 +30,9 @@ pub(crate) struct FileNames<'a> {
     claims: &'a Claims,
     dir: PathBuf,
     taken: HashSet<PathBuf>,
+    /// The new files this output writes, by content (hash and length): identical bytes baked
+    /// for two slots are one file.
+    written: HashMap<(String, usize), String>,
 }
 
 impl<'a> FileNames<'a> {
@@ -57,6 +60,7 @@ impl<'a> FileNames<'a> {
             claims,
             dir: folder_of(output).to_path_buf(),
             taken,
+            written: HashMap::new(),
         }
     }
 
@@ -109,14 +113,26 @@ pub(crate) fn file_sink<'s, 'c: 's>(
             return Ok(());
         };
         let name = output_name(images, &plan.outputs[id.0]);
-        let (dir, file) = {
+        let content = (content_hash(&bytes), bytes.len());
+        let (dir, file, new) = {
             let mut names = names.lock().unwrap_or_else(|e| e.into_inner());
-            let file = file_candidates(&name, format, &bytes)
-                .find(|candidate| names.claim(candidate, &bytes))
-                .expect("some name is free");
-            (names.dir().to_path_buf(), file)
+            // The same bytes already written for this output (another slot's bake came out
+            // identical): one file, named by both. Equal hash and length are taken for equal
+            // bytes, as the run's name claims take them.
+            match names.written.get(&content).cloned() {
+                Some(file) => (names.dir().to_path_buf(), file, false),
+                None => {
+                    let file = file_candidates(&name, format, &bytes)
+                        .find(|candidate| names.claim(candidate, &bytes))
+                        .expect("some name is free");
+                    names.written.insert(content, file.clone());
+                    (names.dir().to_path_buf(), file, true)
+                }
+            }
         };
-        staging.stage_bytes(&dir, &file, &bytes)?;
+        if new {
+            staging.stage_bytes(&dir, &file, &bytes)?;
+        }
         baked.stored = Some(StoredFile {
             name: file,
             format,
