@@ -113,6 +113,10 @@ struct LoadArgs {
     /// Refuse to decode an image whose header declares more pixels (width × height) than this.
     #[arg(long, value_name = "PIXELS", default_value_t = velvet::asset::limits::DEFAULT_MAX_IMAGE_PIXELS)]
     max_image_pixels: u64,
+    /// The memory budget in bytes (K, M, G suffixes: binary units); default a quarter of the
+    /// machine's memory. A file or image that would need more to read or decode is refused.
+    #[arg(long, value_name = "BYTES", value_parser = parse_bytes)]
+    max_memory: Option<u64>,
     /// Read resources whose URI leaves the asset's folder (../, absolute paths, file:).
     /// Outputs never follow such URIs.
     #[arg(long)]
@@ -125,9 +129,31 @@ impl LoadArgs {
             max_document_bytes: self.max_document_bytes,
             max_json_depth: usize::from(self.max_json_depth),
             max_image_pixels: self.max_image_pixels,
+            max_memory: self
+                .max_memory
+                .unwrap_or_else(velvet::asset::limits::default_max_memory),
             allow_outside_uris: self.allow_outside_uris,
         }
     }
+}
+
+/// A byte count: digits, then K, M, G or T (binary units, an optional "iB" or "B").
+fn parse_bytes(text: &str) -> Result<u64, String> {
+    let upper = text.trim().to_ascii_uppercase();
+    let number = upper.trim_end_matches('B').trim_end_matches('I');
+    let (digits, shift) = match number.char_indices().last() {
+        Some((at, 'K')) => (&number[..at], 10),
+        Some((at, 'M')) => (&number[..at], 20),
+        Some((at, 'G')) => (&number[..at], 30),
+        Some((at, 'T')) => (&number[..at], 40),
+        _ => (number, 0),
+    };
+    digits
+        .trim()
+        .parse::<u64>()
+        .ok()
+        .and_then(|n| n.checked_mul(1 << shift))
+        .ok_or_else(|| format!("{text:?} is not a byte count (e.g. 2147483648, 512M, 4G)"))
 }
 
 /// The files a command works on, shared by `validate`, `migrate` and `bake`.

@@ -1923,3 +1923,148 @@ fn identical_baked_images_are_written_once() {
         assert!(uris.len() > named.len(), "{command}: {uris:?}");
     }
 }
+
+// ---------------------------------------------------------------------------------------------
+// Memory within a stated budget
+
+/// CRC-32 (the PNG chunk checksum), bit by bit.
+fn crc32(bytes: &[u8]) -> u32 {
+    let mut crc = !0u32;
+    for &b in bytes {
+        crc ^= u32::from(b);
+        for _ in 0..8 {
+            crc = if crc & 1 != 0 {
+                (crc >> 1) ^ 0xEDB8_8320
+            } else {
+                crc >> 1
+            };
+        }
+    }
+    !crc
+}
+
+/// A PNG whose header declares `width` × `height` 16-bit RGBA and whose data is one empty
+/// IDAT: what a decoder learns before it allocates, and nothing to decode.
+fn forged_16bit_rgba_png(width: u32, height: u32) -> Vec<u8> {
+    let chunk = |kind: &[u8], data: &[u8]| {
+        let mut out = (data.len() as u32).to_be_bytes().to_vec();
+        let mut body = kind.to_vec();
+        body.extend_from_slice(data);
+        out.extend_from_slice(&body);
+        out.extend_from_slice(&crc32(&body).to_be_bytes());
+        out
+    };
+    let mut ihdr = Vec::new();
+    ihdr.extend_from_slice(&width.to_be_bytes());
+    ihdr.extend_from_slice(&height.to_be_bytes());
+    ihdr.extend_from_slice(&[16, 6, 0, 0, 0]);
+    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+    png.extend(chunk(b"IHDR", &ihdr));
+    png.extend(chunk(
+        b"IDAT",
+        &[0x78, 0x9c, 0x03, 0x00, 0x00, 0x00, 0x00, 0x01],
+    ));
+    png.extend(chunk(b"IEND", &[]));
+    png
+}
+
+/// A 16384² 16-bit RGBA PNG (within the pixel limit, which is inclusive) whose bake would need
+/// about 6 GiB is refused before any pixel buffer exists when the memory budget is 2 GiB, with
+/// a message naming --max-memory; the same budget in bytes is the same refusal.
+#[test]
+fn a_16384_square_16_bit_png_over_the_memory_budget_is_refused_before_decoding() {
+    let png = forged_16bit_rgba_png(16384, 16384);
+    let expected = "PNG: decoding the 16384 × 16384 Rgba16 image needs about 6.0 GiB, over \
+                    the memory budget of 2.0 GiB (raise it with --max-memory); it was not \
+                    decoded";
+    let (result, largest) =
+        largest_allocation(|| codec::decode_within(&png, 16384 * 16384, 2 << 30));
+    match result {
+        Err(e @ CodecError::TooLarge { .. }) => assert_eq!(e.to_string(), expected),
+        other => panic!("{:?}", other.map(|_| ())),
+    }
+    assert!(largest < 1 << 20, "largest allocation {largest} bytes");
+
+    let dir = tempfile::tempdir().unwrap();
+    write(&dir.path().join("huge16.png"), &png);
+    let input = dir.path().join("huge16.gltf");
+    write(&input, sheen_document("huge16.png").to_string());
+    for budget in ["2G", "2147483648"] {
+        let output = dir.path().join("out.gltf");
+        let (status, out, err) =
+            velvet(&["bake", s(&input), "-o", s(&output), "--max-memory", budget]);
+        assert_eq!(status, 1, "{out}{err}");
+        assert!(out.contains(expected), "{out}");
+        assert!(!output.exists());
+    }
+    let (status, _, err) = velvet(&["bake", s(&input), "--dry-run", "--max-memory", "lots"]);
+    assert_eq!(status, 2, "{err}");
+    assert!(err.contains("\"lots\" is not a byte count"), "{err}");
+}
+
+/// A GLB whose bytes and BIN copy would exceed the memory budget is refused before it is read
+/// (here a sparse file of 200 MiB under a budget of 100 MiB): an IO_ERROR naming --max-memory.
+#[test]
+fn a_glb_larger_than_the_memory_budget_is_refused_before_it_is_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("sparse.glb");
+    let json = br#"{"asset":{"version":"2.0"},"buffers":[{"byteLength":209715100}]}   "#;
+    let mut head = Vec::new();
+    head.extend_from_slice(b"glTF");
+    head.extend_from_slice(&2u32.to_le_bytes());
+    head.extend_from_slice(&(200u32 << 20).to_le_bytes());
+    head.extend_from_slice(&(json.len() as u32).to_le_bytes());
+    head.extend_from_slice(b"JSON");
+    head.extend_from_slice(json);
+    let bin_len = (200u32 << 20) - head.len() as u32 - 8;
+    head.extend_from_slice(&bin_len.to_le_bytes());
+    head.extend_from_slice(b"BIN\0");
+    write(&path, &head);
+    std::fs::File::options()
+        .write(true)
+        .open(&path)
+        .unwrap()
+        .set_len(200 << 20)
+        .unwrap();
+    let (status, out, err) = velvet(&["validate", s(&path), "--max-memory", "100M"]);
+    assert_eq!(status, 1, "{out}{err}");
+    assert!(
+        out.contains(&format!(
+            "error IO_ERROR: reading {} (a GLB of 209715200 bytes) needs about 400.0 MiB, over \
+             the memory budget of 100.0 MiB (raise it with --max-memory)",
+            velvet::report::display_path(&path)
+        )),
+        "{out}"
+    );
+}
+
+/// `--files-from` and velvet.toml are read no further than their limits: an endless list is a
+/// usage error at once, and a configuration over 1 MiB is refused naming the file.
+#[cfg(unix)]
+#[test]
+fn an_endless_list_and_a_huge_configuration_are_refused_at_their_limits() {
+    let (status, out, err) = velvet_within_20s(&["validate", "--files-from", "/dev/zero"]);
+    assert_eq!(status, Some(2), "{out}{err}");
+    assert_eq!(
+        err,
+        "velvet: --files-from /dev/zero: the list is longer than 67108864 bytes; velvet reads no \
+         further (split it, or name folders)\n"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let mut config = String::from("exclude = []\n");
+    while config.len() <= 1 << 20 {
+        config.push_str("# padding padding padding padding padding padding padding padding\n");
+    }
+    write(&dir.path().join("velvet.toml"), &config);
+    write(&dir.path().join("a.gltf"), r#"{"asset":{"version":"2.0"}}"#);
+    let (status, out, err) = velvet_within_20s(&["validate", s(dir.path())]);
+    assert_eq!(status, Some(2), "{out}{err}");
+    assert!(
+        err.contains(&format!(
+            "{}: the file is larger than 1048576 bytes, more than a configuration needs; velvet \
+             reads no further",
+            dir.path().join("velvet.toml").display()
+        )),
+        "{err}"
+    );
+}

@@ -167,6 +167,8 @@ pub enum InputError {
     },
     #[error("--files-from {}: entry {entry} is not a valid path on this system", .list.display())]
     ListedNotAPath { list: PathBuf, entry: usize },
+    #[error("--files-from {}: the list is longer than {} bytes; velvet reads no further (split it, or name folders)", .list.display(), MAX_LIST_BYTES)]
+    ListTooLong { list: PathBuf },
 }
 
 /// Refuses a path that does not exist, one that is neither a regular file nor a folder (a FIFO
@@ -247,6 +249,9 @@ fn path_from_bytes(bytes: &[u8]) -> Option<PathBuf> {
     std::str::from_utf8(bytes).ok().map(PathBuf::from)
 }
 
+/// The longest `--files-from` list velvet reads: 64 MiB, some 500,000 paths of 130 bytes.
+pub const MAX_LIST_BYTES: u64 = 64 << 20;
+
 /// Reads a `--files-from` list (`-`: standard input) and returns the inputs it names: folders
 /// (walked as on the command line) and `.gltf`/`.glb` files. Other entries are skipped, so the
 /// output of `git diff --name-only` or `find` can be fed as it is; a listed folder or asset
@@ -256,16 +261,24 @@ pub fn read_list(list: &Path) -> Result<Vec<PathBuf>, InputError> {
         list: list.to_path_buf(),
         source,
     };
-    let bytes = if list == Path::new("-") {
-        let mut bytes = Vec::new();
+    // Read no further than the limit: `--files-from /dev/zero` costs an error, not memory.
+    let mut bytes = Vec::new();
+    if list == Path::new("-") {
         io::stdin()
             .lock()
+            .take(MAX_LIST_BYTES + 1)
             .read_to_end(&mut bytes)
             .map_err(unreadable)?;
-        bytes
     } else {
-        std::fs::read(list).map_err(unreadable)?
-    };
+        std::fs::File::open(list)
+            .and_then(|file| file.take(MAX_LIST_BYTES + 1).read_to_end(&mut bytes))
+            .map_err(unreadable)?;
+    }
+    if bytes.len() as u64 > MAX_LIST_BYTES {
+        return Err(InputError::ListTooLong {
+            list: list.to_path_buf(),
+        });
+    }
     let mut inputs = Vec::new();
     for (entry, path) in parse_list(&bytes) {
         let Some(path) = path else {

@@ -122,6 +122,14 @@ pub fn read(path: &Path, options: &LoadOptions) -> Result<FileBytes, Diagnostic>
                     options.document_too_large(meta.len()),
                 ));
             }
+            // A GLB's bytes are held while its BIN chunk is copied out of them: twice its
+            // size, asked for before it is read. (A .gltf over the document limit is refused
+            // above; one within it is far below any budget.)
+            let what = format!("reading {} (a GLB of {} bytes)", path.display(), meta.len());
+            let needed = meta.len().saturating_mul(2);
+            if let Some(message) = limits::over_memory_budget(&what, needed, options.max_memory) {
+                return Err(Diagnostic::new(&codes::IO_ERROR, "", message));
+            }
         }
     }
     limits::read_asset_file(path, options).map_err(io_error)

@@ -246,6 +246,7 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
             ..EncodeOptions::default()
         },
         max_image_pixels: MaxImagePixels(options.load.max_image_pixels),
+        max_memory: super::engine::MaxMemory(options.load.max_memory),
     };
     // File names next to the output that the document already uses are not free. New image
     // files are written as they are encoded (a .gltf with file images), so a run holds only

@@ -205,6 +205,7 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
             max_image_pixels: crate::bake::engine::MaxImagePixels(
                 plan.asset.options.max_image_pixels,
             ),
+            max_memory: crate::bake::engine::MaxMemory(plan.asset.options.max_memory),
             ..BakeOptions::default()
         };
         // The images as loaded, read alone (the whole document is not built for them).
