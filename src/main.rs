@@ -591,6 +591,8 @@ enum MigrateFormat {
 
 fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
     use velvet::migrate;
+    // Before anything is read or written: a signal from here on stops the run cleanly.
+    velvet::output::interrupt::install();
     use velvet::output::{paths::Destination, summary::Detail};
     let paths = match args.input.resolve() {
         Ok(p) => p,
@@ -643,7 +645,6 @@ fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
             summary: migrate::Summary::default(),
         }
     } else {
-        velvet::output::interrupt::install();
         match migrate::run_shard(&request, args.input.shard) {
             Ok(report) => report,
             Err(e) => return usage_error(e),
@@ -698,6 +699,8 @@ fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
 
 fn bake(args: BakeArgs, quiet: bool) -> ExitCode {
     use velvet::bake::command::{self, Options, Request};
+    // Before anything is read or written: a signal from here on stops the run cleanly.
+    velvet::output::interrupt::install();
     use velvet::output::{paths::Destination, summary::Detail};
     let paths = match args.input.resolve() {
         Ok(p) => p,
@@ -735,7 +738,6 @@ fn bake(args: BakeArgs, quiet: bool) -> ExitCode {
     let results = if request.inputs.is_empty() {
         Vec::new()
     } else {
-        velvet::output::interrupt::install();
         match command::run_shard(&request, args.input.shard) {
             Ok(r) => r,
             Err(e) => return usage_error(e),
