@@ -11,14 +11,14 @@ pub const EXIT_STATUS: &str = "\
 Exit status:
   0  no file has an issue at or above --fail-on
   1  a file has an issue at or above --fail-on (a file that cannot be read or parsed has an error)
-  2  usage or configuration error (bad flag, unknown code, invalid velvet.toml, a path that does not exist, a folder without .gltf/.glb files)";
+  2  usage or configuration error (bad flag, unknown code, invalid velvet.toml, a path that does not exist or is not a regular file or folder, a folder without .gltf/.glb files, every file found excluded)";
 
 /// The exit statuses common to every command, for `velvet --help`.
 pub const EXIT_STATUS_ALL: &str = "\
 Exit status:
   0  success: no file has an issue at or above --fail-on (validate); every file done (migrate, bake)
   1  a file has an issue at or above --fail-on (validate), or a file failed (migrate, bake)
-  2  usage or configuration error (bad flag, unknown code, invalid velvet.toml, a path that does not exist, a folder without .gltf/.glb files)";
+  2  usage or configuration error (bad flag, unknown code, invalid velvet.toml, a path that does not exist or is not a regular file or folder, a folder without .gltf/.glb files, every file found excluded)";
 
 const HEADING: &str = "Exit status:\n";
 

@@ -113,6 +113,10 @@ struct LoadArgs {
     /// Refuse to decode an image whose header declares more pixels (width × height) than this.
     #[arg(long, value_name = "PIXELS", default_value_t = velvet::asset::limits::DEFAULT_MAX_IMAGE_PIXELS)]
     max_image_pixels: u64,
+    /// The memory budget in bytes (K, M, G suffixes: binary units); default a quarter of the
+    /// machine's memory. A file or image that would need more to read or decode is refused.
+    #[arg(long, value_name = "BYTES", value_parser = parse_bytes)]
+    max_memory: Option<u64>,
     /// Read resources whose URI leaves the asset's folder (../, absolute paths, file:).
     /// Outputs never follow such URIs.
     #[arg(long)]
@@ -125,9 +129,31 @@ impl LoadArgs {
             max_document_bytes: self.max_document_bytes,
             max_json_depth: usize::from(self.max_json_depth),
             max_image_pixels: self.max_image_pixels,
+            max_memory: self
+                .max_memory
+                .unwrap_or_else(velvet::asset::limits::default_max_memory),
             allow_outside_uris: self.allow_outside_uris,
         }
     }
+}
+
+/// A byte count: digits, then K, M, G or T (binary units, an optional "iB" or "B").
+fn parse_bytes(text: &str) -> Result<u64, String> {
+    let upper = text.trim().to_ascii_uppercase();
+    let number = upper.trim_end_matches('B').trim_end_matches('I');
+    let (digits, shift) = match number.char_indices().last() {
+        Some((at, 'K')) => (&number[..at], 10),
+        Some((at, 'M')) => (&number[..at], 20),
+        Some((at, 'G')) => (&number[..at], 30),
+        Some((at, 'T')) => (&number[..at], 40),
+        _ => (number, 0),
+    };
+    digits
+        .trim()
+        .parse::<u64>()
+        .ok()
+        .and_then(|n| n.checked_mul(1 << shift))
+        .ok_or_else(|| format!("{text:?} is not a byte count (e.g. 2147483648, 512M, 4G)"))
 }
 
 /// The files a command works on, shared by `validate`, `migrate` and `bake`.
@@ -225,7 +251,7 @@ struct BakeArgs {
     /// lead there) instead of getting its own copies beside it (the default).
     #[arg(long)]
     rewrite_uris: bool,
-    /// Copy (or hard-link) resources beside outputs in another folder: the default, kept so
+    /// Copy resources beside outputs in another folder (never hard links): the default, kept so
     /// that existing scripts run.
     #[arg(long, hide = true, conflicts_with = "rewrite_uris")]
     copy_resources: bool,
@@ -282,6 +308,26 @@ fn usage_error(message: impl std::fmt::Display) -> ExitCode {
     ExitCode::from(2)
 }
 
+/// When SIGINT or SIGTERM stopped a migrate or bake run: the one line saying what was finished
+/// (`finished` says it of each file) and the exit status, 128 + the signal. Files that failed
+/// for another reason are counted with those not finished: nothing of either was written.
+fn stopped(finished: impl Iterator<Item = bool>) -> Option<ExitCode> {
+    let signal = velvet::output::interrupt::requested()?;
+    let (mut done, mut total) = (0usize, 0usize);
+    for finished in finished {
+        total += 1;
+        done += usize::from(finished);
+    }
+    eprintln!(
+        "velvet: stopped by {}: {done} of {total} {} finished (their outputs are complete); \
+         nothing was written for the other {}",
+        velvet::output::interrupt::name(signal),
+        if total == 1 { "file" } else { "files" },
+        total - done
+    );
+    Some(ExitCode::from(128 + signal as u8))
+}
+
 /// Writes to standard output; a closed pipe (`velvet … | head`) is not an error.
 fn emit(text: &[u8]) {
     let _ = std::io::stdout().lock().write_all(text);
@@ -297,7 +343,6 @@ fn in_pool<T: Send>(job: impl FnOnce() -> T + Send) -> T {
 
 fn main() -> ExitCode {
     velvet::asset::pages::limit_heaps();
-    velvet::asset::source::enable_mapping();
     let cli = Cli::parse();
     match cli.command {
         Command::Validate(args) => in_pool(|| validate(args, cli.color, cli.quiet)),
@@ -520,7 +565,7 @@ struct MigrateArgs {
     /// lead there) instead of getting its own copies beside it (the default).
     #[arg(long)]
     rewrite_uris: bool,
-    /// Copy (or hard-link) resources beside outputs in another folder: the default, kept so
+    /// Copy resources beside outputs in another folder (never hard links): the default, kept so
     /// that existing scripts run.
     #[arg(long, hide = true, conflicts_with = "rewrite_uris")]
     copy_resources: bool,
@@ -546,6 +591,8 @@ enum MigrateFormat {
 
 fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
     use velvet::migrate;
+    // Before anything is read or written: a signal from here on stops the run cleanly.
+    velvet::output::interrupt::install();
     use velvet::output::{paths::Destination, summary::Detail};
     let paths = match args.input.resolve() {
         Ok(p) => p,
@@ -603,6 +650,14 @@ fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
             Err(e) => return usage_error(e),
         }
     };
+    if let Some(stopped) = stopped(
+        report
+            .files
+            .iter()
+            .map(|f| !matches!(f.outcome, migrate::FileOutcome::Failed { .. })),
+    ) {
+        return stopped;
+    }
     print!(
         "{}",
         match args.format {
@@ -644,6 +699,8 @@ fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
 
 fn bake(args: BakeArgs, quiet: bool) -> ExitCode {
     use velvet::bake::command::{self, Options, Request};
+    // Before anything is read or written: a signal from here on stops the run cleanly.
+    velvet::output::interrupt::install();
     use velvet::output::{paths::Destination, summary::Detail};
     let paths = match args.input.resolve() {
         Ok(p) => p,
@@ -686,6 +743,9 @@ fn bake(args: BakeArgs, quiet: bool) -> ExitCode {
             Err(e) => return usage_error(e),
         }
     };
+    if let Some(stopped) = stopped(results.iter().map(|r| !r.failed())) {
+        return stopped;
+    }
     match args.format {
         BakeFormat::Text => print!(
             "{}",

@@ -1943,7 +1943,7 @@ fn large_sheen_document(materials: usize, pad: usize) -> String {
 #[test]
 fn a_large_file_is_migrated_in_place_as_the_library_migrates_its_bytes() {
     let text = large_sheen_document(800, 4000);
-    assert!(text.len() as u64 > 2 * velvet::asset::source::MAPPED_FROM);
+    assert!(text.len() as u64 > 2 << 20);
     let dir = tempfile::tempdir().unwrap();
     let input = dir.path().join("large.gltf");
     std::fs::write(&input, &text).unwrap();

@@ -4,9 +4,12 @@
 //! `file` is the path relative to the working directory (the checkout, in a workflow); `line`
 //! and `col` are given for a .gltf finding whose pointer names a value (a .glb has no lines:
 //! its byte offset goes into the message instead). Properties and message are escaped as the
-//! runner unescapes them: `%`, CR and LF everywhere, and `:` and `,` in properties too.
+//! runner unescapes them: `%`, CR and LF everywhere, and `:` and `,` in properties too. What
+//! came from the asset is first passed through [`super::escape::terminal`], so no character of
+//! it can end the command's line or act in the log viewer (ESC), whatever the runner unescapes.
 
 use super::display_path;
+use super::escape::terminal;
 use crate::asset::Container;
 use crate::diagnostics::Severity;
 use crate::validate::FileReport;
@@ -36,7 +39,7 @@ fn command(severity: Severity) -> &'static str {
 pub fn render(reports: &[FileReport]) -> String {
     let mut out = String::new();
     for report in reports {
-        let file = escape_property(&display_path(&report.path));
+        let file = escape_property(&terminal(&display_path(&report.path)));
         for f in &report.findings {
             let d = &f.diagnostic;
             let mut properties = format!("file={file}");
@@ -64,7 +67,7 @@ pub fn render(reports: &[FileReport]) -> String {
                 "::{} {properties},title={}::{}",
                 command(d.severity),
                 escape_property(d.code),
-                escape_data(&message)
+                escape_data(&terminal(&message))
             );
         }
         if report.truncated() {

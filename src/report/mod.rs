@@ -3,6 +3,7 @@
 //! Actions workflow commands. Renderers only format; they decide nothing. This module also
 //! owns the choices that shape output on a terminal: the format, colour, and the progress bar.
 
+pub mod escape;
 pub mod fold;
 pub mod github;
 pub mod json;
