@@ -24,7 +24,9 @@ fn main() {
         eprintln!("{path}: cannot be loaded");
         std::process::exit(1);
     };
-    let materials = material::materials(&asset);
+    let options = velvet::migrate::Options::default();
+    let plan = velvet::migrate::plan_document(&asset, &options);
+    let materials = material::materials(&asset, &plan, options.roughness);
     println!(
         "{} material(s) to preview, {} thread(s)",
         materials.len(),

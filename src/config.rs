@@ -38,6 +38,10 @@ pub enum ConfigError {
     Invalid { path: PathBuf, message: String },
     #[error("{0}")]
     CommandLine(String),
+    /// Every file found was excluded: a run that checks nothing fails rather than pass as
+    /// "0 files checked".
+    #[error("no asset left to check: {found} found, all excluded by {by}; a run that checks nothing fails")]
+    AllExcluded { found: usize, by: String },
 }
 
 /// Which codes a run reports.
@@ -322,18 +326,39 @@ impl Layer {
         })
     }
 
-    /// Reads and parses a velvet.toml.
+    /// Reads and parses a velvet.toml, refusing one over [`MAX_CONFIG_BYTES`] (read no
+    /// further than that: a configuration that is a stream or a huge file costs an error, not
+    /// memory).
     pub fn read(path: &Path) -> Result<Layer, ConfigError> {
-        let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
+        use std::io::Read;
+        let unreadable = |source| ConfigError::Read {
             path: path.to_path_buf(),
             source,
-        })?;
+        };
+        let mut bytes = Vec::new();
+        std::fs::File::open(path)
+            .and_then(|file| file.take(MAX_CONFIG_BYTES + 1).read_to_end(&mut bytes))
+            .map_err(unreadable)?;
+        if bytes.len() as u64 > MAX_CONFIG_BYTES {
+            return Err(ConfigError::Invalid {
+                path: path.to_path_buf(),
+                message: format!(
+                    "the file is larger than {MAX_CONFIG_BYTES} bytes, more than a configuration \
+                     needs; velvet reads no further"
+                ),
+            });
+        }
+        let text = String::from_utf8(bytes)
+            .map_err(|e| unreadable(std::io::Error::new(std::io::ErrorKind::InvalidData, e)))?;
         Layer::parse(&text).map_err(|message| ConfigError::Invalid {
             path: path.to_path_buf(),
             message,
         })
     }
 }
+
+/// The largest velvet.toml velvet reads: 1 MiB, thousands of times a real one.
+pub const MAX_CONFIG_BYTES: u64 = 1 << 20;
 
 /// An exclude pattern: `*` and `?` stay inside one path component, `**` crosses them.
 fn glob(pattern: &str) -> Result<Glob, globset::Error> {

@@ -110,12 +110,15 @@ pub struct TextureRef {
 }
 
 /// A glTF index: a non-negative integer, also when written with a zero fraction (`1.0`), which
-/// JSON Schema counts as an integer.
+/// JSON Schema counts as an integer. Indices are judged as numbers of any size: one beyond 64
+/// bits (`18446744073709551617`, `1e30`) is `u64::MAX`, which no array reaches, so it resolves
+/// to nothing, as it would at its own size; it is not taken for a missing index.
 pub fn as_index<'a>(value: impl JsonView<'a>) -> Option<u64> {
     value.unsigned().or_else(|| {
         value
             .number()
-            .filter(|n| *n >= 0.0 && n.fract() == 0.0 && *n < u64::MAX as f64)
+            .filter(|n| *n >= 0.0 && (n.fract() == 0.0 || n.is_infinite()))
+            // `as` saturates: an integer beyond u64 becomes u64::MAX.
             .map(|n| n as u64)
     })
 }

@@ -118,6 +118,10 @@ struct LoadArgs {
     /// Refuse to decode an image whose header declares more pixels (width × height) than this.
     #[arg(long, value_name = "PIXELS", default_value_t = velvet::asset::limits::DEFAULT_MAX_IMAGE_PIXELS)]
     max_image_pixels: u64,
+    /// The memory budget in bytes (K, M, G suffixes: binary units); default a quarter of the
+    /// machine's memory. A file or image that would need more to read or decode is refused.
+    #[arg(long, value_name = "BYTES", value_parser = parse_bytes)]
+    max_memory: Option<u64>,
     /// Read resources whose URI leaves the asset's folder (../, absolute paths, file:).
     /// Outputs never follow such URIs.
     #[arg(long)]
@@ -130,9 +134,31 @@ impl LoadArgs {
             max_document_bytes: self.max_document_bytes,
             max_json_depth: usize::from(self.max_json_depth),
             max_image_pixels: self.max_image_pixels,
+            max_memory: self
+                .max_memory
+                .unwrap_or_else(velvet::asset::limits::default_max_memory),
             allow_outside_uris: self.allow_outside_uris,
         }
     }
+}
+
+/// A byte count: digits, then K, M, G or T (binary units, an optional "iB" or "B").
+fn parse_bytes(text: &str) -> Result<u64, String> {
+    let upper = text.trim().to_ascii_uppercase();
+    let number = upper.trim_end_matches('B').trim_end_matches('I');
+    let (digits, shift) = match number.char_indices().last() {
+        Some((at, 'K')) => (&number[..at], 10),
+        Some((at, 'M')) => (&number[..at], 20),
+        Some((at, 'G')) => (&number[..at], 30),
+        Some((at, 'T')) => (&number[..at], 40),
+        _ => (number, 0),
+    };
+    digits
+        .trim()
+        .parse::<u64>()
+        .ok()
+        .and_then(|n| n.checked_mul(1 << shift))
+        .ok_or_else(|| format!("{text:?} is not a byte count (e.g. 2147483648, 512M, 4G)"))
 }
 
 /// The files a command works on, shared by `validate`, `migrate` and `bake`.
@@ -230,7 +256,7 @@ struct BakeArgs {
     /// lead there) instead of getting its own copies beside it (the default).
     #[arg(long)]
     rewrite_uris: bool,
-    /// Copy (or hard-link) resources beside outputs in another folder: the default, kept so
+    /// Copy resources beside outputs in another folder (never hard links): the default, kept so
     /// that existing scripts run.
     #[arg(long, hide = true, conflicts_with = "rewrite_uris")]
     copy_resources: bool,
@@ -292,6 +318,26 @@ fn usage_error(message: impl std::fmt::Display) -> ExitCode {
     ExitCode::from(2)
 }
 
+/// When SIGINT or SIGTERM stopped a migrate or bake run: the one line saying what was finished
+/// (`finished` says it of each file) and the exit status, 128 + the signal. Files that failed
+/// for another reason are counted with those not finished: nothing of either was written.
+fn stopped(finished: impl Iterator<Item = bool>) -> Option<ExitCode> {
+    let signal = velvet::output::interrupt::requested()?;
+    let (mut done, mut total) = (0usize, 0usize);
+    for finished in finished {
+        total += 1;
+        done += usize::from(finished);
+    }
+    eprintln!(
+        "velvet: stopped by {}: {done} of {total} {} finished (their outputs are complete); \
+         nothing was written for the other {}",
+        velvet::output::interrupt::name(signal),
+        if total == 1 { "file" } else { "files" },
+        total - done
+    );
+    Some(ExitCode::from(128 + signal as u8))
+}
+
 /// Writes to standard output; a closed pipe (`velvet … | head`) is not an error.
 fn emit(text: &[u8]) {
     let _ = std::io::stdout().lock().write_all(text);
@@ -307,7 +353,6 @@ fn in_pool<T: Send>(job: impl FnOnce() -> T + Send) -> T {
 
 fn main() -> ExitCode {
     velvet::asset::pages::limit_heaps();
-    velvet::asset::source::enable_mapping();
     let cli = Cli::parse();
     match cli.command {
         Command::Validate(args) => in_pool(|| validate(args, cli.color, cli.quiet)),
@@ -543,7 +588,7 @@ struct MigrateArgs {
     /// lead there) instead of getting its own copies beside it (the default).
     #[arg(long)]
     rewrite_uris: bool,
-    /// Copy (or hard-link) resources beside outputs in another folder: the default, kept so
+    /// Copy resources beside outputs in another folder (never hard links): the default, kept so
     /// that existing scripts run.
     #[arg(long, hide = true, conflicts_with = "rewrite_uris")]
     copy_resources: bool,
@@ -571,6 +616,8 @@ enum MigrateFormat {
 
 fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
     use velvet::migrate;
+    // Before anything is read or written: a signal from here on stops the run cleanly.
+    velvet::output::interrupt::install();
     use velvet::output::{paths::Destination, summary::Detail};
     let paths = match args.input.resolve() {
         Ok(p) => p,
@@ -613,7 +660,7 @@ fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
                 .map(|f| f.path)
                 .collect(),
         };
-        velvet::preview::render(&inputs, &request.options.load)
+        velvet::preview::render(&inputs, &request.options)
     });
     // A list that names no asset (a change that touched none) is nothing to do, not an error.
     let report = if request.inputs.is_empty() {
@@ -628,6 +675,14 @@ fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
             Err(e) => return usage_error(e),
         }
     };
+    if let Some(stopped) = stopped(
+        report
+            .files
+            .iter()
+            .map(|f| !matches!(f.outcome, migrate::FileOutcome::Failed { .. })),
+    ) {
+        return stopped;
+    }
     print!(
         "{}",
         match args.format {
@@ -669,6 +724,8 @@ fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
 
 fn bake(args: BakeArgs, quiet: bool) -> ExitCode {
     use velvet::bake::command::{self, Options, Request};
+    // Before anything is read or written: a signal from here on stops the run cleanly.
+    velvet::output::interrupt::install();
     use velvet::output::{paths::Destination, summary::Detail};
     let paths = match args.input.resolve() {
         Ok(p) => p,
@@ -711,6 +768,9 @@ fn bake(args: BakeArgs, quiet: bool) -> ExitCode {
             Err(e) => return usage_error(e),
         }
     };
+    if let Some(stopped) = stopped(results.iter().map(|r| !r.failed())) {
+        return stopped;
+    }
     match args.format {
         BakeFormat::Text => print!(
             "{}",
@@ -739,7 +799,13 @@ fn preview(args: PreviewArgs, quiet: bool) -> ExitCode {
     if let Err(e) = discover::check_inputs(&args.paths) {
         return usage_error(e);
     }
-    let previews = velvet::preview::render(&args.paths, &args.load.options());
+    let previews = velvet::preview::render(
+        &args.paths,
+        &migrate::Options {
+            load: args.load.options(),
+            ..migrate::Options::default()
+        },
+    );
     let mut failed = !previews.failures.is_empty();
     for f in &previews.failures {
         eprintln!("velvet: {}: {}", f.file.display(), f.message);

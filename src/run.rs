@@ -82,12 +82,30 @@ pub fn validate_shard_each(
     let (found, walk_errors) = discover::find(inputs, shard);
     let mut planned = Vec::with_capacity(found.len());
     let mut excluded = Vec::new();
+    let mut excluded_by = None;
     for file in found.into_iter().map(|f| f.path) {
         let config = resolver.for_path(&file)?;
         if config.excludes(&crate::config::absolute(&file)) {
             excluded.push(file);
+            excluded_by = excluded_by.or_else(|| {
+                Some(match &config.file {
+                    Some(file) => format!("the exclude patterns of {}", file.display()),
+                    None => "the exclude patterns".to_string(),
+                })
+            });
         } else {
             planned.push((file, config));
+        }
+    }
+    // A configuration may leave files out, but not all of them: the inputs were checked to
+    // hold assets (discover::check_inputs), and a run that checks none of them must not pass.
+    // A shard may be left with nothing by the split alone, so only a whole run is held to it.
+    if shard.is_none() && planned.is_empty() && walk_errors.is_empty() {
+        if let Some(by) = excluded_by {
+            return Err(ConfigError::AllExcluded {
+                found: excluded.len(),
+                by,
+            });
         }
     }
     // Every configuration is resolved before the first report goes out: a configuration error

@@ -137,6 +137,9 @@ impl Validator {
             // rather than ending the process from the pool.
             let _ = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
                 job.get_or_init(Schemas::builtin);
+                // The kinds of objects the extension and texture rules walk, read from the
+                // schemas once per process: here, rather than in the first file's rules.
+                crate::rules::extensions::prepare();
             }));
         });
         Validator::with_compiled(schemas, settings)

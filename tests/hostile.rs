@@ -211,13 +211,24 @@ fn a_document_over_the_size_limit_is_refused_naming_the_limit_and_its_flag() {
     assert!(!out.contains("DOCUMENT_TOO_LARGE"), "{status} {out}");
 }
 
+/// The library reads a stream up to the document limit; the command refuses one named as an
+/// input (see `a_fifo_or_device_named_as_input_is_a_usage_error_without_blocking`).
+#[cfg(unix)]
 #[test]
-fn an_endless_stream_named_as_input_stops_at_the_document_limit() {
-    let (status, out, _) = velvet(&["validate", "--max-document-bytes", "100000", "/dev/zero"]);
-    assert_eq!(status, 1, "{out}");
+fn an_endless_stream_loaded_by_the_library_stops_at_the_document_limit() {
+    let options = LoadOptions {
+        max_document_bytes: 100_000,
+        ..LoadOptions::default()
+    };
+    let loaded = asset::load_with(Path::new("/dev/zero"), &options);
+    assert!(loaded.asset.is_none());
+    assert_eq!(codes(&loaded.diagnostics), ["DOCUMENT_TOO_LARGE"]);
     assert!(
-        out.contains("the JSON document is 100004 bytes, over the limit of 100000"),
-        "{out}"
+        loaded.diagnostics[0]
+            .message
+            .contains("the JSON document is 100004 bytes, over the limit of 100000"),
+        "{:?}",
+        loaded.diagnostics
     );
 }
 
@@ -458,35 +469,46 @@ fn the_pixel_limit_is_inclusive_and_raised_by_its_flag() {
 }
 
 #[test]
-fn data_uris_that_are_not_base64_are_refused() {
+fn percent_encoded_data_uris_are_read_with_a_warning_and_malformed_ones_refused() {
+    // RFC 2397's percent-encoded form is valid glTF: the image is read from it (its header is
+    // checked) and the only finding is the warning that some loaders decode base64 alone.
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("chair.gltf");
+    let bytes = png(2, 2, image::ExtendedColorType::Rgba8);
+    let encoded =
+        percent_encoding::percent_encode(&bytes, percent_encoding::NON_ALPHANUMERIC).to_string();
     write(
         &path,
-        sheen_document("data:image/png,%89PNG%0D%0A").to_string(),
+        sheen_document(&format!("data:image/png,{encoded}")).to_string(),
     );
     let validator = Validator::new(Schemas::builtin(), Settings::default());
     let report = validator.validate_file(&path);
     let found: Vec<_> = report
         .findings
         .iter()
+        .map(|f| (f.diagnostic.code, f.diagnostic.pointer.as_str()))
+        .collect();
+    assert_eq!(found, [("DATA_URI_NOT_BASE64", "/images/0/uri")]);
+    assert_eq!(report.counts.errors, 0);
+
+    // A '%' without two hexadecimal digits decodes to nothing: refused, by validate and bake.
+    write(
+        &path,
+        sheen_document("data:image/png,%89PNG%zz").to_string(),
+    );
+    let report = validator.validate_file(&path);
+    let refused = "the data: URI's payload has a '%' not followed by two hexadecimal digits";
+    let found: Vec<_> = report
+        .findings
+        .iter()
         .filter(|f| f.diagnostic.code == "INVALID_URI")
         .map(|f| (f.diagnostic.pointer.as_str(), f.diagnostic.message.as_str()))
         .collect();
-    assert_eq!(
-        found,
-        [(
-            "/images/0/uri",
-            "the data: URI is not base64-encoded (glTF requires ';base64')"
-        )]
-    );
+    assert_eq!(found, [("/images/0/uri", refused)]);
     let output = dir.path().join("out.gltf");
     let (status, out, _) = velvet(&["bake", s(&path), "-o", s(&output)]);
     assert_eq!(status, 1, "{out}");
-    assert!(
-        out.contains("the data: URI is not base64-encoded (glTF requires ';base64')"),
-        "{out}"
-    );
+    assert!(out.contains(refused), "{out}");
     assert!(!output.exists());
 }
 
@@ -729,12 +751,13 @@ fn an_interrupted_batch_leaves_only_complete_outputs() {
         "the interrupted write was mid-file"
     );
     assert_eq!(tree(&input), inputs_before);
-    // A rerun completes the batch; the leftover temporaries are hidden and never taken for
-    // assets.
+    // A rerun completes the batch and removes the staging files the killed run left (its
+    // process is gone).
     let (status, out, _) = velvet(&["migrate", s(&input), "--out-dir", s(&out_dir)]);
     assert_eq!(status, 0, "{out}");
-    let (outputs, _) = complete_outputs(&out_dir, &expected);
+    let (outputs, temporaries) = complete_outputs(&out_dir, &expected);
     assert_eq!(outputs.len(), 12);
+    assert_eq!(temporaries, Vec::<PathBuf>::new());
 
     // In place: every input is its old bytes or its complete migration.
     let in_place = dir.path().join("in-place");
@@ -1094,4 +1117,971 @@ fn bake_leaves_a_document_whose_arrays_are_not_arrays_of_objects() {
             std::fs::read(&input).unwrap()
         );
     }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Inputs read as a snapshot
+
+/// A sheen document of about 2 MiB (large files were once mapped rather than read), its
+/// materials named `cloth N`.
+fn large_sheen_text() -> String {
+    let mut doc = json!({
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_materials_sheen"],
+        "materials": [],
+    });
+    for i in 0..400 {
+        doc["materials"].as_array_mut().unwrap().push(json!({
+            "name": format!("cloth {i} {}", "x".repeat(5000)),
+            "extensions": {"KHR_materials_sheen": {
+                "sheenColorFactor": [0.5, 0.25, 1.0],
+                "sheenRoughnessFactor": 0.75
+            }}
+        }));
+    }
+    let text = serde_json::to_string_pretty(&doc).unwrap();
+    assert!(text.len() > 2 << 20);
+    text
+}
+
+/// Overwrites `len` bytes of `path` at `at` with `byte`, in place (no new file, same size), as
+/// an editor or a sync client writing into the file would.
+fn rewrite_in_place(path: &Path, at: u64, len: usize, byte: u8) {
+    use std::io::{Seek, SeekFrom, Write};
+    let mut file = std::fs::OpenOptions::new().write(true).open(path).unwrap();
+    file.seek(SeekFrom::Start(at)).unwrap();
+    file.write_all(&vec![byte; len]).unwrap();
+    file.sync_all().unwrap();
+}
+
+/// An input another program rewrites in place between velvet reading it and writing its
+/// migration (here with bytes that are not UTF-8, which once made velvet panic) is not written:
+/// the migration fails naming the file, and the file keeps the other program's bytes.
+#[test]
+fn an_input_rewritten_during_migrate_in_place_fails_naming_it_without_a_write() {
+    use velvet::migrate::apply::{execute, plan_file};
+    use velvet::output::files::Claims;
+    use velvet::output::paths::Job;
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("large.gltf");
+    write(&input, large_sheen_text());
+    let job = Job {
+        input: input.clone(),
+        output: Some(input.clone()),
+    };
+    let mut plan = plan_file(&job, &velvet::migrate::Options::default()).unwrap();
+    assert!(plan.changes());
+    rewrite_in_place(&input, 100_000, 4096, 0xff);
+    let rewritten = std::fs::read(&input).unwrap();
+    let error = execute(&mut plan, &Claims::default()).unwrap_err();
+    assert_eq!(
+        error,
+        format!(
+            "{} changed while velvet worked on it (another program wrote it); nothing was \
+             written for it",
+            input.display()
+        )
+    );
+    assert_eq!(std::fs::read(&input).unwrap(), rewritten);
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+}
+
+/// A file last written long before it was read gets no digest: its times alone tell a later
+/// write, and an output to another folder is not written either.
+#[test]
+fn an_input_rewritten_after_it_was_read_is_caught_by_its_times_alone() {
+    use velvet::migrate::apply::{execute, plan_file};
+    use velvet::output::files::Claims;
+    use velvet::output::paths::Job;
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("old.gltf");
+    write(&input, large_sheen_text());
+    // Last written an hour ago: no digest is taken, the times decide.
+    let hour_ago = std::time::SystemTime::now() - std::time::Duration::from_secs(3600);
+    std::fs::File::options()
+        .write(true)
+        .open(&input)
+        .unwrap()
+        .set_modified(hour_ago)
+        .unwrap();
+    let out = dir.path().join("out");
+    let job = Job {
+        input: input.clone(),
+        output: Some(out.join("old.gltf")),
+    };
+    let mut plan = plan_file(&job, &velvet::migrate::Options::default()).unwrap();
+    rewrite_in_place(&input, 100_000, 16, b' ');
+    let error = execute(&mut plan, &Claims::default()).unwrap_err();
+    assert!(
+        error.starts_with(&format!(
+            "{} changed while velvet worked on it",
+            input.display()
+        )),
+        "{error}"
+    );
+    assert!(!out.join("old.gltf").exists());
+}
+
+// ---------------------------------------------------------------------------------------------
+// No aliasing
+
+/// A document whose sheen changes and whose buffer and image are files beside it.
+fn document_with_resources(dir: &Path) -> PathBuf {
+    write(&dir.join("geometry.bin"), [7u8; 64]);
+    write(
+        &dir.join("tex.png"),
+        png(4, 4, image::ExtendedColorType::Rgba8),
+    );
+    let doc = json!({
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_materials_sheen"],
+        "buffers": [{"uri": "geometry.bin", "byteLength": 64}],
+        "images": [{"uri": "tex.png"}],
+        "textures": [{"source": 0}],
+        "materials": [{
+            "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}},
+            "extensions": {"KHR_materials_sheen": {
+                "sheenColorFactor": [0.5, 0.25, 1.0],
+                "sheenRoughnessFactor": 0.75
+            }}
+        }]
+    });
+    let path = dir.join("asset.gltf");
+    write(&path, serde_json::to_string_pretty(&doc).unwrap());
+    path
+}
+
+/// The resources an output in another folder needs are files of their own: no output resource
+/// shares an inode with its input, and writing into one in place leaves the input as it was.
+#[cfg(unix)]
+#[test]
+fn an_output_resource_never_shares_an_inode_with_its_input() {
+    use std::io::Write;
+    use std::os::unix::fs::MetadataExt;
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in");
+    document_with_resources(&input);
+    for command in ["migrate", "bake"] {
+        let out = dir.path().join(format!("out-{command}"));
+        let (status, stdout, stderr) = velvet(&[command, s(&input), "--out-dir", s(&out)]);
+        assert_eq!(status, 0, "{stdout}{stderr}");
+        for name in ["geometry.bin", "tex.png"] {
+            let (from, to) = (input.join(name), out.join(name));
+            let before = std::fs::read(&from).unwrap();
+            assert_eq!(std::fs::read(&to).unwrap(), before, "{command} {name}");
+            let meta = |p: &Path| std::fs::metadata(p).unwrap();
+            assert_ne!(
+                (meta(&from).dev(), meta(&from).ino()),
+                (meta(&to).dev(), meta(&to).ino()),
+                "{command} {name}"
+            );
+            assert_eq!(meta(&from).nlink(), 1, "{command} {name}");
+            std::fs::OpenOptions::new()
+                .write(true)
+                .open(&to)
+                .unwrap()
+                .write_all(b"EDITED IN PLACE")
+                .unwrap();
+            assert_eq!(std::fs::read(&from).unwrap(), before, "{command} {name}");
+        }
+    }
+}
+
+/// `--in-place` on a symbolic link migrates the file it leads to and keeps the link; a folder
+/// holding a link and its target migrates the file once; a link leading out of the folder
+/// given is refused before anything is written (exit status 2).
+#[cfg(unix)]
+#[test]
+fn in_place_on_a_link_migrates_its_target_and_keeps_the_link() {
+    let dir = tempfile::tempdir().unwrap();
+    let reference = dir.path().join("reference");
+    let reference_doc = document_with_resources(&reference);
+    let (status, _, stderr) = velvet(&["migrate", "--in-place", s(&reference_doc)]);
+    assert_eq!(status, 0, "{stderr}");
+    let migrated = std::fs::read(&reference_doc).unwrap();
+
+    let tree = dir.path().join("tree");
+    let real = document_with_resources(&tree.join("real"));
+    let original = std::fs::read(&real).unwrap();
+    assert_ne!(original, migrated);
+    let link = tree.join("link.gltf");
+    std::os::unix::fs::symlink("real/asset.gltf", &link).unwrap();
+    let (status, stdout, stderr) = velvet(&["migrate", "--in-place", s(&link)]);
+    // A link named alone leads into its own folder's tree: accepted.
+    assert_eq!(status, 0, "{stdout}{stderr}");
+    assert!(std::fs::symlink_metadata(&link).unwrap().is_symlink());
+    assert_eq!(
+        std::fs::read_link(&link).unwrap(),
+        Path::new("real/asset.gltf")
+    );
+    assert_eq!(std::fs::read(&real).unwrap(), migrated);
+
+    // The folder holding both: the one file is migrated once, no collision is claimed.
+    std::fs::write(&real, &original).unwrap();
+    let (status, stdout, stderr) = velvet(&["migrate", "--in-place", s(&tree)]);
+    assert_eq!(status, 0, "{stdout}{stderr}");
+    assert!(std::fs::symlink_metadata(&link).unwrap().is_symlink());
+    assert_eq!(std::fs::read(&real).unwrap(), migrated);
+
+    // A link out of the folder given: refused, nothing written.
+    let inner = tree.join("real");
+    let outside = dir.path().join("outside");
+    let outside_doc = document_with_resources(&outside);
+    let before = std::fs::read(&outside_doc).unwrap();
+    std::os::unix::fs::symlink(&outside_doc, inner.join("away.gltf")).unwrap();
+    let (status, stdout, stderr) = velvet(&["migrate", "--in-place", s(&inner)]);
+    assert_eq!(status, 2, "{stdout}{stderr}");
+    assert_eq!(
+        stderr,
+        format!(
+            "velvet: --in-place: {} is a symbolic link to {}, outside {}; velvet writes only \
+             inside the folders it is given (name the target itself to migrate it)\n",
+            inner.join("away.gltf").display(),
+            outside_doc.canonicalize().unwrap().display(),
+            inner.display()
+        )
+    );
+    assert_eq!(std::fs::read(&outside_doc).unwrap(), before);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Output escapes what it did not write
+
+/// An image URI that would start a GitHub workflow command on a line of its own, and a
+/// material name that would retitle a terminal.
+const INJECTED_URI: &str = "x\n::error file=README.md,line=1::INJECTED\n.png";
+const INJECTED_NAME: &str = "\u{1b}]0;owned\u{7}cloth";
+
+fn injecting_document(dir: &Path) -> PathBuf {
+    let mut doc = sheen_document(INJECTED_URI);
+    doc["materials"][0]["name"] = json!(INJECTED_NAME);
+    let path = dir.join("inject.gltf");
+    write(&path, serde_json::to_string_pretty(&doc).unwrap());
+    path
+}
+
+/// Asserts that `output` holds no control character but newlines and that no line of it is a
+/// workflow command other than velvet's own (`allowed` of them, none the injected one).
+fn assert_inert(output: &str, allowed: usize, what: &str) {
+    assert!(
+        !output.chars().any(|c| c.is_control() && c != '\n'),
+        "{what}: {output:?}"
+    );
+    let commands: Vec<&str> = output.lines().filter(|l| l.starts_with("::")).collect();
+    assert_eq!(commands.len(), allowed, "{what}: {output}");
+    assert!(
+        !commands
+            .iter()
+            .any(|l| l.starts_with("::error file=README.md")),
+        "{what}: {output}"
+    );
+}
+
+/// A URI holding a newline and `::error` prints no workflow command, in any format or command,
+/// and a name holding an escape sequence reaches no terminal: both are shown as escapes.
+#[test]
+fn a_uri_with_a_newline_and_error_prints_no_workflow_command() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = injecting_document(dir.path());
+    let shown_uri = "x\\u000a::error file=README.md,line=1::INJECTED\\u000a.png";
+
+    let (status, out, err) = velvet(&["validate", s(&path)]);
+    assert_eq!(status, 1, "{out}{err}");
+    assert_inert(&out, 0, "validate text");
+    assert_inert(&err, 0, "validate text, stderr");
+    assert!(out.contains(shown_uri), "{out}");
+
+    let (status, out, err) = velvet(&["validate", "--format", "github", s(&path)]);
+    assert_eq!(status, 1, "{out}{err}");
+    let findings = out.lines().count();
+    assert!(findings >= 1);
+    assert_inert(&out, findings, "validate github");
+    assert!(out.contains(shown_uri), "{out}");
+
+    for command in ["migrate", "bake"] {
+        let (_, out, err) = velvet(&[command, "-v", "--dry-run", s(&path)]);
+        assert_inert(&out, 0, command);
+        assert_inert(&err, 0, command);
+        let (_, out, err) = velvet(&[
+            command,
+            "-v",
+            "--out-dir",
+            s(&dir.path().join("o")),
+            s(&path),
+        ]);
+        assert_inert(&out, 0, command);
+        assert_inert(&err, 0, command);
+        assert!(out.contains("::error file=README.md"), "{command}: {out}");
+    }
+    let (_, out, _) = velvet(&["migrate", "-v", "--dry-run", s(&path)]);
+    assert!(out.contains("\"\\u001b]0;owned\\u0007cloth\""), "{out}");
+}
+
+// ---------------------------------------------------------------------------------------------
+// The gate
+
+/// Runs velvet with `args`, killing it after 20 s: (exit status, stdout, stderr), status
+/// `None` when it had to be killed.
+fn velvet_within_20s(args: &[&str]) -> (Option<i32>, String, String) {
+    use std::io::Read;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_velvet"))
+        .args(args)
+        .stdin(std::process::Stdio::null())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    let status = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break status.code();
+        }
+        if start.elapsed() > std::time::Duration::from_secs(20) {
+            child.kill().unwrap();
+            child.wait().unwrap();
+            break None;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    };
+    let (mut out, mut err) = (String::new(), String::new());
+    child
+        .stdout
+        .take()
+        .unwrap()
+        .read_to_string(&mut out)
+        .unwrap();
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut err)
+        .unwrap();
+    (status, out, err)
+}
+
+/// A FIFO or a device named as an input is a usage error (exit status 2) naming it, at once:
+/// nothing waits for a writer that never comes.
+#[cfg(unix)]
+#[test]
+fn a_fifo_or_device_named_as_input_is_a_usage_error_without_blocking() {
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("pipe.gltf");
+    let made = Command::new("mkfifo").arg(&fifo).status().unwrap();
+    assert!(made.success());
+    for command in ["validate", "migrate", "bake"] {
+        let mut args = vec![command, s(&fifo)];
+        if command != "validate" {
+            args.push("--dry-run");
+        }
+        let (status, out, err) = velvet_within_20s(&args);
+        assert_eq!(status, Some(2), "{command}: {out}{err}");
+        assert_eq!(
+            err,
+            format!(
+                "velvet: {}: not a regular file or folder (a FIFO); velvet reads assets from \
+                 files\n",
+                fifo.display()
+            ),
+            "{command}"
+        );
+    }
+    let (status, _, err) = velvet_within_20s(&["validate", "/dev/zero"]);
+    assert_eq!(status, Some(2), "{err}");
+    assert_eq!(
+        err,
+        "velvet: /dev/zero: not a regular file or folder (a character device); velvet reads \
+         assets from files\n"
+    );
+}
+
+/// A velvet.toml that excludes every file found, even one in a folder above the checkout, does
+/// not let a run pass as "0 files checked": exit status 2, saying why.
+#[test]
+fn a_config_that_excludes_every_asset_found_fails_the_run_with_status_2() {
+    let dir = tempfile::tempdir().unwrap();
+    write(&dir.path().join("velvet.toml"), "exclude = [\"**\"]\n");
+    let checkout = dir.path().join("checkout");
+    write(
+        &checkout.join("assets/a.gltf"),
+        r#"{"asset":{"version":"2.0"}}"#,
+    );
+    let (status, out, err) = velvet(&["validate", s(&checkout.join("assets"))]);
+    assert_eq!(status, 2, "{out}{err}");
+    assert_eq!(out, "");
+    assert_eq!(
+        err,
+        format!(
+            "velvet: no asset left to check: 1 found, all excluded by the exclude patterns of \
+             {}; a run that checks nothing fails\n",
+            dir.path().join("velvet.toml").display()
+        )
+    );
+    // Excluding some files is fine: the rest are checked.
+    write(
+        &dir.path().join("velvet.toml"),
+        "exclude = [\"checkout/assets/b.gltf\"]\n",
+    );
+    write(
+        &checkout.join("assets/b.gltf"),
+        r#"{"asset":{"version":"2.0"}}"#,
+    );
+    let (status, out, err) = velvet(&["validate", s(&checkout.join("assets"))]);
+    assert_eq!(status, 0, "{out}{err}");
+    assert!(out.contains("1 file checked"), "{out}");
+}
+
+/// An asset whose path is longer than the system allows (over 4,096 bytes) is reported as an
+/// IO_ERROR finding (exit status 1), not skipped by the folder scan.
+#[cfg(unix)]
+#[test]
+fn an_overlong_path_is_a_finding_not_a_silent_skip() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = dir.path().join("deep");
+    write(&root.join("top.gltf"), r#"{"asset":{"version":"2.0"}}"#);
+    // Made from inside, a folder at a time: no single path handed to the system is too long.
+    let script = format!(
+        "cd '{}' && n=$(printf 'd%.0s' $(seq 200)) && for i in $(seq 22); do mkdir $n && cd -P $n \
+         || exit 1; done && printf '{{}}' > deep.gltf",
+        root.display()
+    );
+    let made = Command::new("sh").args(["-c", &script]).status().unwrap();
+    assert!(made.success());
+    let (status, out, err) = velvet(&["validate", s(&root)]);
+    assert_eq!(status, 1, "{out}{err}");
+    let io_errors: Vec<&str> = out.lines().filter(|l| l.contains("IO_ERROR")).collect();
+    assert_eq!(io_errors.len(), 1, "{out}");
+    assert!(
+        io_errors[0].ends_with("File name too long (os error 36)"),
+        "{}",
+        io_errors[0]
+    );
+    assert!(out.contains("2 files checked"), "{out}");
+}
+
+/// An index beyond 64 bits is judged as the number it is: 2^64 + 1 names no texture
+/// (UNRESOLVED_REFERENCE, as the reference validator says), and migrate refuses to carry it
+/// into a new layer rather than copy it in silence.
+#[test]
+fn an_index_of_two_to_the_64_plus_one_is_an_unresolved_reference() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("huge-index.gltf");
+    let mut doc = sheen_document("tex.png");
+    let text = serde_json::to_string_pretty(&doc).unwrap().replace(
+        "\"sheenColorTexture\": {\n            \"index\": 0",
+        "\"sheenColorTexture\": {\n            \"index\": 18446744073709551617",
+    );
+    assert!(text.contains("18446744073709551617"), "{text}");
+    write(
+        &dir.path().join("tex.png"),
+        png(2, 2, image::ExtendedColorType::Rgba8),
+    );
+    write(&path, &text);
+    let validator = Validator::new(Schemas::builtin(), Settings::default());
+    let report = validator.validate_file(&path);
+    assert_eq!(
+        error_findings(&report),
+        [(
+            "UNRESOLVED_REFERENCE",
+            "/materials/0/extensions/KHR_materials_sheen/sheenColorTexture/index"
+        )]
+    );
+    let unresolved = |report: &velvet::validate::FileReport| {
+        report
+            .findings
+            .iter()
+            .find(|f| f.diagnostic.code == "UNRESOLVED_REFERENCE")
+            .map(|f| f.diagnostic.message.clone())
+    };
+    assert_eq!(
+        unresolved(&report).unwrap(),
+        "sheenColorTexture names texture 18446744073709551617, but the asset has 1 texture"
+    );
+    // The same at 1e30 and at a value just inside u64.
+    for (index, expected) in [
+        ("1e30", "1e30"),
+        ("18446744073709551615", "18446744073709551615"),
+    ] {
+        write(&path, text.replace("18446744073709551617", index));
+        let report = validator.validate_file(&path);
+        assert_eq!(
+            unresolved(&report).unwrap(),
+            format!("sheenColorTexture names texture {expected}, but the asset has 1 texture")
+        );
+    }
+    write(&path, &text);
+    let out_dir = dir.path().join("out");
+    let (status, out, err) = velvet(&["migrate", s(&path), "--out-dir", s(&out_dir)]);
+    assert_eq!(status, 1, "{out}{err}");
+    assert!(
+        out.contains(
+            "cannot be migrated: sheenColorTexture names texture 18446744073709551617, but the \
+             asset has 1 texture (UNRESOLVED_REFERENCE at \
+             /materials/0/extensions/KHR_materials_sheen/sheenColorTexture/index)"
+        ),
+        "{out}"
+    );
+    assert!(!out_dir.join("huge-index.gltf").exists());
+    doc["materials"][0]["extensions"]["KHR_materials_sheen"]["sheenColorTexture"]["index"] =
+        json!(0);
+    write(&path, serde_json::to_string_pretty(&doc).unwrap());
+    assert!(error_findings(&validator.validate_file(&path)).is_empty());
+}
+
+// ---------------------------------------------------------------------------------------------
+// Interruption
+
+/// A 64 × 64 RGBA texture whose texels depend on `seed`, so that no two are alike.
+fn seeded_png(seed: usize) -> Vec<u8> {
+    let data: Vec<u8> = (0..64 * 64 * 4)
+        .map(|i| ((i * 31 + seed * 97) % 253) as u8)
+        .collect();
+    let mut out = Vec::new();
+    image::ImageEncoder::write_image(
+        image::codecs::png::PngEncoder::new(&mut out),
+        &data,
+        64,
+        64,
+        image::ExtendedColorType::Rgba8,
+    )
+    .unwrap();
+    out
+}
+
+/// A sheen material whose colour and roughness textures read texture `texture`.
+fn textured_sheen_material(texture: usize, roughness: f64) -> Value {
+    json!({"extensions": {"KHR_materials_sheen": {
+        "sheenColorFactor": [0.5, 0.4, 0.3],
+        "sheenColorTexture": {"index": texture},
+        "sheenRoughnessFactor": roughness,
+        "sheenRoughnessTexture": {"index": texture}
+    }}})
+}
+
+/// A folder of `files` documents, each with its own texture, and one library document of
+/// `materials` materials, each with its own texture: work that bakes a new texture per
+/// material in both commands.
+fn interruptible_inputs(root: &Path, files: usize, materials: usize) -> (PathBuf, PathBuf) {
+    let folder = root.join("folder");
+    for i in 0..files {
+        write(&folder.join(format!("t{i:02}.png")), seeded_png(i));
+        let doc = json!({
+            "asset": {"version": "2.0"},
+            "extensionsUsed": ["KHR_materials_sheen"],
+            "materials": [textured_sheen_material(0, 0.3 + i as f64 / 100.0)],
+            "textures": [{"source": 0}],
+            "images": [{"uri": format!("t{i:02}.png")}]
+        });
+        write(
+            &folder.join(format!("d{i:02}.gltf")),
+            serde_json::to_string_pretty(&doc).unwrap(),
+        );
+    }
+    let library = root.join("library");
+    let mut doc = json!({
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_materials_sheen"],
+        "materials": [], "textures": [], "images": []
+    });
+    for i in 0..materials {
+        write(&library.join(format!("m{i:02}.png")), seeded_png(100 + i));
+        doc["materials"]
+            .as_array_mut()
+            .unwrap()
+            .push(textured_sheen_material(i, 0.2 + i as f64 / 100.0));
+        doc["textures"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!({"source": i}));
+        doc["images"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!({"uri": format!("m{i:02}.png")}));
+    }
+    write(
+        &library.join("library.gltf"),
+        serde_json::to_string_pretty(&doc).unwrap(),
+    );
+    (folder, library)
+}
+
+/// The relative URIs a document names (its buffers' and images').
+fn uris_of(document: &[u8]) -> Vec<String> {
+    let doc: Value = serde_json::from_slice(document).unwrap();
+    ["buffers", "images"]
+        .iter()
+        .flat_map(|kind| doc[*kind].as_array().cloned().unwrap_or_default())
+        .filter_map(|item| item["uri"].as_str().map(str::to_string))
+        .filter(|uri| !uri.starts_with("data:"))
+        .collect()
+}
+
+/// Checks an output folder after a stopped run against the complete run's `expected`: every
+/// file is one of the complete run's, byte for byte; every document there has every file it
+/// names; every other file is named by a document there; no temporary file is left.
+fn assert_only_finished_outputs(out: &Path, expected: &BTreeMap<PathBuf, Vec<u8>>, what: &str) {
+    let found = if out.exists() {
+        tree(out)
+    } else {
+        BTreeMap::new()
+    };
+    let mut named = std::collections::BTreeSet::new();
+    for (path, bytes) in &found {
+        let name = path.to_string_lossy();
+        assert!(!name.contains(".velvet-"), "{what}: {name} left behind");
+        assert_eq!(
+            expected.get(path),
+            Some(bytes),
+            "{what}: {name} is not complete"
+        );
+        if name.ends_with(".gltf") {
+            for uri in uris_of(bytes) {
+                let resource = path.parent().unwrap().join(&uri);
+                assert!(
+                    found.contains_key(&resource),
+                    "{what}: {name} names {uri}, which is missing"
+                );
+                named.insert(resource);
+            }
+        }
+    }
+    for path in found.keys() {
+        if !path.to_string_lossy().ends_with(".gltf") {
+            assert!(
+                named.contains(path),
+                "{what}: {} belongs to no finished document",
+                path.display()
+            );
+        }
+    }
+}
+
+/// SIGINT and SIGTERM at several moments of a migrate and a bake, of a folder of documents and
+/// of one library document, leave only finished outputs, every file they name, and no
+/// temporary file; a stopped run says what it finished on one line and exits 130 or 143.
+#[cfg(unix)]
+#[test]
+fn sigint_and_sigterm_leave_only_finished_outputs_and_no_temporary_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let (folder, library) = interruptible_inputs(dir.path(), 16, 16);
+    let mut stopped = 0;
+    for command in ["migrate", "bake"] {
+        for input in [&folder, &library] {
+            let what = format!("{command} {}", input.display());
+            let reference = dir.path().join("reference");
+            let (status, out, err) = velvet(&[command, s(input), "--out-dir", s(&reference)]);
+            assert_eq!(status, 0, "{what}: {out}{err}");
+            let expected = tree(&reference);
+            std::fs::remove_dir_all(&reference).unwrap();
+            assert!(expected.len() > 16, "{what}: {expected:?}");
+            for (k, (signal, delay_ms)) in [
+                (libc::SIGINT, 20),
+                (libc::SIGTERM, 60),
+                (libc::SIGINT, 150),
+                (libc::SIGTERM, 400),
+            ]
+            .into_iter()
+            .enumerate()
+            {
+                let out_dir = dir.path().join(format!("out-{k}"));
+                let child = Command::new(env!("CARGO_BIN_EXE_velvet"))
+                    .args([command, s(input), "--out-dir", s(&out_dir)])
+                    .stdout(std::process::Stdio::piped())
+                    .stderr(std::process::Stdio::piped())
+                    .spawn()
+                    .unwrap();
+                std::thread::sleep(std::time::Duration::from_millis(delay_ms));
+                // SAFETY: kill(2) on the child's id, which it holds until it is waited for.
+                unsafe { libc::kill(child.id() as libc::pid_t, signal) };
+                let output = child.wait_with_output().unwrap();
+                let err = String::from_utf8_lossy(&output.stderr);
+                let what = format!("{what}, signal {signal} after {delay_ms} ms");
+                match output.status.code() {
+                    Some(0) => assert_eq!(tree(&out_dir), expected, "{what}"),
+                    Some(code) => {
+                        assert_eq!(code, 128 + signal, "{what}: {err}");
+                        let name = if signal == libc::SIGINT {
+                            "SIGINT"
+                        } else {
+                            "SIGTERM"
+                        };
+                        let line = err.lines().last().unwrap_or_default();
+                        assert!(
+                            line.starts_with(&format!("velvet: stopped by {name}: ")),
+                            "{what}: {err}"
+                        );
+                        assert!(
+                            line.contains(
+                                " finished (their outputs are complete); nothing was \
+                                           written for the other "
+                            ),
+                            "{what}: {err}"
+                        );
+                        assert_eq!(err.lines().count(), 1, "{what}: {err}");
+                        assert_only_finished_outputs(&out_dir, &expected, &what);
+                        stopped += 1;
+                    }
+                    None => {
+                        // The signal came before velvet installed its handler, which it does
+                        // before reading or writing anything: nothing may have been written.
+                        use std::os::unix::process::ExitStatusExt;
+                        assert_eq!(output.status.signal(), Some(signal), "{what}: {err}");
+                        assert!(!out_dir.exists(), "{what}: written before the handler");
+                    }
+                }
+                if out_dir.exists() {
+                    std::fs::remove_dir_all(&out_dir).unwrap();
+                }
+            }
+        }
+    }
+    assert!(
+        stopped >= 4,
+        "only {stopped} runs were stopped before they finished"
+    );
+}
+
+// ---------------------------------------------------------------------------------------------
+// Nothing dropped
+
+/// A GLB chunk of a type the spec does not define (here 0x4B4E5558, "XUNK", 12 bytes) survives
+/// migrate and bake byte for byte: it follows the BIN chunk in the output as it stood in the
+/// input, and the header's length counts it.
+#[test]
+fn an_unknown_glb_chunk_survives_migrate_and_bake_byte_for_byte() {
+    let dir = tempfile::tempdir().unwrap();
+    let rgba = png(2, 2, image::ExtendedColorType::Rgba8);
+    let mut doc = sheen_document("unused");
+    doc["images"] = json!([{"bufferView": 0, "mimeType": "image/png"}]);
+    doc["bufferViews"] = json!([{"buffer": 0, "byteLength": rgba.len()}]);
+    doc["buffers"] = json!([{"byteLength": rgba.len()}]);
+    let mut chunk = Vec::new();
+    chunk.extend_from_slice(&12u32.to_le_bytes());
+    chunk.extend_from_slice(b"XUNK");
+    chunk.extend_from_slice(b"kept as is!\x01");
+    let mut bytes = glb::join(doc.to_string().as_bytes(), Some(&rgba));
+    bytes.extend_from_slice(&chunk);
+    let length = bytes.len() as u32;
+    bytes[8..12].copy_from_slice(&length.to_le_bytes());
+    let input = dir.path().join("unknown.glb");
+    write(&input, &bytes);
+    for (command, extra) in [
+        ("migrate", None),
+        ("bake", None),
+        ("migrate", Some("--exact")),
+    ] {
+        let output = dir
+            .path()
+            .join(format!("{command}-{}.glb", extra.is_some()));
+        let mut args = vec![command, s(&input), "-o", s(&output)];
+        args.extend(extra);
+        let (status, out, err) = velvet(&args);
+        assert_eq!(status, 0, "{command}: {out}{err}");
+        let written = std::fs::read(&output).unwrap();
+        assert_ne!(written, bytes, "{command}: the output is a rewrite");
+        assert!(written.ends_with(&chunk), "{command}: {out}");
+        assert_eq!(
+            u32::from_le_bytes(written[8..12].try_into().unwrap()) as usize,
+            written.len()
+        );
+        let mut diagnostics = Vec::new();
+        let parts = glb::split(&written, &mut diagnostics).unwrap();
+        assert_eq!(parts.other, [chunk.as_slice()], "{command}");
+        assert_eq!(codes(&diagnostics), ["GLB_UNKNOWN_CHUNK_TYPE"], "{command}");
+    }
+}
+
+/// Two slots whose bakes come out identical (two source images with the same pixels) get one
+/// new file, named by both images, in bake and in migrate.
+#[test]
+fn identical_baked_images_are_written_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in");
+    let texture = seeded_png(7);
+    write(&input.join("a.png"), &texture);
+    write(&input.join("b.png"), &texture);
+    let doc = json!({
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_materials_sheen"],
+        "materials": [textured_sheen_material(0, 0.5), textured_sheen_material(1, 0.5)],
+        "textures": [{"source": 0}, {"source": 1}],
+        "images": [{"uri": "a.png"}, {"uri": "b.png"}]
+    });
+    write(
+        &input.join("pair.gltf"),
+        serde_json::to_string_pretty(&doc).unwrap(),
+    );
+    for command in ["bake", "migrate"] {
+        let out = dir.path().join(command);
+        let (status, stdout, err) = velvet(&[command, s(&input), "--out-dir", s(&out)]);
+        assert_eq!(status, 0, "{command}: {stdout}{err}");
+        let written = tree(&out);
+        let new: Vec<&PathBuf> = written
+            .keys()
+            .filter(|p| !["pair.gltf", "a.png", "b.png"].contains(&p.to_str().unwrap()))
+            .collect();
+        let output: Value = serde_json::from_slice(&written[Path::new("pair.gltf")]).unwrap();
+        let uris: Vec<&str> = output["images"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter_map(|i| i["uri"].as_str())
+            .filter(|u| *u != "a.png" && *u != "b.png")
+            .collect();
+        assert!(!uris.is_empty(), "{command}: {output}");
+        // Every new image names the one file per distinct content.
+        let distinct: std::collections::BTreeSet<&Vec<u8>> =
+            new.iter().map(|p| &written[*p]).collect();
+        assert_eq!(new.len(), distinct.len(), "{command}: {new:?}");
+        for uri in &uris {
+            assert!(written.contains_key(Path::new(uri)), "{command}: {uri}");
+        }
+        let named: std::collections::BTreeSet<&str> = uris.iter().copied().collect();
+        assert_eq!(named.len(), new.len(), "{command}: {uris:?} {new:?}");
+        assert!(uris.len() > named.len(), "{command}: {uris:?}");
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Memory within a stated budget
+
+/// CRC-32 (the PNG chunk checksum), bit by bit.
+fn crc32(bytes: &[u8]) -> u32 {
+    let mut crc = !0u32;
+    for &b in bytes {
+        crc ^= u32::from(b);
+        for _ in 0..8 {
+            crc = if crc & 1 != 0 {
+                (crc >> 1) ^ 0xEDB8_8320
+            } else {
+                crc >> 1
+            };
+        }
+    }
+    !crc
+}
+
+/// A PNG whose header declares `width` × `height` 16-bit RGBA and whose data is one empty
+/// IDAT: what a decoder learns before it allocates, and nothing to decode.
+fn forged_16bit_rgba_png(width: u32, height: u32) -> Vec<u8> {
+    let chunk = |kind: &[u8], data: &[u8]| {
+        let mut out = (data.len() as u32).to_be_bytes().to_vec();
+        let mut body = kind.to_vec();
+        body.extend_from_slice(data);
+        out.extend_from_slice(&body);
+        out.extend_from_slice(&crc32(&body).to_be_bytes());
+        out
+    };
+    let mut ihdr = Vec::new();
+    ihdr.extend_from_slice(&width.to_be_bytes());
+    ihdr.extend_from_slice(&height.to_be_bytes());
+    ihdr.extend_from_slice(&[16, 6, 0, 0, 0]);
+    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+    png.extend(chunk(b"IHDR", &ihdr));
+    png.extend(chunk(
+        b"IDAT",
+        &[0x78, 0x9c, 0x03, 0x00, 0x00, 0x00, 0x00, 0x01],
+    ));
+    png.extend(chunk(b"IEND", &[]));
+    png
+}
+
+/// A 16384² 16-bit RGBA PNG (within the pixel limit, which is inclusive) whose bake would need
+/// about 6 GiB is refused before any pixel buffer exists when the memory budget is 2 GiB, with
+/// a message naming --max-memory; the same budget in bytes is the same refusal.
+#[test]
+fn a_16384_square_16_bit_png_over_the_memory_budget_is_refused_before_decoding() {
+    let png = forged_16bit_rgba_png(16384, 16384);
+    let expected = "PNG: decoding the 16384 × 16384 Rgba16 image needs about 6.0 GiB, over \
+                    the memory budget of 2.0 GiB (raise it with --max-memory); it was not \
+                    decoded";
+    let (result, largest) =
+        largest_allocation(|| codec::decode_within(&png, 16384 * 16384, 2 << 30));
+    match result {
+        Err(e @ CodecError::TooLarge { .. }) => assert_eq!(e.to_string(), expected),
+        other => panic!("{:?}", other.map(|_| ())),
+    }
+    assert!(largest < 1 << 20, "largest allocation {largest} bytes");
+
+    let dir = tempfile::tempdir().unwrap();
+    write(&dir.path().join("huge16.png"), &png);
+    let input = dir.path().join("huge16.gltf");
+    write(&input, sheen_document("huge16.png").to_string());
+    for budget in ["2G", "2147483648"] {
+        let output = dir.path().join("out.gltf");
+        let (status, out, err) =
+            velvet(&["bake", s(&input), "-o", s(&output), "--max-memory", budget]);
+        assert_eq!(status, 1, "{out}{err}");
+        assert!(out.contains(expected), "{out}");
+        assert!(!output.exists());
+    }
+    let (status, _, err) = velvet(&["bake", s(&input), "--dry-run", "--max-memory", "lots"]);
+    assert_eq!(status, 2, "{err}");
+    assert!(err.contains("\"lots\" is not a byte count"), "{err}");
+}
+
+/// A GLB whose bytes and BIN copy would exceed the memory budget is refused before it is read
+/// (here a sparse file of 200 MiB under a budget of 100 MiB): an IO_ERROR naming --max-memory.
+#[test]
+fn a_glb_larger_than_the_memory_budget_is_refused_before_it_is_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("sparse.glb");
+    let json = br#"{"asset":{"version":"2.0"},"buffers":[{"byteLength":209715100}]}   "#;
+    let mut head = Vec::new();
+    head.extend_from_slice(b"glTF");
+    head.extend_from_slice(&2u32.to_le_bytes());
+    head.extend_from_slice(&(200u32 << 20).to_le_bytes());
+    head.extend_from_slice(&(json.len() as u32).to_le_bytes());
+    head.extend_from_slice(b"JSON");
+    head.extend_from_slice(json);
+    let bin_len = (200u32 << 20) - head.len() as u32 - 8;
+    head.extend_from_slice(&bin_len.to_le_bytes());
+    head.extend_from_slice(b"BIN\0");
+    write(&path, &head);
+    std::fs::File::options()
+        .write(true)
+        .open(&path)
+        .unwrap()
+        .set_len(200 << 20)
+        .unwrap();
+    let (status, out, err) = velvet(&["validate", s(&path), "--max-memory", "100M"]);
+    assert_eq!(status, 1, "{out}{err}");
+    assert!(
+        out.contains(&format!(
+            "error IO_ERROR: reading {} (a GLB of 209715200 bytes) needs about 400.0 MiB, over \
+             the memory budget of 100.0 MiB (raise it with --max-memory)",
+            velvet::report::display_path(&path)
+        )),
+        "{out}"
+    );
+}
+
+/// `--files-from` and velvet.toml are read no further than their limits: an endless list is a
+/// usage error at once, and a configuration over 1 MiB is refused naming the file.
+#[cfg(unix)]
+#[test]
+fn an_endless_list_and_a_huge_configuration_are_refused_at_their_limits() {
+    let (status, out, err) = velvet_within_20s(&["validate", "--files-from", "/dev/zero"]);
+    assert_eq!(status, Some(2), "{out}{err}");
+    assert_eq!(
+        err,
+        "velvet: --files-from /dev/zero: the list is longer than 67108864 bytes; velvet reads no \
+         further (split it, or name folders)\n"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let mut config = String::from("exclude = []\n");
+    while config.len() <= 1 << 20 {
+        config.push_str("# padding padding padding padding padding padding padding padding\n");
+    }
+    write(&dir.path().join("velvet.toml"), &config);
+    write(&dir.path().join("a.gltf"), r#"{"asset":{"version":"2.0"}}"#);
+    let (status, out, err) = velvet_within_20s(&["validate", s(dir.path())]);
+    assert_eq!(status, Some(2), "{out}{err}");
+    assert!(
+        err.contains(&format!(
+            "{}: the file is larger than 1048576 bytes, more than a configuration needs; velvet \
+             reads no further",
+            dir.path().join("velvet.toml").display()
+        )),
+        "{err}"
+    );
 }

@@ -28,6 +28,19 @@ fn load(path: &Path) -> velvet::asset::Asset {
         .expect("the test asset loads")
 }
 
+/// The sheets' materials of `asset`, with what a default migration of it writes.
+fn materials_of(asset: &velvet::asset::Asset) -> Vec<material::Material> {
+    materials_with(asset, &velvet::migrate::Options::default())
+}
+
+fn materials_with(
+    asset: &velvet::asset::Asset,
+    options: &velvet::migrate::Options,
+) -> Vec<material::Material> {
+    let plan = velvet::migrate::plan_document(asset, options);
+    material::materials(asset, &plan, options.roughness)
+}
+
 /// Interior pixels (whole pixel on the sphere) of a sphere of `size`.
 fn interior(size: usize) -> Vec<(usize, usize)> {
     let mut v = Vec::new();
@@ -174,7 +187,7 @@ fn the_fallback_of_a_black_fuzz_shows_no_layer() {
                "extensions": {"KHR_materials_fuzz": {"fuzzFactor": 1, "fuzzColorFactor": [0, 0, 0], "fuzzRoughnessFactor": 0.5}}}"#,
         ),
     );
-    let materials = material::materials(&load(&path));
+    let materials = materials_of(&load(&path));
     assert_eq!(materials.len(), 1);
     let m = &materials[0];
     assert_eq!(m.kind, Kind::FuzzFallback);
@@ -207,7 +220,7 @@ fn sheen_migrates_to_fuzz_with_the_fitted_and_the_copied_roughness() {
                "extensions": {"KHR_materials_sheen": {"sheenColorFactor": [1.0, 0.0, 0.75], "sheenRoughnessFactor": 0.5}}}"#,
         ),
     );
-    let m = &material::materials(&load(&path))[0];
+    let m = &materials_of(&load(&path))[0];
     assert_eq!(m.kind, Kind::SheenToFuzz);
     let cols = columns(m, &m.factors);
     let alpha = velvet::shading::mapping::fuzz_roughness_for_sheen(0.5);
@@ -217,8 +230,13 @@ fn sheen_migrates_to_fuzz_with_the_fitted_and_the_copied_roughness() {
         weight: 1.0,
         roughness,
     };
-    assert_eq!(cols[1].look.layer, fuzz(alpha));
+    // The migrated column is the file migrate writes: α(0.5) to four decimals.
+    let written = velvet::migrate::roughness::written(alpha);
+    assert_eq!(written, 0.5558);
+    assert_eq!(cols[1].look.layer, fuzz(written));
+    assert_eq!(cols[1].detail, "A 0.556 FITTED");
     assert_eq!(cols[2].look.layer, fuzz(0.5));
+    assert_eq!(cols[2].detail, "A 0.500 COPIED");
     // What a loader without fuzz sees: the sheen, kept.
     assert_eq!(cols[3].look, cols[0].look);
     let sheet = sheet::render("sheen.gltf", m);
@@ -278,7 +296,7 @@ fn a_textured_layer_gives_three_swatches_and_a_missing_texture_leaves_the_factor
         png_data_uri(&rough)
     );
     let path = write(dir.path(), "textured.gltf", &text);
-    let m = &material::materials(&load(&path))[0];
+    let m = &materials_of(&load(&path))[0];
     let labels: Vec<&str> = m.swatches.iter().map(|s| s.label).collect();
     assert_eq!(labels, ["P5", "MEAN", "P95"]);
     let r: Vec<f64> = m
@@ -294,7 +312,21 @@ fn a_textured_layer_gives_three_swatches_and_a_missing_texture_leaves_the_factor
         assert_eq!(s.sheen.unwrap().color, [1.0; 3]);
     }
     assert_eq!(m.base, [0.5; 3]);
-    assert_eq!(m.notes.len(), 2, "{:?}", m.notes);
+    // The fuzz colour texture migrate carries from the sheen reads the same missing image.
+    assert_eq!(m.notes.len(), 3, "{:?}", m.notes);
+    assert!(m.notes[2].starts_with("fuzzColorTexture not read"));
+    // The roughness texture is baked by the plan: at the codes the swatches read (p5 = 0,
+    // p95 = 216), the migrated fuzz reads α(0.5 × texel) within the budget 0.01 (and the
+    // four-decimal rounding of the factor).
+    for (s, code) in [(&m.swatches[0], 0.0), (&m.swatches[2], 216.0)] {
+        let exact = velvet::shading::mapping::fuzz_roughness_for_sheen(0.5 * code / 255.0);
+        let read = s.written_fuzz.unwrap().roughness;
+        assert!(
+            (read - exact).abs() <= 0.01 + 5e-5,
+            "{} reads {read}, α is {exact}",
+            s.label
+        );
+    }
     assert!(m
         .notes
         .iter()
@@ -308,10 +340,10 @@ fn a_textured_layer_gives_three_swatches_and_a_missing_texture_leaves_the_factor
             && n.ends_with("sheenColorFactor alone is used")));
     let sheet = sheet::render("textured.gltf", m);
     // The sheet says what the inputs lacked, and how its rows read the textures.
-    assert_eq!(sheet.summary.notes[..2], m.notes[..]);
-    assert_eq!(sheet.summary.notes.len(), 3);
+    assert_eq!(sheet.summary.notes[..3], m.notes[..]);
+    assert_eq!(sheet.summary.notes.len(), 4);
     assert!(
-        sheet.summary.notes[2].starts_with("the column headings give the values at the factors")
+        sheet.summary.notes[3].starts_with("the column headings give the values at the factors")
     );
     // The headings and the verdict name the columns at the factors (r = 0.5).
     assert_eq!(sheet.summary.columns[0], "authored: sheen r 0.500");
@@ -499,9 +531,112 @@ fn switched_off_layers_alone_get_no_sheet() {
                {"extensions": {"KHR_materials_fuzz": {"fuzzFactor": 0.5}}}"#,
         ),
     );
-    let materials = material::materials(&load(&path));
+    let materials = materials_of(&load(&path));
     let indices: Vec<usize> = materials.iter().map(|m| m.index).collect();
     assert_eq!(indices, [3]);
     assert!(materials[0].fuzz_roughness_assumed);
     assert_eq!(materials[0].factors.fuzz.unwrap().roughness, 0.5);
+}
+
+/// Migrates `path` with `options` into a folder of `dir` and returns the written document.
+fn migrated_file(dir: &Path, path: &Path, options: &velvet::migrate::Options) -> serde_json::Value {
+    let out = dir.join(format!("out-{:?}", options.roughness));
+    let report = velvet::migrate::run(&velvet::migrate::Request {
+        inputs: vec![path.to_path_buf()],
+        destination: velvet::output::paths::Destination::Dir(out.clone()),
+        options: options.clone(),
+        dry_run: false,
+        progress: false,
+    })
+    .unwrap();
+    assert_eq!(report.files.len(), 1);
+    let written = out.join(path.file_name().unwrap());
+    serde_json::from_slice(&std::fs::read(written).unwrap()).unwrap()
+}
+
+#[test]
+fn the_migrated_column_is_the_fuzz_migrate_writes_for_each_roughness_option() {
+    // A sheen roughness of 0 (its best fuzz match lies below the floor, so migrate writes
+    // 0.07), a roughness texture migrate cannot read (it copies the roughness then), the
+    // pre-ratification draft (upgraded first), and a plain sheen.
+    let dir = tempfile::tempdir().unwrap();
+    let text = r#"{"asset": {"version": "2.0"}, "extensionsUsed": ["KHR_materials_sheen"],
+        "images": [{"uri": "missing.png"}], "textures": [{"source": 0}],
+        "materials": [
+          {"name": "smooth", "extensions": {"KHR_materials_sheen": {"sheenColorFactor": [0.8, 0.2, 0.2], "sheenRoughnessFactor": 0.0}}},
+          {"name": "unreadable", "extensions": {"KHR_materials_sheen": {"sheenColorFactor": [0.5, 0.5, 0.5], "sheenRoughnessFactor": 0.6, "sheenRoughnessTexture": {"index": 0}}}},
+          {"name": "draft", "pbrMetallicRoughness": {"roughnessFactor": 0.4}, "extensions": {"KHR_materials_sheen": {"sheenFactor": 0.5, "sheenColor": [1.0, 0.5, 0.2]}}},
+          {"name": "cloth", "extensions": {"KHR_materials_sheen": {"sheenColorFactor": [0.9, 0.9, 0.9], "sheenRoughnessFactor": 0.5}}}
+        ]}"#;
+    let path = write(dir.path(), "cases.gltf", text);
+    let asset = load(&path);
+    let mut sheets = Vec::new();
+    for mapping in [
+        velvet::migrate::roughness::RoughnessMapping::Fitted,
+        velvet::migrate::roughness::RoughnessMapping::Identity,
+    ] {
+        let options = velvet::migrate::Options {
+            roughness: mapping,
+            ..velvet::migrate::Options::default()
+        };
+        let file = migrated_file(dir.path(), &path, &options);
+        let materials = materials_with(&asset, &options);
+        assert_eq!(materials.len(), 4, "every case has a sheet, the draft too");
+        for m in &materials {
+            assert_eq!(m.kind, Kind::SheenToFuzz, "{:?}", m.name);
+            let fuzz = &file["materials"][m.index]["extensions"]["KHR_materials_fuzz"];
+            let number = |key: &str| fuzz[key].as_f64().unwrap();
+            let written = m.factors.written_fuzz.expect("the plan writes a fuzz");
+            assert_eq!(written.weight, number("fuzzFactor"), "{:?}", m.name);
+            assert_eq!(
+                written.roughness,
+                number("fuzzRoughnessFactor"),
+                "{:?}",
+                m.name
+            );
+            let color: Vec<f64> = fuzz["fuzzColorFactor"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|c| c.as_f64().unwrap())
+                .collect();
+            assert_eq!(written.color.to_vec(), color, "{:?}", m.name);
+            let cols = columns(m, &m.factors);
+            assert_eq!(
+                cols[1].look.layer,
+                Layer::Fuzz {
+                    color: written.color,
+                    weight: written.weight,
+                    roughness: written.roughness
+                }
+            );
+        }
+        let roughness = |i: usize| materials[i].factors.written_fuzz.unwrap().roughness;
+        // The floor, whatever the mapping: a fitted α(0) lies below it, a copied 0 too.
+        assert_eq!(roughness(0), 0.07);
+        // The unreadable texture: the roughness is copied, whatever the mapping asked.
+        assert_eq!(roughness(1), 0.6);
+        assert!(materials[1]
+            .notes
+            .iter()
+            .any(|n| n.starts_with("sheenRoughnessTexture not read")));
+        // The draft, as migrate upgrades it: sheenColor × sheenFactor, the material's roughness.
+        let draft = materials[2].factors.sheen.unwrap();
+        assert_eq!(draft.color, [0.5, 0.25, 0.1]);
+        assert_eq!(draft.roughness, 0.4);
+        sheets.push(sheet::to_png(&sheet::render("cases.gltf", &materials[3])));
+        let expected = match mapping {
+            velvet::migrate::roughness::RoughnessMapping::Fitted => {
+                velvet::migrate::roughness::written(
+                    velvet::shading::mapping::fuzz_roughness_for_sheen(0.5),
+                )
+            }
+            velvet::migrate::roughness::RoughnessMapping::Identity => 0.5,
+        };
+        assert_eq!(roughness(3), expected);
+    }
+    assert_ne!(
+        sheets[0], sheets[1],
+        "--roughness identity shows another sheet"
+    );
 }

@@ -673,7 +673,7 @@ fn a_large_file_reports_its_last_material_at_its_line_and_column() {
         ));
     }
     text.push_str("\n  ]\n}\n");
-    assert!(text.len() as u64 > 2 * velvet::asset::source::MAPPED_FROM);
+    assert!(text.len() as u64 > 2 << 20);
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("large.gltf");
     std::fs::write(&path, &text).unwrap();
@@ -690,5 +690,500 @@ fn a_large_file_reports_its_last_material_at_its_line_and_column() {
             path.display(),
             materials - 1
         )
+    );
+}
+
+/// Sets the value at `pointer` in `doc`, making the objects on the way.
+fn set(doc: &mut Value, pointer: &str, value: Value) {
+    let mut at = doc;
+    let tokens: Vec<&str> = pointer.split('/').skip(1).collect();
+    for (i, token) in tokens.iter().enumerate() {
+        let last = i + 1 == tokens.len();
+        at = match at {
+            Value::Array(items) => {
+                let index: usize = token.parse().unwrap();
+                if index == items.len() {
+                    items.push(json!({}));
+                }
+                &mut items[index]
+            }
+            Value::Object(map) => {
+                if last {
+                    map.insert(token.to_string(), value);
+                    return;
+                }
+                map.entry(token.to_string()).or_insert_with(|| json!({}))
+            }
+            other => panic!("{pointer}: {other} holds no members"),
+        };
+        if last {
+            *at = value;
+            return;
+        }
+    }
+}
+
+/// A valid document every extension case adds its objects to: a scene whose node draws a mesh
+/// with a material, a texture, an animation, and a buffer file (data.bin, written beside it)
+/// that holds the accessors and images, none of which velvet reads.
+fn extension_base() -> Value {
+    json!({
+        "asset": {"version": "2.0"},
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1, "TANGENT": 2, "TEXCOORD_0": 3}, "material": 0}]}],
+        "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],
+        "textures": [{"source": 0}],
+        "images": [
+            {"bufferView": 1, "mimeType": "image/png"},
+            {"bufferView": 1, "mimeType": "image/webp"},
+            {"bufferView": 1, "mimeType": "image/ktx2"}
+        ],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 1, "type": "VEC3", "min": [0, 0, 0], "max": [0, 0, 0]},
+            {"bufferView": 0, "componentType": 5126, "count": 1, "type": "VEC3"},
+            {"bufferView": 0, "componentType": 5126, "count": 1, "type": "VEC4"},
+            {"bufferView": 0, "componentType": 5126, "count": 1, "type": "VEC2"},
+            {"bufferView": 0, "componentType": 5126, "count": 1, "type": "SCALAR", "min": [0], "max": [1]}
+        ],
+        "animations": [{"channels": [{"sampler": 0, "target": {"node": 0, "path": "translation"}}],
+                        "samplers": [{"input": 4, "output": 0}]}],
+        "bufferViews": [{"buffer": 0, "byteLength": 16}, {"buffer": 0, "byteOffset": 16, "byteLength": 16}],
+        "buffers": [{"byteLength": 32, "uri": "data.bin"}]
+    })
+}
+
+/// One extension's case: the objects it adds (pointer, value), and the one value that puts it
+/// out of its schema (pointer, value or `None` to remove it) with the code and pointer of the
+/// finding that gives.
+struct ExtensionCase {
+    extension: &'static str,
+    objects: Vec<(&'static str, Value)>,
+    bad: (&'static str, Option<Value>),
+    expected: (&'static str, &'static str),
+}
+
+fn extension_cases() -> Vec<ExtensionCase> {
+    let case = |extension, objects, bad, expected| ExtensionCase {
+        extension,
+        objects,
+        bad,
+        expected,
+    };
+    let material = |extension: &'static str, object: Value, property: &'static str, bad: Value| {
+        let pointer: &'static str =
+            Box::leak(format!("/materials/0/extensions/{extension}/{property}").into_boxed_str());
+        case(
+            extension,
+            vec![(
+                Box::leak(format!("/materials/0/extensions/{extension}").into_boxed_str()) as &str,
+                object,
+            )],
+            (pointer, Some(bad)),
+            ("VALUE_NOT_IN_RANGE", pointer),
+        )
+    };
+    let meshopt = |extension: &'static str| {
+        let view: &'static str =
+            Box::leak(format!("/bufferViews/2/extensions/{extension}").into_boxed_str());
+        let stride: &'static str = Box::leak(format!("{view}/byteStride").into_boxed_str());
+        case(
+            extension,
+            vec![
+                // The fallback buffer has no uri: valid in a .gltf.
+                ("/buffers/1", json!({"byteLength": 64})),
+                (
+                    Box::leak(format!("/buffers/1/extensions/{extension}").into_boxed_str())
+                        as &str,
+                    json!({"fallback": true}),
+                ),
+                ("/bufferViews/2", json!({"buffer": 1, "byteLength": 64})),
+                (
+                    view,
+                    json!({"buffer": 0, "byteLength": 16, "byteStride": 4, "count": 4, "mode": "ATTRIBUTES"}),
+                ),
+            ],
+            (stride, Some(json!(300))),
+            ("VALUE_NOT_IN_RANGE", stride),
+        )
+    };
+    let node_flag = |extension: &'static str, flag: &'static str| {
+        let pointer: &'static str =
+            Box::leak(format!("/nodes/0/extensions/{extension}/{flag}").into_boxed_str());
+        case(
+            extension,
+            vec![(
+                Box::leak(format!("/nodes/0/extensions/{extension}").into_boxed_str()) as &str,
+                json!({ flag: false }),
+            )],
+            (pointer, Some(json!("no"))),
+            ("TYPE_MISMATCH", pointer),
+        )
+    };
+    let texture_source = |extension: &'static str, image: u64| {
+        let pointer: &'static str =
+            Box::leak(format!("/textures/0/extensions/{extension}/source").into_boxed_str());
+        case(
+            extension,
+            vec![(
+                Box::leak(format!("/textures/0/extensions/{extension}").into_boxed_str()) as &str,
+                json!({ "source": image }),
+            )],
+            (pointer, Some(json!(-1))),
+            ("VALUE_NOT_IN_RANGE", pointer),
+        )
+    };
+    vec![
+        case(
+            "EXT_lights_ies",
+            vec![
+                ("/extensions/EXT_lights_ies", json!({"lights": [{"uri": "lamp.ies"}]})),
+                ("/nodes/0/extensions/EXT_lights_ies", json!({"light": 0, "multiplier": 2, "color": [1, 0.5, 0]})),
+            ],
+            ("/nodes/0/extensions/EXT_lights_ies/multiplier", Some(json!(-1))),
+            ("VALUE_NOT_IN_RANGE", "/nodes/0/extensions/EXT_lights_ies/multiplier"),
+        ),
+        case(
+            "EXT_lights_image_based",
+            vec![
+                (
+                    "/extensions/EXT_lights_image_based",
+                    json!({"lights": [{"irradianceCoefficients": vec![json!([0, 0, 0]); 9],
+                                       "specularImages": [[0, 0, 0, 0, 0, 0]], "specularImageSize": 256}]}),
+                ),
+                ("/scenes/0/extensions/EXT_lights_image_based", json!({"light": 0})),
+            ],
+            ("/extensions/EXT_lights_image_based/lights/0/intensity", Some(json!(-1))),
+            ("VALUE_NOT_IN_RANGE", "/extensions/EXT_lights_image_based/lights/0/intensity"),
+        ),
+        case(
+            "EXT_mesh_gpu_instancing",
+            vec![("/nodes/0/extensions/EXT_mesh_gpu_instancing", json!({"attributes": {"TRANSLATION": 0}}))],
+            ("/nodes/0/extensions/EXT_mesh_gpu_instancing/attributes/TRANSLATION", Some(json!(-1))),
+            ("VALUE_NOT_IN_RANGE", "/nodes/0/extensions/EXT_mesh_gpu_instancing/attributes/TRANSLATION"),
+        ),
+        case(
+            "EXT_mesh_manifold",
+            vec![("/meshes/0/extensions/EXT_mesh_manifold", json!({"manifoldPrimitive": {"attributes": {"POSITION": 0}}}))],
+            ("/meshes/0/extensions/EXT_mesh_manifold/mergeIndices", Some(json!(-1))),
+            ("VALUE_NOT_IN_RANGE", "/meshes/0/extensions/EXT_mesh_manifold/mergeIndices"),
+        ),
+        case(
+            "EXT_mesh_primitive_edge_visibility",
+            vec![(
+                "/meshes/0/primitives/0/extensions/EXT_mesh_primitive_edge_visibility",
+                json!({"visibility": 4, "lineStrings": [{"indices": 4}]}),
+            )],
+            ("/meshes/0/primitives/0/extensions/EXT_mesh_primitive_edge_visibility/lineStrings/0/indices", Some(json!(-1))),
+            ("VALUE_NOT_IN_RANGE", "/meshes/0/primitives/0/extensions/EXT_mesh_primitive_edge_visibility/lineStrings/0/indices"),
+        ),
+        case(
+            "EXT_mesh_primitive_restart",
+            vec![("/meshes/0/extensions/EXT_mesh_primitive_restart", json!({"primitiveGroups": [{"primitives": [0], "indices": 4}]}))],
+            ("/meshes/0/extensions/EXT_mesh_primitive_restart/primitiveGroups/0/indices", Some(json!(-1))),
+            ("VALUE_NOT_IN_RANGE", "/meshes/0/extensions/EXT_mesh_primitive_restart/primitiveGroups/0/indices"),
+        ),
+        meshopt("EXT_meshopt_compression"),
+        texture_source("EXT_texture_astc", 2),
+        texture_source("EXT_texture_webp", 1),
+        case(
+            "KHR_animation_pointer",
+            vec![
+                ("/animations/0/channels/0/target", json!({"path": "pointer"})),
+                ("/animations/0/channels/0/target/extensions/KHR_animation_pointer", json!({"pointer": "/nodes/0/translation"})),
+            ],
+            ("/animations/0/channels/0/target/extensions/KHR_animation_pointer/pointer", Some(json!("nodes/0/translation"))),
+            ("PATTERN_MISMATCH", "/animations/0/channels/0/target/extensions/KHR_animation_pointer/pointer"),
+        ),
+        case(
+            "KHR_draco_mesh_compression",
+            vec![("/meshes/0/primitives/0/extensions/KHR_draco_mesh_compression", json!({"bufferView": 0, "attributes": {"POSITION": 0}}))],
+            ("/meshes/0/primitives/0/extensions/KHR_draco_mesh_compression/bufferView", Some(json!(-1))),
+            ("VALUE_NOT_IN_RANGE", "/meshes/0/primitives/0/extensions/KHR_draco_mesh_compression/bufferView"),
+        ),
+        case(
+            "KHR_gaussian_splatting",
+            vec![("/meshes/0/primitives/0/extensions/KHR_gaussian_splatting", json!({"kernel": "ellipse", "colorSpace": "srgb_rec709_display"}))],
+            ("/meshes/0/primitives/0/extensions/KHR_gaussian_splatting/kernel", None),
+            ("UNDEFINED_PROPERTY", "/meshes/0/primitives/0/extensions/KHR_gaussian_splatting"),
+        ),
+        case(
+            "KHR_lights_punctual",
+            vec![
+                ("/extensions/KHR_lights_punctual", json!({"lights": [{"type": "spot", "intensity": 3, "spot": {"innerConeAngle": 0.1, "outerConeAngle": 0.5}}]})),
+                ("/nodes/0/extensions/KHR_lights_punctual", json!({"light": 0})),
+            ],
+            ("/extensions/KHR_lights_punctual/lights/0/spot/outerConeAngle", Some(json!(2))),
+            ("VALUE_NOT_IN_RANGE", "/extensions/KHR_lights_punctual/lights/0/spot/outerConeAngle"),
+        ),
+        material("KHR_materials_anisotropy", json!({"anisotropyStrength": 0.5, "anisotropyRotation": 1}), "anisotropyStrength", json!(1.5)),
+        material("KHR_materials_clearcoat", json!({"clearcoatFactor": 1, "clearcoatTexture": {"index": 0}}), "clearcoatRoughnessFactor", json!(-0.5)),
+        material("KHR_materials_diffuse_transmission", json!({"diffuseTransmissionFactor": 0.25}), "diffuseTransmissionFactor", json!(2)),
+        material("KHR_materials_dispersion", json!({"dispersion": 0.1}), "dispersion", json!(-1)),
+        material("KHR_materials_emissive_strength", json!({"emissiveStrength": 5}), "emissiveStrength", json!(-1)),
+        material("KHR_materials_ior", json!({"ior": 1.4}), "ior", json!(0.5)),
+        material("KHR_materials_iridescence", json!({"iridescenceFactor": 1, "iridescenceIor": 1.3}), "iridescenceIor", json!(0.9)),
+        material("KHR_materials_specular", json!({"specularFactor": 0.5, "specularColorFactor": [1, 1, 1]}), "specularFactor", json!(1.5)),
+        material("KHR_materials_transmission", json!({"transmissionFactor": 0.5}), "transmissionFactor", json!(1.5)),
+        case(
+            "KHR_materials_unlit",
+            vec![("/materials/0/extensions/KHR_materials_unlit", json!({}))],
+            ("/materials/0/extensions/KHR_materials_unlit", Some(json!(1))),
+            ("TYPE_MISMATCH", "/materials/0/extensions/KHR_materials_unlit"),
+        ),
+        case(
+            "KHR_materials_variants",
+            vec![
+                ("/extensions/KHR_materials_variants", json!({"variants": [{"name": "red"}]})),
+                ("/meshes/0/primitives/0/extensions/KHR_materials_variants", json!({"mappings": [{"material": 0, "variants": [0]}]})),
+            ],
+            ("/meshes/0/primitives/0/extensions/KHR_materials_variants/mappings/0/variants", None),
+            ("UNDEFINED_PROPERTY", "/meshes/0/primitives/0/extensions/KHR_materials_variants/mappings/0"),
+        ),
+        material("KHR_materials_volume", json!({"thicknessFactor": 1, "attenuationDistance": 2}), "thicknessFactor", json!(-1)),
+        meshopt("KHR_meshopt_compression"),
+        node_flag("KHR_node_hoverability", "hoverable"),
+        node_flag("KHR_node_selectability", "selectable"),
+        node_flag("KHR_node_visibility", "visible"),
+        texture_source("KHR_texture_basisu", 2),
+        case(
+            "KHR_texture_transform",
+            vec![(
+                "/materials/0/pbrMetallicRoughness/baseColorTexture/extensions/KHR_texture_transform",
+                json!({"offset": [0, 1], "rotation": 1.5, "scale": [2, 2], "texCoord": 0}),
+            )],
+            ("/materials/0/pbrMetallicRoughness/baseColorTexture/extensions/KHR_texture_transform/texCoord", Some(json!(-1))),
+            ("VALUE_NOT_IN_RANGE", "/materials/0/pbrMetallicRoughness/baseColorTexture/extensions/KHR_texture_transform/texCoord"),
+        ),
+        case(
+            "KHR_xmp_json_ld",
+            vec![
+                ("/extensions/KHR_xmp_json_ld", json!({"packets": [{"@context": {"dc": "http://purl.org/dc/elements/1.1/"}, "dc:title": "chair"}]})),
+                ("/asset/extensions/KHR_xmp_json_ld", json!({"packet": 0})),
+                ("/materials/0/extensions/KHR_xmp_json_ld", json!({"packet": 0})),
+            ],
+            ("/materials/0/extensions/KHR_xmp_json_ld/packet", Some(json!(-1))),
+            ("VALUE_NOT_IN_RANGE", "/materials/0/extensions/KHR_xmp_json_ld/packet"),
+        ),
+    ]
+}
+
+/// Writes `doc` as a .gltf beside a data.bin of 32 bytes, and validates it.
+fn validate_doc(validator: &Validator, dir: &Path, name: &str, doc: &Value) -> FileReport {
+    std::fs::write(dir.join("data.bin"), [0u8; 32]).unwrap();
+    let path = dir.join(format!("{name}.gltf"));
+    std::fs::write(&path, serde_json::to_string_pretty(doc).unwrap()).unwrap();
+    validator.validate_file(&path)
+}
+
+#[test]
+fn every_published_extension_is_judged_by_its_schema_valid_uses_clean_one_bad_value_one_finding() {
+    let validator = Validator::new(Schemas::builtin(), Settings::default());
+    let dir = tempfile::tempdir().unwrap();
+    let cases = extension_cases();
+    // Every extension whose schemas velvet ships has its case.
+    let mut folders: Vec<String> = std::fs::read_dir("schema/extensions")
+        .unwrap()
+        .map(|e| e.unwrap())
+        .filter(|e| e.path().is_dir())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .collect();
+    folders.sort();
+    let mut covered: Vec<String> = cases.iter().map(|c| c.extension.to_string()).collect();
+    covered.sort();
+    assert_eq!(covered, folders);
+    for case in &cases {
+        let mut doc = extension_base();
+        set(&mut doc, "/extensionsUsed", json!([case.extension]));
+        for (pointer, value) in &case.objects {
+            set(&mut doc, pointer, value.clone());
+        }
+        let valid = validate_doc(&validator, dir.path(), case.extension, &doc);
+        let above_info: Vec<(String, String)> = valid
+            .findings
+            .iter()
+            .filter(|f| f.diagnostic.severity < velvet::diagnostics::Severity::Info)
+            .map(|f| (f.diagnostic.code.to_string(), f.diagnostic.pointer.clone()))
+            .collect();
+        assert_eq!(
+            above_info,
+            [],
+            "{}: the valid use has findings",
+            case.extension
+        );
+
+        let (pointer, bad) = &case.bad;
+        match bad {
+            Some(value) => set(&mut doc, pointer, value.clone()),
+            None => {
+                let (parent, key) = pointer.rsplit_once('/').unwrap();
+                doc.pointer_mut(parent)
+                    .and_then(Value::as_object_mut)
+                    .unwrap()
+                    .remove(key);
+            }
+        }
+        let invalid = validate_doc(&validator, dir.path(), case.extension, &doc);
+        let schema_findings: Vec<(String, String)> = invalid
+            .findings
+            .iter()
+            .filter(|f| {
+                velvet::diagnostics::codes::SCHEMA
+                    .iter()
+                    .any(|c| c.name == f.diagnostic.code)
+                    || ["PATTERN_MISMATCH", "EMPTY_ENTITY", "ONE_OF_MISMATCH"]
+                        .contains(&f.diagnostic.code)
+            })
+            .map(|f| (f.diagnostic.code.to_string(), f.diagnostic.pointer.clone()))
+            .collect();
+        assert_eq!(
+            schema_findings,
+            [(case.expected.0.to_string(), case.expected.1.to_string())],
+            "{}: the value out of its schema",
+            case.extension
+        );
+    }
+}
+
+#[test]
+fn a_number_past_the_range_of_f64_is_out_of_range_where_a_number_is_asked_and_nowhere_else() {
+    // 1e400 reads as infinity in f64: valid JSON, never an error of the parser's own, and out
+    // of range wherever the schema asks for a number (once, though the sheen roughness fails
+    // both its type and its maximum); in extras it is free.
+    let text = r#"{
+  "asset": {"version": "2.0"},
+  "extensionsUsed": ["KHR_materials_sheen"],
+  "nodes": [{"translation": [1e400, 0, -1E+400]}],
+  "cameras": [{"type": "perspective", "perspective": {"yfov": 1, "znear": 1e400}}],
+  "materials": [{"extensions": {"KHR_materials_sheen": {"sheenColorFactor": [1, 1, 1], "sheenRoughnessFactor": 1e400}}}],
+  "extras": {"far": 1e400}
+}"#;
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("far.gltf");
+    std::fs::write(&path, text).unwrap();
+    let report = Validator::new(Schemas::builtin(), Settings::default()).validate_file(&path);
+    let found: Vec<(String, String)> = report
+        .findings
+        .iter()
+        .map(|f| (f.diagnostic.code.to_string(), f.diagnostic.pointer.clone()))
+        .collect();
+    let expected: Vec<(String, String)> = [
+        "/nodes/0/translation/0",
+        "/nodes/0/translation/2",
+        "/cameras/0/perspective/znear",
+        "/materials/0/extensions/KHR_materials_sheen/sheenRoughnessFactor",
+    ]
+    .iter()
+    .map(|p| ("VALUE_NOT_IN_RANGE".to_string(), p.to_string()))
+    .collect();
+    let mut sorted = found.clone();
+    sorted.sort();
+    let mut expected_sorted = expected;
+    expected_sorted.sort();
+    assert_eq!(sorted, expected_sorted, "{found:?}");
+}
+
+/// The code and pointer of every finding on `doc`, written as chair.gltf in a fresh folder.
+fn codes_and_pointers_of(doc: &Value) -> Vec<(String, String)> {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("chair.gltf");
+    std::fs::write(&path, doc.to_string()).unwrap();
+    Validator::new(Schemas::builtin(), Settings::default())
+        .validate_file(&path)
+        .findings
+        .iter()
+        .map(|f| (f.diagnostic.code.to_string(), f.diagnostic.pointer.clone()))
+        .collect()
+}
+
+#[test]
+fn every_texture_of_a_material_needs_its_texcoord_set_as_texture_transform_says() {
+    // A primitive with TEXCOORD_0 only, drawn with material 0, whose textures read: the base
+    // colour set 1 (missing), the normal texture set 1 but KHR_texture_transform's texCoord 0
+    // (present), a clearcoat texture set 0 but KHR_texture_transform's texCoord 2 (missing).
+    let doc = json!({
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_materials_clearcoat", "KHR_texture_transform"],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1, "TANGENT": 2, "TEXCOORD_0": 3}, "material": 0}]}],
+        "materials": [{
+            "pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": 1}},
+            "normalTexture": {"index": 0, "texCoord": 1, "extensions": {"KHR_texture_transform": {"texCoord": 0}}},
+            "extensions": {"KHR_materials_clearcoat": {"clearcoatFactor": 1,
+                "clearcoatTexture": {"index": 0, "extensions": {"KHR_texture_transform": {"texCoord": 2}}}}}
+        }],
+        "textures": [{"source": 0}],
+        "images": [{"uri": "data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR4nGNgYGD4DwABBAEAWB0S5wAAAABJRU5ErkJggg=="}],
+        "accessors": [
+            {"componentType": 5126, "count": 1, "type": "VEC3", "min": [0, 0, 0], "max": [0, 0, 0]},
+            {"componentType": 5126, "count": 1, "type": "VEC3"},
+            {"componentType": 5126, "count": 1, "type": "VEC4"},
+            {"componentType": 5126, "count": 1, "type": "VEC2"}
+        ]
+    });
+    let at = "/meshes/0/primitives/0/material".to_string();
+    assert_eq!(
+        codes_and_pointers_of(&doc),
+        [
+            ("MESH_PRIMITIVE_TOO_FEW_TEXCOORDS".to_string(), at.clone()),
+            ("MESH_PRIMITIVE_TOO_FEW_TEXCOORDS".to_string(), at)
+        ]
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("chair.gltf");
+    std::fs::write(&path, doc.to_string()).unwrap();
+    let messages: Vec<String> = Validator::new(Schemas::builtin(), Settings::default())
+        .validate_file(&path)
+        .findings
+        .iter()
+        .map(|f| f.diagnostic.message.clone())
+        .collect();
+    assert_eq!(
+        messages,
+        [
+            "material 0's /materials/0/pbrMetallicRoughness/baseColorTexture reads TEXCOORD_1, which this primitive does not have",
+            "material 0's /materials/0/extensions/KHR_materials_clearcoat/clearcoatTexture reads TEXCOORD_2, which this primitive does not have",
+        ]
+    );
+}
+
+#[test]
+fn only_a_glbs_first_buffer_needs_the_bin_chunk() {
+    // Buffer 1 has no uri: nothing reads it (or an extension fills it). Valid in a .gltf and in
+    // a .glb; only buffer 0 of a .glb without a BIN chunk lacks its data.
+    let doc = json!({
+        "asset": {"version": "2.0"},
+        "buffers": [{"byteLength": 4}, {"byteLength": 8}]
+    });
+    let text = doc.to_string();
+    let dir = tempfile::tempdir().unwrap();
+    let validator = Validator::new(Schemas::builtin(), Settings::default());
+    let codes_of = |name: &str, bytes: Vec<u8>| -> Vec<(String, String)> {
+        let path = dir.path().join(name);
+        std::fs::write(&path, bytes).unwrap();
+        validator
+            .validate_file(&path)
+            .findings
+            .iter()
+            .map(|f| (f.diagnostic.code.to_string(), f.diagnostic.pointer.clone()))
+            .collect()
+    };
+    assert_eq!(codes_of("buffers.gltf", text.clone().into_bytes()), []);
+    assert_eq!(
+        codes_of(
+            "with_bin.glb",
+            velvet::asset::glb::join(text.as_bytes(), Some(&[0u8; 4]))
+        ),
+        []
+    );
+    assert_eq!(
+        codes_of(
+            "without_bin.glb",
+            velvet::asset::glb::join(text.as_bytes(), None)
+        ),
+        [(
+            "BUFFER_MISSING_GLB_DATA".to_string(),
+            "/buffers/0".to_string()
+        )]
     );
 }

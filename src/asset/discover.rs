@@ -98,8 +98,16 @@ fn walk(dir: &Path, files: &mut Vec<PathBuf>, errors: &mut Vec<WalkError>) {
     let mut paths: Vec<PathBuf> = entries.filter_map(|e| e.ok().map(|e| e.path())).collect();
     paths.sort();
     for path in paths {
-        let Ok(meta) = std::fs::symlink_metadata(&path) else {
-            continue;
+        let meta = match std::fs::symlink_metadata(&path) {
+            Ok(meta) => meta,
+            // Gone between the listing and now: nothing to report.
+            Err(e) if e.kind() == io::ErrorKind::NotFound => continue,
+            // An entry that cannot be looked at (a path longer than the system allows, a
+            // permission): reported, never skipped in silence.
+            Err(e) => {
+                errors.push((path, e));
+                continue;
+            }
         };
         if meta.is_dir() {
             walk(&path, files, errors);
@@ -125,8 +133,11 @@ fn has_asset(dir: &Path) -> bool {
     let mut folders = Vec::new();
     for entry in entries.filter_map(Result::ok) {
         let path = entry.path();
-        let Ok(meta) = std::fs::symlink_metadata(&path) else {
-            continue;
+        let meta = match std::fs::symlink_metadata(&path) {
+            Ok(meta) => meta,
+            Err(e) if e.kind() == io::ErrorKind::NotFound => continue,
+            // Reported by the walk (see `walk`).
+            Err(_) => return true,
         };
         if meta.is_dir() {
             folders.push(path);
@@ -144,6 +155,8 @@ pub enum InputError {
     Missing(PathBuf),
     #[error("{}: no .gltf or .glb file in this folder or below", .0.display())]
     NoAssets(PathBuf),
+    #[error("{}: not a regular file or folder ({kind}); velvet reads assets from files", .path.display())]
+    NotAFile { path: PathBuf, kind: &'static str },
     #[error("--files-from {}: {source}", .list.display())]
     ListUnreadable { list: PathBuf, source: io::Error },
     #[error("--files-from {}: {path} (entry {entry}) does not exist", .list.display())]
@@ -154,10 +167,14 @@ pub enum InputError {
     },
     #[error("--files-from {}: entry {entry} is not a valid path on this system", .list.display())]
     ListedNotAPath { list: PathBuf, entry: usize },
+    #[error("--files-from {}: the list is longer than {} bytes; velvet reads no further (split it, or name folders)", .list.display(), MAX_LIST_BYTES)]
+    ListTooLong { list: PathBuf },
 }
 
-/// Refuses a path that does not exist and a folder with no asset in it or below. A link named
-/// on the command line is taken even when it dangles: the loader reports that file.
+/// Refuses a path that does not exist, one that is neither a regular file nor a folder (a FIFO
+/// would block the run until something writes to it, a device would be read without end), and
+/// a folder with no asset in it or below. A link named on the command line is taken even when
+/// it dangles: the loader reports that file.
 pub fn check_inputs(inputs: &[PathBuf]) -> Result<(), InputError> {
     for input in inputs {
         match std::fs::symlink_metadata(input) {
@@ -166,11 +183,42 @@ pub fn check_inputs(inputs: &[PathBuf]) -> Result<(), InputError> {
             }
             _ => {}
         }
+        if let Ok(meta) = std::fs::metadata(input) {
+            if !meta.is_file() && !meta.is_dir() {
+                return Err(InputError::NotAFile {
+                    path: input.clone(),
+                    kind: file_kind(&meta),
+                });
+            }
+        }
         if input.is_dir() && !has_asset(input) {
             return Err(InputError::NoAssets(input.clone()));
         }
     }
     Ok(())
+}
+
+/// What a file that is neither a regular file nor a folder is, for messages.
+fn file_kind(meta: &std::fs::Metadata) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        let t = meta.file_type();
+        if t.is_fifo() {
+            return "a FIFO";
+        }
+        if t.is_socket() {
+            return "a socket";
+        }
+        if t.is_char_device() {
+            return "a character device";
+        }
+        if t.is_block_device() {
+            return "a block device";
+        }
+    }
+    let _ = meta;
+    "a special file"
 }
 
 /// The entries of a `--files-from` list: NUL-separated when the bytes hold a NUL, else one per
@@ -201,6 +249,9 @@ fn path_from_bytes(bytes: &[u8]) -> Option<PathBuf> {
     std::str::from_utf8(bytes).ok().map(PathBuf::from)
 }
 
+/// The longest `--files-from` list velvet reads: 64 MiB, some 500,000 paths of 130 bytes.
+pub const MAX_LIST_BYTES: u64 = 64 << 20;
+
 /// Reads a `--files-from` list (`-`: standard input) and returns the inputs it names: folders
 /// (walked as on the command line) and `.gltf`/`.glb` files. Other entries are skipped, so the
 /// output of `git diff --name-only` or `find` can be fed as it is; a listed folder or asset
@@ -210,16 +261,24 @@ pub fn read_list(list: &Path) -> Result<Vec<PathBuf>, InputError> {
         list: list.to_path_buf(),
         source,
     };
-    let bytes = if list == Path::new("-") {
-        let mut bytes = Vec::new();
+    // Read no further than the limit: `--files-from /dev/zero` costs an error, not memory.
+    let mut bytes = Vec::new();
+    if list == Path::new("-") {
         io::stdin()
             .lock()
+            .take(MAX_LIST_BYTES + 1)
             .read_to_end(&mut bytes)
             .map_err(unreadable)?;
-        bytes
     } else {
-        std::fs::read(list).map_err(unreadable)?
-    };
+        std::fs::File::open(list)
+            .and_then(|file| file.take(MAX_LIST_BYTES + 1).read_to_end(&mut bytes))
+            .map_err(unreadable)?;
+    }
+    if bytes.len() as u64 > MAX_LIST_BYTES {
+        return Err(InputError::ListTooLong {
+            list: list.to_path_buf(),
+        });
+    }
     let mut inputs = Vec::new();
     for (entry, path) in parse_list(&bytes) {
         let Some(path) = path else {

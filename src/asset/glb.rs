@@ -23,6 +23,9 @@ pub struct GlbParts<'a> {
     /// Byte offset of the JSON chunk's data in the file.
     pub json_offset: usize,
     pub bin: Option<&'a [u8]>,
+    /// Whole chunks of types the spec does not define (header and data, as they stand in the
+    /// file), in file order: extensions may define them, and a rewrite keeps them.
+    pub other: Vec<&'a [u8]>,
 }
 
 fn u32_at(bytes: &[u8], at: usize) -> u32 {
@@ -93,6 +96,7 @@ pub fn split<'a>(bytes: &'a [u8], out: &mut Vec<Diagnostic>) -> Option<GlbParts<
     let mut bin: Option<(usize, usize)> = None;
     let mut index = 0usize;
     let mut after_unknown = false;
+    let mut other = Vec::new();
     while at < end {
         if end - at < CHUNK_HEADER_LEN {
             out.push(Diagnostic::new(
@@ -148,6 +152,9 @@ pub fn split<'a>(bytes: &'a [u8], out: &mut Vec<Diagnostic>) -> Option<GlbParts<
             )),
             _ => {
                 after_unknown = true;
+                if !truncated {
+                    other.push(&bytes[at..data_end]);
+                }
                 out.push(Diagnostic::new(
                     &codes::GLB_UNKNOWN_CHUNK_TYPE,
                     "",
@@ -186,11 +193,18 @@ pub fn split<'a>(bytes: &'a [u8], out: &mut Vec<Diagnostic>) -> Option<GlbParts<
         json: json_bytes,
         json_offset: json_start,
         bin: bin.map(|(s, e)| &bytes[s..e]),
+        other,
     })
 }
 
 /// Builds a GLB file from a JSON text and an optional BIN chunk; both are padded to 4 bytes.
 pub fn join(json: &[u8], bin: Option<&[u8]>) -> Vec<u8> {
+    join_with(json, bin, &[])
+}
+
+/// Builds a GLB file as [`join`] does, then appends `other` chunks (whole, header and data) as
+/// they were read: the chunks of unknown types a rewrite keeps.
+pub fn join_with(json: &[u8], bin: Option<&[u8]>, other: &[Vec<u8>]) -> Vec<u8> {
     let glb = gltf::binary::Glb {
         header: gltf::binary::Header {
             magic: *MAGIC,
@@ -201,7 +215,17 @@ pub fn join(json: &[u8], bin: Option<&[u8]>) -> Vec<u8> {
         json: Cow::Borrowed(json),
         bin: bin.map(Cow::Borrowed),
     };
-    glb.to_vec().expect("writing a GLB into memory cannot fail")
+    let mut bytes = glb.to_vec().expect("writing a GLB into memory cannot fail");
+    if !other.is_empty() {
+        for chunk in other {
+            bytes.extend_from_slice(chunk);
+        }
+        // The header's length covers the chunks after BIN too; a length beyond 4 GiB is not
+        // a GLB (the loader refuses such a file before this).
+        let length = u32::try_from(bytes.len()).unwrap_or(u32::MAX);
+        bytes[8..12].copy_from_slice(&length.to_le_bytes());
+    }
+    bytes
 }
 
 #[cfg(test)]

@@ -28,6 +28,9 @@ pub struct LoadOptions {
     pub max_json_depth: usize,
     /// Most pixels (width × height) an image may declare and still be decoded.
     pub max_image_pixels: u64,
+    /// The memory budget, in bytes: a file or an image whose reading or decoding would need
+    /// more is refused, naming `--max-memory`, before the memory is asked for.
+    pub max_memory: u64,
     /// Read resources whose URI leads out of the asset's folder: `../` past its root, absolute
     /// paths and `file:` URIs. Writing never follows such URIs, whatever this says.
     pub allow_outside_uris: bool,
@@ -41,12 +44,60 @@ pub const DEFAULT_MAX_JSON_DEPTH: usize = 64;
 /// 16384 × 16384: the largest textures in use; decoded as 16-bit RGBA, 2 GiB.
 pub const DEFAULT_MAX_IMAGE_PIXELS: u64 = 16384 * 16384;
 
+/// The default memory budget: a quarter of the machine's physical memory (4 GiB where that
+/// cannot be told), so that a run shares the machine with what else runs on it.
+pub fn default_max_memory() -> u64 {
+    static QUARTER: std::sync::OnceLock<u64> = std::sync::OnceLock::new();
+    *QUARTER.get_or_init(|| physical_memory().map_or(4 << 30, |bytes| bytes / 4))
+}
+
+fn physical_memory() -> Option<u64> {
+    #[cfg(unix)]
+    {
+        // SAFETY: sysconf reads system values; it has no preconditions.
+        let (pages, page) = unsafe {
+            (
+                libc::sysconf(libc::_SC_PHYS_PAGES),
+                libc::sysconf(libc::_SC_PAGESIZE),
+            )
+        };
+        if pages > 0 && page > 0 {
+            return Some((pages as u64).saturating_mul(page as u64));
+        }
+    }
+    None
+}
+
+/// A byte count as people read it: GiB, MiB or KiB with one decimal, or bytes.
+pub fn bytes_text(bytes: u64) -> String {
+    const UNITS: [(u64, &str); 3] = [(1 << 30, "GiB"), (1 << 20, "MiB"), (1 << 10, "KiB")];
+    for (size, unit) in UNITS {
+        if bytes >= size {
+            return format!("{:.1} {unit}", bytes as f64 / size as f64);
+        }
+    }
+    format!("{bytes} bytes")
+}
+
+/// The message for work that needs `needed` bytes (`what` says of what) over the budget
+/// `budget`, or `None` when it fits.
+pub fn over_memory_budget(what: &str, needed: u64, budget: u64) -> Option<String> {
+    (needed > budget).then(|| {
+        format!(
+            "{what} needs about {}, over the memory budget of {} (raise it with --max-memory)",
+            bytes_text(needed),
+            bytes_text(budget)
+        )
+    })
+}
+
 impl Default for LoadOptions {
     fn default() -> Self {
         LoadOptions {
             max_document_bytes: DEFAULT_MAX_DOCUMENT_BYTES,
             max_json_depth: DEFAULT_MAX_JSON_DEPTH,
             max_image_pixels: DEFAULT_MAX_IMAGE_PIXELS,
+            max_memory: default_max_memory(),
             allow_outside_uris: false,
         }
     }
@@ -141,19 +192,15 @@ pub fn find_too_deep(text: &str, max_depth: usize) -> Option<TooDeep> {
     None
 }
 
-/// Reads a file that is to be parsed as an asset. A regular file is read whole (its size is
-/// what the user stored), or mapped when it is large and mapping is enabled (see
-/// [`super::source`]); anything else — a pipe, a device — is read up to what the limits
-/// allow, so that `/dev/zero` named as an input costs an error, not all memory. A GLB stream
+/// Reads a file that is to be parsed as an asset. A regular file is read whole into memory
+/// (its size is what the user stored; [`super::source`] says why it is not mapped); anything
+/// else — a pipe, a device — is read up to what the limits allow, so that `/dev/zero` named as an input costs an error, not all memory. A GLB stream
 /// is read up to the length its header declares (at most 4 GiB), anything else up to the
 /// document limit; one byte more is read so that a longer stream is seen to be longer.
 pub fn read_asset_file(path: &Path, options: &LoadOptions) -> std::io::Result<FileBytes> {
     let mut file = std::fs::File::open(path)?;
     let metadata = file.metadata()?;
     if metadata.is_file() {
-        if let Some(mapped) = FileBytes::map(&file, path, metadata.len()) {
-            return Ok(mapped);
-        }
         // Sized to the file (and one byte more, to see that it ends there) before it is read,
         // so that a large one can be advised huge pages (see super::pages).
         let size = usize::try_from(metadata.len()).unwrap_or(0);
@@ -213,6 +260,17 @@ mod tests {
         let message = options.image_too_large(100_000, 100_000).unwrap();
         assert!(message.contains("10000000000 pixels"), "{message}");
         assert!(message.contains("--max-image-pixels"), "{message}");
+    }
+
+    #[test]
+    fn the_memory_budget_is_inclusive_and_named_with_its_flag() {
+        assert_eq!(over_memory_budget("x", 1 << 30, 1 << 30), None);
+        assert_eq!(
+            over_memory_budget("decoding it", 6 << 30, 2 << 30).unwrap(),
+            "decoding it needs about 6.0 GiB, over the memory budget of 2.0 GiB (raise it \
+             with --max-memory)"
+        );
+        assert!(default_max_memory() >= 1 << 20);
     }
 
     #[test]

@@ -24,7 +24,7 @@ use crate::diagnostics::{codes, Diagnostic};
 pub use limits::LoadOptions;
 use resource::{ImageHeader, Location};
 use serde_json::Value;
-pub use source::{FileBytes, SourceText};
+pub use source::{FileBytes, Snapshot, SourceText};
 use std::borrow::Cow;
 use std::collections::HashMap;
 use std::io::{BufReader, Cursor};
@@ -62,6 +62,8 @@ pub struct Asset {
     pub json_offset: usize,
     /// The GLB BIN chunk, if any.
     pub bin: Option<Vec<u8>>,
+    /// A GLB's chunks of unknown types, whole, in file order: written back after BIN.
+    pub other_chunks: Vec<Vec<u8>>,
     /// The limits and URI policy it was loaded with; resources are read under them too.
     pub options: LoadOptions,
     image_headers: Mutex<HashMap<usize, Result<ImageHeader, Diagnostic>>>,
@@ -120,9 +122,37 @@ pub fn read(path: &Path, options: &LoadOptions) -> Result<FileBytes, Diagnostic>
                     options.document_too_large(meta.len()),
                 ));
             }
+            // A GLB's bytes are held while its BIN chunk is copied out of them: twice its
+            // size, asked for before it is read. (A .gltf over the document limit is refused
+            // above; one within it is far below any budget.)
+            let what = format!("reading {} (a GLB of {} bytes)", path.display(), meta.len());
+            let needed = meta.len().saturating_mul(2);
+            if let Some(message) = limits::over_memory_budget(&what, needed, options.max_memory) {
+                return Err(Diagnostic::new(&codes::IO_ERROR, "", message));
+            }
         }
     }
     limits::read_asset_file(path, options).map_err(io_error)
+}
+
+/// Reads an asset file as [`read`] does, for a command that will write something for it: with
+/// the [`Snapshot`] of the file to compare before writing. A file that changed while it was
+/// read (its snapshot before and after differ) is refused, naming it.
+pub fn read_for_writing(
+    path: &Path,
+    options: &LoadOptions,
+) -> Result<(FileBytes, Snapshot), String> {
+    let cannot = |e: std::io::Error| format!("cannot read {}: {e}", path.display());
+    let before = Snapshot::before_reading(path).map_err(cannot)?;
+    let bytes = read(path, options).map_err(|d| format!("{} ({})", d.message, d.code))?;
+    match Snapshot::taken(path, before, &bytes).map_err(cannot)? {
+        Some(snapshot) => Ok((bytes, snapshot)),
+        None => Err(format!(
+            "{} changed while velvet read it (another program wrote it); nothing was written \
+             for it",
+            path.display()
+        )),
+    }
 }
 
 /// Parses the bytes of a file that lives (or would live) at `path` under the default limits.
@@ -171,14 +201,18 @@ pub fn load_bytes_with(path: &Path, bytes: &[u8], options: &LoadOptions) -> Load
         || path
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("glb"));
+    let mut other_chunks = Vec::new();
     let (container, json_bytes, json_offset, bin) = if is_glb {
         match glb::split(bytes, &mut diagnostics) {
-            Some(parts) => (
-                Container::Glb,
-                parts.json,
-                parts.json_offset,
-                parts.bin.map(<[u8]>::to_vec),
-            ),
+            Some(parts) => {
+                other_chunks = parts.other.iter().map(|c| c.to_vec()).collect();
+                (
+                    Container::Glb,
+                    parts.json,
+                    parts.json_offset,
+                    parts.bin.map(<[u8]>::to_vec),
+                )
+            }
             None => {
                 return Loaded {
                     asset: None,
@@ -249,7 +283,7 @@ pub fn load_bytes_with(path: &Path, bytes: &[u8], options: &LoadOptions) -> Load
             };
         }
     };
-    load_text(
+    let mut loaded = load_text(
         path,
         json_text,
         container,
@@ -257,7 +291,11 @@ pub fn load_bytes_with(path: &Path, bytes: &[u8], options: &LoadOptions) -> Load
         bin,
         diagnostics,
         options,
-    )
+    );
+    if let Some(asset) = &mut loaded.asset {
+        asset.other_chunks = other_chunks;
+    }
+    loaded
 }
 
 /// Indexes a document's JSON text and makes the asset.
@@ -363,6 +401,7 @@ fn load_text(
             json_text,
             json_offset,
             bin,
+            other_chunks: Vec::new(),
             options: *options,
             image_headers: Mutex::new(HashMap::new()),
             real_base: OnceLock::new(),
@@ -599,7 +638,7 @@ impl Asset {
         let pointer = format!("/images/{index}");
         let unreadable = |detail: String| {
             Diagnostic::new(
-                &codes::IMAGE_UNRECOGNIZED_FORMAT,
+                &codes::IMAGE_DATA_INVALID,
                 &pointer,
                 format!("image {index}: {detail}"),
             )
@@ -621,11 +660,18 @@ impl Asset {
             Some(resource::ImageFormat::Jpeg) => image::ImageFormat::Jpeg,
             Some(resource::ImageFormat::Webp) => image::ImageFormat::WebP,
             Some(resource::ImageFormat::Ktx2) => {
-                return Err(unreadable("KTX2 images are not decoded".to_string()))
+                return Err(Diagnostic::new(
+                    &codes::IMAGE_UNRECOGNIZED_FORMAT,
+                    &pointer,
+                    format!("image {index}: velvet does not decode KTX2 images"),
+                ))
             }
+            // read_header has refused it already.
             None => {
-                return Err(unreadable(
-                    "not a PNG, JPEG, WebP or KTX2 image".to_string(),
+                return Err(Diagnostic::new(
+                    &codes::IMAGE_UNRECOGNIZED_FORMAT,
+                    &pointer,
+                    format!("image {index}: not a PNG, JPEG, WebP or KTX2 image"),
                 ))
             }
         };

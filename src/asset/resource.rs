@@ -15,8 +15,13 @@ use std::path::{Component, Path, PathBuf};
 /// Where a URI leads.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Location {
-    /// The decoded bytes of a `data:` URI, with its media type.
-    Data { media_type: String, bytes: Vec<u8> },
+    /// The decoded bytes of a `data:` URI, with its media type (its parameters, such as
+    /// `;charset=…`, included) and whether it was base64 (or else percent-encoded).
+    Data {
+        media_type: String,
+        bytes: Vec<u8>,
+        base64: bool,
+    },
     /// A file next to the asset.
     File(PathBuf),
 }
@@ -43,25 +48,36 @@ pub fn resolve_with(
                 "the data: URI has no ',' before its payload",
             )
         })?;
-        let Some(media_type) = header.strip_suffix(";base64") else {
-            return Err(Diagnostic::new(
-                &codes::INVALID_URI,
-                pointer,
-                "the data: URI is not base64-encoded (glTF requires ';base64')",
-            ));
+        // RFC 2397: `;base64` marks base64; without it the payload is percent-encoded
+        // bytes. glTF's "MAY use base64" does not forbid the second form, which the Khronos
+        // validator decodes too (the resources rule warns that some loaders do not).
+        let (media_type, base64) = match header.strip_suffix(";base64") {
+            Some(media_type) => (media_type, true),
+            None => (header, false),
         };
-        let bytes = base64::engine::general_purpose::STANDARD
-            .decode(payload.trim_end())
-            .map_err(|e| {
+        let bytes = if base64 {
+            base64::engine::general_purpose::STANDARD
+                .decode(payload.trim_end())
+                .map_err(|e| {
+                    Diagnostic::new(
+                        &codes::INVALID_URI,
+                        pointer,
+                        format!("the data: URI's base64 is invalid: {e}"),
+                    )
+                })?
+        } else {
+            percent_decode_strict(payload).ok_or_else(|| {
                 Diagnostic::new(
                     &codes::INVALID_URI,
                     pointer,
-                    format!("the data: URI's base64 is invalid: {e}"),
+                    "the data: URI's payload has a '%' not followed by two hexadecimal digits",
                 )
-            })?;
+            })?
+        };
         return Ok(Location::Data {
             media_type: media_type.to_string(),
             bytes,
+            base64,
         });
     }
     let mut path_part = uri;
@@ -247,6 +263,26 @@ pub fn read_file(path: &Path, uri: &str, pointer: &str) -> Result<Vec<u8>, Diagn
     Ok(bytes)
 }
 
+/// Percent-decodes `text` into bytes; `None` when a '%' is not followed by two hexadecimal
+/// digits (which `percent_encoding` would pass through as they stand).
+fn percent_decode_strict(text: &str) -> Option<Vec<u8>> {
+    let bytes = text.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut at = 0;
+    while at < bytes.len() {
+        if bytes[at] == b'%' {
+            let hex = bytes.get(at + 1..at + 3)?;
+            let digits = std::str::from_utf8(hex).ok()?;
+            out.push(u8::from_str_radix(digits, 16).ok()?);
+            at += 3;
+        } else {
+            out.push(bytes[at]);
+            at += 1;
+        }
+    }
+    Some(out)
+}
+
 /// RFC 3986 scheme: a letter, then letters, digits, '+', '-' or '.', then ':'. A Windows drive
 /// letter ("C:") counts too, which is what we want: it is not a relative path either.
 fn has_scheme(uri: &str) -> bool {
@@ -307,9 +343,10 @@ pub fn read_header<R: std::io::BufRead + std::io::Seek>(
     what: &str,
 ) -> Result<ImageHeader, Diagnostic> {
     use image::ImageDecoder;
+    // Past its first bytes, an image of a known format whose header cannot be read is damaged.
     let unrecognized = |detail: String| {
         Diagnostic::new(
-            &codes::IMAGE_UNRECOGNIZED_FORMAT,
+            &codes::IMAGE_DATA_INVALID,
             pointer,
             format!("{what}: {detail}"),
         )
@@ -319,8 +356,13 @@ pub fn read_header<R: std::io::BufRead + std::io::Seek>(
     reader
         .seek(std::io::SeekFrom::Start(0))
         .map_err(|e| unrecognized(e.to_string()))?;
-    let format = ImageFormat::sniff(&magic[..read])
-        .ok_or_else(|| unrecognized("not a PNG, JPEG, WebP or KTX2 image".to_string()))?;
+    let format = ImageFormat::sniff(&magic[..read]).ok_or_else(|| {
+        Diagnostic::new(
+            &codes::IMAGE_UNRECOGNIZED_FORMAT,
+            pointer,
+            format!("{what}: not a PNG, JPEG, WebP or KTX2 image"),
+        )
+    })?;
     if format == ImageFormat::Ktx2 {
         let mut head = [0u8; 28];
         let n = read_up_to(&mut reader, &mut head).map_err(|e| unrecognized(e.to_string()))?;
@@ -464,15 +506,41 @@ mod tests {
     }
 
     #[test]
-    fn data_uris_decode_base64_and_refuse_the_rest() {
+    fn percent_encoded_data_uris_decode_to_their_bytes() {
+        assert_eq!(
+            resolve("data:application/gltf-buffer,%00%01%FFa+b", base(), "").unwrap(),
+            Location::Data {
+                media_type: "application/gltf-buffer".into(),
+                bytes: vec![0, 1, 255, b'a', b'+', b'b'],
+                base64: false,
+            }
+        );
+        assert_eq!(
+            resolve("data:text/plain,hello", base(), "").unwrap(),
+            Location::Data {
+                media_type: "text/plain".into(),
+                bytes: b"hello".to_vec(),
+                base64: false,
+            }
+        );
+    }
+
+    #[test]
+    fn data_uris_decode_base64_and_refuse_malformed_ones() {
         assert_eq!(
             resolve("data:application/octet-stream;base64,AAEC", base(), "").unwrap(),
             Location::Data {
                 media_type: "application/octet-stream".into(),
-                bytes: vec![0, 1, 2]
+                bytes: vec![0, 1, 2],
+                base64: true,
             }
         );
-        for uri in ["data:text/plain,hello", "data:;base64,@@@", "data:nocomma"] {
+        for uri in [
+            "data:;base64,@@@",
+            "data:nocomma",
+            "data:,100%",
+            "data:,%zz",
+        ] {
             assert_eq!(
                 resolve(uri, base(), "").unwrap_err().code,
                 "INVALID_URI",
@@ -517,7 +585,7 @@ mod tests {
     }
 
     #[test]
-    fn garbage_is_an_unrecognized_image() {
+    fn garbage_is_an_unrecognized_image_and_a_cut_png_invalid_data() {
         let err = read_header(
             std::io::Cursor::new(b"hello world, not an image".to_vec()),
             "/images/1",
@@ -531,6 +599,6 @@ mod tests {
             "image 1",
         )
         .unwrap_err();
-        assert_eq!(err.code, "IMAGE_UNRECOGNIZED_FORMAT");
+        assert_eq!(err.code, "IMAGE_DATA_INVALID");
     }
 }

@@ -85,8 +85,15 @@ impl<'a> json::Node<'a, TapeJson> for Node<'a> {
     fn is_null(&self) -> bool {
         Node::is_null(self)
     }
+    /// A number past f64's range (`1e400`, which reads as infinity) is, where a schema asks
+    /// for a number, no number: the schema checks report it as out of range. Only a text with
+    /// an exponent or of 300 characters can be one, so most numbers are not parsed here.
     fn is_number(&self) -> bool {
-        Node::is_number(self)
+        Node::is_number(self) && {
+            let text = self.raw();
+            !(text.len() >= 300 || text.bytes().any(|b| b == b'e' || b == b'E'))
+                || text.parse::<f64>().is_ok_and(f64::is_finite)
+        }
     }
     fn json_type(&self) -> JsonType {
         match self.kind() {

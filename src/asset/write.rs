@@ -252,7 +252,7 @@ fn source(asset: &Asset) -> &str {
 fn in_container(asset: &Asset, text: Vec<u8>, bin: Option<&[u8]>) -> Vec<u8> {
     match asset.container {
         Container::Gltf => text,
-        Container::Glb => glb::join(&text, bin),
+        Container::Glb => glb::join_with(&text, bin, &asset.other_chunks),
     }
 }
 
@@ -271,9 +271,14 @@ pub fn spliced_bytes<'a, 'e>(
     };
     let output = match asset.container {
         Container::Gltf => Output::Spliced(spliced),
-        Container::Glb => {
-            Output::Bytes(glb::join(spliced.to_text().as_bytes(), asset.bin.as_deref()).into())
-        }
+        Container::Glb => Output::Bytes(
+            glb::join_with(
+                spliced.to_text().as_bytes(),
+                asset.bin.as_deref(),
+                &asset.other_chunks,
+            )
+            .into(),
+        ),
     };
     Ok(Some((output, changed)))
 }
@@ -321,63 +326,182 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
 
 /// Writes `output` to `path` atomically, as [`write_atomic`] writes bytes.
 pub fn write_output_atomic(path: &Path, output: &Output) -> io::Result<()> {
-    let dir = match path.parent() {
+    stage_output(path, output)?.put_in_place()
+}
+
+/// A complete file written under a temporary name in its target's folder, flushed to disk,
+/// waiting to be renamed into place ([`Staged::put_in_place`]). Dropped without that, it is
+/// removed. Its name, `.velvet-PID-*.tmp`, carries the writing process's id, so that the next
+/// run into the folder removes it when that process is gone ([`remove_leftovers`]): a kill
+/// or a power cut leaves nothing that lasts.
+#[derive(Debug)]
+pub struct Staged {
+    tmp: tempfile::NamedTempFile,
+    to: std::path::PathBuf,
+}
+
+impl Staged {
+    /// Where the file goes.
+    pub fn target(&self) -> &Path {
+        &self.to
+    }
+
+    /// Renames the file into place, over whatever was there.
+    pub fn put_in_place(self) -> io::Result<()> {
+        self.tmp.persist(&self.to).map_err(|e| e.error)?;
+        Ok(())
+    }
+}
+
+/// The folder a file at `path` is written in.
+fn folder(path: &Path) -> &Path {
+    match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
-    };
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(".velvet-").suffix(".tmp");
-    // A temporary file is private (0600) by default; a new output is an ordinary file, so it
-    // asks for 0666 and the umask trims it, as any other program's new file.
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        builder.permissions(std::fs::Permissions::from_mode(0o666));
     }
-    let tmp = builder.tempfile_in(dir)?;
+}
+
+/// Writes `output` to a temporary file next to `path`, flushed to disk, with the mode of the
+/// file it will replace (or the umask's), to be put in place later.
+pub fn stage_output(path: &Path, output: &Output) -> io::Result<Staged> {
+    let tmp = temporary_in(folder(path))?;
     write_temporary(&mut HandedOn::new(tmp.as_file()), output)?;
     tmp.as_file().sync_all()?;
     if let Ok(meta) = std::fs::metadata(path) {
         // Keep the permissions of a file being replaced.
         let _ = std::fs::set_permissions(tmp.path(), meta.permissions());
     }
-    tmp.persist(path).map_err(|e| e.error)?;
-    Ok(())
+    Ok(Staged {
+        tmp,
+        to: path.to_path_buf(),
+    })
 }
 
-/// How [`copy_atomic`] placed a file.
+/// How [`copy_atomic`] placed a file. Either way the output is a file of its own (another
+/// inode): a tool that edits an output in place never edits the input.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Placed {
-    /// A hard link to the source (same filesystem): no bytes copied.
-    Linked,
+    /// A copy-on-write clone of the source (a reflink, where the filesystem has them: Btrfs,
+    /// XFS, bcachefs…): no bytes copied, and a write to either file leaves the other as it was.
+    Cloned,
     /// A copy of the bytes.
     Copied,
 }
 
-/// Places a regular file holding `from`'s bytes at `to`, atomically: a hard link made under a
-/// temporary name in `to`'s folder and renamed into place where the filesystem allows it, else
-/// a copy through [`write_atomic`]. `from` should be a resolved path (a link to a link is not
-/// made: `link(2)` does not follow a symbolic link, so the caller passes its target).
+/// Places a regular file holding `from`'s bytes at `to`, atomically: see [`stage_copy`].
 pub fn copy_atomic(from: &Path, to: &Path) -> io::Result<Placed> {
-    static LINKS: AtomicUsize = AtomicUsize::new(0);
-    let dir = match to.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
+    let (staged, placed) = stage_copy(from, to)?;
+    staged.put_in_place()?;
+    Ok(placed)
+}
+
+/// A copy of `from` staged for `to`: a temporary file in `to`'s folder gets a copy-on-write
+/// clone of `from` where the filesystem can make one, else an ordinary copy, and is flushed to
+/// disk. Never a hard link: an output's resource sharing the input's inode would let an edit
+/// of the output change the input.
+pub fn stage_copy(from: &Path, to: &Path) -> io::Result<(Staged, Placed)> {
+    let mut source = std::fs::File::open(from)?;
+    if injected_fault().is_some() {
+        // The fault seam covers the bytes' write, as it does every other output's.
+        let mut bytes = Vec::new();
+        io::Read::read_to_end(&mut source, &mut bytes)?;
+        let staged = stage_output(to, &Output::Bytes(bytes.into()))?;
+        return Ok((staged, Placed::Copied));
+    }
+    let tmp = temporary_in(folder(to))?;
+    let placed = if clone_file(&source, tmp.as_file()) {
+        Placed::Cloned
+    } else {
+        // std's copy between files uses copy_file_range(2) on Linux, in the kernel.
+        io::copy(&mut source, &mut tmp.as_file())?;
+        Placed::Copied
     };
-    if injected_fault().is_none() {
-        let n = LINKS.fetch_add(1, Ordering::Relaxed);
-        let tmp = dir.join(format!(".velvet-{}-{n}.link", std::process::id()));
-        if std::fs::hard_link(from, &tmp).is_ok() {
-            let renamed = std::fs::rename(&tmp, to);
-            // rename(2) does nothing when both names are links to one file already (an
-            // earlier run's copy): the temporary name is then still there.
-            let _ = std::fs::remove_file(&tmp);
-            return renamed.map(|()| Placed::Linked);
+    tmp.as_file().sync_all()?;
+    Ok((
+        Staged {
+            tmp,
+            to: to.to_path_buf(),
+        },
+        placed,
+    ))
+}
+
+/// The name prefix of this process's temporary files: `.velvet-PID-`.
+fn temporary_prefix() -> String {
+    format!(".velvet-{}-", std::process::id())
+}
+
+/// Removes from `dir` the temporary files (`.velvet-PID-*.tmp`) of velvet processes that are
+/// no longer running: what a killed run, a crash or a power cut left. A file of a process
+/// still running (another run into the same folder) is left alone. Returns how many were
+/// removed.
+pub fn remove_leftovers(dir: &Path) -> usize {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return 0;
+    };
+    let mut removed = 0;
+    for entry in entries.filter_map(Result::ok) {
+        let name = entry.file_name();
+        let Some(pid) = name.to_str().and_then(leftover_pid) else {
+            continue;
+        };
+        if pid != std::process::id() && !process_running(pid) {
+            removed += usize::from(std::fs::remove_file(entry.path()).is_ok());
         }
     }
-    let bytes = std::fs::read(from)?;
-    write_atomic(to, &bytes)?;
-    Ok(Placed::Copied)
+    removed
+}
+
+/// The process id in a temporary file's name `.velvet-PID-*.tmp`.
+fn leftover_pid(name: &str) -> Option<u32> {
+    let rest = name.strip_prefix(".velvet-")?.strip_suffix(".tmp")?;
+    let (pid, _) = rest.split_once('-')?;
+    pid.parse().ok()
+}
+
+/// Whether a process with id `pid` runs (or may: where that cannot be told, yes).
+fn process_running(pid: u32) -> bool {
+    #[cfg(unix)]
+    {
+        let Ok(pid) = libc::pid_t::try_from(pid) else {
+            return true;
+        };
+        // SAFETY: kill with signal 0 sends nothing; it only checks that the process exists.
+        let alive = unsafe { libc::kill(pid, 0) } == 0;
+        alive || std::io::Error::last_os_error().raw_os_error() != Some(libc::ESRCH)
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = pid;
+        true
+    }
+}
+
+/// A new temporary file in `dir`, named `.velvet-PID-*.tmp`, asking for mode 0666 (the umask trims
+/// it, as it does any program's new file; tempfile's default is 0600).
+fn temporary_in(dir: &Path) -> io::Result<tempfile::NamedTempFile> {
+    let prefix = temporary_prefix();
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(&prefix).suffix(".tmp");
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    builder.tempfile_in(dir)
+}
+
+/// Makes `to` a copy-on-write clone of `from` (FICLONE); false where the filesystem cannot.
+#[cfg(target_os = "linux")]
+fn clone_file(from: &std::fs::File, to: &std::fs::File) -> bool {
+    use std::os::fd::AsRawFd;
+    // SAFETY: FICLONE takes the source's descriptor as its argument; both are open files.
+    unsafe { libc::ioctl(to.as_raw_fd(), libc::FICLONE, from.as_raw_fd()) == 0 }
+}
+
+#[cfg(not(target_os = "linux"))]
+fn clone_file(_: &std::fs::File, _: &std::fs::File) -> bool {
+    false
 }
 
 #[cfg(test)]
@@ -472,8 +596,7 @@ mod tests {
         std::fs::write(&from, b"resource").unwrap();
         let to = dir.path().join("to.bin");
         std::fs::write(&to, b"old").unwrap();
-        let placed = copy_atomic(&from, &to).unwrap();
-        assert_eq!(placed, Placed::Linked, "one filesystem allows a hard link");
+        copy_atomic(&from, &to).unwrap();
         assert_eq!(std::fs::read(&to).unwrap(), b"resource");
         assert!(std::fs::symlink_metadata(&to)
             .unwrap()
@@ -485,9 +608,64 @@ mod tests {
             .collect();
         names.sort();
         assert_eq!(names, ["from.bin", "to.bin"], "no temporary name is left");
-        // Again, onto the link made the first time: still no temporary name left.
-        assert_eq!(copy_atomic(&from, &to).unwrap(), Placed::Linked);
+        // Again, onto the copy made the first time: still no temporary name left.
+        copy_atomic(&from, &to).unwrap();
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
+        // A copy is a file of its own: writing into it leaves the source as it was.
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::MetadataExt;
+            let inode = |p: &Path| std::fs::metadata(p).unwrap().ino();
+            assert_ne!(inode(&from), inode(&to));
+        }
+        std::fs::OpenOptions::new()
+            .write(true)
+            .open(&to)
+            .and_then(|mut f| f.write_all(b"EDITED"))
+            .unwrap();
+        assert_eq!(std::fs::read(&from).unwrap(), b"resource");
+    }
+
+    #[test]
+    fn leftovers_of_processes_gone_are_removed_and_others_kept() {
+        let dir = tempfile::tempdir().unwrap();
+        // A process id no process holds: above the kernel's largest (2^22).
+        let gone = dir.path().join(".velvet-99999999-abc.tmp");
+        let mine = dir
+            .path()
+            .join(format!(".velvet-{}-abc.tmp", std::process::id()));
+        // The parent process (the test harness's caller) runs.
+        #[cfg(unix)]
+        let running = dir.path().join(format!(
+            ".velvet-{}-abc.tmp",
+            std::os::unix::process::parent_id()
+        ));
+        let other = dir.path().join("velvet-99999999-abc.tmp");
+        for path in [&gone, &mine, &other] {
+            std::fs::write(path, b"x").unwrap();
+        }
+        #[cfg(unix)]
+        std::fs::write(&running, b"x").unwrap();
+        assert_eq!(remove_leftovers(dir.path()), 1);
+        assert!(!gone.exists());
+        assert!(mine.exists() && other.exists());
+        #[cfg(unix)]
+        assert!(running.exists());
+    }
+
+    #[test]
+    fn a_staged_file_dropped_before_it_is_put_in_place_is_removed() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("out.png");
+        let staged = stage_output(&target, &Output::Bytes(b"png".as_slice().into())).unwrap();
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+        assert!(!target.exists());
+        drop(staged);
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+        let staged = stage_output(&target, &Output::Bytes(b"png".as_slice().into())).unwrap();
+        staged.put_in_place().unwrap();
+        assert_eq!(std::fs::read(&target).unwrap(), b"png");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
     }
 
     #[test]

@@ -478,6 +478,10 @@ pub fn add_image(
             json!({"name": name, "uri": format!("data:{};base64,{data}", format.mime_type())}),
             "data: URI".to_owned(),
         )
+    } else if let Some(same) = files.iter().find(|f| f.bytes == bytes) {
+        // Identical bytes baked for another slot are one file: written once, named twice.
+        let file = same.name.clone();
+        (json!({"name": name, "uri": file_uri(&file)}), file)
     } else {
         let file = file_candidates(name, format, &bytes)
             .find(|candidate| names.claim(candidate, &bytes))

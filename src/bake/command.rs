@@ -24,11 +24,14 @@ use super::prune::Dropped;
 use crate::asset::discover::Shard;
 use crate::asset::{self, write};
 use crate::diagnostics::Severity;
-use crate::output::files::{copy_resources, create_parent, file_sink, write_new_files};
+use crate::output::files::{copy_resources, create_parent, file_sink, stage_new_files};
 use crate::output::files::{Claims, FileNames};
+use crate::output::interrupt;
 use crate::output::paths::{check_links, relocate, Destination, Job, Relocation};
+use crate::output::staging::Staging;
 use crate::output::summary::{added, bytes, files_line, plural, Detail};
 use crate::output::{run_each, Scope, UsageError};
+use crate::report::escape::push_line;
 
 /// What a run does besides where it writes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -162,12 +165,13 @@ fn slot_reports(plan: &BakePlan, names: &[String]) -> Vec<SlotReport> {
 
 /// Bakes one file; errors name what is wrong (the caller adds the file).
 fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult, String> {
+    interrupt::check()?;
     let input = job.input.as_path();
     let options = request.options;
-    let bytes = asset::read(input, &options.load)
-        .map_err(|d| format!("cannot be baked: {} ({})", d.message, d.code))?;
-    // A .gltf's bytes become the asset's text as they are (a mapped file's stay mapped); a
-    // GLB's come back, for copying one with nothing to bake.
+    let (bytes, snapshot) = asset::read_for_writing(input, &options.load)
+        .map_err(|e| format!("cannot be baked: {e}"))?;
+    // A .gltf's bytes become the asset's text as they are; a GLB's come back, for copying one
+    // with nothing to bake.
     let (loaded, bytes) = asset::load_read(input, bytes, &options.load);
     let errors: Vec<String> = loaded
         .diagnostics
@@ -209,7 +213,9 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
         if output == input {
             return Ok(result);
         }
-        copy_resources(&relocation, asset.json())?;
+        interrupt::check()?;
+        let staging = Staging::default();
+        copy_resources(&relocation, asset.json(), &staging)?;
         create_parent(output)?;
         let out_bytes = if relocation.edits.is_empty() {
             Cow::Borrowed(match &bytes {
@@ -221,8 +227,9 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
             crate::edit::apply(&mut json, &relocation.edits).map_err(|e| e.to_string())?;
             Cow::Owned(write::to_bytes(&asset, &json, asset.bin.as_deref()))
         };
-        write::write_atomic(output, &out_bytes)
-            .map_err(|e| format!("cannot write {}: {e}", output.display()))?;
+        staging.stage_document(output, &write::Output::Bytes(out_bytes))?;
+        snapshot.unchanged(input)?;
+        staging.commit()?;
         result.outcome = Outcome::Copied;
         return Ok(result);
     }
@@ -239,10 +246,13 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
             ..EncodeOptions::default()
         },
         max_image_pixels: MaxImagePixels(options.load.max_image_pixels),
+        max_memory: super::engine::MaxMemory(options.load.max_memory),
     };
     // File names next to the output that the document already uses are not free. New image
     // files are written as they are encoded (a .gltf with file images), so a run holds only
     // the images in flight.
+    interrupt::check()?;
+    let staging = Staging::default();
     let names = Mutex::new(FileNames::next_to(
         claims,
         &asset,
@@ -254,7 +264,7 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
     let streamed = asset.container == asset::Container::Gltf && !options.embed;
     let mut baked = Vec::with_capacity(plan.recipes.len());
     let results = {
-        let sink = file_sink(&names, &images, &plan);
+        let sink = file_sink(&names, &images, &plan, &staging);
         bake_into(
             &plan.recipes,
             &asset,
@@ -282,11 +292,12 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
         },
         &mut names,
     );
-    copy_resources(&relocation, &applied.json)?;
-    write_new_files(&out_dir, &applied.files)?;
+    copy_resources(&relocation, &applied.json, &staging)?;
+    stage_new_files(&out_dir, &applied.files, &staging)?;
     let out_bytes = write::to_bytes(&asset, &applied.json, applied.bin.as_deref());
-    write::write_atomic(output, &out_bytes)
-        .map_err(|e| format!("cannot write {}: {e}", output.display()))?;
+    staging.stage_document(output, &write::Output::Bytes(out_bytes.into()))?;
+    snapshot.unchanged(input)?;
+    staging.commit()?;
     let names: Vec<String> = applied.outputs.iter().map(|o| o.name.clone()).collect();
     let mut result = FileResult::new(input, Some(output), Outcome::Changed);
     result.slots = slot_reports(&plan, &names);
@@ -436,17 +447,22 @@ pub fn render_text(results: &[FileResult], dry_run: bool, detail: Detail) -> Str
             Outcome::Planned { changes: false } => format!("nothing to bake{warned}"),
             Outcome::Failed { error } => format!("FAILED: {error}"),
         };
-        let _ = writeln!(out, "{}{target}: {status}", r.input.display());
+        push_line(
+            &mut out,
+            &format!("{}{target}: {status}", r.input.display()),
+        );
         if detail != Detail::Verbose {
             continue;
         }
         for s in &r.slots {
-            let _ = writeln!(
-                out,
-                "  {}: factor {:?} -> {}",
-                s.pointer,
-                s.factor,
-                s.outputs.join(", ")
+            push_line(
+                &mut out,
+                &format!(
+                    "  {}: factor {:?} -> {}",
+                    s.pointer,
+                    s.factor,
+                    s.outputs.join(", ")
+                ),
             );
         }
         for o in &r.outputs {
@@ -475,14 +491,16 @@ pub fn render_text(results: &[FileResult], dry_run: bool, detail: Detail) -> Str
                     o.clamped
                 );
             }
-            let _ = writeln!(out, "{line}");
+            push_line(&mut out, &line);
         }
         if !r.dropped_images.is_empty() {
-            let _ = writeln!(
-                out,
-                "  dropped images {:?} ({} cut from the BIN chunk)",
-                r.dropped_images,
-                bytes(r.dropped_bin_bytes)
+            push_line(
+                &mut out,
+                &format!(
+                    "  dropped images {:?} ({} cut from the BIN chunk)",
+                    r.dropped_images,
+                    bytes(r.dropped_bin_bytes)
+                ),
             );
         }
         for n in &r.notes {
@@ -490,7 +508,7 @@ pub fn render_text(results: &[FileResult], dry_run: bool, detail: Detail) -> Str
                 super::plan::Level::Info => "info",
                 super::plan::Level::Warning => "warning",
             };
-            let _ = writeln!(out, "  {level} {}: {}", n.pointer, n.message);
+            push_line(&mut out, &format!("  {level} {}: {}", n.pointer, n.message));
         }
     }
     if detail == Detail::Quiet {

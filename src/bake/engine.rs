@@ -122,6 +122,18 @@ pub struct BakeOptions {
     pub encode: EncodeOptions,
     /// Images whose header declares more pixels are refused before decoding.
     pub max_image_pixels: MaxImagePixels,
+    /// Images whose decoding would need more memory are refused before decoding.
+    pub max_memory: MaxMemory,
+}
+
+/// The memory budget for decoding (see [`crate::asset::limits::default_max_memory`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MaxMemory(pub u64);
+
+impl Default for MaxMemory {
+    fn default() -> Self {
+        MaxMemory(crate::asset::limits::default_max_memory())
+    }
 }
 
 /// The pixel limit for decoding (see [`crate::asset::limits`]); defaults to the loader's.
@@ -284,11 +296,12 @@ pub fn bake_into(
 
 type Decoded = Result<(Pixels, ImageFormat), BakeError>;
 
-fn decode_image(source: &dyn ImageSource, image: ImageId, max_pixels: u64) -> Decoded {
+fn decode_image(source: &dyn ImageSource, image: ImageId, options: &BakeOptions) -> Decoded {
     let bytes = source
         .image_bytes(image)
         .map_err(|message| BakeError::Source { image, message })?;
-    codec::decode_limited(&bytes, max_pixels).map_err(|error| BakeError::Decode { image, error })
+    codec::decode_within(&bytes, options.max_image_pixels.0, options.max_memory.0)
+        .map_err(|error| BakeError::Decode { image, error })
 }
 
 fn bake_component(
@@ -306,12 +319,7 @@ fn bake_component(
     images.dedup();
     let decoded: Vec<(ImageId, Decoded)> = images
         .par_iter()
-        .map(|&image| {
-            (
-                image,
-                decode_image(source, image, options.max_image_pixels.0),
-            )
-        })
+        .map(|&image| (image, decode_image(source, image, options)))
         .collect();
     let mut pixels = HashMap::new();
     let mut formats = HashMap::new();

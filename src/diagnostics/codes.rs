@@ -84,10 +84,17 @@ pub const BUFFER_VIEW_OUT_OF_RANGE: Code = Code::new(
     Error,
     "An image's bufferView lies outside the data of its buffer.",
 );
+/// A warning, as in the Khronos validator: the document is valid, and a loader may know the
+/// format. A damaged header of a format velvet knows is IMAGE_DATA_INVALID.
 pub const IMAGE_UNRECOGNIZED_FORMAT: Code = Code::new(
     "IMAGE_UNRECOGNIZED_FORMAT",
+    Warning,
+    "An image's bytes are not PNG, JPEG, WebP or KTX2; loaders that know only those cannot read it.",
+);
+pub const IMAGE_DATA_INVALID: Code = Code::new(
+    "IMAGE_DATA_INVALID",
     Error,
-    "An image's header is not PNG, JPEG, WebP or KTX2, or is damaged.",
+    "An image starts as a PNG, JPEG, WebP or KTX2 but its header is damaged or cut short.",
 );
 
 /// Reported by the references rule for every index, and by the loader when a resource it is
@@ -100,7 +107,7 @@ pub const UNRESOLVED_REFERENCE: Code = Code::new(
 pub const BUFFER_MISSING_GLB_DATA: Code = Code::new(
     "BUFFER_MISSING_GLB_DATA",
     Error,
-    "A buffer without uri has no data: it is not the first buffer of a GLB that has a BIN chunk.",
+    "A GLB's first buffer has no uri, and the GLB has no BIN chunk to hold its data.",
 );
 pub const GLB_TRAILING_DATA: Code = Code::new(
     "GLB_TRAILING_DATA",
@@ -163,6 +170,7 @@ pub const LOADER: &[&Code] = &[
     &BUFFER_VIEW_OUT_OF_RANGE,
     &BUFFER_BYTE_LENGTH_MISMATCH,
     &IMAGE_UNRECOGNIZED_FORMAT,
+    &IMAGE_DATA_INVALID,
     &UNRESOLVED_REFERENCE,
     &BUFFER_MISSING_GLB_DATA,
 ];

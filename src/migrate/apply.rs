@@ -13,14 +13,16 @@ use super::plan::{plan_document, DocumentPlan};
 use super::textures;
 use super::Options;
 use crate::asset::write::Output;
-use crate::asset::{self, write, Asset, FileBytes};
+use crate::asset::{self, write, Asset, FileBytes, Snapshot};
 use crate::bake::apply::{apply as bake_apply, ApplyOptions, OutputReport};
 use crate::bake::{bake_into, BakeOptions, KernelOptions};
 use crate::diagnostics::Severity;
 use crate::edit;
-use crate::output::files::{copy_resources, create_parent, file_sink, write_new_files};
+use crate::output::files::{copy_resources, create_parent, file_sink, stage_new_files};
 use crate::output::files::{Claims, FileNames};
+use crate::output::interrupt;
 use crate::output::paths::{check_links, relocate, Job, Relocation};
+use crate::output::staging::Staging;
 use std::borrow::Cow;
 use std::path::PathBuf;
 use std::sync::Mutex;
@@ -29,6 +31,8 @@ use std::sync::Mutex;
 #[derive(Debug)]
 pub struct FilePlan {
     pub input: PathBuf,
+    /// The input as it was read, compared before anything is written for it.
+    pub snapshot: Snapshot,
     pub output: Option<PathBuf>,
     /// The input's bytes, kept when the plan changes nothing (then written as they are).
     pub bytes: Option<FileBytes>,
@@ -65,14 +69,8 @@ pub enum Written {
 
 /// Loads and plans one file. Errors name the file and what is wrong.
 pub fn plan_file(job: &Job, options: &Options) -> Result<FilePlan, String> {
-    let bytes = asset::read(&job.input, &options.load).map_err(|d| {
-        format!(
-            "{} cannot be migrated: {} ({})",
-            job.input.display(),
-            d.message,
-            d.code
-        )
-    })?;
+    let (bytes, snapshot) = asset::read_for_writing(&job.input, &options.load)
+        .map_err(|e| format!("{} cannot be migrated: {e}", job.input.display()))?;
     // A .gltf's bytes become the asset's text as they are: a copy of a large document cost as
     // much as reading it (a page fault per 4 KiB on first touch).
     let (loaded, bytes) = asset::load_read(&job.input, bytes, &options.load);
@@ -94,6 +92,12 @@ pub fn plan_file(job: &Job, options: &Options) -> Result<FilePlan, String> {
     };
     check_links(&asset).map_err(|e| format!("{}: {e}", job.input.display()))?;
     let document = plan_document(&asset, options);
+    if let Some(dangling) = dangling_layer_texture(&asset, &document) {
+        return Err(format!(
+            "{} cannot be migrated: {dangling}",
+            job.input.display()
+        ));
+    }
     let relocation = match &job.output {
         Some(output) if output != &job.input => relocate(&asset, output, options.rewrite_uris)
             .map_err(|e| format!("{}: {e}", job.input.display()))?,
@@ -107,6 +111,7 @@ pub fn plan_file(job: &Job, options: &Options) -> Result<FilePlan, String> {
     };
     Ok(FilePlan {
         input: job.input.clone(),
+        snapshot,
         output: job.output.clone(),
         bytes,
         asset,
@@ -115,6 +120,52 @@ pub fn plan_file(job: &Job, options: &Options) -> Result<FilePlan, String> {
         embed: options.embed,
         baked: Vec::new(),
     })
+}
+
+/// The first texture reference of a layer the plan converts that names no texture (an index
+/// past the textures, at any size: `18446744073709551617` included), worded as validate's
+/// UNRESOLVED_REFERENCE. A conversion would carry it into the new layer as it is: an output
+/// that repeats the input's dangling reference under another name, with a clean report. A
+/// draft sheen is left out: its upgrade checks its texture and drops one that names nothing,
+/// saying so.
+fn dangling_layer_texture(asset: &Asset, document: &DocumentPlan) -> Option<String> {
+    let root = asset.root();
+    let textures = root
+        .get("textures")
+        .and_then(|t| t.as_array())
+        .map_or(0, |t| t.len());
+    let materials = root.get("materials")?;
+    document
+        .materials
+        .iter()
+        .filter(|m| {
+            !m.conversions.is_empty() && !m.conversions.contains(&super::Conversion::LegacyUpgrade)
+        })
+        .find_map(|m| {
+            let extensions = materials.get(m.index)?.get("extensions")?;
+            ["KHR_materials_sheen", "KHR_materials_fuzz"]
+                .into_iter()
+                .filter_map(|name| Some((name, extensions.get(name)?.as_object()?)))
+                .find_map(|(name, layer)| {
+                    layer.iter().find_map(|(key, info)| {
+                        if !key.ends_with("Texture") {
+                            return None;
+                        }
+                        let index = info.get("index")?;
+                        let i = crate::layers::as_index(index)?;
+                        (i >= textures as u64).then(|| {
+                            format!(
+                                "{key} names texture {}, but the asset has {textures} \
+                                 texture{} (UNRESOLVED_REFERENCE at \
+                                 /materials/{}/extensions/{name}/{key}/index)",
+                                index.raw(),
+                                if textures == 1 { "" } else { "s" },
+                                m.index
+                            )
+                        })
+                    })
+                })
+        })
 }
 
 /// Applies a file's plan and writes its output (and resource copies). On failure the output
@@ -131,6 +182,10 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
     // Names for new image files, from the document's URIs before they are relocated. In a
     // .gltf whose new images are files, each is written as soon as it is encoded, so the run
     // holds only the images in flight, however many there are.
+    // Every file written for this output is staged and put in place with the document; an
+    // error or a stop drops them all (see output::staging).
+    interrupt::check()?;
+    let staging = Staging::default();
     let names = Mutex::new(FileNames::next_to(
         claims,
         &plan.asset,
@@ -150,6 +205,7 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
             max_image_pixels: crate::bake::engine::MaxImagePixels(
                 plan.asset.options.max_image_pixels,
             ),
+            max_memory: crate::bake::engine::MaxMemory(plan.asset.options.max_memory),
             ..BakeOptions::default()
         };
         // The images as loaded, read alone (the whole document is not built for them).
@@ -159,7 +215,7 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
             .get("images")
             .map_or(serde_json::Value::Null, |images| images.to_value());
         let results = {
-            let sink = file_sink(&names, &images, &bake_plan);
+            let sink = file_sink(&names, &images, &bake_plan, &staging);
             bake_into(
                 &bake_plan.recipes,
                 &plan.asset,
@@ -181,6 +237,7 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
     let mut names = names.into_inner().unwrap_or_else(|e| e.into_inner());
     let names_dir = names.dir().to_path_buf();
     let input = plan.input.clone();
+    let snapshot = plan.snapshot;
     let in_place = plan.in_place();
     let fail = |e: edit::EditError| format!("{}: {e}", input.display());
     // Without bakes the edits are written as splices straight into the loaded text, reading
@@ -207,6 +264,7 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
             &bake_plan,
             &mut baked,
             &mut names,
+            &staging,
         )?
     } else {
         None
@@ -220,7 +278,7 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
             // Without bakes no edit touches a URI that is copied (resources are copied or
             // their URIs rewritten, never both), so the document as loaded names what the
             // output uses.
-            copy_resources(&plan.relocation, plan.asset.root())?;
+            copy_resources(&plan.relocation, plan.asset.root(), &staging)?;
             match changed {
                 true => out,
                 false => Output::Bytes(input_bytes(plan)?),
@@ -228,8 +286,9 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
         } else {
             out
         };
-        write::write_output_atomic(&output, &out)
-            .map_err(|e| format!("cannot write {}: {e}", output.display()))?;
+        staging.stage_document(&output, &out)?;
+        snapshot.unchanged(&input)?;
+        staging.commit()?;
         plan.baked = outputs;
         return Ok(if changed {
             Written::Changed
@@ -260,7 +319,7 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
     }
     create_parent(&output)?;
     let bytes = if bake_plan.is_empty() {
-        copy_resources(&plan.relocation, plan.asset.root())?;
+        copy_resources(&plan.relocation, plan.asset.root(), &staging)?;
         match changed {
             true => Cow::Owned(write::to_bytes(
                 &plan.asset,
@@ -280,8 +339,8 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
             ApplyOptions { embed: plan.embed },
             &mut names,
         );
-        copy_resources(&plan.relocation, &applied.json)?;
-        write_new_files(&names_dir, &applied.files)?;
+        copy_resources(&plan.relocation, &applied.json, &staging)?;
+        stage_new_files(&names_dir, &applied.files, &staging)?;
         let bytes = Cow::Owned(write::to_bytes(
             &plan.asset,
             &applied.json,
@@ -292,8 +351,9 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
         plan.baked = applied.outputs;
         bytes
     };
-    write::write_atomic(&output, &bytes)
-        .map_err(|e| format!("cannot write {}: {e}", output.display()))?;
+    staging.stage_document(&output, &Output::Bytes(bytes))?;
+    snapshot.unchanged(&input)?;
+    staging.commit()?;
     Ok(if changed {
         Written::Changed
     } else {
@@ -338,6 +398,7 @@ fn baked_by_part<'a>(
     bake_plan: &crate::bake::plan::BakePlan,
     baked: &mut Vec<crate::bake::engine::Baked>,
     names: &mut FileNames,
+    staging: &Staging,
 ) -> Result<Option<PartWritten<'a>>, String> {
     let Some(mut part) = BakePart::new(asset, bake_plan, document) else {
         return Ok(None);
@@ -369,7 +430,7 @@ fn baked_by_part<'a>(
         *baked = as_baked;
         return Ok(None);
     }
-    copy_resources(relocation, &applied.json)?;
+    copy_resources(relocation, &applied.json, staging)?;
     let part_edits = part.into_edits(asset, applied.json);
     let spliced =
         write::spliced_bytes(asset, others.iter().copied().chain(&part_edits)).map_err(fail)?;

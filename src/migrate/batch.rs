@@ -112,6 +112,9 @@ impl RunReport {
 }
 
 fn migrate_one(job: &Job, options: &Options, dry_run: bool, claims: &Claims) -> FileResult {
+    if let Err(stopped) = crate::output::interrupt::check() {
+        return FileResult::failed(job, stopped);
+    }
     let mut plan = match plan_file(job, options) {
         Ok(plan) => plan,
         Err(error) => return FileResult::failed(job, error),

@@ -375,8 +375,12 @@ pub fn plan(asset: &Asset, materials: &mut [MaterialPlan], budget: Budget) {
 
 fn codes_of(asset: &Asset, image: usize, channel: Channel) -> Result<Codes, String> {
     let bytes = asset.image_bytes(image).map_err(|d| d.message)?;
-    let (pixels, _) =
-        codec::decode_limited(&bytes, asset.options.max_image_pixels).map_err(|e| e.to_string())?;
+    let (pixels, _) = codec::decode_within(
+        &bytes,
+        asset.options.max_image_pixels,
+        asset.options.max_memory,
+    )
+    .map_err(|e| e.to_string())?;
     Ok(Codes::of(&pixels, channel))
 }
 

@@ -7,7 +7,7 @@ use super::textures::{self, TextureBake};
 use super::{fallback, legacy, sheen_to_fuzz, Options};
 use crate::asset::tape::Node;
 use crate::asset::Asset;
-use crate::edit::Edit;
+use crate::edit::{Edit, SetValue};
 use crate::layers;
 use serde::Serialize;
 use serde_json::Value;
@@ -72,6 +72,41 @@ impl MaterialPlan {
         self.notes.shrink_to_fit();
         self.bakes.shrink_to_fit();
         self.conversions.shrink_to_fit();
+    }
+
+    /// Writes into the edit that sets each baked slot's layer object the factor the bake
+    /// leaves in the file (see [`TextureBake::factor_in_file`]), once the budget has chosen
+    /// it: the plan's edits, and so a dry run and `--check`, then show the value the file
+    /// gets, not the factor before the bake.
+    fn settle_baked_factors(&mut self) {
+        for bake in &self.bakes {
+            let factor_pointer = format!("{}/{}", bake.layer_pointer, bake.factor_key);
+            for edit in &mut self.edits {
+                let Edit::Set { pointer, value } = edit else {
+                    continue;
+                };
+                if *pointer == factor_pointer {
+                    *value = SetValue::Value(crate::edit::splice::written(bake.factor_in_file()));
+                    continue;
+                }
+                if *pointer != bake.layer_pointer {
+                    continue;
+                }
+                let mut layer = value.to_value().into_owned();
+                let Some(members) = layer.as_object_mut() else {
+                    continue;
+                };
+                members.insert(bake.factor_key.to_string(), bake.factor_in_file());
+                *value = match value {
+                    SetValue::Text(_) => {
+                        let mut text = String::new();
+                        crate::edit::splice::write_compact(&layer, &mut text);
+                        SetValue::Text(text.into_boxed_str())
+                    }
+                    SetValue::Value(_) => SetValue::Value(crate::edit::splice::written(layer)),
+                };
+            }
+        }
     }
 
     pub fn migrated(&self) -> bool {
@@ -252,7 +287,10 @@ pub fn plan_document(asset: &Asset, options: &Options) -> DocumentPlan {
         (0..count).filter_map(plan).collect()
     };
     super::budget::plan(asset, &mut materials, options.budget);
-    materials.iter_mut().for_each(MaterialPlan::shrink_to_fit);
+    materials.iter_mut().for_each(|m| {
+        m.settle_baked_factors();
+        m.shrink_to_fit();
+    });
     let declared: Vec<std::borrow::Cow<str>> =
         crate::rules::elements(asset.root().get("extensionsUsed"))
             .filter_map(|e| e.as_str())

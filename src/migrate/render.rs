@@ -9,6 +9,7 @@ use super::batch::{FileOutcome, FileResult, RunReport, Summary};
 use super::note::Level;
 use super::plan::MaterialPlan;
 use crate::output::summary::{added, files_line, plural, Detail};
+use crate::report::escape::push_line;
 use std::fmt::Write;
 
 fn level(l: Level) -> &'static str {
@@ -82,38 +83,42 @@ fn file_line(f: &FileResult, dry_run: bool) -> String {
 /// The text report of one file. `plan` lists every material with its edits (a dry run);
 /// otherwise only the materials something is said about are listed.
 pub fn file_text(f: &FileResult, plan: bool) -> String {
-    let mut out = file_line(f, plan);
-    out.push('\n');
+    let mut out = String::new();
+    push_line(&mut out, &file_line(f, plan));
     for m in &f.materials {
         if !plan && m.notes.is_empty() {
             continue;
         }
-        let _ = writeln!(out, "  {}", material_line(m));
+        push_line(&mut out, &format!("  {}", material_line(m)));
         for note in &m.notes {
-            let _ = writeln!(out, "    {}: {}", level(note.level()), note.message());
+            push_line(
+                &mut out,
+                &format!("    {}: {}", level(note.level()), note.message()),
+            );
         }
         if plan {
             for edit in &m.edits {
-                let _ = writeln!(out, "    {edit}");
+                push_line(&mut out, &format!("    {edit}"));
             }
             for bake in &m.bakes {
-                let _ = writeln!(out, "    {bake}");
+                push_line(&mut out, &format!("    {bake}"));
             }
         }
     }
     for note in &f.notes {
-        let _ = writeln!(out, "  {}: {}", level(note.level()), note.message());
+        push_line(
+            &mut out,
+            &format!("  {}: {}", level(note.level()), note.message()),
+        );
     }
     if plan {
         for edit in &f.edits {
-            let _ = writeln!(out, "  {edit}");
+            push_line(&mut out, &format!("  {edit}"));
         }
         for copy in &f.copies {
-            let _ = writeln!(
-                out,
-                "  copy {} → {}",
-                copy.from.display(),
-                copy.to.display()
+            push_line(
+                &mut out,
+                &format!("  copy {} → {}", copy.from.display(), copy.to.display()),
             );
         }
     }
@@ -167,8 +172,7 @@ pub fn text(report: &RunReport, detail: Detail) -> String {
         match detail {
             Detail::Quiet if !failed => {}
             Detail::Quiet | Detail::Normal if !report.dry_run => {
-                out += &file_line(f, report.dry_run);
-                out.push('\n');
+                push_line(&mut out, &file_line(f, report.dry_run));
             }
             _ => out += &file_text(f, report.dry_run),
         }

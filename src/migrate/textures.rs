@@ -217,6 +217,16 @@ impl TextureBake {
         format!("{}/{}", self.layer_pointer, self.texture_key)
     }
 
+    /// The factor the slot holds once the texture is baked: the written factor, or the
+    /// identity (`1.0`, or `[1.0, 1.0, 1.0]` for a colour) when the factor is baked in.
+    pub fn factor_in_file(&self) -> Value {
+        match self.written_factor {
+            Some(w) => Value::from(w),
+            None if self.factor.len() == 3 => serde_json::json!([1.0, 1.0, 1.0]),
+            None => serde_json::json!(1.0),
+        }
+    }
+
     /// The short name of the slot (`fuzzTexture` → `fuzz`), which names the new images.
     pub fn label(&self) -> &'static str {
         self.texture_key

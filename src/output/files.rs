@@ -8,8 +8,10 @@ use std::sync::Mutex;
 
 use serde_json::Value;
 
+use super::interrupt;
 use super::paths::{folder_of, identity, relative_uris, Relocation};
-use crate::asset::{self, resource, write};
+use super::staging::Staging;
+use crate::asset::{self, resource};
 use crate::bake::apply::{content_hash, file_candidates, output_name, Names, NewFile};
 use crate::bake::plan::BakePlan;
 use crate::bake::{Baked, OutputId, StoredFile};
@@ -28,6 +30,9 @@ pub(crate) struct FileNames<'a> {
     claims: &'a Claims,
     dir: PathBuf,
     taken: HashSet<PathBuf>,
+    /// The new files this output writes, by content (hash and length): identical bytes baked
+    /// for two slots are one file.
+    written: HashMap<(String, usize), String>,
 }
 
 impl<'a> FileNames<'a> {
@@ -55,6 +60,7 @@ impl<'a> FileNames<'a> {
             claims,
             dir: folder_of(output).to_path_buf(),
             taken,
+            written: HashMap::new(),
         }
     }
 
@@ -91,27 +97,42 @@ impl Names for FileNames<'_> {
 /// What [`file_sink`] returns: a [`Sink`](crate::bake::Sink) it owns.
 pub(crate) type FileSink<'s> = Box<dyn Fn(OutputId, &mut Baked) -> Result<(), String> + Sync + 's>;
 
-/// A [`Sink`](crate::bake::Sink) that writes each output as a file into `dir` as soon as it is encoded
+/// A [`Sink`](crate::bake::Sink) that stages each output as a file into `dir` as soon as it is encoded
 /// (named from the source image, the slots and a hash of the bytes, claimed through `names`)
 /// and drops its bytes. Only for a .gltf whose new images are files.
 pub(crate) fn file_sink<'s, 'c: 's>(
     names: &'s Mutex<FileNames<'c>>,
     images: &'s Value,
     plan: &'s BakePlan,
+    staging: &'s Staging,
 ) -> FileSink<'s> {
     Box::new(move |id, baked| {
+        // A run asked to stop writes no further texture; what the file staged is dropped.
+        interrupt::check()?;
         let Some((format, bytes)) = baked.encoded.take() else {
             return Ok(());
         };
         let name = output_name(images, &plan.outputs[id.0]);
-        let (dir, file) = {
+        let content = (content_hash(&bytes), bytes.len());
+        let (dir, file, new) = {
             let mut names = names.lock().unwrap_or_else(|e| e.into_inner());
-            let file = file_candidates(&name, format, &bytes)
-                .find(|candidate| names.claim(candidate, &bytes))
-                .expect("some name is free");
-            (names.dir().to_path_buf(), file)
+            // The same bytes already written for this output (another slot's bake came out
+            // identical): one file, named by both. Equal hash and length are taken for equal
+            // bytes, as the run's name claims take them.
+            match names.written.get(&content).cloned() {
+                Some(file) => (names.dir().to_path_buf(), file, false),
+                None => {
+                    let file = file_candidates(&name, format, &bytes)
+                        .find(|candidate| names.claim(candidate, &bytes))
+                        .expect("some name is free");
+                    names.written.insert(content, file.clone());
+                    (names.dir().to_path_buf(), file, true)
+                }
+            }
         };
-        write_new_file(&dir, &file, &bytes)?;
+        if new {
+            staging.stage_bytes(&dir, &file, &bytes)?;
+        }
         baked.stored = Some(StoredFile {
             name: file,
             format,
@@ -121,23 +142,16 @@ pub(crate) fn file_sink<'s, 'c: 's>(
     })
 }
 
-/// Writes new image files into `dir` (each atomically; one already holding the bytes is left).
-pub(crate) fn write_new_files(dir: &Path, files: &[NewFile]) -> Result<(), String> {
+/// Stages new image files for `dir` (one already holding the bytes is left).
+pub(crate) fn stage_new_files(
+    dir: &Path,
+    files: &[NewFile],
+    staging: &Staging,
+) -> Result<(), String> {
     for file in files {
-        write_new_file(dir, &file.name, &file.bytes)?;
+        staging.stage_bytes(dir, &file.name, &file.bytes)?;
     }
     Ok(())
-}
-
-/// Writes one new file into `dir` atomically, unless it already holds `bytes`.
-pub(crate) fn write_new_file(dir: &Path, name: &str, bytes: &[u8]) -> Result<(), String> {
-    std::fs::create_dir_all(dir)
-        .map_err(|e| format!("cannot create folder {}: {e}", dir.display()))?;
-    let path = dir.join(name);
-    if std::fs::read(&path).is_ok_and(|b| b == bytes) {
-        return Ok(());
-    }
-    write::write_atomic(&path, bytes).map_err(|e| format!("cannot write {}: {e}", path.display()))
 }
 
 /// Creates the folder `path` goes in, if it has one.
@@ -150,11 +164,12 @@ pub(crate) fn create_parent(path: &Path) -> Result<(), String> {
 }
 
 /// Places a relocation's resource copies that the written document `json` still names (each a
-/// regular file, hard-linked or copied atomically from the resolved source), for migrate and
-/// bake alike.
+/// regular file of its own, cloned or copied atomically from the resolved source), for migrate
+/// and bake alike.
 pub(crate) fn copy_resources<'a>(
     relocation: &Relocation,
     json: impl crate::asset::tape::JsonView<'a>,
+    staging: &Staging,
 ) -> Result<(), String> {
     let used = relative_uris(json);
     for copy in relocation
@@ -167,8 +182,7 @@ pub(crate) fn copy_resources<'a>(
             .canonicalize()
             .map_err(|e| format!("cannot read resource {}: {e}", copy.from.display()))?;
         create_parent(&copy.to)?;
-        write::copy_atomic(&from, &copy.to)
-            .map_err(|e| format!("cannot write resource {}: {e}", copy.to.display()))?;
+        staging.stage_copy(&from, &copy.to)?;
     }
     Ok(())
 }

@@ -10,7 +10,9 @@
 //! [`UsageError`] is a request either command refuses before anything is read or written.
 
 pub mod files;
+pub mod interrupt;
 pub mod paths;
+pub mod staging;
 pub mod summary;
 
 use crate::asset::discover::Shard;
@@ -29,7 +31,8 @@ pub struct Scope<'a> {
 
 /// Runs `each` over every file of `scope` in parallel, under one set of name claims, after one
 /// `unreadable` result per folder that could not be read; results come in that order, files in
-/// input order. `Err` is a usage error: nothing was read or written.
+/// input order. Before any file, the temporary files a killed run left in the output folders
+/// are removed. `Err` is a usage error: nothing was read or written.
 pub fn run_each<R: Send>(
     scope: &Scope,
     unreadable: impl Fn(PathBuf, std::io::Error) -> R,
@@ -37,6 +40,16 @@ pub fn run_each<R: Send>(
 ) -> Result<Vec<R>, UsageError> {
     let (jobs, walk_errors) =
         paths::jobs(scope.inputs, scope.destination, scope.dry_run, scope.shard)?;
+    if !scope.dry_run {
+        // What a killed run left in the folders this one writes to goes first.
+        let folders: std::collections::BTreeSet<&std::path::Path> = jobs
+            .iter()
+            .filter_map(|job| job.output.as_deref().map(paths::folder_of))
+            .collect();
+        for folder in folders {
+            crate::asset::write::remove_leftovers(folder);
+        }
+    }
     let claims = files::Claims::default();
     let bar = progress_bar(scope.progress, jobs.len());
     let mut results: Vec<R> = walk_errors
@@ -97,4 +110,10 @@ pub enum UsageError {
     },
     #[error("no inputs given")]
     NoInputs,
+    #[error("--in-place: {link} is a symbolic link to {target}, outside {root}; velvet writes only inside the folders it is given (name the target itself to migrate it)")]
+    LinkOutside {
+        link: String,
+        target: String,
+        root: String,
+    },
 }

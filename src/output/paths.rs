@@ -6,9 +6,10 @@
 //! with another container than the input's.
 //!
 //! [`relocate`] keeps an output in another folder loadable and self-contained: each resource a
-//! relative URI names is copied (hard-linked where the filesystem allows) to the same relative
-//! place next to the output and its URI kept, so no output URI leaves its folder and the output
-//! tree can be moved as a whole. A URI that climbs out of the input's folder cannot be kept so:
+//! relative URI names is copied (a copy-on-write clone where the filesystem can make one, never
+//! a hard link: see [`crate::asset::write::copy_atomic`]) to the same relative place next to
+//! the output and its URI kept, so no output URI leaves its folder and the output tree can be
+//! moved as a whole. A URI that climbs out of the input's folder cannot be kept so:
 //! the file fails, naming it. `--rewrite-uris` (the old behaviour) rewrites each URI to lead
 //! back to the input's folder instead. `data:` URIs, URIs with a scheme and absolute paths need
 //! neither.
@@ -116,8 +117,20 @@ pub fn jobs(
     }
     let mut jobs = Vec::new();
     let (found, walk_errors) = discover::find(inputs, shard);
+    let mut in_place_targets = std::collections::HashSet::new();
     for discover::Found { path: file, input } in found {
         let input = &inputs[input];
+        let file = match destination {
+            Destination::InPlace => match link_target_in_place(&file, input)? {
+                // A link and its target both found (or two links to one file): the file is
+                // migrated once.
+                Some(target) if !in_place_targets.insert(identity(&target)) => continue,
+                Some(target) => target,
+                None if !in_place_targets.insert(identity(&file)) => continue,
+                None => file,
+            },
+            _ => file,
+        };
         let output = match destination {
             Destination::None => None,
             Destination::InPlace => Some(file.clone()),
@@ -159,6 +172,37 @@ pub fn jobs(
         }
     }
     Ok((jobs, walk_errors))
+}
+
+/// For `--in-place`: the file a symbolic link `file` leads to, which is migrated in its place so
+/// that the link stays a link (renaming an output over the link would replace it with a
+/// regular file and leave its target as it was). `None` when `file` is not a link, or one that
+/// leads nowhere (the loader reports it). The target must lie inside the folder the file was
+/// found under (for a file named alone, its folder): `--in-place` writes nowhere else.
+fn link_target_in_place(file: &Path, input: &Path) -> Result<Option<PathBuf>, UsageError> {
+    let is_link = std::fs::symlink_metadata(file).is_ok_and(|m| m.is_symlink());
+    if !is_link {
+        return Ok(None);
+    }
+    let Ok(target) = file.canonicalize() else {
+        return Ok(None);
+    };
+    let root = if input.is_dir() {
+        input
+    } else {
+        folder_of(input)
+    };
+    let inside = root
+        .canonicalize()
+        .is_ok_and(|root| target.starts_with(root));
+    if !inside {
+        return Err(UsageError::LinkOutside {
+            link: file.display().to_string(),
+            target: target.display().to_string(),
+            root: root.display().to_string(),
+        });
+    }
+    Ok(Some(target))
 }
 
 /// A resource to copy next to an output.

@@ -3,16 +3,15 @@
 //! percentile), and the columns a sheet compares — the material as authored, as migrated and
 //! as a loader without KHR_materials_fuzz sees it.
 //!
-//! What migrate would produce is computed here from `shading::mapping` in one function,
-//! [`columns`], rather than by running the migrate planner (whose per-material result is a set
-//! of JSON edits, not values): it follows the planner's default (fast) conversions —
-//! sheen → fuzz writes fuzzFactor w = max3(sheenColorFactor), fuzzColor = sheenColor / w (a
-//! colour texture carried as it is, so the texel's colour divided by the factor's w) and
-//! fuzzRoughness α(r) (fitted, the mapping applied to factor × texel as the bake does) or r
-//! (copied); fuzz → fallback sheen writes sheenColor = fuzzColor × w (clamped into [0, 1]) and
-//! sheenRoughness r(α) (fitted) or α (copied). A black fuzz gives a switched-off sheen, which
-//! shows the base alone, as a loader without fuzz shows a material to which migrate adds no
-//! fallback. A material that has both layers keeps its sheen (migrate leaves it).
+//! What migrate produces is read from its plan ([`crate::migrate::plan_document`], with the
+//! options of the run): the plan's edits applied to the material give the layers the migrated
+//! file holds (factors as written: rounded, floored, settled by the bakes), and a slot the plan
+//! bakes reads the bake's own recipe evaluated on the source texture. The sheet's first
+//! migrated column is that file; the next one shows the other roughness mapping (fitted or
+//! copied), computed from the same function migrate writes through
+//! ([`roughness::written`] of [`roughness::map`]). A black fuzz gives no fallback, which shows
+//! the base alone. A material with the pre-ratification sheen draft is shown as migrate
+//! upgrades it (the plan's ratified sheen stands for it as authored).
 //!
 //! Textures: a readable texture (PNG, JPEG, WebP, decoded to 8 bits per channel) is reduced to
 //! its mean and its 5th and 95th percentiles (nearest rank; a colour texture is ranked by the
@@ -22,9 +21,12 @@
 //! note says so.
 
 use crate::asset::Asset;
+use crate::bake::recipe::{Channel, ChannelRecipe, ImageId, Texel};
 use crate::layers::{self, Channels, FuzzView, SheenView, Slot, Transfer};
+use crate::migrate::roughness::{self, Direction, RoughnessMapping};
+use crate::migrate::textures::TextureBake;
+use crate::migrate::{Conversion, DocumentPlan, MaterialPlan};
 use crate::shading::layering::{max3, FuzzParams, SheenParams};
-use crate::shading::mapping::{fuzz_roughness_for_sheen, sheen_roughness_for_fuzz};
 use serde_json::Value;
 
 use super::shade::{Layer, Look};
@@ -49,8 +51,12 @@ pub struct FuzzValues {
 pub struct Swatch {
     /// "FACTORS", "P5", "MEAN" or "P95".
     pub label: &'static str,
+    /// The layers as authored.
     pub sheen: Option<SheenValues>,
     pub fuzz: Option<FuzzValues>,
+    /// The layers of the migrated file, as a reader computes them from what the plan writes.
+    pub written_sheen: Option<SheenValues>,
+    pub written_fuzz: Option<FuzzValues>,
 }
 
 /// Which conversion the material's sheet shows.
@@ -80,6 +86,9 @@ pub struct Material {
     pub notes: Vec<String>,
     /// fuzzRoughnessFactor was absent: the table default 0.5 is used.
     pub fuzz_roughness_assumed: bool,
+    /// The roughness mapping of the run the plan was made for; the sheet's other column
+    /// shows the other one.
+    pub mapping: RoughnessMapping,
 }
 
 /// One column of a sheet: a label of two lines and the look it shows.
@@ -98,46 +107,101 @@ pub struct TextureStats {
     pub p95: Vec<f64>,
 }
 
-/// The materials of `asset` that have or get a sheen or fuzz layer, in document order.
+/// The materials of `asset` that have or get a sheen or fuzz layer, in document order, with
+/// what `plan` (the migration of `asset` with the run's options; `mapping` is theirs) writes.
 /// Materials that use KHR_materials_unlit or KHR_materials_pbrSpecularGlossiness (which
 /// exclude both layers, so migrate leaves them), and a switched-off sheen or fuzz alone (to
 /// which migrate adds nothing), are left out.
-pub fn materials(asset: &Asset) -> Vec<Material> {
+pub fn materials(asset: &Asset, plan: &DocumentPlan, mapping: RoughnessMapping) -> Vec<Material> {
     let mut images = ImageCache::default();
     layers::materials(asset.json())
         .iter()
         .enumerate()
-        .filter_map(|(index, m)| read(asset, index, m, &mut images))
+        .filter_map(|(index, m)| {
+            let planned = plan.materials.iter().find(|p| p.index == index);
+            read(asset, index, m, planned, mapping, &mut images)
+        })
         .collect()
+}
+
+/// `material` (the material at `index`) with the edits of its plan applied: the material the
+/// migrated file holds. Declarations and edits outside the material are left out.
+fn migrated(material: &Value, index: usize, plan: &MaterialPlan) -> Result<Value, String> {
+    let prefix = format!("/materials/{index}");
+    let edits: Vec<crate::edit::Edit> = plan
+        .edits
+        .iter()
+        .filter_map(|edit| {
+            let pointer = match edit {
+                crate::edit::Edit::Set { pointer, .. }
+                | crate::edit::Edit::Replace { pointer, .. }
+                | crate::edit::Edit::Remove { pointer } => pointer,
+                crate::edit::Edit::DeclareUsed { .. } => return None,
+            };
+            let within = pointer.strip_prefix(&prefix)?;
+            (within.starts_with('/')).then(|| edit.at(within))
+        })
+        .collect();
+    let mut out = material.clone();
+    crate::edit::apply(&mut out, &edits).map_err(|e| e.to_string())?;
+    Ok(out)
 }
 
 #[derive(Default)]
 struct ImageCache {
-    stats: Vec<(usize, Channels, Transfer, Result<TextureStats, String>)>,
+    stats: Vec<(usize, Read, Transfer, Result<TextureStats, String>)>,
 }
 
 fn read(
     asset: &Asset,
     index: usize,
     material: &Value,
+    plan: Option<&MaterialPlan>,
+    mapping: RoughnessMapping,
     images: &mut ImageCache,
 ) -> Option<Material> {
-    let ext = layers::extensions(material);
-    let get = |name: &str| ext.and_then(|e| e.get(name)).filter(|v| v.is_object());
-    if get(layers::UNLIT).is_some() || get(layers::SPEC_GLOSS).is_some() {
+    let mut notes = Vec::new();
+    let written = match plan.map(|p| migrated(material, index, p)) {
+        Some(Ok(written)) => written,
+        Some(Err(e)) => {
+            notes.push(format!(
+                "the plan could not be applied ({e}): shown unmigrated"
+            ));
+            material.clone()
+        }
+        None => material.clone(),
+    };
+    let layer = |json: &Value, name: &str| -> Option<Value> {
+        layers::extensions(json)
+            .and_then(|e| e.get(name))
+            .filter(|v| v.is_object())
+            .cloned()
+    };
+    if layer(material, layers::UNLIT).is_some() || layer(material, layers::SPEC_GLOSS).is_some() {
         return None;
     }
-    let sheen_json = get(layers::SHEEN);
-    let fuzz_json = get(layers::FUZZ);
-    let sheen = sheen_json.and_then(SheenView::read);
-    let fuzz = fuzz_json.and_then(FuzzView::read);
+    // A draft sheen is shown as migrate upgrades it: the sheen of the migrated file.
+    let legacy = plan.is_some_and(|p| p.conversions.contains(&Conversion::LegacyUpgrade));
+    if legacy {
+        notes.push(
+            "the pre-ratification sheen draft is shown as migrate upgrades it to ratified sheen"
+                .into(),
+        );
+    }
+    let sheen_json = layer(if legacy { &written } else { material }, layers::SHEEN);
+    let fuzz_json = layer(material, layers::FUZZ);
+    let written_sheen_json = layer(&written, layers::SHEEN);
+    let written_fuzz_json = layer(&written, layers::FUZZ);
+    let sheen = sheen_json.as_ref().and_then(SheenView::read);
+    let fuzz = fuzz_json.as_ref().and_then(FuzzView::read);
     let kind = match (&sheen, &fuzz) {
         (Some(_), Some(_)) => Kind::FuzzWithSheen,
         (None, Some(f)) if f.is_on() => Kind::FuzzFallback,
         (Some(s), None) if s.is_on() => Kind::SheenToFuzz,
         _ => return None,
     };
-    let mut notes = Vec::new();
+    let written_sheen = written_sheen_json.as_ref().and_then(SheenView::read);
+    let written_fuzz = written_fuzz_json.as_ref().and_then(FuzzView::read);
     let name = material
         .get("name")
         .and_then(Value::as_str)
@@ -171,34 +235,62 @@ fn read(
         ));
     }
 
-    // The layer textures, each reduced to three values.
-    let mut textured: Vec<(&'static str, TextureStats)> = Vec::new();
-    for (json, extension) in [(sheen_json, layers::SHEEN), (fuzz_json, layers::FUZZ)] {
+    // The layer textures, each reduced to three values: as authored, and as the migrated file
+    // reads them (a slot the plan bakes through the bake's recipe on its source).
+    let bakes: &[TextureBake] = plan.map_or(&[], |p| p.bakes.as_slice());
+    let mut textured: Vec<(&'static Slot, TextureStats)> = Vec::new();
+    let mut written_textured: Vec<(&'static Slot, TextureStats)> = Vec::new();
+    for (json, extension, in_written, baked) in [
+        (&sheen_json, layers::SHEEN, false, legacy),
+        (&fuzz_json, layers::FUZZ, false, false),
+        (&written_sheen_json, layers::SHEEN, true, true),
+        (&written_fuzz_json, layers::FUZZ, true, true),
+    ] {
         let Some(json) = json else { continue };
         for slot in layers::slots_of(extension) {
             let Some(info) = json.get(slot.texture) else {
                 continue;
             };
-            match texture_stats(asset, info, slot.channels, slot.transfer, images) {
-                Ok(s) => textured.push((slot.texture, s)),
-                Err(e) => notes.push(format!(
-                    "{} not read ({e}): {} alone is used",
-                    slot.texture, slot.factor
-                )),
+            let bake = bakes
+                .iter()
+                .find(|b| baked && b.extension == extension && b.texture_key == slot.texture);
+            let stats = match bake {
+                Some(bake) => baked_stats(asset, bake, slot, images),
+                None => texture_stats(asset, info, slot.channels, slot.transfer, images),
+            };
+            match stats {
+                Ok(s) if in_written => written_textured.push((slot, s)),
+                Ok(s) => textured.push((slot, s)),
+                Err(e) => {
+                    let note = format!(
+                        "{} not read ({e}): {} alone is used",
+                        slot.texture, slot.factor
+                    );
+                    if !notes.contains(&note) {
+                        notes.push(note);
+                    }
+                }
             }
         }
     }
+    let views = Views {
+        sheen: sheen.as_ref(),
+        fuzz: fuzz.as_ref(),
+        written_sheen: written_sheen.as_ref(),
+        written_fuzz: written_fuzz.as_ref(),
+    };
     let at = |pick: fn(&TextureStats) -> &Vec<f64>, label: &'static str| {
-        let value = |slot: &Slot| -> Option<Vec<f64>> {
-            textured
-                .iter()
-                .find(|(t, _)| *t == slot.texture)
+        let value = |list: &[(&'static Slot, TextureStats)], slot: &Slot| -> Option<Vec<f64>> {
+            list.iter()
+                .find(|(s, _)| s.texture == slot.texture)
                 .map(|(_, s)| pick(s).clone())
         };
-        swatch_values(label, sheen.as_ref(), fuzz.as_ref(), &value)
+        swatch_values(label, &views, &|slot| value(&textured, slot), &|slot| {
+            value(&written_textured, slot)
+        })
     };
-    let factors = swatch_values("FACTORS", sheen.as_ref(), fuzz.as_ref(), &|_| None);
-    let swatches = if textured.is_empty() {
+    let factors = swatch_values("FACTORS", &views, &|_| None, &|_| None);
+    let swatches = if textured.is_empty() && written_textured.is_empty() {
         vec![factors.clone()]
     } else {
         vec![
@@ -216,16 +308,115 @@ fn read(
         swatches,
         notes,
         fuzz_roughness_assumed,
+        mapping,
+    })
+}
+
+/// The four layer views a swatch reads.
+struct Views<'a> {
+    sheen: Option<&'a SheenView>,
+    fuzz: Option<&'a FuzzView>,
+    written_sheen: Option<&'a SheenView>,
+    written_fuzz: Option<&'a FuzzView>,
+}
+
+/// What a baked slot reads, reduced to three values: the bake's recipe (the one the bake
+/// engine runs) evaluated on the source images' values at each percentile. A recipe that
+/// reads red, green and blue of its base reads them at the base's colour percentiles; any
+/// other channel at that channel's own.
+fn baked_stats(
+    asset: &Asset,
+    bake: &TextureBake,
+    slot: &Slot,
+    images: &mut ImageCache,
+) -> Result<TextureStats, String> {
+    let (_, base) = *bake
+        .sources
+        .first()
+        .ok_or("the baked texture has no source image")?;
+    let recipe = bake
+        .contents
+        .recipe(ImageId(base))
+        .map_err(|e| e.to_string())?;
+    let outputs: &[Channel] = match slot.channels {
+        Channels::Rgb => &[Channel::R, Channel::G, Channel::B],
+        Channels::Red => &[Channel::R],
+        Channels::Alpha => &[Channel::A],
+    };
+    let channel_recipes: Vec<ChannelRecipe> = outputs.iter().map(|&c| recipe.resolved(c)).collect();
+    let mut texels: Vec<Texel> = Vec::new();
+    for r in &channel_recipes {
+        match r {
+            ChannelRecipe::Copy(image, channel) => texels.push(Texel {
+                image: *image,
+                channel: *channel,
+                transfer: match slot.transfer {
+                    Transfer::Srgb => crate::bake::Transfer::Srgb,
+                    Transfer::Linear => crate::bake::Transfer::Linear,
+                },
+            }),
+            ChannelRecipe::Computed { value, .. } => texels.extend(value.texels()),
+        }
+    }
+    texels.sort();
+    texels.dedup();
+    let colour_of = |image: ImageId| {
+        [Channel::R, Channel::G, Channel::B]
+            .iter()
+            .filter(|c| texels.iter().any(|t| t.image == image && t.channel == **c))
+            .count()
+            > 1
+    };
+    let mut read = Vec::with_capacity(texels.len());
+    for t in &texels {
+        let transfer = match t.transfer {
+            crate::bake::Transfer::Srgb => Transfer::Srgb,
+            crate::bake::Transfer::Linear => Transfer::Linear,
+        };
+        let (read_as, component) = if colour_of(t.image) && t.channel != Channel::A {
+            (Read::Rgb, t.channel as usize)
+        } else {
+            (Read::One(t.channel as usize), 0)
+        };
+        read.push((
+            *t,
+            image_stats(asset, t.image.0, read_as, transfer, images)?,
+            component,
+        ));
+    }
+    let at = |pick: fn(&TextureStats) -> &Vec<f64>| -> Vec<f64> {
+        let mut value_of = |texel: &Texel| {
+            read.iter()
+                .find(|(t, _, _)| t == texel)
+                .map_or(0.0, |(_, s, k)| pick(s)[*k])
+        };
+        channel_recipes
+            .iter()
+            .map(|r| match r {
+                ChannelRecipe::Copy(image, channel) => value_of(&Texel {
+                    image: *image,
+                    channel: *channel,
+                    transfer: texels[0].transfer,
+                }),
+                ChannelRecipe::Computed { value, .. } => value.eval(&mut value_of).clamp(0.0, 1.0),
+            })
+            .collect()
+    };
+    Ok(TextureStats {
+        p5: at(|s| &s.p5),
+        mean: at(|s| &s.mean),
+        p95: at(|s| &s.p95),
     })
 }
 
 /// The layers' values at one swatch: each factor times its texture's value there (`texel`
-/// gives it for a slot, `None` when the slot has no readable texture).
+/// gives it for an authored slot and `written_texel` for a slot of the migrated file, `None`
+/// when the slot has no readable texture).
 fn swatch_values(
     label: &'static str,
-    sheen: Option<&SheenView>,
-    fuzz: Option<&FuzzView>,
+    views: &Views,
     texel: &dyn Fn(&Slot) -> Option<Vec<f64>>,
+    written_texel: &dyn Fn(&Slot) -> Option<Vec<f64>>,
 ) -> Swatch {
     let slot = |name: &str| {
         layers::SLOTS
@@ -233,21 +424,33 @@ fn swatch_values(
             .find(|s| s.texture == name)
             .expect("a slot velvet knows")
     };
-    let scalar = |name: &str, factor: f64| texel(slot(name)).map_or(factor, |v| factor * v[0]);
-    let color = |name: &str, factor: [f64; 3]| {
-        texel(slot(name)).map_or(factor, |v| std::array::from_fn(|k| factor[k] * v[k]))
-    };
-    Swatch {
-        label,
-        sheen: sheen.map(|s| SheenValues {
+    let sheen_values = |s: &SheenView, texel: &dyn Fn(&Slot) -> Option<Vec<f64>>| {
+        let scalar = |name: &str, factor: f64| texel(slot(name)).map_or(factor, |v| factor * v[0]);
+        let color = |name: &str, factor: [f64; 3]| {
+            texel(slot(name)).map_or(factor, |v| std::array::from_fn(|k| factor[k] * v[k]))
+        };
+        SheenValues {
             color: color("sheenColorTexture", s.color_factor),
             roughness: scalar("sheenRoughnessTexture", s.roughness_factor),
-        }),
-        fuzz: fuzz.map(|f| FuzzValues {
+        }
+    };
+    let fuzz_values = |f: &FuzzView, texel: &dyn Fn(&Slot) -> Option<Vec<f64>>| {
+        let scalar = |name: &str, factor: f64| texel(slot(name)).map_or(factor, |v| factor * v[0]);
+        let color = |name: &str, factor: [f64; 3]| {
+            texel(slot(name)).map_or(factor, |v| std::array::from_fn(|k| factor[k] * v[k]))
+        };
+        FuzzValues {
             weight: scalar("fuzzTexture", f.factor),
             color: color("fuzzColorTexture", f.color_factor),
             roughness: scalar("fuzzRoughnessTexture", f.roughness_or_table_default()),
-        }),
+        }
+    };
+    Swatch {
+        label,
+        sheen: views.sheen.map(|s| sheen_values(s, texel)),
+        fuzz: views.fuzz.map(|f| fuzz_values(f, texel)),
+        written_sheen: views.written_sheen.map(|s| sheen_values(s, written_texel)),
+        written_fuzz: views.written_fuzz.map(|f| fuzz_values(f, written_texel)),
     }
 }
 
@@ -273,38 +476,72 @@ fn texture_stats(
     cache: &mut ImageCache,
 ) -> Result<TextureStats, String> {
     let image = image_index(asset, info)?;
+    let read = match channels {
+        Channels::Rgb => Read::Rgb,
+        Channels::Red => Read::One(0),
+        Channels::Alpha => Read::One(3),
+    };
+    image_stats(asset, image, read, transfer, cache)
+}
+
+/// Which values of an image a percentile ranks: its colour (by the largest channel), or one
+/// channel (0 red … 3 alpha).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Read {
+    Rgb,
+    One(usize),
+}
+
+fn image_stats(
+    asset: &Asset,
+    image: usize,
+    read: Read,
+    transfer: Transfer,
+    cache: &mut ImageCache,
+) -> Result<TextureStats, String> {
     if let Some((_, _, _, s)) = cache
         .stats
         .iter()
-        .find(|(i, c, t, _)| *i == image && *c == channels && *t == transfer)
+        .find(|(i, r, t, _)| *i == image && *r == read && *t == transfer)
     {
         return s.clone();
     }
     let stats = asset
         .decode_image(image)
         .map_err(|d| d.message)
-        .map(|img| stats_of(&img.to_rgba8(), channels, transfer));
-    cache.stats.push((image, channels, transfer, stats.clone()));
+        .map(|img| stats_by(&img.to_rgba8(), read, transfer));
+    cache.stats.push((image, read, transfer, stats.clone()));
     stats
 }
 
 /// The mean, 5th and 95th percentiles of the values a slot reads from `img` (see the module
 /// comment), linear.
 pub fn stats_of(img: &image::RgbaImage, channels: Channels, transfer: Transfer) -> TextureStats {
+    let read = match channels {
+        Channels::Rgb => Read::Rgb,
+        Channels::Red => Read::One(0),
+        Channels::Alpha => Read::One(3),
+    };
+    stats_by(img, read, transfer)
+}
+
+fn stats_by(img: &image::RgbaImage, read: Read, transfer: Transfer) -> TextureStats {
     let lin: [f64; 256] = std::array::from_fn(|c| transfer.to_linear(c as f64 / 255.0));
-    let dims = if channels == Channels::Rgb { 3 } else { 1 };
+    let dims = if read == Read::Rgb { 3 } else { 1 };
     // Per rank (the largest channel's code, or the channel's code): texel count and sums.
     let mut count = [0u64; 256];
     let mut sums = vec![[0.0f64; 3]; 256];
     for p in img.pixels() {
         let [r, g, b, a] = p.0;
-        let (rank, values) = match channels {
-            Channels::Rgb => (
+        let (rank, values) = match read {
+            Read::Rgb => (
                 r.max(g).max(b),
                 [lin[r as usize], lin[g as usize], lin[b as usize]],
             ),
-            Channels::Red => (r, [lin[r as usize], 0.0, 0.0]),
-            Channels::Alpha => (a, [lin[a as usize], 0.0, 0.0]),
+            Read::One(k) => {
+                let c = [r, g, b, a][k];
+                (c, [lin[c as usize], 0.0, 0.0])
+            }
         };
         count[rank as usize] += 1;
         for k in 0..3 {
@@ -347,10 +584,31 @@ fn rough(x: f64) -> String {
     format!("{x:.3}")
 }
 
-/// The columns of `material`'s sheet at one swatch: the material as authored first, then what
-/// migrate makes of it with the fitted and the copied roughness mapping, and what a loader
-/// without KHR_materials_fuzz sees. Column 1 is the one the difference image and the verdict
-/// compare with column 0.
+/// The detail word for a roughness mapping.
+fn mapping_word(mapping: RoughnessMapping) -> &'static str {
+    match mapping {
+        RoughnessMapping::Fitted => "FITTED",
+        RoughnessMapping::Identity => "COPIED",
+    }
+}
+
+/// The mapping the sheet shows beside the run's.
+fn other(mapping: RoughnessMapping) -> RoughnessMapping {
+    match mapping {
+        RoughnessMapping::Fitted => RoughnessMapping::Identity,
+        RoughnessMapping::Identity => RoughnessMapping::Fitted,
+    }
+}
+
+/// A roughness carried with `mapping` as migrate writes it (mapped, rounded, floored).
+fn carried(roughness: f64, direction: Direction, mapping: RoughnessMapping) -> f64 {
+    roughness::written(roughness::map(roughness, direction, mapping))
+}
+
+/// The columns of `material`'s sheet at one swatch: the material as authored first, then the
+/// migrated file (the plan's values), the other roughness mapping, and what a loader without
+/// KHR_materials_fuzz sees. Column 1 is the one the difference image and the verdict compare
+/// with column 0.
 pub fn columns(material: &Material, swatch: &Swatch) -> Vec<Column> {
     let base = material.base;
     let look = |layer| Look { base, layer };
@@ -363,17 +621,26 @@ pub fn columns(material: &Material, swatch: &Swatch) -> Vec<Column> {
         weight: f.weight,
         roughness: f.roughness,
     };
+    let mapping = material.mapping;
     match material.kind {
         Kind::SheenToFuzz => {
             let s = swatch.sheen.expect("a sheen material has sheen values");
+            // Without a written fuzz (the plan could not be applied), the conversion's
+            // factors: w = max3(sheenColorFactor), the colour divided by it.
             let w = max3(material.factors.sheen.expect("sheen").color).clamp(0.0, 1.0);
-            let color = s.color.map(|c| if w > 0.0 { c / w } else { 0.0 });
-            let fuzz = |roughness| FuzzValues {
+            let computed = |roughness| FuzzValues {
                 weight: w,
-                color,
+                color: s.color.map(|c| if w > 0.0 { c / w } else { 0.0 }),
                 roughness,
             };
-            let fitted = fuzz_roughness_for_sheen(s.roughness);
+            let migrated = swatch
+                .written_fuzz
+                .unwrap_or_else(|| computed(carried(s.roughness, Direction::SheenToFuzz, mapping)));
+            let alternative = FuzzValues {
+                roughness: carried(s.roughness, Direction::SheenToFuzz, other(mapping)),
+                ..migrated
+            };
+            let kept = swatch.written_sheen.unwrap_or(s);
             vec![
                 Column {
                     title: "AUTHORED: SHEEN".into(),
@@ -382,53 +649,80 @@ pub fn columns(material: &Material, swatch: &Swatch) -> Vec<Column> {
                 },
                 Column {
                     title: "MIGRATED: FUZZ".into(),
-                    detail: format!("A {} FITTED", rough(fitted)),
-                    look: look(fuzz_layer(fuzz(fitted))),
+                    detail: format!("A {} {}", rough(migrated.roughness), mapping_word(mapping)),
+                    look: look(fuzz_layer(migrated)),
                 },
                 Column {
-                    title: "MIGRATED: FUZZ".into(),
-                    detail: format!("A {} COPIED", rough(s.roughness)),
-                    look: look(fuzz_layer(fuzz(s.roughness))),
+                    title: format!("IF {}: FUZZ", mapping_word(other(mapping))),
+                    detail: format!(
+                        "A {} {}",
+                        rough(alternative.roughness),
+                        mapping_word(other(mapping))
+                    ),
+                    look: look(fuzz_layer(alternative)),
                 },
                 Column {
                     title: "NO FUZZ: SHEEN".into(),
-                    detail: format!("KEPT, R {}", rough(s.roughness)),
-                    look: look(sheen_layer(s)),
+                    detail: format!("KEPT, R {}", rough(kept.roughness)),
+                    look: look(sheen_layer(kept)),
                 },
             ]
         }
         Kind::FuzzFallback | Kind::FuzzWithSheen => {
             let f = swatch.fuzz.expect("a fuzz material has fuzz values");
+            // The fallback's colour as migrate computes it; a black fuzz gets no fallback,
+            // which shows as a switched-off sheen.
             let color = f
                 .color
                 .map(|c| (c * f.weight.clamp(0.0, 1.0)).clamp(0.0, 1.0));
-            let fallback = |roughness| SheenValues { color, roughness };
-            let fitted = sheen_roughness_for_fuzz(f.roughness);
+            let fallback = |mapping| SheenValues {
+                color,
+                roughness: carried(f.roughness, Direction::FuzzToSheen, mapping),
+            };
             let mut cols = vec![Column {
                 title: "AUTHORED: FUZZ".into(),
                 detail: format!("A {}", rough(f.roughness)),
                 look: look(fuzz_layer(f)),
             }];
-            let prefix = if let (Kind::FuzzWithSheen, Some(s)) = (material.kind, swatch.sheen) {
+            if material.kind == Kind::FuzzWithSheen {
+                let in_file = swatch
+                    .written_sheen
+                    .or(swatch.sheen)
+                    .expect("a material with both layers has sheen values");
                 cols.push(Column {
                     title: "NO FUZZ: SHEEN".into(),
-                    detail: format!("IN FILE, R {}", rough(s.roughness)),
-                    look: look(sheen_layer(s)),
+                    detail: format!("IN FILE, R {}", rough(in_file.roughness)),
+                    look: look(sheen_layer(in_file)),
                 });
-                "REFRESHED"
+                for m in [mapping, other(mapping)] {
+                    let s = fallback(m);
+                    cols.push(Column {
+                        title: "REFRESHED: SHEEN".into(),
+                        detail: format!("R {} {}", rough(s.roughness), mapping_word(m)),
+                        look: look(sheen_layer(s)),
+                    });
+                }
             } else {
-                "NO FUZZ"
-            };
-            cols.push(Column {
-                title: format!("{prefix}: SHEEN"),
-                detail: format!("R {} FITTED", rough(fitted)),
-                look: look(sheen_layer(fallback(fitted))),
-            });
-            cols.push(Column {
-                title: format!("{prefix}: SHEEN"),
-                detail: format!("R {} COPIED", rough(f.roughness)),
-                look: look(sheen_layer(fallback(f.roughness))),
-            });
+                let migrated = swatch.written_sheen.unwrap_or_else(|| fallback(mapping));
+                let alternative = SheenValues {
+                    roughness: carried(f.roughness, Direction::FuzzToSheen, other(mapping)),
+                    ..migrated
+                };
+                cols.push(Column {
+                    title: "NO FUZZ: SHEEN".into(),
+                    detail: format!("R {} {}", rough(migrated.roughness), mapping_word(mapping)),
+                    look: look(sheen_layer(migrated)),
+                });
+                cols.push(Column {
+                    title: format!("IF {}: SHEEN", mapping_word(other(mapping))),
+                    detail: format!(
+                        "R {} {}",
+                        rough(alternative.roughness),
+                        mapping_word(other(mapping))
+                    ),
+                    look: look(sheen_layer(alternative)),
+                });
+            }
             cols
         }
     }
@@ -508,10 +802,13 @@ mod tests {
                     color: [0.0; 3],
                     roughness: 0.5,
                 }),
+                written_sheen: None,
+                written_fuzz: None,
             },
             swatches: vec![],
             notes: vec![],
             fuzz_roughness_assumed: false,
+            mapping: RoughnessMapping::Fitted,
         };
         let cols = columns(&m, &m.factors);
         assert_eq!(cols.len(), 3);

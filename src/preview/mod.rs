@@ -21,7 +21,6 @@ pub mod sheet;
 
 use crate::asset::discover;
 use crate::asset::write::write_atomic;
-use crate::asset::LoadOptions;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
@@ -79,8 +78,10 @@ fn file_safe(text: &str, max: usize) -> String {
 }
 
 /// Reads every asset under `inputs` and renders the sheets of their materials, in parallel;
-/// writes nothing. Sheets come in input order, then document order.
-pub fn render(inputs: &[PathBuf], load: &LoadOptions) -> Previews {
+/// writes nothing. Each asset's migration is planned with `options` (`velvet preview`: the
+/// defaults; `migrate --preview`: the run's), and the sheets show what that plan writes.
+/// Sheets come in input order, then document order.
+pub fn render(inputs: &[PathBuf], options: &crate::migrate::Options) -> Previews {
     let (found, walk_errors) = discover::find(inputs, None);
     let mut previews = Previews::default();
     for (path, e) in walk_errors {
@@ -93,9 +94,12 @@ pub fn render(inputs: &[PathBuf], load: &LoadOptions) -> Previews {
     let files: Vec<(PathBuf, String, Result<Vec<material::Material>, String>)> = found
         .par_iter()
         .map(|f| {
-            let loaded = crate::asset::load_with(&f.path, load);
+            let loaded = crate::asset::load_with(&f.path, &options.load);
             let result = match loaded.asset {
-                Some(asset) => Ok(material::materials(&asset)),
+                Some(asset) => {
+                    let plan = crate::migrate::plan_document(&asset, options);
+                    Ok(material::materials(&asset, &plan, options.roughness))
+                }
                 None => Err(loaded
                     .diagnostics
                     .iter()

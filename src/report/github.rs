@@ -4,13 +4,16 @@
 //! `file` is the path relative to the working directory (the checkout, in a workflow); `line`
 //! and `col` are given for a .gltf finding whose pointer names a value (a .glb has no lines:
 //! its byte offset goes into the message instead). Properties and message are escaped as the
-//! runner unescapes them: `%`, CR and LF everywhere, and `:` and `,` in properties too.
+//! runner unescapes them: `%`, CR and LF everywhere, and `:` and `,` in properties too. What
+//! came from the asset is first passed through [`super::escape::terminal`], so no character of
+//! it can end the command's line or act in the log viewer (ESC), whatever the runner unescapes.
 //!
 //! Each file's missing resources are one annotation (see [`super::Listing`]), and these come
 //! after every other finding of the run: GitHub shows only a step's first ten error
 //! annotations, and they go to the findings a checkout with every resource would still have.
 
 use super::display_path;
+use super::escape::terminal;
 use crate::asset::Container;
 use crate::diagnostics::Severity;
 use crate::validate::{FileReport, Finding};
@@ -53,7 +56,7 @@ pub fn render(reports: &[FileReport]) -> String {
 /// one for its missing resources (empty when none is missing), which the run lists last.
 pub fn render_file(report: &FileReport) -> (String, String) {
     let listing = super::listing(report);
-    let file = escape_property(&display_path(&report.path));
+    let file = escape_property(&terminal(&display_path(&report.path)));
     let mut out = String::new();
     for f in listing.others {
         command_line(&mut out, &file, report, f);
@@ -99,7 +102,7 @@ fn command_line(out: &mut String, file: &str, report: &FileReport, f: &Finding) 
         "::{} {properties},title={}::{}",
         command(d.severity),
         escape_property(d.code),
-        escape_data(&message)
+        escape_data(&terminal(&message))
     );
 }
 

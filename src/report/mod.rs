@@ -3,6 +3,7 @@
 //! Actions workflow commands. Renderers only format; they decide nothing. This module also
 //! owns the choices that shape output on a terminal: the format, colour, and the progress bar.
 
+pub mod escape;
 pub mod fold;
 pub mod github;
 pub mod json;
@@ -191,7 +192,10 @@ pub fn failed_run(format: Format, message: &str, json_array: bool) -> String {
     };
     match format {
         Format::Text => String::new(),
-        Format::Github => format!("::error title=velvet::{}\n", github::escape_data(message)),
+        Format::Github => format!(
+            "::error title=velvet::{}\n",
+            github::escape_data(&escape::terminal(message))
+        ),
         // As the stream writes an array of one report.
         Format::Json if json_array => format!("[\n{}\n]\n", json_element(&report())),
         Format::Json => json::render(&[report()]),

@@ -1,11 +1,14 @@
 //! Human-readable report: one line per finding, `file:line:column: severity CODE message`,
 //! then the pointer; a summary line at the end. Colour (ANSI, via anstyle) only when asked.
+//! Paths, messages and pointers hold an asset's text and are escaped for the terminal
+//! ([`super::escape`]): they cannot start a line of their own nor send a control sequence.
 //!
 //! A file's findings are printed in file order, and a finding (code and message) found more
 //! than once in a file is printed once, followed by a line with how many more there are and
 //! where the first [`SHOWN`] of them stand (see [`fold`]); `--no-fold` prints each one. A
 //! file's missing resources are one entry after its other findings (see [`super::Listing`]).
 
+use super::escape::terminal;
 use super::{display_path, fold, Options};
 use crate::asset::Container;
 use crate::diagnostics::Severity;
@@ -40,7 +43,7 @@ pub fn render_with(reports: &[FileReport], options: &Options) -> String {
     let mut out = String::new();
     let mut totals = [0usize; 4];
     for report in reports {
-        let file = display_path(&report.path);
+        let file = terminal(&display_path(&report.path)).into_owned();
         let place = |f: &Finding| match (f.position, report.container) {
             (Some(p), Some(Container::Glb)) => {
                 format!("{file}: byte {}", report.json_offset + p.offset)
@@ -74,18 +77,25 @@ pub fn render_with(reports: &[FileReport], options: &Options) -> String {
                 paint(Style::new().bold(), &place(group.first)),
                 paint(severity_style(d.severity), d.severity.as_str()),
                 paint(Style::new().bold(), d.code),
-                d.message
+                terminal(&d.message)
             );
             if !d.pointer.is_empty() {
                 let _ = writeln!(
                     out,
                     "    {}",
-                    paint(Style::new().dimmed(), &format!("at {}", d.pointer))
+                    paint(
+                        Style::new().dimmed(),
+                        &format!("at {}", terminal(&d.pointer))
+                    )
                 );
             }
             if !group.rest.is_empty() {
                 let line = folded_line(&group.rest, report.container, report.json_offset);
-                let _ = writeln!(out, "    {}", paint(Style::new().dimmed(), &line));
+                let _ = writeln!(
+                    out,
+                    "    {}",
+                    paint(Style::new().dimmed(), &terminal(&line))
+                );
             }
         }
         if report.truncated() {

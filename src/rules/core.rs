@@ -125,13 +125,69 @@ impl CoreSchema {
         if self.validator.is_valid(json) {
             return;
         }
-        for error in self.validator.iter_errors(json) {
-            let at = error.instance_path().as_str().to_string();
-            let schema_path = error.schema_path().as_str().to_string();
-            let instance = error.instance().clone().into_owned();
-            out.push(diagnostic(error.kind(), &schema_path, &instance, at));
-        }
+        diagnostics(&self.validator, json, out);
     }
+}
+
+/// Every error of `validator` on `json` as a diagnostic, its pointer relative to `json`: the
+/// core schema check's, and the extension schemas' (`rules/extensions.rs`).
+pub(crate) fn diagnostics(
+    validator: &jsonschema::Validator<TapeJson>,
+    json: Node,
+    out: &mut Vec<Diagnostic>,
+) {
+    // The (code, pointer) of each finding so far: a document with many faults has many
+    // findings, and comparing each with all the others would take quadratic time.
+    let mut seen: std::collections::HashSet<(&'static str, String)> =
+        std::collections::HashSet::new();
+    for error in validator.iter_errors(json) {
+        let at = error.instance_path().as_str().to_string();
+        let schema_path = error.schema_path().as_str().to_string();
+        let instance = error.instance().clone().into_owned();
+        let found = diagnostic(error.kind(), &schema_path, &instance, at);
+        // A fault is one finding, though the schema may say so twice: a number past f64's
+        // range fails both its type and its maximum, a value its own `type` and its base's.
+        if !seen.insert((found.code, found.pointer.clone())) {
+            continue;
+        }
+        out.push(found);
+    }
+}
+
+/// Whether `value` is a number that reads as an infinity in f64 (`1e400`): the index keeps its
+/// text, and schemas that ask for a number see none there (see `asset/tape_schema.rs`).
+pub(crate) fn is_non_finite(value: &Value) -> bool {
+    value
+        .as_number()
+        .is_some_and(|n| n.to_string().parse::<f64>().is_ok_and(|f| !f.is_finite()))
+}
+
+/// Whether a type error asked for a number (not only an integer).
+fn asks_for_number(kind: &jsonschema::error::TypeKind) -> bool {
+    use jsonschema::types::JsonType;
+    match kind {
+        jsonschema::error::TypeKind::Single(t) => *t == JsonType::Number,
+        jsonschema::error::TypeKind::Multiple(ts) => ts.contains(JsonType::Number),
+    }
+}
+
+/// Whether every alternative of a `oneOf` or `anyOf` failed on a bound alone: the value is out
+/// of every range the schema allows (KHR_materials_ior's `ior`, 0 or at least 1).
+fn only_bounds_failed(context: &[Vec<jsonschema::ValidationError<'static>>]) -> bool {
+    use ValidationErrorKind as K;
+    !context.is_empty()
+        && context.iter().all(|branch| {
+            !branch.is_empty()
+                && branch.iter().all(|e| {
+                    matches!(
+                        e.kind(),
+                        K::Minimum { .. }
+                            | K::Maximum { .. }
+                            | K::ExclusiveMinimum { .. }
+                            | K::ExclusiveMaximum { .. }
+                    )
+                })
+        })
 }
 
 /// A value as messages quote it: strings in single quotes, the rest as JSON, long values cut.
@@ -162,6 +218,28 @@ fn diagnostic(
 ) -> Diagnostic {
     use ValidationErrorKind as K;
     let (code, message): (&Code, String) = match kind {
+        K::Type { kind } if asks_for_number(kind) && is_non_finite(instance) => (
+            &codes::VALUE_NOT_IN_RANGE,
+            format!(
+                "{} is past the range of a 64-bit float: it reads as infinity",
+                quote(instance)
+            ),
+        ),
+        K::OneOfNotValid { context } | K::AnyOf { context }
+            if instance.is_number() && only_bounds_failed(context) =>
+        {
+            (
+                &codes::VALUE_NOT_IN_RANGE,
+                format!(
+                    "{} is outside every range the schema allows",
+                    quote(instance)
+                ),
+            )
+        }
+        K::Format { format } => (
+            &PATTERN_MISMATCH,
+            format!("{} is not a valid {format}", quote(instance)),
+        ),
         K::Type { kind } => (
             &codes::TYPE_MISMATCH,
             format!("{} is not of type {}", quote(instance), type_names(kind)),
@@ -211,6 +289,13 @@ fn diagnostic(
             &PATTERN_MISMATCH,
             format!("{} does not match the pattern '{pattern}'", quote(instance)),
         ),
+        K::OneOfNotValid { context } if required_names(context).is_some() => (
+            &ONE_OF_MISMATCH,
+            format!(
+                "exactly one of {} must be defined",
+                required_names(context).unwrap_or_default()
+            ),
+        ),
         K::OneOfNotValid { .. } | K::OneOfMultipleValid { .. } => (
             &ONE_OF_MISMATCH,
             format!("exactly one of {} must be defined", one_of_names(&at)),
@@ -246,6 +331,24 @@ fn type_names(kind: &jsonschema::error::TypeKind) -> String {
             names.join(" or ")
         }
     }
+}
+
+/// The properties a `oneOf` of `required` alternatives names ("'uri' and 'bufferView'"), when
+/// every alternative failed for want of one property.
+fn required_names(context: &[Vec<jsonschema::ValidationError<'static>>]) -> Option<String> {
+    let names: Option<Vec<String>> = context
+        .iter()
+        .map(|branch| match branch.as_slice() {
+            [one] => match one.kind() {
+                ValidationErrorKind::Required { property } => {
+                    Some(format!("'{}'", property_name(property)))
+                }
+                _ => None,
+            },
+            _ => None,
+        })
+        .collect();
+    names.filter(|n| n.len() > 1).map(|n| n.join(" and "))
 }
 
 /// The properties a `oneOf` of `required` names, from where it stands (only an image has one).

@@ -12,16 +12,19 @@ pub mod core;
 pub mod declaration;
 pub mod disabled_layer;
 pub mod exclusions;
+pub mod extensions;
 pub mod fallback;
 pub mod fuzz_roughness_default;
 pub mod fuzz_roughness_mapping;
 pub mod image_size;
 pub mod legacy_sheen;
-pub mod placement;
+pub mod lights;
 pub mod references;
 pub mod resources;
 pub mod roughness_alpha;
 pub mod schema;
+pub mod skins;
+pub mod tangent_space;
 pub mod texcoord;
 
 use crate::asset::tape::{JsonView, Node};
@@ -35,6 +38,8 @@ pub struct Context<'a> {
     pub schemas: &'a schema::Schemas,
     /// The sheen and fuzz objects, found and read once for every rule.
     layers: std::sync::OnceLock<Vec<Layer<'a>>>,
+    /// The textures each material reads, found once for every rule.
+    material_textures: std::sync::OnceLock<Vec<Vec<extensions::MaterialTexture>>>,
 }
 
 impl<'a> Context<'a> {
@@ -43,7 +48,33 @@ impl<'a> Context<'a> {
             asset,
             schemas,
             layers: std::sync::OnceLock::new(),
+            material_textures: std::sync::OnceLock::new(),
         }
+    }
+
+    /// The textures each material reads (core and extensions, see
+    /// [`extensions::material_textures`]), by material index: found on first use, then shared.
+    /// Only a material that holds an `index` key can read one, and only those are walked.
+    pub fn material_textures(&self) -> &[Vec<extensions::MaterialTexture>] {
+        self.material_textures.get_or_init(|| {
+            let json = self.json();
+            let indices: Vec<usize> = json
+                .members_named("index")
+                .map(|n| n.span().start)
+                .collect();
+            let keys = extensions::WalkKeys::of(json);
+            materials(json)
+                .map(|material| {
+                    let span = material.span();
+                    let first = indices.partition_point(|start| *start < span.start);
+                    if indices.get(first).is_some_and(|start| *start < span.end) {
+                        extensions::material_textures(material, &keys)
+                    } else {
+                        Vec::new()
+                    }
+                })
+                .collect()
+        })
     }
 
     /// The document, read through the asset's index.
@@ -162,12 +193,15 @@ pub static REGISTRY: &[&dyn Rule] = &[
     &schema::SchemaCheck,
     &asset_version::AssetVersion,
     &declaration::Declaration,
-    &placement::Placement,
+    &extensions::ExtensionObjects,
+    &lights::Lights,
     &exclusions::Exclusions,
     &references::References,
     &attributes::Attributes,
     &resources::Resources,
     &texcoord::TexCoords,
+    &tangent_space::TangentSpace,
+    &skins::Skins,
     &disabled_layer::DisabledLayer,
     &roughness_alpha::RoughnessAlpha,
     &image_size::ImageSize,

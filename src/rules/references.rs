@@ -149,7 +149,12 @@ impl Rule for References {
                         Token::Key(key) => pointer::push_escaped(&mut at, key),
                     }
                 }
-                let message = unresolved_message(&at, index, &target, len);
+                // An index beyond 64 bits is named as written, not as the u64::MAX it is read as.
+                let named = match index {
+                    u64::MAX => value.raw().to_string(),
+                    index => index.to_string(),
+                };
+                let message = unresolved_message(&at, &named, &target, len);
                 found.push((link, Diagnostic::new(&UNRESOLVED_REFERENCE, at, message)));
             }
         };
@@ -161,7 +166,7 @@ impl Rule for References {
 }
 
 /// "sheenColorTexture names texture 5, but the asset has 2 textures".
-fn unresolved_message(at: &str, index: u64, target: &str, len: usize) -> String {
+fn unresolved_message(at: &str, index: &str, target: &str, len: usize) -> String {
     let segments: Vec<&str> = at.rsplit('/').collect();
     let name = segments
         .iter()
@@ -376,27 +381,27 @@ mod tests {
         assert_eq!(
             unresolved_message(
                 "/materials/0/extensions/KHR_materials_sheen/sheenColorTexture/index",
-                5,
+                "5",
                 "/textures",
                 2
             ),
             "sheenColorTexture names texture 5, but the asset has 2 textures"
         );
         assert_eq!(
-            unresolved_message("/nodes/3/mesh", 1, "/meshes", 1),
+            unresolved_message("/nodes/3/mesh", "1", "/meshes", 1),
             "mesh names mesh 1, but the asset has 1 mesh"
         );
         assert_eq!(
             unresolved_message(
                 "/animations/2/channels/0/sampler",
-                4,
+                "4",
                 "/animations/2/samplers",
                 0
             ),
             "sampler names sampler 4, but animation 2 has 0 samplers"
         );
         assert_eq!(
-            unresolved_message("/scenes/0/nodes/1", 7, "/nodes", 3),
+            unresolved_message("/scenes/0/nodes/1", "7", "/nodes", 3),
             "nodes names node 7, but the asset has 3 nodes"
         );
     }

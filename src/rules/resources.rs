@@ -15,7 +15,6 @@
 use super::{Context, Rule};
 use crate::asset::resource::{self, ImageFormat, Location};
 use crate::asset::tape::Node;
-use crate::asset::Container;
 use crate::diagnostics::{codes, Code, Diagnostic, Severity};
 use std::path::Path;
 
@@ -45,6 +44,14 @@ pub const NON_RELATIVE_URI: Code = Code::new(
     "A resource URI with a URL scheme (https:, …): valid glTF, but not portable, and not checked.",
 );
 
+/// A warning, not an error: the spec's "MAY use base64" does not forbid RFC 2397's
+/// percent-encoded form, and the Khronos validator decodes it.
+pub const DATA_URI_NOT_BASE64: Code = Code::new(
+    "DATA_URI_NOT_BASE64",
+    Severity::Warning,
+    "A data: URI is percent-encoded rather than base64: valid, but some loaders decode only base64.",
+);
+
 const LFS_POINTER_PREFIX: &[u8] = b"version https://git-lfs.github.com/spec/";
 /// Git LFS pointer files are about 130 bytes; anything larger is real content.
 const LFS_POINTER_MAX_LEN: u64 = 1024;
@@ -58,12 +65,13 @@ impl Rule for Resources {
             &GIT_LFS_POINTER,
             &IMAGE_MIME_TYPE_INVALID,
             &BUFFER_DATA_URI_MIME_TYPE_INVALID,
-            &codes::BUFFER_MISSING_GLB_DATA,
             &NON_RELATIVE_URI,
+            &DATA_URI_NOT_BASE64,
             &codes::URI_NOT_FOLLOWED,
             &codes::INVALID_URI,
             &codes::IO_ERROR,
             &codes::IMAGE_UNRECOGNIZED_FORMAT,
+            &codes::IMAGE_DATA_INVALID,
             &codes::BUFFER_BYTE_LENGTH_MISMATCH,
         ]
     }
@@ -111,19 +119,10 @@ fn short_buffer(index: usize, declared: u64, actual: u64, what: &str) -> Diagnos
 
 fn check_buffer(cx: &Context, index: usize, buffer: Node, out: &mut Vec<Diagnostic>) {
     let declared = byte_length(buffer);
+    // A buffer without uri is valid glTF: in a GLB the first one takes its bytes from the BIN
+    // chunk (the loader reports BUFFER_MISSING_GLB_DATA when the chunk is absent); any other
+    // is filled by an extension (EXT_meshopt_compression's fallback) or read by nothing.
     let Some(uri) = buffer.get("uri") else {
-        // The GLB's own buffer is checked against its BIN chunk on load; a buffer that an
-        // extension fills (EXT_meshopt_compression's fallback buffer) has no data of its own.
-        let glb_bin = cx.asset.container == Container::Glb && index == 0;
-        if !glb_bin && buffer.get("extensions").is_none() {
-            out.push(Diagnostic::new(
-                &codes::BUFFER_MISSING_GLB_DATA,
-                format!("/buffers/{index}"),
-                format!(
-                    "buffer {index} has no uri; only the first buffer of a GLB takes its data from the BIN chunk"
-                ),
-            ));
-        }
         return;
     };
     let Some(uri) = uri.as_str() else { return }; // TYPE_MISMATCH from the schema
@@ -266,11 +265,22 @@ fn locate(cx: &Context, uri: &str, pointer: &str, out: &mut Vec<Diagnostic>) -> 
         return None;
     }
     let path = match cx.asset.resolve(uri, pointer) {
-        Ok(Location::Data { media_type, bytes }) => {
+        Ok(Location::Data {
+            media_type,
+            bytes,
+            base64,
+        }) => {
+            if !base64 {
+                out.push(Diagnostic::new(
+                    &DATA_URI_NOT_BASE64,
+                    pointer,
+                    "the data: URI is percent-encoded, not base64; it is valid, but some loaders decode only base64",
+                ));
+            }
             return Some(Located::Data {
                 media_type,
                 len: bytes.len() as u64,
-            })
+            });
         }
         Ok(Location::File(path)) => path,
         Err(d) => {

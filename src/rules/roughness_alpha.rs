@@ -30,6 +30,7 @@ impl Rule for RoughnessAlpha {
             &codes::INVALID_URI,
             &codes::BUFFER_VIEW_OUT_OF_RANGE,
             &codes::IMAGE_UNRECOGNIZED_FORMAT,
+            &codes::IMAGE_DATA_INVALID,
         ]
     }
 

@@ -83,6 +83,8 @@ pub struct Schemas {
     fuzz: LayerSchema,
     /// The official glTF 2.0 schemas (always the built-in files).
     pub core: super::core::CoreSchema,
+    /// The published extension schemas (always the built-in files), compiled on first use.
+    pub extensions: super::extensions::ExtensionSchemas,
 }
 
 /// Serves `$ref`s from in-memory schema files, by the reference's last path segment.
@@ -168,6 +170,7 @@ impl Schemas {
             sheen: layer("material.KHR_materials_sheen.schema.json")?,
             fuzz: layer("material.KHR_materials_fuzz.schema.json")?,
             core: super::core::CoreSchema::builtin(),
+            extensions: super::extensions::ExtensionSchemas::default(),
         })
     }
 }
@@ -307,13 +310,22 @@ fn check_layer(schemas: &Schemas, layer: &LayerObject<Node>) -> Vec<Diagnostic> 
     // Most objects are valid, and the yes-or-no check is the cheaper walk.
     let errors = (!schema.validator.is_valid(layer.value))
         .then(|| schema.validator.iter_errors(layer.value));
+    // The pointers of the values found out of range, each reported once (a set: a hostile
+    // object may have many).
+    let mut out_of_range = std::collections::HashSet::new();
     for error in errors.into_iter().flatten() {
-        let code = code_for(error.kind());
-        out.push(Diagnostic::new(
-            code,
-            error.instance_path().as_str(),
-            error.to_string(),
-        ));
+        let code = match error.kind() {
+            // A number past f64's range fails its type: it is out of range, reported once.
+            ValidationErrorKind::Type { .. } if super::core::is_non_finite(error.instance()) => {
+                &codes::VALUE_NOT_IN_RANGE
+            }
+            kind => code_for(kind),
+        };
+        let at = error.instance_path().as_str();
+        if code.name == codes::VALUE_NOT_IN_RANGE.name && !out_of_range.insert(at.to_string()) {
+            continue;
+        }
+        out.push(Diagnostic::new(code, at, error.to_string()));
     }
     let before = out.len();
     unexpected(layer.value, &schema.properties, "", &mut out);

@@ -1,16 +1,17 @@
-//! Texture coordinates: a sheen or fuzz texture read through `texCoord` N (or the N that
-//! KHR_texture_transform substitutes) needs every mesh primitive drawn with that material to
-//! carry TEXCOORD_N, or loaders sample garbage or refuse the mesh.
+//! Texture coordinates: a texture read through `texCoord` N (or the N that
+//! KHR_texture_transform substitutes) needs every mesh primitive drawn with its material to carry
+//! TEXCOORD_N, or loaders sample garbage or refuse the mesh. Every texture of the material counts:
+//! the core's (baseColorTexture, normalTexture, …) and those of its extensions that have a schema
+//! (clearcoat, sheen, fuzz, …), as [`super::Context::material_textures`] finds them.
 
-use super::{effective_tex_coord, slot_pointer, slot_uses, Context, Rule};
+use super::{Context, Rule};
 use crate::diagnostics::{Code, Diagnostic, Severity};
-use crate::layers::Slot;
 use std::borrow::Cow;
 
 pub const MESH_PRIMITIVE_TOO_FEW_TEXCOORDS: Code = Code::new(
     "MESH_PRIMITIVE_TOO_FEW_TEXCOORDS",
     Severity::Error,
-    "A primitive uses a material whose sheen/fuzz texture reads TEXCOORD_N, which the primitive lacks.",
+    "A primitive uses a material with a texture (of the core or of an extension) that reads TEXCOORD_N, which the primitive lacks.",
 );
 
 pub struct TexCoords;
@@ -27,15 +28,11 @@ impl Rule for TexCoords {
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
         let json = cx.json();
-        // Each sheen/fuzz texture slot with the TEXCOORD set it reads, in material order (the
-        // order the layers come in), so that a primitive's material finds its slots by a
-        // binary search: a large document has a material per primitive.
-        let needs: Vec<(usize, u64, &'static Slot)> = cx
-            .layer_objects()
-            .flat_map(|layer| slot_uses(&layer))
-            .map(|slot| (slot.material, effective_tex_coord(slot.value), slot.slot))
-            .collect();
-        if needs.is_empty() {
+        if json.get("meshes").is_none() {
+            return;
+        }
+        let textures = cx.material_textures();
+        if textures.iter().all(Vec::is_empty) {
             return;
         }
         // Attribute names by set, written once each.
@@ -45,23 +42,20 @@ impl Rule for TexCoords {
                 let Some(material) = primitive.get("material").and_then(|v| v.as_u64()) else {
                     continue;
                 };
-                let Ok(material) = usize::try_from(material) else {
-                    continue;
+                let Some(reads) = usize::try_from(material).ok().and_then(|i| textures.get(i))
+                else {
+                    continue; // dangling: the references rule reports it
                 };
-                let first = needs.partition_point(|(of, _, _)| *of < material);
-                let slots = needs[first..]
-                    .iter()
-                    .take_while(|(of, _, _)| *of == material);
                 let attributes = primitive.get("attributes").and_then(|a| a.as_object());
-                for (_, set, slot) in slots {
-                    let attribute = attribute_name(&mut names, *set);
+                for texture in reads {
+                    let attribute = attribute_name(&mut names, texture.set);
                     if !attributes.is_some_and(|a| a.contains_key(&attribute)) {
                         out.push(Diagnostic::new(
                             &MESH_PRIMITIVE_TOO_FEW_TEXCOORDS,
                             format!("/meshes/{m}/primitives/{p}/material"),
                             format!(
-                                "material {material}'s {} reads {attribute}, which this primitive does not have",
-                                slot_pointer(material, slot)
+                                "material {material}'s /materials/{material}{} reads {attribute}, which this primitive does not have",
+                                texture.pointer
                             ),
                         ));
                     }

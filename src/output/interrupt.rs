@@ -1,0 +1,71 @@
+//! SIGINT and SIGTERM during `migrate` and `bake`: a clean stop. The handler only records the
+//! signal; the run looks at it between files and between a file's steps (before each new
+//! texture is written, before a file's outputs are put in place), abandons the files in
+//! progress, whose staged files are removed as they are dropped (see [`super::staging`]), and
+//! keeps every output already put in place. The command then prints one line saying what was
+//! finished and exits with 128 + the signal (130, 143).
+//!
+//! The handler is installed with SA_RESETHAND: a second Ctrl-C ends the process at once, as
+//! if velvet had no handler (its staging files are then removed by the next run into that
+//! folder). `validate` writes nothing and keeps the default behaviour.
+
+use std::sync::atomic::{AtomicI32, Ordering};
+
+/// The signal that asked the run to stop, 0 while none has.
+static STOP: AtomicI32 = AtomicI32::new(0);
+
+/// The message of a file abandoned because the run was asked to stop.
+pub const ABANDONED: &str = "stopped before it was finished (nothing of it was written)";
+
+/// Installs the handler for SIGINT and SIGTERM (Unix; elsewhere nothing).
+pub fn install() {
+    #[cfg(unix)]
+    {
+        extern "C" fn on_signal(signal: libc::c_int) {
+            // An atomic store is async-signal-safe.
+            STOP.store(signal, Ordering::SeqCst);
+        }
+        for signal in [libc::SIGINT, libc::SIGTERM] {
+            // SAFETY: sigaction with a zeroed struct, an empty mask and a handler that stores
+            // to an atomic; SA_RESETHAND puts the default back once it has run, SA_RESTART
+            // resumes the system calls it interrupted.
+            unsafe {
+                let mut action: libc::sigaction = std::mem::zeroed();
+                action.sa_sigaction = on_signal as *const () as libc::sighandler_t;
+                action.sa_flags = libc::SA_RESETHAND | libc::SA_RESTART;
+                libc::sigemptyset(&mut action.sa_mask);
+                libc::sigaction(signal, &action, std::ptr::null_mut());
+            }
+        }
+    }
+}
+
+/// The signal that asked the run to stop, if one has.
+pub fn requested() -> Option<i32> {
+    match STOP.load(Ordering::SeqCst) {
+        0 => None,
+        signal => Some(signal),
+    }
+}
+
+/// `Err` with [`ABANDONED`] once the run was asked to stop: where a file's work checks it.
+pub fn check() -> Result<(), String> {
+    match requested() {
+        None => Ok(()),
+        Some(_) => Err(ABANDONED.to_string()),
+    }
+}
+
+/// The signal's name, for the closing line.
+pub fn name(signal: i32) -> String {
+    #[cfg(unix)]
+    {
+        if signal == libc::SIGINT {
+            return "SIGINT".to_string();
+        }
+        if signal == libc::SIGTERM {
+            return "SIGTERM".to_string();
+        }
+    }
+    format!("signal {signal}")
+}
