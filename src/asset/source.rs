@@ -173,7 +173,7 @@ impl Snapshot {
             return Ok(None);
         }
         let recent = before.regular
-            && before.modified.map_or(true, |m| {
+            && before.modified.is_none_or(|m| {
                 std::time::SystemTime::now()
                     .duration_since(m)
                     .map_or(true, |age| age < RECENT)
