@@ -353,7 +353,23 @@ fn in_pool<T: Send>(job: impl FnOnce() -> T + Send) -> T {
 
 fn main() -> ExitCode {
     velvet::asset::pages::limit_heaps();
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            // A validate run refused for its arguments (a mistyped flag or value) still writes
+            // the report its --format asks for, as every other run that cannot start does.
+            if e.use_stderr() {
+                if let Some(format) = validate_format_asked(std::env::args_os().skip(1)) {
+                    // clap's own wording, its first line: "unexpected argument '--formt' found".
+                    let rendered = e.render().to_string();
+                    let first = rendered.lines().next().unwrap_or_default();
+                    let message = first.strip_prefix("error: ").unwrap_or(first);
+                    emit(report::failed_run(format, &message, true).as_bytes());
+                }
+            }
+            e.exit()
+        }
+    };
     match cli.command {
         Command::Validate(args) => in_pool(|| validate(args, cli.color, cli.quiet)),
         Command::Migrate(args) => in_pool(|| migrate(args, cli.quiet)),
@@ -378,6 +394,34 @@ fn main() -> ExitCode {
             }
         }
     }
+}
+
+/// The output format a `velvet validate` command line asks for, read from the raw arguments
+/// of a command line clap refused: the last `--format F` or `--format=F` with a known F, if the
+/// command is validate.
+fn validate_format_asked(args: impl Iterator<Item = std::ffi::OsString>) -> Option<Format> {
+    let args: Vec<String> = args.map(|a| a.to_string_lossy().into_owned()).collect();
+    // The subcommand is the first argument that is not an option or its value (--color WHEN).
+    let mut i = 0;
+    while i < args.len() && args[i].starts_with('-') {
+        i += if args[i] == "--color" { 2 } else { 1 };
+    }
+    if args.get(i).map(String::as_str) != Some("validate") {
+        return None;
+    }
+    let mut format = None;
+    let mut rest = args[i + 1..].iter();
+    while let Some(a) = rest.next() {
+        let value = match a.strip_prefix("--format") {
+            Some("") => rest.next().map(String::as_str),
+            Some(v) => v.strip_prefix('='),
+            None => None,
+        };
+        if let Some(f) = value.and_then(|v| Format::from_str(v, false).ok()) {
+            format = Some(f);
+        }
+    }
+    format
 }
 
 fn man(dir: Option<PathBuf>) -> ExitCode {

@@ -2138,3 +2138,46 @@ fn velvet_help_gives_each_exit_status_for_each_command() {
         }
     }
 }
+
+#[test]
+fn a_validate_command_line_clap_refuses_still_writes_the_report_its_format_asks_for() {
+    let dir = tempfile::tempdir().unwrap();
+    for args in [
+        &["validate", "--format", "sarif", "--formt", "x", "."][..],
+        &[
+            "--color",
+            "never",
+            "validate",
+            "--format=sarif",
+            "--fail-on",
+            "bogus",
+            ".",
+        ][..],
+    ] {
+        let o = velvet_in(dir.path(), args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}");
+        let log: Value = serde_json::from_slice(&o.stdout).expect("a SARIF log");
+        let invocation = &log["runs"][0]["invocations"][0];
+        assert_eq!(invocation["executionSuccessful"], false, "{args:?}");
+        let said = invocation["toolExecutionNotifications"][0]["message"]["text"]
+            .as_str()
+            .unwrap();
+        assert!(
+            said.contains("--formt") || said.contains("bogus"),
+            "{args:?}: {said}"
+        );
+        assert!(
+            stderr(&o).starts_with("error: "),
+            "clap's message stays on stderr"
+        );
+    }
+    let o = velvet_in(dir.path(), &["validate", "--formt", "x", "."]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        o.stdout.is_empty(),
+        "text output writes nothing but the message"
+    );
+    let o = velvet_in(dir.path(), &["migrate", "--format", "json", "--bogus"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(o.stdout.is_empty(), "only validate writes reports");
+}
