@@ -364,7 +364,7 @@ fn main() -> ExitCode {
                     let rendered = e.render().to_string();
                     let first = rendered.lines().next().unwrap_or_default();
                     let message = first.strip_prefix("error: ").unwrap_or(first);
-                    emit(report::failed_run(format, &message, true).as_bytes());
+                    emit(report::failed_run(format, message, true).as_bytes());
                 }
             }
             e.exit()
