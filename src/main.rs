@@ -198,8 +198,8 @@ struct ValidateArgs {
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Text)]
     format: Format,
-    /// Text output: print every finding, instead of one per code, message and file with a count and
-    /// the first positions of the others.
+    /// Text output: print every finding (each missing resource too), instead of one per code,
+    /// message and file with a count and the first positions of the others.
     #[arg(long)]
     no_fold: bool,
     #[command(flatten)]

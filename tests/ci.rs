@@ -1779,6 +1779,25 @@ fn missing_resources_are_one_text_entry_per_file_after_its_other_findings() {
              2 files checked: 6 errors, 1 warning, 0 info, 0 hints\n"
         )
     );
+    // --no-fold prints every finding as it is, each missing file on its own line.
+    let o = velvet_in(
+        dir.path(),
+        &["validate", "--color", "never", "--no-fold", "-q", "a.gltf"],
+    );
+    let lines: Vec<String> = stdout(&o)
+        .lines()
+        .filter(|l| !l.starts_with(' '))
+        .map(|l| l.split(": ").take(2).collect::<Vec<_>>().join(": "))
+        .collect();
+    assert_eq!(
+        lines,
+        [
+            "a.gltf:4:21: error FILE_NOT_FOUND",
+            "a.gltf:5:20: error FILE_NOT_FOUND",
+            "a.gltf:5:47: error FILE_NOT_FOUND",
+            "a.gltf:6:62: warning UNEXPECTED_PROPERTY"
+        ]
+    );
 }
 
 #[test]

@@ -51,7 +51,15 @@ pub fn render_with(reports: &[FileReport], options: &Options) -> String {
             (Some(p), _) => format!("{file}:{}:{}", p.line, p.column),
             (None, _) => file.clone(),
         };
-        let listing = super::listing(report);
+        // --no-fold prints every finding as the rules gave it, each missing file too.
+        let listing = if options.no_fold {
+            super::Listing {
+                others: report.findings.iter().collect(),
+                missing: None,
+            }
+        } else {
+            super::listing(report)
+        };
         let sorted = fold::by_position_of(&listing.others);
         let mut groups = if options.no_fold {
             sorted
