@@ -72,7 +72,7 @@ pub fn write_man_pages(command: clap::Command, dir: &Path) -> std::io::Result<()
             write(sub, dir)?;
         }
         let name = Man::new(command.clone()).get_filename();
-        crate::asset::write::write_atomic(&dir.join(name), &man_page(command)?)
+        crate::edit::write::write_atomic(&dir.join(name), &man_page(command)?)
     }
     std::fs::create_dir_all(dir)?;
     let mut command = command.disable_help_subcommand(true);

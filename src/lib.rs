@@ -9,6 +9,7 @@
 pub mod asset;
 pub mod bake;
 pub mod cli_docs;
+pub mod command;
 pub mod config;
 pub mod diagnostics;
 pub mod edit;
@@ -21,3 +22,6 @@ pub mod rules;
 pub mod run;
 pub mod shading;
 pub mod validate;
+
+#[cfg(test)]
+mod import_graph;

@@ -767,7 +767,7 @@ fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
 }
 
 fn bake(args: BakeArgs, quiet: bool) -> ExitCode {
-    use velvet::bake::command::{self, Options, Request};
+    use velvet::command::bake::{self as command, Options, Request};
     // Before anything is read or written: a signal from here on stops the run cleanly.
     velvet::output::interrupt::install();
     use velvet::output::{paths::Destination, summary::Detail};

@@ -7,9 +7,9 @@ use std::path::{Path, PathBuf};
 use serde_json::{json, Value};
 use velvet::asset;
 use velvet::bake::codec::{self, EncodeOptions, OutputFormat};
-use velvet::bake::command::{self, Options, Outcome, Request};
 use velvet::bake::plan::PlanOptions;
 use velvet::bake::{Layout, Pixels, Samples};
+use velvet::command::bake::{self as command, Options, Outcome, Request};
 use velvet::output::paths::Destination;
 use velvet::output::UsageError;
 

@@ -15,7 +15,7 @@ use base64::Engine;
 use proptest::prelude::*;
 use serde_json::{json, Map, Value};
 use std::path::{Path, PathBuf};
-use velvet::bake::command as bake;
+use velvet::command::bake;
 use velvet::diagnostics::{Settings, Severity};
 use velvet::migrate::{self, FileOutcome, Options};
 use velvet::output::paths::Destination;

@@ -3,7 +3,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use velvet::asset::write;
+use velvet::edit::write;
 use velvet::bake::apply::{apply, ApplyOptions, Names};
 use velvet::bake::engine::{bake, BakeOptions, MaxImagePixels};
 use velvet::bake::plan::{plan, PlanOptions};

@@ -7,7 +7,7 @@
 
 use libfuzzer_sys::fuzz_target;
 use std::path::Path;
-use velvet::asset::write;
+use velvet::edit::write;
 use velvet::migrate::{plan_document, Options};
 
 fuzz_target!(|data: &[u8]| {

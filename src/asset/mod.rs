@@ -18,7 +18,6 @@ pub mod resource;
 pub mod source;
 pub mod tape;
 pub mod tape_schema;
-pub mod write;
 
 use crate::diagnostics::{codes, Diagnostic};
 pub use limits::LoadOptions;

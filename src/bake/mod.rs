@@ -12,7 +12,6 @@
 
 pub mod apply;
 pub mod codec;
-pub mod command;
 pub mod engine;
 pub mod kernel;
 pub mod pixels;

@@ -8,6 +8,7 @@
 //! keep their text.
 
 pub mod splice;
+pub mod write;
 
 use crate::asset::pointer;
 use serde::Serialize;

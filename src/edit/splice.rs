@@ -1117,7 +1117,7 @@ impl<'t> Layout<'t> {
         let newline = if text.contains("\r\n") { "\r\n" } else { "\n" };
         let pretty = text.trim_end().contains('\n');
         let unit = pretty.then(|| {
-            crate::asset::write::JsonStyle::detect(text)
+            crate::edit::write::JsonStyle::detect(text)
                 .indent
                 .unwrap_or_else(|| "  ".to_string())
         });

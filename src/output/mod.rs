@@ -47,7 +47,7 @@ pub fn run_each<R: Send>(
             .filter_map(|job| job.output.as_deref().map(paths::folder_of))
             .collect();
         for folder in folders {
-            crate::asset::write::remove_leftovers(folder);
+            crate::edit::write::remove_leftovers(folder);
         }
     }
     let claims = files::Claims::default();

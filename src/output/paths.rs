@@ -7,7 +7,7 @@
 //!
 //! [`relocate`] keeps an output in another folder loadable and self-contained: each resource a
 //! relative URI names is copied (a copy-on-write clone where the filesystem can make one, never
-//! a hard link: see [`crate::asset::write::copy_atomic`]) to the same relative place next to
+//! a hard link: see [`crate::edit::write::copy_atomic`]) to the same relative place next to
 //! the output and its URI kept, so no output URI leaves its folder and the output tree can be
 //! moved as a whole. A URI that climbs out of the input's folder cannot be kept so:
 //! the file fails, naming it. `--rewrite-uris` (the old behaviour) rewrites each URI to lead

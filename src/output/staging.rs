@@ -7,7 +7,7 @@
 //! (only `.velvet-PID-*.tmp` files) the next run into the folder removes
 //! ([`write::remove_leftovers`]).
 
-use crate::asset::write::{self, Output, Placed, Staged};
+use crate::edit::write::{self, Output, Placed, Staged};
 use std::path::Path;
 use std::sync::Mutex;
 

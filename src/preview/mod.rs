@@ -9,7 +9,7 @@
 //! [`shade`] shades a sphere exactly from `shading`'s formulas, [`sheet`] lays out and encodes a
 //! sheet with the built-in [`font`], and [`index`] writes the HTML index. [`render`] is pure
 //! (files in, images and words out) and runs the materials of a whole library in parallel;
-//! [`write()`] alone touches the output folder, every file through `asset::write::write_atomic`.
+//! [`write()`] alone touches the output folder, every file through `edit::write::write_atomic`.
 //! The same inputs give the same bytes at any thread count: every value is computed by one
 //! task from its inputs alone, and names come from the inputs.
 
@@ -20,7 +20,7 @@ pub mod shade;
 pub mod sheet;
 
 use crate::asset::discover;
-use crate::asset::write::write_atomic;
+use crate::edit::write::write_atomic;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 

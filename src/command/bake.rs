@@ -15,15 +15,16 @@ use std::sync::Mutex;
 use serde::Serialize;
 use serde_json::Value;
 
-use super::apply::{apply, ApplyOptions, OutputReport};
-use super::codec::{EncodeOptions, PngCompression};
-use super::engine::{bake_into, BakeOptions, MaxImagePixels};
-use super::kernel::KernelOptions;
-use super::plan::{plan, BakePlan, Note, PlanOptions};
-use super::prune::Dropped;
+use crate::asset;
 use crate::asset::discover::Shard;
-use crate::asset::{self, write};
+use crate::bake::apply::{apply, ApplyOptions, OutputReport};
+use crate::bake::codec::{EncodeOptions, PngCompression};
+use crate::bake::engine::{bake_into, BakeOptions, MaxImagePixels};
+use crate::bake::kernel::KernelOptions;
+use crate::bake::plan::{plan, BakePlan, Note, PlanOptions};
+use crate::bake::prune::Dropped;
 use crate::diagnostics::Severity;
+use crate::edit::write;
 use crate::output::files::{copy_resources, create_parent, file_sink, stage_new_files};
 use crate::output::files::{Claims, FileNames};
 use crate::output::interrupt;
@@ -246,7 +247,7 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
             ..EncodeOptions::default()
         },
         max_image_pixels: MaxImagePixels(options.load.max_image_pixels),
-        max_memory: super::engine::MaxMemory(options.load.max_memory),
+        max_memory: crate::bake::engine::MaxMemory(options.load.max_memory),
     };
     // File names next to the output that the document already uses are not free. New image
     // files are written as they are encoded (a .gltf with file images), so a run holds only
@@ -269,7 +270,7 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
             &plan.recipes,
             &asset,
             &bake_options,
-            streamed.then_some(&*sink as super::Sink),
+            streamed.then_some(&*sink as crate::bake::Sink),
         )
     };
     for (name, result) in planned_names.iter().zip(results) {
@@ -411,7 +412,7 @@ pub fn render_text(results: &[FileResult], dry_run: bool, detail: Detail) -> Str
         let warnings = r
             .notes
             .iter()
-            .filter(|n| n.level == super::plan::Level::Warning)
+            .filter(|n| n.level == crate::bake::plan::Level::Warning)
             .count();
         let added_bytes = r
             .outputs
@@ -505,8 +506,8 @@ pub fn render_text(results: &[FileResult], dry_run: bool, detail: Detail) -> Str
         }
         for n in &r.notes {
             let level = match n.level {
-                super::plan::Level::Info => "info",
-                super::plan::Level::Warning => "warning",
+                crate::bake::plan::Level::Info => "info",
+                crate::bake::plan::Level::Warning => "warning",
             };
             push_line(&mut out, &format!("  {level} {}: {}", n.pointer, n.message));
         }

@@ -8,7 +8,7 @@
 //! file with an I/O error, `abort:N` aborts the process there instead, as a kill or a power cut
 //! would. Unset (always, outside those tests), it costs one cached lookup per write.
 
-use super::{glb, Asset, Container};
+use crate::asset::{glb, Asset, Container};
 use serde::Serialize;
 use serde_json::Value;
 use std::io::{self, Write};
