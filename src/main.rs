@@ -213,7 +213,7 @@ struct ValidateArgs {
 
 #[derive(clap::Args)]
 #[command(
-    after_help = "Exit status: 0 done, 1 a file failed (the others are still baked), 2 usage error (nothing written)."
+    after_help = "Exit status: 0 done, 1 a file failed (the others are still baked), 2 usage error (nothing written), 130 / 143 stopped by SIGINT / SIGTERM (finished files complete, nothing left of the others)."
 )]
 struct BakeArgs {
     #[command(flatten)]
@@ -576,7 +576,7 @@ fn validate(args: ValidateArgs, color: ColorChoice, quiet: bool) -> ExitCode {
 
 #[derive(clap::Args)]
 #[command(
-    after_help = "Exit status: 0 done, 1 a file failed (the others are still migrated) or, with --check, a file would change, 2 usage error (nothing written)."
+    after_help = "Exit status: 0 done, 1 a file failed (the others are still migrated) or, with --check, a file would change, 2 usage error (nothing written), 130 / 143 stopped by SIGINT / SIGTERM (finished files complete, nothing left of the others)."
 )]
 struct MigrateArgs {
     #[command(flatten)]
