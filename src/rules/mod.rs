@@ -77,6 +77,30 @@ impl<'a> Context<'a> {
         })
     }
 
+    /// Every mesh primitive drawn with a material that exists, with what its material reads:
+    /// (mesh index, primitive index, the primitive, the material's index, its textures). A
+    /// dangling material index is the references rule's finding, not these rules'.
+    pub fn primitives_with_textures(
+        &self,
+    ) -> impl Iterator<Item = (usize, usize, Node<'a>, u64, &[extensions::MaterialTexture])> + '_
+    {
+        let textures = self.material_textures();
+        elements(self.json().get("meshes"))
+            .enumerate()
+            .flat_map(|(m, mesh)| {
+                elements(mesh.get("primitives"))
+                    .enumerate()
+                    .map(move |(p, primitive)| (m, p, primitive))
+            })
+            .filter_map(move |(m, p, primitive)| {
+                let material = primitive.get("material").and_then(|v| v.as_u64())?;
+                let reads = usize::try_from(material)
+                    .ok()
+                    .and_then(|i| textures.get(i))?;
+                Some((m, p, primitive, material, reads.as_slice()))
+            })
+    }
+
     /// The document, read through the asset's index.
     pub fn json(&self) -> Node<'a> {
         self.asset.root()

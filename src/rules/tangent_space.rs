@@ -41,43 +41,34 @@ impl Rule for TangentSpace {
         if !textures.iter().flatten().any(|t| t.normal) {
             return;
         }
-        for (m, mesh) in super::elements(json.get("meshes")).enumerate() {
-            for (p, primitive) in super::elements(mesh.get("primitives")).enumerate() {
-                let Some(material) = primitive.get("material").and_then(|v| v.as_u64()) else {
-                    continue;
-                };
-                let Some(reads) = usize::try_from(material).ok().and_then(|i| textures.get(i))
-                else {
-                    continue;
-                };
-                let Some(first) = reads.iter().find(|t| t.normal).map(|t| &t.pointer) else {
-                    continue;
-                };
-                let attributes = primitive.get("attributes").and_then(|a| a.as_object());
-                let has = |name: &str| attributes.is_some_and(|a| a.contains_key(name));
-                if has("NORMAL") && has("TANGENT") {
-                    continue;
-                }
-                let at = format!("/meshes/{m}/primitives/{p}/material");
-                if reads.iter().any(|t| t.pointer == "/normalTexture") {
-                    out.push(Diagnostic::new(
-                        &MESH_PRIMITIVE_GENERATED_TANGENT_SPACE,
-                        at,
-                        format!(
-                            "material {material} has a normal texture but this primitive has no {}: loaders generate the tangent space, and results differ",
-                            missing(has("NORMAL"), has("TANGENT"))
-                        ),
-                    ));
-                } else {
-                    out.push(Diagnostic::new(
-                        &MESH_PRIMITIVE_NO_TANGENT_SPACE,
-                        at,
-                        format!(
-                            "material {material}'s /materials/{material}{first} needs a tangent space, but this primitive has no {} and the material no normalTexture to generate it from",
-                            missing(has("NORMAL"), has("TANGENT"))
-                        ),
-                    ));
-                }
+        for (m, p, primitive, material, reads) in cx.primitives_with_textures() {
+            let Some(first) = reads.iter().find(|t| t.normal).map(|t| &t.pointer) else {
+                continue;
+            };
+            let attributes = primitive.get("attributes").and_then(|a| a.as_object());
+            let has = |name: &str| attributes.is_some_and(|a| a.contains_key(name));
+            if has("NORMAL") && has("TANGENT") {
+                continue;
+            }
+            let at = format!("/meshes/{m}/primitives/{p}/material");
+            if reads.iter().any(|t| t.pointer == "/normalTexture") {
+                out.push(Diagnostic::new(
+                    &MESH_PRIMITIVE_GENERATED_TANGENT_SPACE,
+                    at,
+                    format!(
+                        "material {material} has a normal texture but this primitive has no {}: loaders generate the tangent space, and results differ",
+                        missing(has("NORMAL"), has("TANGENT"))
+                    ),
+                ));
+            } else {
+                out.push(Diagnostic::new(
+                    &MESH_PRIMITIVE_NO_TANGENT_SPACE,
+                    at,
+                    format!(
+                        "material {material}'s /materials/{material}{first} needs a tangent space, but this primitive has no {} and the material no normalTexture to generate it from",
+                        missing(has("NORMAL"), has("TANGENT"))
+                    ),
+                ));
             }
         }
     }

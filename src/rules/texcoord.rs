@@ -37,28 +37,19 @@ impl Rule for TexCoords {
         }
         // Attribute names by set, written once each.
         let mut names: Vec<String> = Vec::new();
-        for (m, mesh) in super::elements(json.get("meshes")).enumerate() {
-            for (p, primitive) in super::elements(mesh.get("primitives")).enumerate() {
-                let Some(material) = primitive.get("material").and_then(|v| v.as_u64()) else {
-                    continue;
-                };
-                let Some(reads) = usize::try_from(material).ok().and_then(|i| textures.get(i))
-                else {
-                    continue; // dangling: the references rule reports it
-                };
-                let attributes = primitive.get("attributes").and_then(|a| a.as_object());
-                for texture in reads {
-                    let attribute = attribute_name(&mut names, texture.set);
-                    if !attributes.is_some_and(|a| a.contains_key(&attribute)) {
-                        out.push(Diagnostic::new(
-                            &MESH_PRIMITIVE_TOO_FEW_TEXCOORDS,
-                            format!("/meshes/{m}/primitives/{p}/material"),
-                            format!(
-                                "material {material}'s /materials/{material}{} reads {attribute}, which this primitive does not have",
-                                texture.pointer
-                            ),
-                        ));
-                    }
+        for (m, p, primitive, material, reads) in cx.primitives_with_textures() {
+            let attributes = primitive.get("attributes").and_then(|a| a.as_object());
+            for texture in reads {
+                let attribute = attribute_name(&mut names, texture.set);
+                if !attributes.is_some_and(|a| a.contains_key(&attribute)) {
+                    out.push(Diagnostic::new(
+                        &MESH_PRIMITIVE_TOO_FEW_TEXCOORDS,
+                        format!("/meshes/{m}/primitives/{p}/material"),
+                        format!(
+                            "material {material}'s /materials/{material}{} reads {attribute}, which this primitive does not have",
+                            texture.pointer
+                        ),
+                    ));
                 }
             }
         }
