@@ -71,27 +71,8 @@ pub struct Request {
     pub progress: bool,
 }
 
-/// What became of one file.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
-#[serde(tag = "status", rename_all = "kebab-case")]
-pub enum Outcome {
-    /// Baked and written.
-    Changed,
-    /// Nothing to bake: the input's bytes were written to the output.
-    Copied,
-    /// Nothing to bake in place: not written.
-    Untouched,
-    /// Dry run.
-    Planned {
-        /// Whether a real run would change the file.
-        changes: bool,
-    },
-    /// Not baked; nothing written for it.
-    Failed {
-        /// Why.
-        error: String,
-    },
-}
+/// What became of one file: the outcome `velvet migrate` reports too.
+pub use crate::output::Outcome;
 
 /// One baked slot, for reports.
 #[derive(Clone, Debug, PartialEq, Serialize)]

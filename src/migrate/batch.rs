@@ -27,21 +27,8 @@ pub struct Request {
     pub progress: bool,
 }
 
-/// What became of one file.
-#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
-#[serde(tag = "status", rename_all = "kebab-case")]
-pub enum FileOutcome {
-    /// Migrated and written.
-    Changed,
-    /// Nothing to migrate: the input's bytes were written to the output.
-    Copied,
-    /// Nothing to migrate in place: not written.
-    Untouched,
-    /// Dry run: what would happen.
-    Planned { changes: bool },
-    /// Not migrated; nothing was written for it.
-    Failed { error: String },
-}
+/// What became of one file: the outcome `velvet bake` reports too.
+pub use crate::output::Outcome as FileOutcome;
 
 /// The report for one file.
 #[derive(Debug, Clone, PartialEq, Serialize)]

@@ -7,7 +7,8 @@
 //! resource copies, link checks); [`files`] writes new image files and resource copies next to
 //! an output; [`summary`] holds the wording the two text reports share. [`run_each`] runs a
 //! command's files in parallel under one set of name claims and one progress bar.
-//! [`UsageError`] is a request either command refuses before anything is read or written.
+//! [`UsageError`] is a request either command refuses before anything is read or written, and
+//! [`Outcome`] what became of one file, in either command.
 
 pub mod files;
 pub mod interrupt;
@@ -18,6 +19,28 @@ pub mod summary;
 use crate::asset::discover::Shard;
 use rayon::prelude::*;
 use std::path::PathBuf;
+
+/// What became of one file in `velvet migrate` or `velvet bake`.
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
+#[serde(tag = "status", rename_all = "kebab-case")]
+pub enum Outcome {
+    /// Migrated or baked, and written.
+    Changed,
+    /// Nothing to do: the input's bytes were written to the output.
+    Copied,
+    /// Nothing to do in place: not written.
+    Untouched,
+    /// Dry run: what would happen.
+    Planned {
+        /// Whether a real run would change the file.
+        changes: bool,
+    },
+    /// Not done; nothing was written for it.
+    Failed {
+        /// Why.
+        error: String,
+    },
+}
 
 /// The files of a migrate or bake request, and how a run over them shows its progress.
 pub struct Scope<'a> {
