@@ -243,6 +243,86 @@ pub fn materials(json: &serde_json::Value) -> &[serde_json::Value] {
         .map_or(&[], Vec::as_slice)
 }
 
+/// The properties of the pre-ratification sheen draft, which ratified loaders ignore.
+pub const LEGACY_PROPERTIES: [&str; 3] = ["sheenFactor", "sheenColor", "sheenTexture"];
+
+/// One sheen or fuzz object on a material.
+#[derive(Clone, Copy)]
+pub struct LayerObject<J> {
+    pub material: usize,
+    pub extension: &'static str,
+    pub value: J,
+    /// The material's `extensions` object, which holds `value`.
+    pub extensions: J,
+}
+
+impl<J> LayerObject<J> {
+    /// Pointer to the extension object.
+    pub fn pointer(&self) -> String {
+        format!("/materials/{}/extensions/{}", self.material, self.extension)
+    }
+}
+
+/// Every KHR_materials_sheen and KHR_materials_fuzz object in `materials[*].extensions`.
+pub fn layer_objects<'a, J: JsonView<'a>>(json: J) -> impl Iterator<Item = LayerObject<J>> + 'a {
+    let materials = json.member("materials");
+    let count = materials.and_then(JsonView::length).unwrap_or(0);
+    (0..count).flat_map(move |i| {
+        let extensions = materials
+            .and_then(|m| m.element(i))
+            .and_then(|m| m.member("extensions"));
+        [SHEEN, FUZZ].into_iter().filter_map(move |ext| {
+            let extensions = extensions?;
+            let value = extensions.member(ext)?;
+            Some(LayerObject {
+                material: i,
+                extension: ext,
+                value,
+                extensions,
+            })
+        })
+    })
+}
+
+/// A texture slot that is present on a layer object.
+pub struct SlotUse<J> {
+    pub slot: &'static Slot,
+    pub texture: TextureRef,
+    pub value: J,
+    material: usize,
+}
+
+impl<J> SlotUse<J> {
+    /// Pointer to the textureInfo.
+    pub fn pointer(&self) -> String {
+        slot_pointer(self.material, self.slot)
+    }
+}
+
+/// Pointer to the textureInfo of `slot` on material `material`.
+pub fn slot_pointer(material: usize, slot: &Slot) -> String {
+    format!(
+        "/materials/{material}/extensions/{}/{}",
+        slot.extension, slot.texture
+    )
+}
+
+/// The texture slots a layer object fills.
+pub fn slot_uses<'a, J: JsonView<'a>>(
+    layer: &LayerObject<J>,
+) -> impl Iterator<Item = SlotUse<J>> + 'a {
+    let (value, material) = (layer.value, layer.material);
+    slots_of(layer.extension).filter_map(move |slot| {
+        let info = value.member(slot.texture)?;
+        Some(SlotUse {
+            slot,
+            texture: TextureRef::read(info)?,
+            value: info,
+            material,
+        })
+    })
+}
+
 #[cfg(test)]
 mod transfer_tests {
     use super::Transfer;

@@ -12,6 +12,7 @@ pub mod cli_docs;
 pub mod command;
 pub mod config;
 pub mod diagnostics;
+pub mod document;
 pub mod edit;
 pub mod layers;
 pub mod migrate;

@@ -21,8 +21,9 @@ use super::engine::{OutputId, RecipeSet};
 use super::recipe::{Channel, ChannelRecipe, Factor, ImageId, Recipe, Transfer, Value as Expr};
 use crate::asset::resource::ImageFormat;
 use crate::asset::Asset;
+use crate::document::texture_sources;
 use crate::layers::{self, Channels, Slot};
-use crate::rules::{layer_objects, slot_uses, texture_sources};
+use crate::layers::{layer_objects, slot_uses};
 
 /// Choices that change the plan.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

@@ -15,7 +15,7 @@ use serde_json::Value;
 
 use crate::asset::pointer;
 use crate::asset::tape::JsonView;
-use crate::rules::texture_sources;
+use crate::document::texture_sources;
 
 /// What was dropped (indices before dropping).
 #[derive(Clone, Debug, Default, PartialEq, Eq)]

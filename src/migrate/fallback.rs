@@ -23,9 +23,9 @@ use super::roughness::{self, Direction, RoughnessMapping};
 use super::textures::{self, texture_index, Contents, TextureBake};
 use crate::asset::pointer;
 use crate::bake::Channel;
+use crate::document::effective_tex_coord;
 use crate::edit::Edit;
 use crate::layers::{self, max3, FuzzView};
-use crate::rules::effective_tex_coord;
 use serde_json::{Map, Value};
 
 /// Differences below this share of the layer's reflectance (about 2.5 steps of an 8-bit

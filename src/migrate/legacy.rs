@@ -21,7 +21,7 @@ use crate::asset::pointer;
 use crate::bake::Channel;
 use crate::edit::Edit;
 use crate::layers;
-use crate::rules::legacy_sheen::LEGACY_PROPERTIES;
+use crate::layers::LEGACY_PROPERTIES;
 use serde_json::Value;
 
 const RATIFIED_PROPERTIES: [&str; 4] = [

@@ -7,8 +7,8 @@
 //! only here, and only when the user asked for the report.
 
 use crate::asset::Asset;
+use crate::document::texture_sources;
 use crate::layers::{max3, Transfer};
-use crate::rules::texture_sources;
 use serde_json::Value;
 
 /// The attenuation difference over one image.

@@ -149,8 +149,9 @@ impl<'a> Primitives<'a> {
     fn of(&self, material: usize) -> &[PrimitiveSets] {
         let by_material = self.by_material.get_or_init(|| {
             let mut by_material: HashMap<u64, Vec<_>> = HashMap::new();
-            for (m, mesh) in crate::rules::elements(self.json.get("meshes")).enumerate() {
-                for (p, primitive) in crate::rules::elements(mesh.get("primitives")).enumerate() {
+            for (m, mesh) in crate::document::elements(self.json.get("meshes")).enumerate() {
+                for (p, primitive) in crate::document::elements(mesh.get("primitives")).enumerate()
+                {
                     if let Some(material) = primitive.get("material").and_then(|v| v.as_u64()) {
                         let sets =
                             primitive
@@ -292,7 +293,7 @@ pub fn plan_document(asset: &Asset, options: &Options) -> DocumentPlan {
         m.shrink_to_fit();
     });
     let declared: Vec<std::borrow::Cow<str>> =
-        crate::rules::elements(asset.root().get("extensionsUsed"))
+        crate::document::elements(asset.root().get("extensionsUsed"))
             .filter_map(|e| e.as_str())
             .collect();
     let any = |wanted: &[Conversion]| {
@@ -408,7 +409,7 @@ pub(crate) fn primitive_lacking_tex_coord(
     material: usize,
     texture_info: &Value,
 ) -> Option<String> {
-    let set = crate::rules::effective_tex_coord(texture_info);
+    let set = crate::document::effective_tex_coord(texture_info);
     let attribute = format!("TEXCOORD_{set}");
     primitives
         .of(material)

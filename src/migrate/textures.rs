@@ -268,7 +268,7 @@ pub fn sources(asset: &Asset, index: usize) -> Result<Vec<(String, usize)>, Stri
         .map_or(0, |i| i.len());
     let texture_pointer = format!("/textures/{index}");
     let mut out = Vec::new();
-    for (image, pointer) in crate::rules::texture_sources(texture, &texture_pointer) {
+    for (image, pointer) in crate::document::texture_sources(texture, &texture_pointer) {
         let within = pointer[texture_pointer.len()..].to_owned();
         let image = match image {
             Some(i) if (i as usize) < image_count => i as usize,

@@ -47,7 +47,7 @@ impl<'a> FileNames<'a> {
     ) -> FileNames<'a> {
         let taken: HashSet<PathBuf> = ["buffers", "images"]
             .iter()
-            .flat_map(|kind| crate::rules::elements(asset.root().get(*kind)))
+            .flat_map(|kind| crate::document::elements(asset.root().get(*kind)))
             .filter_map(|item| item.get("uri").and_then(|u| u.as_str()))
             .filter_map(|uri| match resource::resolve(&uri, asset.base_dir(), "") {
                 Ok(resource::Location::File(p)) => Some(identity(&p)),

@@ -13,7 +13,7 @@ pub const SHEEN_LEGACY_DRAFT: Code = Code::new(
     "A property of the pre-ratification sheen draft (sheenFactor, sheenColor, sheenTexture); ratified loaders ignore it.",
 );
 
-pub const LEGACY_PROPERTIES: [&str; 3] = ["sheenFactor", "sheenColor", "sheenTexture"];
+pub use crate::layers::LEGACY_PROPERTIES;
 
 pub struct LegacySheen;
 

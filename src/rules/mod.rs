@@ -27,10 +27,10 @@ pub mod skins;
 pub mod tangent_space;
 pub mod texcoord;
 
-use crate::asset::tape::{JsonView, Node};
-use crate::asset::{pointer, Asset};
+use crate::asset::tape::Node;
+use crate::asset::Asset;
 use crate::diagnostics::{Code, Diagnostic};
-use crate::layers::{self, FuzzView, SheenView, Slot, TextureRef};
+use crate::layers::{self, FuzzView, SheenView};
 
 /// What a rule sees: the asset and the schemas compiled for this run.
 pub struct Context<'a> {
@@ -259,136 +259,8 @@ pub fn find_code(name: &str) -> Option<&'static Code> {
     all_codes().into_iter().find(|c| c.name == name)
 }
 
-/// One sheen or fuzz object on a material.
-#[derive(Clone, Copy)]
-pub struct LayerObject<J> {
-    pub material: usize,
-    pub extension: &'static str,
-    pub value: J,
-    /// The material's `extensions` object, which holds `value`.
-    pub extensions: J,
-}
-
-impl<J> LayerObject<J> {
-    /// Pointer to the extension object.
-    pub fn pointer(&self) -> String {
-        format!("/materials/{}/extensions/{}", self.material, self.extension)
-    }
-}
-
-/// Every KHR_materials_sheen and KHR_materials_fuzz object in `materials[*].extensions`.
-pub fn layer_objects<'a, J: JsonView<'a>>(json: J) -> impl Iterator<Item = LayerObject<J>> + 'a {
-    let materials = json.member("materials");
-    let count = materials.and_then(JsonView::length).unwrap_or(0);
-    (0..count).flat_map(move |i| {
-        let extensions = materials
-            .and_then(|m| m.element(i))
-            .and_then(|m| m.member("extensions"));
-        [layers::SHEEN, layers::FUZZ]
-            .into_iter()
-            .filter_map(move |ext| {
-                let extensions = extensions?;
-                let value = extensions.member(ext)?;
-                Some(LayerObject {
-                    material: i,
-                    extension: ext,
-                    value,
-                    extensions,
-                })
-            })
-    })
-}
-
-/// A texture slot that is present on a layer object.
-pub struct SlotUse<J> {
-    pub slot: &'static Slot,
-    pub texture: TextureRef,
-    pub value: J,
-    material: usize,
-}
-
-impl<J> SlotUse<J> {
-    /// Pointer to the textureInfo.
-    pub fn pointer(&self) -> String {
-        slot_pointer(self.material, self.slot)
-    }
-}
-
-/// Pointer to the textureInfo of `slot` on material `material`.
-pub fn slot_pointer(material: usize, slot: &Slot) -> String {
-    format!(
-        "/materials/{material}/extensions/{}/{}",
-        slot.extension, slot.texture
-    )
-}
-
-/// The texture slots a layer object fills.
-pub fn slot_uses<'a, J: JsonView<'a>>(
-    layer: &LayerObject<J>,
-) -> impl Iterator<Item = SlotUse<J>> + 'a {
-    let (value, material) = (layer.value, layer.material);
-    layers::slots_of(layer.extension).filter_map(move |slot| {
-        let info = value.member(slot.texture)?;
-        Some(SlotUse {
-            slot,
-            texture: TextureRef::read(info)?,
-            value: info,
-            material,
-        })
-    })
-}
-
-pub use crate::layers::as_index;
-
-/// The elements of an array that may be absent or not an array (then there are none).
-pub fn elements(array: Option<Node<'_>>) -> impl Iterator<Item = Node<'_>> {
-    array
-        .and_then(|a| a.as_array())
-        .into_iter()
-        .flat_map(|a| a.iter())
-}
-
-/// The materials array's elements.
-pub fn materials(json: Node<'_>) -> impl Iterator<Item = Node<'_>> {
-    elements(json.get("materials"))
-}
-
-/// The texCoord set a textureInfo really uses: KHR_texture_transform may override it.
-pub fn effective_tex_coord<'a>(texture_info: impl JsonView<'a>) -> u64 {
-    texture_info
-        .member("extensions")
-        .and_then(|e| e.member(layers::TEXTURE_TRANSFORM))
-        .and_then(|t| t.member("texCoord"))
-        .and_then(JsonView::unsigned)
-        .or_else(|| texture_info.member("texCoord").and_then(JsonView::unsigned))
-        .unwrap_or(0)
-}
-
-/// The images a texture may be drawn from: `source` and the sources of image-format extensions
-/// (EXT_texture_webp, KHR_texture_basisu, …), each with its pointer.
-pub fn texture_sources<'a>(
-    texture: impl JsonView<'a>,
-    texture_pointer: &str,
-) -> Vec<(Option<u64>, String)> {
-    let mut out = Vec::new();
-    if let Some(source) = texture.member("source") {
-        out.push((source.unsigned(), format!("{texture_pointer}/source")));
-    }
-    if let Some(exts) = texture.member("extensions").and_then(JsonView::members) {
-        for (name, ext) in exts {
-            if let Some(source) = ext.member("source") {
-                out.push((
-                    source.unsigned(),
-                    format!(
-                        "{texture_pointer}/extensions/{}/source",
-                        pointer::escape(&name)
-                    ),
-                ));
-            }
-        }
-    }
-    out
-}
+pub use crate::document::{effective_tex_coord, elements, materials, texture_sources};
+pub use crate::layers::{as_index, layer_objects, slot_pointer, slot_uses, LayerObject, SlotUse};
 
 #[cfg(test)]
 mod tests {
