@@ -246,6 +246,14 @@ pub fn materials(json: &serde_json::Value) -> &[serde_json::Value] {
 /// The properties of the pre-ratification sheen draft, which ratified loaders ignore.
 pub const LEGACY_PROPERTIES: [&str; 3] = ["sheenFactor", "sheenColor", "sheenTexture"];
 
+/// The draft properties present on a sheen object, read as a value or through the index.
+pub fn legacy_properties<'a>(sheen: impl JsonView<'a>) -> Vec<&'static str> {
+    LEGACY_PROPERTIES
+        .into_iter()
+        .filter(|p| sheen.member(p).is_some())
+        .collect()
+}
+
 /// One sheen or fuzz object on a material.
 #[derive(Clone, Copy)]
 pub struct LayerObject<J> {

@@ -5,10 +5,10 @@
 //! The flow: callers (bake, migrate) plan [`Recipe`] values and insert them into a
 //! [`RecipeSet`], which deduplicates them; [`bake`] fetches and decodes the images they read
 //! through an [`ImageSource`], applies each recipe, and returns encoded outputs with statistics.
-//! The recipe, kernel, codec and engine modules know nothing of glTF JSON; [`plan`], [`apply`],
-//! [`prune`] and [`command`] are the `velvet bake` command built on them: plan (which slots need
-//! baking, with which recipes), bake, apply (new images and textures, factors, dropped sources),
-//! write.
+//! The recipe, kernel, codec and engine modules know nothing of glTF JSON; [`plan`], [`apply`]
+//! and [`prune`] are their glTF side: plan (which slots need baking, with which recipes), apply
+//! (new images and textures, factors, dropped sources). The `velvet bake` command over many
+//! files is [`crate::command::bake`].
 
 pub mod apply;
 pub mod codec;

@@ -3,8 +3,8 @@
 //! bar on a terminal, and sum up what happened.
 
 use super::apply::{execute, plan_file, Written};
+use super::material::MaterialPlan;
 use super::note::{Conversion, Level, Note, Skip};
-use super::plan::MaterialPlan;
 use super::Options;
 use crate::asset::discover::Shard;
 use crate::edit::Edit;
@@ -41,7 +41,7 @@ pub struct FileResult {
     /// Edits outside the materials: declarations and URI rewrites.
     pub edits: Vec<Edit>,
     pub copies: Vec<ResourceCopy>,
-    #[serde(serialize_with = "super::plan::notes_json")]
+    #[serde(serialize_with = "super::material::notes_json")]
     pub notes: Vec<Note>,
     /// New textures (distinct baked images) the output gains; in a dry run, those planned.
     pub textures_added: usize,

@@ -24,14 +24,13 @@
 //! channel), only when some material maps one; each texture's materials are planned in
 //! parallel with the others'.
 
+use super::material::MaterialPlan;
 use super::note::Note;
-use super::plan::MaterialPlan;
 use super::roughness;
 use super::textures::Contents;
 use crate::asset::Asset;
 use crate::bake::{codec, srgb, Channel, Curve, Pixels};
 use rayon::prelude::*;
-use serde::Serialize;
 use std::collections::BTreeMap;
 
 /// The default budget: the largest roughness difference a plan may leave, in roughness units.
@@ -83,27 +82,7 @@ impl std::str::FromStr for Budget {
     }
 }
 
-/// Which texture a mapped roughness slot reads.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum TexturePlan {
-    /// One mapped texture per source texture; the factor carries the material's difference.
-    Shared,
-    /// A mapped texture shared by materials of nearby factors.
-    Grouped,
-    /// A bake for this material alone.
-    Exact,
-}
-
-impl TexturePlan {
-    pub fn describe(self) -> &'static str {
-        match self {
-            TexturePlan::Shared => "the source's one mapped texture, the factor carrying the rest",
-            TexturePlan::Grouped => "a mapped texture shared with materials of nearby factors",
-            TexturePlan::Exact => "a texture baked for this material",
-        }
-    }
-}
+pub use super::note::TexturePlan;
 
 /// The codes one channel of an image holds, each once, and its largest code.
 #[derive(Debug, Clone, PartialEq, Eq)]

@@ -17,8 +17,8 @@
 //! [`DARK_FUZZ_THRESHOLD`]. Black fuzz would give a switched-off sheen, which is no fallback
 //! (and contradicts the active fuzz): none is written, said so.
 
+use super::material::{number_like, MaterialCx, MaterialPlan};
 use super::note::{Conversion, Note, Skip};
-use super::plan::{number_like, MaterialCx, MaterialPlan};
 use super::roughness::{self, Direction, RoughnessMapping};
 use super::textures::{self, texture_index, Contents, TextureBake};
 use crate::asset::pointer;
@@ -28,9 +28,7 @@ use crate::edit::Edit;
 use crate::layers::{self, max3, FuzzView};
 use serde_json::{Map, Value};
 
-/// Differences below this share of the layer's reflectance (about 2.5 steps of an 8-bit
-/// channel) are not reported as dark fuzz.
-pub const DARK_FUZZ_THRESHOLD: f64 = 0.01;
+pub use super::note::DARK_FUZZ_THRESHOLD;
 
 /// The properties a fallback sheen has, in the spec's order; refreshing sets or removes each.
 const SHEEN_PROPERTIES: [&str; 4] = [
@@ -325,7 +323,7 @@ pub fn refresh(cx: &MaterialCx, sheen: &Value, fuzz: &Value, plan: &mut Material
     }
     let base = cx.extension_pointer(layers::SHEEN);
     let mut edits = Vec::new();
-    for property in super::legacy::legacy_properties(sheen) {
+    for property in crate::layers::legacy_properties(sheen) {
         edits.push(Edit::remove(pointer::join(&base, property)));
     }
     for property in SHEEN_PROPERTIES {

@@ -13,15 +13,14 @@
 //! A draft object that also holds ratified properties is not rewritten: ratified loaders read
 //! the ratified ones, and those are what gets migrated.
 
+use super::material::{number_like, texture_unusable, MaterialCx, MaterialPlan};
 use super::note::{Conversion, Note};
-use super::plan::{number_like, texture_unusable, MaterialCx, MaterialPlan};
 use super::sheen_to_fuzz::{Read, Sheen};
 use super::textures::Contents;
 use crate::asset::pointer;
 use crate::bake::Channel;
 use crate::edit::Edit;
 use crate::layers;
-use crate::layers::LEGACY_PROPERTIES;
 use serde_json::Value;
 
 const RATIFIED_PROPERTIES: [&str; 4] = [
@@ -31,13 +30,7 @@ const RATIFIED_PROPERTIES: [&str; 4] = [
     "sheenRoughnessTexture",
 ];
 
-/// The draft properties present on a sheen object, read as a value or through the index.
-pub fn legacy_properties<'a>(sheen: impl crate::asset::tape::JsonView<'a>) -> Vec<&'static str> {
-    LEGACY_PROPERTIES
-        .into_iter()
-        .filter(|p| sheen.member(p).is_some())
-        .collect()
-}
+pub use crate::layers::legacy_properties;
 
 fn rgb(value: Option<&Value>) -> Option<[f64; 3]> {
     match value?.as_array()?.as_slice() {

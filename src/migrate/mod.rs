@@ -16,6 +16,7 @@ pub mod batch;
 pub mod budget;
 pub mod fallback;
 pub mod legacy;
+pub mod material;
 pub mod measure;
 pub mod note;
 pub mod plan;

@@ -8,6 +8,32 @@ use crate::output::paths::RelocationNote;
 use serde::Serialize;
 use serde_json::Value;
 
+/// Differences below this share of the layer's reflectance (about 2.5 steps of an 8-bit
+/// channel) are not reported as dark fuzz.
+pub const DARK_FUZZ_THRESHOLD: f64 = 0.01;
+
+/// Which texture a mapped roughness slot reads.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum TexturePlan {
+    /// One mapped texture per source texture; the factor carries the material's difference.
+    Shared,
+    /// A mapped texture shared by materials of nearby factors.
+    Grouped,
+    /// A bake for this material alone.
+    Exact,
+}
+
+impl TexturePlan {
+    pub fn describe(self) -> &'static str {
+        match self {
+            TexturePlan::Shared => "the source's one mapped texture, the factor carrying the rest",
+            TexturePlan::Grouped => "a mapped texture shared with materials of nearby factors",
+            TexturePlan::Exact => "a texture baked for this material",
+        }
+    }
+}
+
 /// A conversion applied to one material.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
 #[serde(rename_all = "kebab-case")]
@@ -182,7 +208,7 @@ pub enum Note {
     /// The texture plan of a mapped roughness texture, with its measured worst-case error.
     RoughnessPlan {
         property: String,
-        plan: super::budget::TexturePlan,
+        plan: TexturePlan,
         factor_key: String,
         factor: f64,
         max_error: f64,
@@ -287,10 +313,10 @@ impl Note {
             ),
             Note::AttenuationMeasured { image, texels, w, max, mean } => format!(
                 "attenuation difference |{w:?} − max3(sheenColor)| over the {texels} texels of image {image}: max {max:.4}, mean {mean:.4}; {}",
-                if *max <= super::fallback::DARK_FUZZ_THRESHOLD {
-                    format!("within {} everywhere, not visible", super::fallback::DARK_FUZZ_THRESHOLD)
+                if *max <= DARK_FUZZ_THRESHOLD {
+                    format!("within {} everywhere, not visible", DARK_FUZZ_THRESHOLD)
                 } else {
-                    format!("{:.4} over {} at worst (--exact bakes it away)", max - super::fallback::DARK_FUZZ_THRESHOLD, super::fallback::DARK_FUZZ_THRESHOLD)
+                    format!("{:.4} over {} at worst (--exact bakes it away)", max - DARK_FUZZ_THRESHOLD, DARK_FUZZ_THRESHOLD)
                 }
             ),
             Note::LayerDifference { mapping, sheen_roughness, fuzz_roughness, max_difference, at_mu, reflectance_max, reflectance_rms, poor_match, fuzz_model, clamped } => {
@@ -353,7 +379,7 @@ impl Note {
             ),
             Note::DarkFuzz { difference, fuzz_color_max, base_color_max } => format!(
                 "the fuzz blends the base towards its colour (brightest channel {fuzz_color_max:?}), which darkens a base whose brightest channel is {base_color_max:?}; sheen only adds light, so loaders without fuzz show it brighter by up to {difference:.4} of the layer's reflectance, over the {} velvet reports from (from the factors; textures can make it larger)",
-                super::fallback::DARK_FUZZ_THRESHOLD
+                DARK_FUZZ_THRESHOLD
             ),
             Note::BlackFuzz => {
                 "the fuzz colour is black: a sheen of that colour is switched off, so no sheen can stand for it; no fallback is written (loaders without fuzz show no layer)".into()

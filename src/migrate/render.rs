@@ -6,8 +6,8 @@
 //! [`crate::output::summary`].
 
 use super::batch::{FileOutcome, FileResult, RunReport, Summary};
+use super::material::MaterialPlan;
 use super::note::Level;
-use super::plan::MaterialPlan;
 use crate::output::summary::{added, files_line, plural, Detail};
 use crate::report::escape::push_line;
 use std::fmt::Write;

@@ -15,141 +15,22 @@
 //! fuzzColorTexture holding the colour normalised by it (factors become the identity), so lobe
 //! and attenuation both match texel by texel up to quantisation, which is reported.
 
+use super::material::{MaterialCx, MaterialPlan};
 use super::measure;
 use super::note::{Conversion, Note, Skip};
-use super::plan::{MaterialCx, MaterialPlan};
 use super::roughness::{self, Direction, RoughnessMapping};
 use super::textures::{Contents, TextureBake};
 use crate::asset::json_text::push_quoted;
-use crate::asset::tape::{JsonView, Node};
 use crate::bake::Channel;
-use crate::edit::splice::{write_compact, write_compact_node};
 use crate::edit::Edit;
 use crate::layers::{self, max3};
 use crate::shading::layering;
 use serde_json::Value;
 
-/// A ratified sheen as the conversion needs it: numbers with the JSON text they came in (so
-/// that unchanged numbers keep it), and the textureInfo objects as they are. Read through the
-/// document's index, those stay places in its text ([`Read::Node`]) until a conversion needs a
-/// value (a bake, a measurement); the fuzz object is written from them as they are.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Sheen<'a> {
-    pub color: [f64; 3],
-    /// The colour as written: each reads as its component of `color`.
-    pub color_values: [Read<'a>; 3],
-    pub roughness: f64,
-    /// The roughness as written: it reads as `roughness`.
-    pub roughness_value: Read<'a>,
-    pub color_texture: Option<Read<'a>>,
-    pub roughness_texture: Option<Read<'a>>,
-    /// The channel the roughness texture holds roughness in: alpha for a ratified sheen, green
-    /// for a draft sheen that followed the material's metallicRoughnessTexture (baked into
-    /// alpha on the way).
-    pub roughness_channel: Channel,
-}
-
-/// A member of a sheen as read: a value, or its place in the document's index.
-#[derive(Debug, Clone)]
-pub enum Read<'a> {
-    Value(Value),
-    Node(Node<'a>),
-}
-
-impl Read<'_> {
-    /// The value (read from the document's text for a place in it).
-    pub fn to_value(&self) -> std::borrow::Cow<'_, Value> {
-        match self {
-            Read::Value(value) => std::borrow::Cow::Borrowed(value),
-            Read::Node(node) => std::borrow::Cow::Owned(node.to_value()),
-        }
-    }
-
-    /// Writes it as [`write_compact`] writes its value.
-    pub fn write_compact(&self, out: &mut String) {
-        match self {
-            Read::Value(value) => write_compact(value, out),
-            Read::Node(node) => write_compact_node(*node, out),
-        }
-    }
-}
-
-impl PartialEq for Read<'_> {
-    fn eq(&self, other: &Read<'_>) -> bool {
-        self.to_value() == other.to_value()
-    }
-}
-
-impl<'a> Sheen<'a> {
-    /// Reads a ratified KHR_materials_sheen object, with the spec's defaults (a malformed
-    /// value reads as its default: the schema check reports it).
-    pub fn read(ext: impl SheenSource<'a>) -> Sheen<'a> {
-        // Each member is looked up once (a layer read through the index pays for every
-        // lookup), with what `layers::SheenView::read` would read from it. A value that is not
-        // an object has no members: every one reads as its default.
-        let raw = ext.member("sheenColorFactor");
-        let parsed = raw.and_then(layers::rgb_of);
-        let color = parsed.unwrap_or(layers::SHEEN_COLOR_DEFAULT);
-        let roughness_raw = ext.member("sheenRoughnessFactor");
-        let roughness_parsed = roughness_raw.and_then(JsonView::number);
-        let roughness = roughness_parsed.unwrap_or(layers::SHEEN_ROUGHNESS_DEFAULT);
-        // A number just read as its component is kept as it is, without reading it again.
-        let color_values = std::array::from_fn(|i| {
-            let element = raw.and_then(|a| a.element(i));
-            match (parsed, element) {
-                (Some(_), Some(element)) => element.read(),
-                _ => number_read(element, color[i]),
-            }
-        });
-        let roughness_value = match (roughness_parsed, roughness_raw) {
-            (Some(_), Some(raw)) => raw.read(),
-            _ => number_read(roughness_raw, roughness),
-        };
-        let texture = |key| {
-            ext.member(key)
-                .filter(|v| v.object())
-                .map(SheenSource::read)
-        };
-        Sheen {
-            color,
-            color_values,
-            roughness,
-            roughness_value,
-            color_texture: texture("sheenColorTexture"),
-            roughness_texture: texture("sheenRoughnessTexture"),
-            roughness_channel: Channel::A,
-        }
-    }
-}
-
-/// The number `original` as read, when it reads as `value`; else `value` as a value.
-fn number_read<'a, S: SheenSource<'a>>(original: Option<S>, value: f64) -> Read<'a> {
-    match original {
-        Some(v) if v.number() == Some(value) => v.read(),
-        _ => Read::Value(Value::from(value)),
-    }
-}
-
-/// What a sheen is read from: a value, or the document's index (the members the conversion
-/// keeps, numbers and textureInfos, then stay places in the text).
-pub trait SheenSource<'a>: JsonView<'a> {
-    fn read(self) -> Read<'a>;
-}
-
-impl<'a> SheenSource<'a> for &'a Value {
-    fn read(self) -> Read<'a> {
-        Read::Value(self.clone())
-    }
-}
-
-impl<'a> SheenSource<'a> for Node<'a> {
-    fn read(self) -> Read<'a> {
-        Read::Node(self)
-    }
-}
+pub use super::material::{Read, Sheen, SheenSource};
 
 /// The KHR_materials_fuzz object that stands for `sheen`, as compact text
-/// ([`write_compact`]), or `None` when the sheen is off. Keys follow the draft's parameter
+/// ([`write_compact`](crate::edit::splice::write_compact)), or `None` when the sheen is off. Keys follow the draft's parameter
 /// table. With `strength_texture`, the fuzzTexture slot reads it (the exact mode, whose bake
 /// fills it).
 pub fn fuzz_for(

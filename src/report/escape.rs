@@ -17,8 +17,8 @@ fn acts(c: char) -> bool {
         || matches!(c, '\u{2028}' | '\u{2029}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}')
 }
 
-/// `text` with every character that [`acts`] shown as `\uXXXX` (its code point in four hex
-/// digits, as JSON writes it).
+/// `text` with every control character, line or paragraph separator and bidirectional mark
+/// shown as `\uXXXX` (its code point in four hex digits, as JSON writes it).
 pub fn terminal(text: &str) -> Cow<'_, str> {
     if !text.chars().any(acts) {
         return Cow::Borrowed(text);
