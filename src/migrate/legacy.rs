@@ -14,8 +14,8 @@
 //! the ratified ones, and those are what gets migrated.
 
 use super::material::{number_like, texture_unusable, MaterialCx, MaterialPlan};
+use super::material::{Read, Sheen};
 use super::note::{Conversion, Note};
-use super::sheen_to_fuzz::{Read, Sheen};
 use super::textures::Contents;
 use crate::asset::pointer;
 use crate::bake::Channel;
