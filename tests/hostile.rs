@@ -1627,6 +1627,56 @@ fn an_index_of_two_to_the_64_plus_one_is_an_unresolved_reference() {
     assert!(error_findings(&validator.validate_file(&path)).is_empty());
 }
 
+#[test]
+fn a_lone_surrogate_escape_is_invalid_json_at_its_line_and_column() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("surrogate.gltf");
+    let validator = Validator::new(Schemas::builtin(), Settings::default());
+    // A leading surrogate with no trailing one, a trailing one alone, and a pair (valid).
+    for (name, expected) in [
+        (r#""\ud800""#, Some((2, 31))),
+        (r#""ab\udc00""#, Some((2, 32))),
+        (r#""\ud83d\ude00""#, None),
+    ] {
+        write(
+            &path,
+            format!(
+                "{{\"asset\": {{\"version\": \"2.0\"}},\n  \"materials\":[{{\"name\":{name}}}]}}"
+            ),
+        );
+        let report = validator.validate_file(&path);
+        let found: Vec<_> = report
+            .findings
+            .iter()
+            .map(|f| {
+                let at = f.diagnostic.position.unwrap();
+                (
+                    f.diagnostic.code,
+                    at.line,
+                    at.column,
+                    f.diagnostic.message.clone(),
+                )
+            })
+            .collect();
+        match expected {
+            Some((line, column)) => assert_eq!(
+                found,
+                [(
+                    "INVALID_JSON",
+                    line,
+                    column,
+                    format!(
+                        "line {line}, column {column}: a \\u escape of this string is half of \
+                         a UTF-16 surrogate pair without its other half, which is no character"
+                    )
+                )],
+                "{name}"
+            ),
+            None => assert!(found.is_empty(), "{name}: {found:?}"),
+        }
+    }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Interruption
 

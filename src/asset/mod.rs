@@ -343,33 +343,14 @@ fn load_text(
     let index = match built {
         Ok(index) => index,
         Err(refused) => {
-            // serde_json words the fault; it refuses what the index refuses (tested), but for
-            // a text too large to index.
-            let e = match serde_json::from_str::<serde::de::IgnoredAny>(parse_text) {
-                Err(e) => e,
-                Ok(_) => serde::de::Error::custom(match refused {
-                    tape::TapeError::TooLarge => "the JSON text is too large to index",
-                    tape::TapeError::Syntax(_) | tape::TapeError::TooDeep(_) => {
-                        "the JSON text could not be indexed"
-                    }
-                }),
-            };
+            let (at, message) = refusal(parse_text, refused);
             diagnostics.push(
                 Diagnostic::new(
                     &codes::INVALID_JSON,
                     "",
-                    format!(
-                        "line {}, column {}: {}",
-                        e.line(),
-                        e.column(),
-                        strip_position(&e.to_string())
-                    ),
+                    format!("line {}, column {}: {message}", at.line, at.column),
                 )
-                .at(crate::diagnostics::Position {
-                    line: e.line(),
-                    column: e.column(),
-                    offset: position::offset_of(parse_text, e.line(), e.column()),
-                }),
+                .at(at),
             );
             return Loaded {
                 asset: None,
@@ -459,6 +440,54 @@ fn check_buffer_length(
 }
 
 /// serde_json appends " at line L column C"; velvet states the position itself, first.
+/// Where and why a JSON text the index refused is wrong. serde_json words the fault and
+/// refuses what the index refuses (tested), with two exceptions: a text too large to index, and
+/// a string whose escapes do not make a string (a lone surrogate), which serde_json skips
+/// without decoding when it reads the whole text and refuses when it reads that string as one.
+fn refusal(text: &str, refused: tape::TapeError) -> (crate::diagnostics::Position, String) {
+    let found = |e: &serde_json::Error| {
+        let offset = position::offset_of(text, e.line(), e.column());
+        (
+            position::position_of(text, offset),
+            strip_position(&e.to_string()).to_owned(),
+        )
+    };
+    if let Err(e) = serde_json::from_str::<serde::de::IgnoredAny>(text) {
+        return found(&e);
+    }
+    match refused {
+        tape::TapeError::Syntax(start) => {
+            let mut string = serde_json::Deserializer::from_str(&text[start..]);
+            match <String as serde::Deserialize>::deserialize(&mut string) {
+                // The string starts a line of its own text: its fault lies `column` characters
+                // into it, on the line it starts on (a JSON string holds no raw line break).
+                Err(e) if e.line() == 1 => {
+                    let within = position::offset_of(&text[start..], 1, e.column());
+                    (
+                        position::position_of(text, start + within),
+                        // serde_json calls a lone trailing surrogate a "lone leading" one.
+                        "a \\u escape of this string is half of a UTF-16 surrogate pair \
+                         without its other half, which is no character"
+                            .to_owned(),
+                    )
+                }
+                _ => (
+                    position::position_of(text, start),
+                    "the JSON text could not be indexed".to_owned(),
+                ),
+            }
+        }
+        tape::TapeError::TooDeep(start) => (
+            position::position_of(text, start),
+            "the JSON text could not be indexed".to_owned(),
+        ),
+        tape::TapeError::TooLarge => (
+            position::position_of(text, 0),
+            "the JSON text is too large to index".to_owned(),
+        ),
+    }
+}
+
 fn strip_position(message: &str) -> &str {
     message.rsplit_once(" at line ").map_or(message, |(m, _)| m)
 }

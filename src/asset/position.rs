@@ -24,6 +24,11 @@ pub fn offset_of(text: &str, line: usize, column: usize) -> usize {
         .map_or(text.len(), |(i, _)| line_start + i)
 }
 
+/// The line and column of byte `offset` (on a character boundary) in `text`.
+pub fn position_of(text: &str, offset: usize) -> Position {
+    Cursor::new(text).advance_to(offset.min(text.len()))
+}
+
 /// Locates the values named by `pointers` in `text`, whose index `root` is: one entry per
 /// pointer, in the order given, `None` where a pointer names nothing. Each value's offset
 /// comes from its span in the index; the offsets are then sorted and the text read once, front
