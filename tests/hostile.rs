@@ -9,6 +9,7 @@ use std::cell::Cell;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use velvet::asset::{self, glb, limits, LoadOptions};
 use velvet::bake::codec::{self, CodecError};
 use velvet::diagnostics::Settings;
@@ -26,18 +27,53 @@ thread_local! {
     static LARGEST: Cell<usize> = const { Cell::new(0) };
 }
 
+/// Bytes allocated now, and the most at any moment, over every thread of the process: read by
+/// a test that runs alone in a process of its own ([`alone_in_a_process`]).
+static HEAP_NOW: AtomicUsize = AtomicUsize::new(0);
+static HEAP_PEAK: AtomicUsize = AtomicUsize::new(0);
+
+fn heap_grew(by: usize) {
+    let now = HEAP_NOW.fetch_add(by, Ordering::Relaxed) + by;
+    HEAP_PEAK.fetch_max(now, Ordering::Relaxed);
+}
+
 unsafe impl GlobalAlloc for LargestAllocation {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
         let _ = LARGEST.try_with(|l| l.set(l.get().max(layout.size())));
+        heap_grew(layout.size());
         System.alloc(layout)
     }
     unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        HEAP_NOW.fetch_sub(layout.size(), Ordering::Relaxed);
         System.dealloc(ptr, layout)
     }
     unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
         let _ = LARGEST.try_with(|l| l.set(l.get().max(new_size)));
+        if new_size >= layout.size() {
+            heap_grew(new_size - layout.size());
+        } else {
+            HEAP_NOW.fetch_sub(layout.size() - new_size, Ordering::Relaxed);
+        }
         System.realloc(ptr, layout, new_size)
     }
+}
+
+/// Whether this is the process [`alone_in_a_process`] started; otherwise starts it (this test
+/// binary, running test `name` alone) and asserts that the test passed there. The peak heap of
+/// a process is a test's own only when no other test runs beside it.
+fn alone_in_a_process(name: &str) -> bool {
+    if std::env::var_os("VELVET_TEST_ALONE").is_some() {
+        return true;
+    }
+    let out = Command::new(std::env::current_exe().unwrap())
+        .args([name, "--exact", "--nocapture", "--test-threads=1"])
+        .env("VELVET_TEST_ALONE", "1")
+        .output()
+        .unwrap();
+    let text =
+        String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success() && text.contains("1 passed"), "{text}");
+    false
 }
 
 #[global_allocator]
@@ -1677,6 +1713,83 @@ fn a_lone_surrogate_escape_is_invalid_json_at_its_line_and_column() {
     }
 }
 
+/// A list of a million equal node indices (2 MB) is one DUPLICATE_ELEMENTS finding, read with
+/// a peak heap of a small multiple of its text: jsonschema's own uniqueItems check and its
+/// error read every element into a value, some 240 bytes an element (a 62 MB list took 7 GB).
+#[test]
+fn a_million_equal_node_indices_are_one_finding_within_a_small_multiple_of_the_text() {
+    const NAME: &str =
+        "a_million_equal_node_indices_are_one_finding_within_a_small_multiple_of_the_text";
+    if !alone_in_a_process(NAME) {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("nodes.gltf");
+    let list = vec!["0"; 1_000_000].join(",");
+    let text = format!(
+        "{{\"asset\":{{\"version\":\"2.0\"}},\"scenes\":[{{\"nodes\":[{list}]}}],\"nodes\":[{{}}]}}"
+    );
+    write(&path, &text);
+    let validator = Validator::new(Schemas::builtin(), Settings::default());
+    let before = HEAP_NOW.load(Ordering::Relaxed);
+    HEAP_PEAK.store(before, Ordering::Relaxed);
+    let report = validator.validate_file(&path);
+    let peak = HEAP_PEAK.load(Ordering::Relaxed) - before;
+    assert_eq!(
+        error_findings(&report),
+        [("DUPLICATE_ELEMENTS", "/scenes/0/nodes")]
+    );
+    eprintln!("peak heap {peak} bytes for a text of {} bytes", text.len());
+    assert!(
+        peak < 20 * text.len(),
+        "peak heap {peak} bytes for a text of {}",
+        text.len()
+    );
+}
+
+/// A PNG whose header reads but whose data is cut short, or whose data chunk fails its CRC,
+/// cannot be baked: migrate's plan finds that (not the bake after it) and carries the roughness
+/// texture as it is with the roughness copied, as it does for an image it cannot read at all;
+/// the dry run says the same, and the file is written.
+#[test]
+fn a_truncated_or_damaged_png_is_carried_as_it_is_by_the_plan_not_a_failed_bake() {
+    let good = png(64, 64, image::ExtendedColorType::Rgba8);
+    let idat = good.windows(4).position(|w| w == b"IDAT").unwrap();
+    let idat_len = u32::from_be_bytes(good[idat - 4..idat].try_into().unwrap()) as usize;
+    let mut bad_crc = good.clone();
+    bad_crc[idat + 4 + idat_len] ^= 0xff;
+    let truncated = good[..good.len() / 2].to_vec();
+    for (name, bytes, why) in [
+        ("truncated", truncated, "unexpected end of file"),
+        ("bad-crc", bad_crc, "CRC error"),
+    ] {
+        let dir = tempfile::tempdir().unwrap();
+        write(&dir.path().join("t.png"), &bytes);
+        let input = dir.path().join(format!("{name}.gltf"));
+        write(
+            &input,
+            serde_json::to_string_pretty(&sheen_document("t.png")).unwrap(),
+        );
+        let (status, dry, err) = velvet(&["migrate", s(&input), "--dry-run", "-v"]);
+        assert_eq!(status, 0, "{name}: {dry}{err}");
+        let warning = "warning: the roughness texture cannot be baked through the roughness \
+                       mapping (image 0 cannot be decoded: ";
+        assert!(dry.contains(warning) && dry.contains(why), "{name}: {dry}");
+        let out = dir.path().join("out");
+        let (status, written, err) = velvet(&["migrate", s(&input), "--out-dir", s(&out), "-v"]);
+        assert_eq!(status, 0, "{name}: {written}{err}");
+        assert!(written.contains(warning), "{name}: {written}");
+        let migrated: Value =
+            serde_json::from_slice(&std::fs::read(out.join(format!("{name}.gltf"))).unwrap())
+                .unwrap();
+        let fuzz = &migrated["materials"][0]["extensions"]["KHR_materials_fuzz"];
+        assert_eq!(fuzz["fuzzRoughnessTexture"], json!({"index": 0}), "{name}");
+        assert_eq!(fuzz["fuzzRoughnessFactor"], json!(0.5), "{name}");
+        assert_eq!(migrated["images"], json!([{"uri": "t.png"}]), "{name}");
+        assert_eq!(std::fs::read(out.join("t.png")).unwrap(), bytes, "{name}");
+    }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Interruption
 
@@ -2067,6 +2180,42 @@ fn a_16384_square_16_bit_png_over_the_memory_budget_is_refused_before_decoding()
     let (status, _, err) = velvet(&["bake", s(&input), "--dry-run", "--max-memory", "lots"]);
     assert_eq!(status, 2, "{err}");
     assert!(err.contains("\"lots\" is not a byte count"), "{err}");
+}
+
+/// The memory budget holds for the decodes of a run together: a decode that fits the budget
+/// alone waits while others hold too much of it, and goes on once they give it back. A 64²
+/// RGBA image takes 48 KiB to bake; with 40,000 bytes of a 64 KiB budget held, its decode waits.
+#[test]
+fn decodes_side_by_side_share_one_memory_budget() {
+    let png = png(64, 64, image::ExtendedColorType::Rgba8);
+    let budget = 64 << 10;
+    let held = limits::reserve("another decode", 40_000, budget).unwrap();
+    let (done_tx, done_rx) = std::sync::mpsc::channel();
+    let decoding = std::thread::spawn(move || {
+        let decoded = codec::decode_within(&png, 1 << 20, budget).map(|(pixels, _)| pixels.width());
+        done_tx.send(()).unwrap();
+        decoded
+    });
+    assert!(
+        done_rx
+            .recv_timeout(std::time::Duration::from_millis(300))
+            .is_err(),
+        "the decode went on while the budget was held"
+    );
+    drop(held);
+    done_rx
+        .recv_timeout(std::time::Duration::from_secs(20))
+        .expect("the decode goes on once the budget is given back");
+    assert_eq!(decoding.join().unwrap().unwrap(), 64);
+    // Over the budget alone, it is refused at once, naming the flag.
+    let alone = limits::reserve("decoding a big image", budget + 1, budget)
+        .err()
+        .unwrap();
+    assert_eq!(
+        alone,
+        "decoding a big image needs about 64.0 KiB, over the memory budget of 64.0 KiB (raise \
+         it with --max-memory)"
+    );
 }
 
 /// A GLB whose bytes and BIN copy would exceed the memory budget is refused before it is read

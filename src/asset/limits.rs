@@ -91,6 +91,45 @@ pub fn over_memory_budget(what: &str, needed: u64, budget: u64) -> Option<String
     })
 }
 
+/// The memory that the decodes running now have reserved, summed over every thread of the
+/// process: each decode reserves what it needs before it starts and gives it back when it
+/// ends, so that images decoded side by side stay within the budget together, not each alone.
+static RESERVED: std::sync::Mutex<u64> = std::sync::Mutex::new(0);
+static RELEASED: std::sync::Condvar = std::sync::Condvar::new();
+
+/// Memory reserved by [`reserve`], given back when dropped.
+#[must_use = "the memory is given back when the reservation is dropped"]
+pub struct Reservation(u64);
+
+/// Reserves `needed` bytes of the memory budget `budget` for `what`: refused (the message
+/// names `--max-memory`) when `needed` alone is over the budget; otherwise waits until the
+/// decodes running beside it leave room, then holds it. A holder never waits for more while it
+/// holds (a decode reserves once), so waiting always ends.
+pub fn reserve(what: &str, needed: u64, budget: u64) -> Result<Reservation, String> {
+    if let Some(message) = over_memory_budget(what, needed, budget) {
+        return Err(message);
+    }
+    let mut reserved = RESERVED.lock().unwrap_or_else(|e| e.into_inner());
+    while reserved.saturating_add(needed) > budget && *reserved > 0 {
+        reserved = RELEASED.wait(reserved).unwrap_or_else(|e| e.into_inner());
+    }
+    *reserved += needed;
+    Ok(Reservation(needed))
+}
+
+/// The memory reserved now by decodes running in this process.
+pub fn reserved() -> u64 {
+    *RESERVED.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+impl Drop for Reservation {
+    fn drop(&mut self) {
+        let mut reserved = RESERVED.lock().unwrap_or_else(|e| e.into_inner());
+        *reserved -= self.0;
+        RELEASED.notify_all();
+    }
+}
+
 impl Default for LoadOptions {
     fn default() -> Self {
         LoadOptions {

@@ -66,6 +66,8 @@ pub struct Asset {
     /// The limits and URI policy it was loaded with; resources are read under them too.
     pub options: LoadOptions,
     image_headers: Mutex<HashMap<usize, Result<ImageHeader, Diagnostic>>>,
+    /// Whether each image asked about decodes, and why not (see [`Asset::image_decodes`]).
+    image_decodes: Mutex<HashMap<usize, Result<(), String>>>,
     /// The folder with its links resolved, found once on the first resource read.
     real_base: OnceLock<Option<PathBuf>>,
 }
@@ -384,6 +386,7 @@ fn load_text(
             other_chunks: Vec::new(),
             options: *options,
             image_headers: Mutex::new(HashMap::new()),
+            image_decodes: Mutex::new(HashMap::new()),
             real_base: OnceLock::new(),
         }),
         diagnostics,
@@ -703,11 +706,63 @@ impl Asset {
                 ))
             }
         };
-        let mut reader = image::ImageReader::with_format(Cursor::new(bytes.as_ref()), format);
-        let mut limits = image::Limits::default();
-        limits.max_alloc = Some(self.options.max_decode_bytes());
-        reader.limits(limits);
-        reader.decode().map_err(|e| unreadable(e.to_string()))
+        let reader = image::ImageReader::with_format(Cursor::new(bytes.as_ref()), format);
+        let mut decoder = reader
+            .into_decoder()
+            .map_err(|e| unreadable(e.to_string()))?;
+        // The pixels returned, one copy; held against the budget with every other decode of
+        // the run while this one lasts.
+        let needed = u64::from(header.width)
+            .saturating_mul(u64::from(header.height))
+            .saturating_mul(u64::from(
+                image::ImageDecoder::color_type(&decoder).bytes_per_pixel(),
+            ));
+        let what = format!(
+            "decoding the {} × {} {:?} image",
+            header.width,
+            header.height,
+            image::ImageDecoder::color_type(&decoder)
+        );
+        let _reserved = limits::reserve(&what, needed, self.options.max_memory).map_err(|m| {
+            Diagnostic::new(
+                &codes::IMAGE_TOO_LARGE,
+                &pointer,
+                format!("image {index}: {m}; it was not decoded"),
+            )
+        })?;
+        let mut decode_limits = image::Limits::default();
+        decode_limits.max_alloc = Some(self.options.max_decode_bytes());
+        image::ImageDecoder::set_limits(&mut decoder, decode_limits)
+            .map_err(|e| unreadable(e.to_string()))?;
+        image::DynamicImage::from_decoder(decoder).map_err(|e| unreadable(e.to_string()))
+    }
+
+    /// Whether the data of image `index` is whole, found once per asset by decoding it (the
+    /// pixels are dropped): `Err` says how it is damaged. A plan that bakes an image asks this
+    /// first: a header can be whole while the data after it is cut short or damaged, and only a
+    /// decode tells, so that the plan, not the bake after it, finds an image that cannot be
+    /// baked and takes the way round it. An image velvet will not decode under the run's limits
+    /// (pixels, memory) or cannot read is no damage: the bake then fails naming the limit, so
+    /// that what a file becomes never depends on a limit.
+    pub fn image_decodes(&self, index: usize) -> Result<(), String> {
+        if let Some(known) = self
+            .image_decodes
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .get(&index)
+        {
+            return known.clone();
+        }
+        // Decoded outside the lock: other images are checked meanwhile.
+        let found = match self.decode_image(index) {
+            Err(d) if d.code == codes::IMAGE_DATA_INVALID.name => Err(d.message),
+            _ => Ok(()),
+        };
+        self.image_decodes
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .insert(index, found.clone());
+        found
     }
 
     /// The header of image `index`, read once per asset. A file is opened and only its header

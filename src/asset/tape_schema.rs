@@ -108,6 +108,20 @@ impl<'a> json::Node<'a, TapeJson> for Node<'a> {
     fn to_value(&self) -> Cow<'a, Value> {
         Cow::Owned(Node::to_value(self))
     }
+    /// An array or object an error names is read into a value only when the error's instance
+    /// is asked for: jsonschema makes the error of a failed `uniqueItems` (or `maxItems`) with
+    /// its instance, and a list of millions of node indices took some 240 bytes an element.
+    fn lazy_value(&self) -> jsonschema_value::LazyInstance<'a> {
+        match self.kind() {
+            Kind::Array | Kind::Object => jsonschema_value::LazyInstance::Deferred {
+                bytes: self.raw().as_bytes(),
+                tag: 0,
+                make: |bytes, _| serde_json::from_slice(bytes).unwrap_or(Value::Null),
+                cell: std::sync::OnceLock::new(),
+            },
+            _ => jsonschema_value::LazyInstance::Ready(Cow::Owned(Node::to_value(self))),
+        }
+    }
     fn identity(&self) -> Option<NodeIdentity> {
         Some(NodeIdentity::tagged(self.document_address(), self.id()))
     }
@@ -139,4 +153,49 @@ impl<'a> json::Array<'a, TapeJson> for tape::Array<'a> {
     fn elements(&self) -> tape::Elements<'a> {
         self.iter()
     }
+
+    /// `uniqueItems`. jsonschema's own check reads every element into a `Value` first, some
+    /// 240 bytes an element: a 62 MB list of node indices took 7 GB. glTF's unique lists are
+    /// of integers (node, joint and attribute indices) or strings (extension names); a list of
+    /// integers that fit 64 bits is compared by their values here, 8 bytes an element, and
+    /// any other list as jsonschema compares it.
+    fn is_unique(&self) -> bool {
+        match integers(self) {
+            Some((mut unsigned, mut negative)) => {
+                unsigned.sort_unstable();
+                negative.sort_unstable();
+                !(unsigned.windows(2).any(|w| w[0] == w[1])
+                    || negative.windows(2).any(|w| w[0] == w[1]))
+            }
+            None => {
+                let values: Vec<Value> = self.iter().map(|e| e.to_value()).collect();
+                json::unique::is_unique(&values)
+            }
+        }
+    }
+}
+
+/// The elements of `array` as integers, the non-negative ones and the negative ones apart (a
+/// negative i64 equals no u64); `None` unless every element is an integer written as one
+/// (`1.0` and `1e2` are left to jsonschema) that fits 64 bits. Stops early at two equal
+/// neighbours (`[0, 0, …]`), answering with just them.
+fn integers(array: &tape::Array<'_>) -> Option<(Vec<u64>, Vec<i64>)> {
+    let mut unsigned = Vec::with_capacity(array.len());
+    let mut negative = Vec::new();
+    let mut previous: Option<&str> = None;
+    for element in array.iter() {
+        if element.kind() != Kind::Number {
+            return None;
+        }
+        let text = element.raw();
+        if previous == Some(text) {
+            return Some((vec![0, 0], Vec::new()));
+        }
+        previous = Some(text);
+        match text.parse::<u64>() {
+            Ok(u) => unsigned.push(u),
+            Err(_) => negative.push(text.parse::<i64>().ok().filter(|i| *i < 0)?),
+        }
+    }
+    Some((unsigned, negative))
 }

@@ -205,12 +205,14 @@ pub fn decode_within(
         "decoding the {width} × {height} {:?} image",
         decoder.color_type()
     );
-    if let Some(message) = crate::asset::limits::over_memory_budget(&what, needed, max_memory) {
-        return Err(CodecError::TooLarge {
-            format: format_name(format),
-            message: format!("{message}; it was not decoded"),
-        });
-    }
+    // Held against the budget with every other decode of the run until this one returns.
+    let _reserved =
+        crate::asset::limits::reserve(&what, needed, max_memory).map_err(|message| {
+            CodecError::TooLarge {
+                format: format_name(format),
+                message: format!("{message}; it was not decoded"),
+            }
+        })?;
     // Within the pixel limit, the allocation limit stops what the header did not tell (a
     // decoder's own buffers) from growing past what such an image needs.
     let mut limits = Limits::default();

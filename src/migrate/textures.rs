@@ -254,8 +254,8 @@ impl std::fmt::Display for TextureBake {
 }
 
 /// The images texture `index` reads, each with where the texture names it; `Err` says why the
-/// texture cannot be baked (no such texture or image, an image that cannot be read, no
-/// source, a KTX2 source).
+/// texture cannot be baked (no such texture or image, an image that cannot be read or
+/// decoded, no source, a KTX2 source).
 pub fn sources(asset: &Asset, index: usize) -> Result<Vec<(String, usize)>, String> {
     let json = asset.root();
     let texture = json
@@ -290,6 +290,11 @@ pub fn sources(asset: &Asset, index: usize) -> Result<Vec<(String, usize)>, Stri
                 "texture {index} has a KTX2 source (image {image}); {KTX2_REASON}"
             ));
         }
+        asset.image_decodes(image).map_err(|why| {
+            let prefix = format!("image {image}: ");
+            let detail = why.strip_prefix(&prefix).unwrap_or(&why);
+            format!("image {image} cannot be decoded: {detail}")
+        })?;
         out.push((within, image));
     }
     if out.is_empty() {
