@@ -687,6 +687,61 @@ fn writing_never_follows_outside_uris_and_outputs_stay_in_the_out_dir() {
     }
 }
 
+/// An absolute path or a `file:` URI cannot be kept by a self-contained output any more than
+/// `../` can: migrate and bake into another folder fail the file naming the URI, write
+/// nothing, and with --rewrite-uris keep the URI as it is.
+#[test]
+fn absolute_and_file_uris_fail_a_self_contained_output_as_dot_dot_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = dir.path();
+    let texture = root.join("shared/tex.png");
+    write(&texture, png(2, 2, image::ExtendedColorType::Rgba8));
+    let absolute = texture.to_str().unwrap().to_owned();
+    for (name, uri) in [
+        ("absolute", absolute.clone()),
+        ("file-uri", format!("file://{absolute}")),
+        ("dot-dot", "../shared/tex.png".to_owned()),
+    ] {
+        let input = root.join(format!("assets/{name}.gltf"));
+        write(&input, sheen_document(&uri).to_string());
+        for command in ["migrate", "bake"] {
+            let out_dir = root.join(format!("out-{command}-{name}"));
+            let (status, out, err) = velvet(&[
+                command,
+                s(&input),
+                "--out-dir",
+                s(&out_dir),
+                "--allow-outside-uris",
+            ]);
+            assert_eq!(status, 1, "{command} {name}: {out}{err}");
+            let why = if name == "dot-dot" {
+                format!("'{uri}' leads out of the input's folder, so a self-contained output cannot keep it (--rewrite-uris refers to it where it is)")
+            } else {
+                format!("'{uri}' names a file by its absolute place, so a self-contained output cannot keep it (--rewrite-uris keeps it as it is)")
+            };
+            assert!(out.contains(&why), "{command} {name}: {out}");
+            assert!(!out_dir.exists(), "{command} {name}");
+        }
+        if name != "dot-dot" {
+            let out_dir = root.join(format!("out-rewrite-{name}"));
+            let (status, out, err) = velvet(&[
+                "migrate",
+                s(&input),
+                "--out-dir",
+                s(&out_dir),
+                "--allow-outside-uris",
+                "--rewrite-uris",
+            ]);
+            assert_eq!(status, 0, "{name}: {out}{err}");
+            let migrated: Value = serde_json::from_slice(
+                &std::fs::read(out_dir.join(format!("{name}.gltf"))).unwrap(),
+            )
+            .unwrap();
+            assert_eq!(migrated["images"][0]["uri"], json!(uri), "{name}");
+        }
+    }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Nothing lost
 

@@ -11,8 +11,9 @@
 //! the output and its URI kept, so no output URI leaves its folder and the output tree can be
 //! moved as a whole. A URI that climbs out of the input's folder cannot be kept so:
 //! the file fails, naming it. `--rewrite-uris` (the old behaviour) rewrites each URI to lead
-//! back to the input's folder instead. `data:` URIs, URIs with a scheme and absolute paths need
-//! neither.
+//! back to the input's folder instead. An absolute path or a `file:` URI fails the file as
+//! `../` does (with `--rewrite-uris` it is kept as it is); `data:` URIs and URIs with another
+//! scheme need neither.
 //!
 //! [`check_links`] refuses, before anything of the asset is read, a resource that reaches
 //! outside the input's folder through a symbolic link: it would otherwise be read, baked or
@@ -286,6 +287,22 @@ fn is_relative_path(uri: &str) -> bool {
     }
 }
 
+/// A URI that names a local file by an absolute path: `/…`, `\\…`, a drive letter (`C:/…`)
+/// or a `file:` URI.
+fn is_local_absolute(uri: &str) -> bool {
+    let bytes = uri.as_bytes();
+    let drive = bytes.len() >= 3
+        && bytes[0].is_ascii_alphabetic()
+        && bytes[1] == b':'
+        && matches!(bytes[2], b'/' | b'\\');
+    uri.starts_with('/')
+        || uri.starts_with('\\')
+        || drive
+        || uri
+            .get(..5)
+            .is_some_and(|s| s.eq_ignore_ascii_case("file:"))
+}
+
 /// The folder a file lies in: its parent, or "." for a bare file name.
 pub fn folder_of(path: &Path) -> &Path {
     match path.parent() {
@@ -364,14 +381,20 @@ pub fn relocate(asset: &Asset, output: &Path, rewrite_uris: bool) -> Result<Relo
             continue;
         };
         for (i, item) in items.iter().enumerate() {
-            let Some(uri) = item
-                .get("uri")
-                .and_then(|u| u.as_str())
-                .filter(|u| is_relative_path(u))
-            else {
+            let Some(uri) = item.get("uri").and_then(|u| u.as_str()) else {
                 continue;
             };
             let uri: &str = &uri;
+            if !is_relative_path(uri) {
+                // An absolute path or file: URI names a file on this machine, outside any
+                // folder the output could be moved with: refused as a `../` URI is.
+                if !rewrite_uris && is_local_absolute(uri) {
+                    return Err(format!(
+                        "'{uri}' names a file by its absolute place, so a self-contained output cannot keep it (--rewrite-uris keeps it as it is)"
+                    ));
+                }
+                continue;
+            }
             let pointer = format!("/{kind}/{i}/uri");
             if !rewrite_uris {
                 let from = match resource::resolve(uri, from_dir, &pointer) {
