@@ -9,7 +9,10 @@
 //! - migrate leaves every byte of the JSON it does not own as it was: with the sheen and fuzz
 //!   objects and `extensionsUsed` set aside, the output's text equals the input's;
 //! - a migration's edits spliced part by part (each part read back alone) give the text the
-//!   whole edited document gives.
+//!   whole edited document gives;
+//! - under every migrate option, each number the plan sets (what the dry run, `--check` and the
+//!   reports show) is the number the written file holds, and the preview's "as migrated" layer
+//!   is the layer the written file holds.
 
 use base64::Engine;
 use proptest::prelude::*;
@@ -442,6 +445,117 @@ proptest! {
         let rewritten = velvet::edit::splice::rewrite(&text, asset.root(), &whole);
         prop_assert!(spliced.is_some());
         prop_assert_eq!(spliced, rewritten);
+    }
+}
+
+/// The migrate options a property is held to: the default, `--exact`, `--roughness-budget
+/// exact`, `--fast` and `--roughness identity`.
+fn migrate_options(which: usize) -> Options {
+    match which {
+        0 => Options::default(),
+        1 => Options {
+            exact: true,
+            ..Options::default()
+        },
+        2 => Options {
+            budget: migrate::budget::Budget::Exact,
+            ..Options::default()
+        },
+        3 => Options {
+            fast: true,
+            ..Options::default()
+        },
+        _ => Options {
+            roughness: migrate::roughness::RoughnessMapping::Identity,
+            ..Options::default()
+        },
+    }
+}
+
+/// Every number below `value` (arrays of numbers whole), each with its pointer under `at`.
+fn numbers_below(at: &str, value: &Value, out: &mut Vec<(String, Value)>) {
+    match value {
+        Value::Object(members) => {
+            for (key, member) in members {
+                numbers_below(&format!("{at}/{key}"), member, out);
+            }
+        }
+        Value::Array(items) if items.iter().all(Value::is_number) => {
+            out.push((at.to_string(), value.clone()))
+        }
+        Value::Number(_) => out.push((at.to_string(), value.clone())),
+        _ => {}
+    }
+}
+
+fn numbers(value: &Value) -> Vec<f64> {
+    value
+        .as_array()
+        .map(|a| a.iter().filter_map(Value::as_f64).collect())
+        .unwrap_or_default()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(CASES))]
+
+    #[test]
+    fn the_plan_and_the_preview_show_the_numbers_the_written_file_holds(
+        doc in document(),
+        which in 0..5usize,
+    ) {
+        let options = migrate_options(which);
+        let (dir, input) = written(&doc);
+        let output = dir.path().join("out.gltf");
+        let report = migrate::run(&migrate::Request {
+            inputs: vec![input.clone()],
+            destination: Destination::File(output.clone()),
+            options: options.clone(),
+            dry_run: false,
+            progress: false,
+        })
+        .unwrap();
+        let result = report.files.into_iter().next().unwrap();
+        prop_assert!(
+            matches!(result.outcome, FileOutcome::Changed | FileOutcome::Copied),
+            "{:?}", result.outcome
+        );
+        let file: Value = serde_json::from_slice(&std::fs::read(&output).unwrap()).unwrap();
+        for material in &result.materials {
+            for edit in &material.edits {
+                let velvet::edit::Edit::Set { pointer, value } = edit else { continue };
+                let mut planned = Vec::new();
+                numbers_below(pointer, &value.to_value(), &mut planned);
+                for (at, number) in planned {
+                    // A textureInfo's index names the texture before the bake; the bake line
+                    // of the plan says which texture it becomes.
+                    if at.ends_with("Texture/index") {
+                        continue;
+                    }
+                    prop_assert_eq!(file.pointer(&at), Some(&number), "option set {}: {}", which, at);
+                }
+            }
+        }
+        let asset = velvet::asset::load(&input).asset.unwrap();
+        let plan = migrate::plan::plan_document(&asset, &options);
+        for m in velvet::preview::material::materials(&asset, &plan, options.roughness) {
+            let extensions = &file["materials"][m.index]["extensions"];
+            match m.kind {
+                velvet::preview::material::Kind::SheenToFuzz => {
+                    let fuzz = &extensions["KHR_materials_fuzz"];
+                    let written = m.factors.written_fuzz.unwrap();
+                    prop_assert_eq!(Some(written.weight), fuzz["fuzzFactor"].as_f64());
+                    prop_assert_eq!(Some(written.roughness), fuzz["fuzzRoughnessFactor"].as_f64());
+                    prop_assert_eq!(written.color.to_vec(), numbers(&fuzz["fuzzColorFactor"]));
+                }
+                velvet::preview::material::Kind::FuzzFallback => {
+                    let sheen = &extensions["KHR_materials_sheen"];
+                    let written = m.factors.written_sheen.unwrap();
+                    prop_assert_eq!(Some(written.roughness), sheen["sheenRoughnessFactor"].as_f64());
+                    prop_assert_eq!(written.color.to_vec(), numbers(&sheen["sheenColorFactor"]));
+                }
+                velvet::preview::material::Kind::FuzzWithSheen => {}
+            }
+        }
     }
 }
 
