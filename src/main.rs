@@ -76,7 +76,8 @@ enum Command {
         dir: Option<PathBuf>,
     },
     /// Numeric reports for developers: what velvet's shading methods cost and how far they are
-    /// off (docs/shading.md). Not part of the user interface.
+    /// off (docs/shading.md). Not part of the user interface: built with `--features bench`.
+    #[cfg(feature = "bench")]
     #[command(subcommand, hide = true)]
     Bench(velvet::shading::bench::BenchCommand),
 }
@@ -387,6 +388,7 @@ fn main() -> ExitCode {
             ExitCode::SUCCESS
         }
         Command::Man { dir } => man(dir),
+        #[cfg(feature = "bench")]
         Command::Bench(cmd) => {
             match velvet::shading::bench::run(&cmd, &mut std::io::stdout().lock()) {
                 Ok(()) => ExitCode::SUCCESS,

@@ -1277,13 +1277,22 @@ fn command_line_ignore_adds_to_the_files_ignore() {
 }
 
 #[test]
-fn bench_is_not_in_the_users_help_but_still_runs() {
+fn bench_is_not_in_the_users_help_and_runs_only_in_a_bench_build() {
     let help = stdout(&velvet(&["--help"]));
     assert!(!help.contains("bench"), "{help}");
     assert!(help.contains("validate") && help.contains("migrate") && help.contains("bake"));
     let o = velvet(&["bench", "--help"]);
-    assert_eq!(o.status.code(), Some(0));
-    assert!(stdout(&o).contains("accuracy"));
+    if cfg!(feature = "bench") {
+        assert_eq!(o.status.code(), Some(0));
+        assert!(stdout(&o).contains("accuracy"));
+    } else {
+        assert_eq!(o.status.code(), Some(2));
+        assert!(
+            String::from_utf8_lossy(&o.stderr).contains("unrecognized subcommand 'bench'"),
+            "{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    }
 }
 
 // ---------------------------------------------------------------- folded, ordered text output

@@ -1,13 +1,14 @@
-//! The shading API as other modules call it, and `velvet bench accuracy` as users run it.
+//! The shading API as other modules call it, and, in a build with the `bench` feature,
+//! `velvet bench accuracy` as developers run it.
 
-use std::process::Command;
 use velvet::migrate::roughness::{self, Direction, RoughnessMapping};
 use velvet::shading::layering::{sheen_to_fuzz_attenuation_difference, FuzzParams, SheenParams};
 use velvet::shading::mapping::layer_match;
 use velvet::shading::{sheen_albedo, AlbedoMethod};
 
+#[cfg(feature = "bench")]
 fn velvet(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_velvet"))
+    std::process::Command::new(env!("CARGO_BIN_EXE_velvet"))
         .args(args)
         .output()
         .expect("run velvet")
@@ -64,6 +65,7 @@ fn sheen_to_fuzz_difference_uses_the_fuzz_model_and_the_mapping_narrows_it() {
     assert!(fitted.max_ordinary < identity.max_ordinary);
 }
 
+#[cfg(feature = "bench")]
 #[test]
 fn points_file_gives_csv_with_one_row_per_point() {
     let dir = tempfile::tempdir().unwrap();
@@ -88,6 +90,7 @@ fn points_file_gives_csv_with_one_row_per_point() {
     }
 }
 
+#[cfg(feature = "bench")]
 #[test]
 fn a_bad_points_row_exits_2_naming_the_file_and_line() {
     let dir = tempfile::tempdir().unwrap();
@@ -106,6 +109,7 @@ fn a_bad_points_row_exits_2_naming_the_file_and_line() {
     );
 }
 
+#[cfg(feature = "bench")]
 #[test]
 fn a_missing_points_file_exits_2_naming_it() {
     let out = velvet(&["bench", "accuracy", "--points", "no-such-points.csv"]);
@@ -117,6 +121,7 @@ fn a_missing_points_file_exits_2_naming_it() {
     );
 }
 
+#[cfg(feature = "bench")]
 #[test]
 fn points_and_plot_together_are_a_usage_error() {
     let out = velvet(&["bench", "accuracy", "--points", "a.csv", "--plot", "b.svg"]);

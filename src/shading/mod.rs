@@ -1,11 +1,14 @@
 //! Sheen and fuzz shading maths (f64): the Charlie sheen BRDF of KHR_materials_sheen
 //! ([`charlie`]), its directional albedo E(μ, r) by three methods behind one function
 //! ([`sheen_albedo`]: quadrature in [`albedo`], tables in [`table`], a closed-form fit in [`fit`]),
-//! the layering of sheen and fuzz over a base ([`layering`]), and the speed-against-error report
-//! ([`accuracy`], drawn by [`plot`], run by `velvet bench` through [`bench`](mod@bench)).
+//! the layering of sheen and fuzz over a base ([`layering`]). With the `bench` feature, the
+//! speed-against-error report (`accuracy`, drawn by `plot`, run by `velvet bench` through
+//! `bench`): developer tooling, outside the default library and binary.
 
+#[cfg(feature = "bench")]
 pub mod accuracy;
 pub mod albedo;
+#[cfg(feature = "bench")]
 pub mod bench;
 pub mod charlie;
 pub mod fit;
@@ -14,6 +17,7 @@ mod fuzz_table;
 pub mod layering;
 pub mod mapping;
 mod mapping_table;
+#[cfg(feature = "bench")]
 pub mod plot;
 pub mod quadrature;
 pub mod table;
