@@ -9,7 +9,8 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use std::time::Duration;
-use velvet::migrate::{self, Options, Request};
+use velvet::command::migrate::{self as migrating, Request};
+use velvet::migrate::Options;
 use velvet::output::paths::Destination;
 
 /// Material `i` of a generated asset: the kind cycles so that every conversion is exercised.
@@ -75,7 +76,7 @@ fn many_files(dir: &Path) -> PathBuf {
     root
 }
 
-fn run(input: &Path, out: &Path) -> migrate::RunReport {
+fn run(input: &Path, out: &Path) -> migrating::RunReport {
     let request = Request {
         inputs: vec![input.to_path_buf()],
         destination: Destination::Dir(out.to_path_buf()),
@@ -83,7 +84,7 @@ fn run(input: &Path, out: &Path) -> migrate::RunReport {
         dry_run: false,
         progress: false,
     };
-    let report = migrate::run(&request).unwrap();
+    let report = migrating::run(&request).unwrap();
     assert!(!report.failed());
     report
 }
@@ -101,7 +102,7 @@ fn benches(c: &mut Criterion) {
         report.summary
     );
     let report = run(&tree, &out);
-    assert_eq!(report.summary.files, 500);
+    assert_eq!(report.summary.totals.files, 500);
 
     let mut group = c.benchmark_group("migrate");
     group

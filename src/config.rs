@@ -564,6 +564,50 @@ impl Config {
     }
 }
 
+/// The settings a command line gives (`--config`, `--max-issues`, `--ignore`, `--only`,
+/// `--override`, `--fail-on`), read as `validate` and `config` read them: each beats
+/// velvet.toml, key by key.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Flags {
+    /// `--config FILE`: one configuration for every input instead of the velvet.toml found.
+    pub config: Option<PathBuf>,
+    pub max_issues: Option<usize>,
+    pub ignore: Vec<String>,
+    pub only: Vec<String>,
+    /// `CODE=SEVERITY`, as given.
+    pub overrides: Vec<String>,
+    pub fail_on: Option<FailOn>,
+}
+
+impl Flags {
+    /// The resolver of every input's configuration under these flags.
+    pub fn resolver(&self) -> Result<Resolver, ConfigError> {
+        let layer = Layer::command_line(
+            self.max_issues,
+            &self.ignore,
+            &self.only,
+            &self.overrides,
+            self.fail_on,
+        )?;
+        Resolver::new(self.config.as_deref(), layer)
+    }
+
+    /// velvet.toml text of the configuration in force for `path`, with where each value
+    /// comes from (`velvet config`), and whether it excludes `path`.
+    pub fn show(&self, path: &Path) -> Result<String, ConfigError> {
+        let config = self.resolver()?.for_path(path)?;
+        let mut text = String::new();
+        if config.excludes(&absolute(path)) {
+            text += &format!(
+                "# {} is excluded by this configuration\n",
+                crate::asset::discover::display_path(path)
+            );
+        }
+        text += &config.to_toml();
+        Ok(text)
+    }
+}
+
 /// Finds the configuration for each path of a run, reading every velvet.toml once.
 pub struct Resolver {
     cli: Layer,

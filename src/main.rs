@@ -1,19 +1,19 @@
-//! The `velvet` command line: parses arguments, calls the library, maps outcomes to exit
-//! codes (0 clean, 1 issues at or above --fail-on or a file failed, 2 usage or configuration
-//! error).
+//! The `velvet` command line: parses the arguments into the library's requests, runs the
+//! command ([`velvet::command`]) and makes its status the exit code (0 clean, 1 issues at or
+//! above --fail-on or a file failed, 2 usage or configuration error, 130 / 143 stopped).
 
 use clap::{CommandFactory, Parser, Subcommand, ValueEnum};
-use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use velvet::asset::discover::{self, Shard};
 use velvet::cli_docs::{self, EXIT_STATUS, EXIT_STATUS_ALL};
-use velvet::config::{self, Layer, Resolver};
-use velvet::diagnostics::{FailOn, Settings};
+use velvet::command::{self, ReportFormat, Status};
+use velvet::config;
+use velvet::diagnostics::FailOn;
 use velvet::migrate;
+use velvet::output::paths::Destination;
+use velvet::output::summary::Detail;
 use velvet::report::{self, ColorChoice, Format};
-use velvet::rules::schema::Schemas;
-use velvet::validate::Validator;
 
 #[derive(Parser)]
 #[command(
@@ -183,12 +183,27 @@ impl InputArgs {
     /// The paths named on the command line and in the list, checked: a path that does not
     /// exist, or a folder without any asset, is a usage error.
     fn resolve(&self) -> Result<Vec<PathBuf>, discover::InputError> {
-        let mut paths = self.paths.clone();
-        if let Some(list) = &self.files_from {
-            paths.extend(discover::read_list(list)?);
-        }
-        discover::check_inputs(&paths)?;
-        Ok(paths)
+        discover::resolve(&self.paths, self.files_from.as_deref())
+    }
+}
+
+/// Where a file command writes, the same for migrate and bake.
+#[derive(clap::Args)]
+struct DestinationArgs {
+    /// Write the one input's output here (same container as the input).
+    #[arg(short = 'o', long = "output", value_name = "FILE", conflicts_with_all = ["out_dir", "in_place"])]
+    output: Option<PathBuf>,
+    /// Write outputs under DIR, mirroring each input folder's tree.
+    #[arg(long, value_name = "DIR", conflicts_with = "in_place")]
+    out_dir: Option<PathBuf>,
+    /// Overwrite the inputs (a file with nothing to change is not written).
+    #[arg(long)]
+    in_place: bool,
+}
+
+impl DestinationArgs {
+    fn destination(self) -> Destination {
+        Destination::from_flags(self.output, self.out_dir, self.in_place)
     }
 }
 
@@ -219,15 +234,8 @@ struct ValidateArgs {
 struct BakeArgs {
     #[command(flatten)]
     input: InputArgs,
-    /// The output file (one input only).
-    #[arg(short, long, value_name = "FILE", conflicts_with_all = ["out_dir", "in_place"])]
-    output: Option<PathBuf>,
-    /// A folder for the outputs, mirroring the inputs' trees.
-    #[arg(long, value_name = "DIR", conflicts_with = "in_place")]
-    out_dir: Option<PathBuf>,
-    /// Overwrite the inputs.
-    #[arg(long)]
-    in_place: bool,
+    #[command(flatten)]
+    destination: DestinationArgs,
     /// Print what would be baked; write nothing.
     #[arg(long)]
     dry_run: bool,
@@ -262,8 +270,8 @@ struct BakeArgs {
     #[arg(long, hide = true, conflicts_with = "rewrite_uris")]
     copy_resources: bool,
     /// Output format.
-    #[arg(long, value_enum, default_value_t = BakeFormat::Text)]
-    format: BakeFormat,
+    #[arg(long, value_enum, default_value_t = ReportFormat::Text)]
+    format: ReportFormat,
     #[command(flatten)]
     load: LoadArgs,
 }
@@ -291,14 +299,6 @@ enum Compression {
 }
 
 #[derive(Clone, Copy, ValueEnum)]
-enum BakeFormat {
-    /// A line per file, then a summary.
-    Text,
-    /// One JSON document: every file with its slots, outputs and notes.
-    Json,
-}
-
-#[derive(Clone, Copy, ValueEnum)]
 enum CodesFormat {
     /// One line per code: name, severity, description.
     Text,
@@ -312,36 +312,6 @@ enum FailOnArg {
     Warning,
     Info,
     Hint,
-}
-
-fn usage_error(message: impl std::fmt::Display) -> ExitCode {
-    eprintln!("velvet: {message}");
-    ExitCode::from(2)
-}
-
-/// When SIGINT or SIGTERM stopped a migrate or bake run: the one line saying what was finished
-/// (`finished` says it of each file) and the exit status, 128 + the signal. Files that failed
-/// for another reason are counted with those not finished: nothing of either was written.
-fn stopped(finished: impl Iterator<Item = bool>) -> Option<ExitCode> {
-    let signal = velvet::output::interrupt::requested()?;
-    let (mut done, mut total) = (0usize, 0usize);
-    for finished in finished {
-        total += 1;
-        done += usize::from(finished);
-    }
-    eprintln!(
-        "velvet: stopped by {}: {done} of {total} {} finished (their outputs are complete); \
-         nothing was written for the other {}",
-        velvet::output::interrupt::name(signal),
-        if total == 1 { "file" } else { "files" },
-        total - done
-    );
-    Some(ExitCode::from(128 + signal as u8))
-}
-
-/// Writes to standard output; a closed pipe (`velvet … | head`) is not an error.
-fn emit(text: &[u8]) {
-    let _ = std::io::stdout().lock().write_all(text);
 }
 
 /// Runs `job` on a worker of the thread pool, the calling thread asleep until it is done. On the
@@ -365,37 +335,49 @@ fn main() -> ExitCode {
                     let rendered = e.render().to_string();
                     let first = rendered.lines().next().unwrap_or_default();
                     let message = first.strip_prefix("error: ").unwrap_or(first);
-                    emit(report::failed_run(format, message, true).as_bytes());
+                    command::emit(report::failed_run(format, message, true).as_bytes());
                 }
             }
             e.exit()
         }
     };
-    match cli.command {
+    let status = match cli.command {
         Command::Validate(args) => in_pool(|| validate(args, cli.color, cli.quiet)),
         Command::Migrate(args) => in_pool(|| migrate(args, cli.quiet)),
-        Command::Config { path, settings } => show_config(path, settings),
+        Command::Config { path, settings } => {
+            let path = path.unwrap_or_else(|| PathBuf::from("."));
+            match settings.flags().show(&path) {
+                Ok(text) => {
+                    command::emit(text.as_bytes());
+                    Status::Done
+                }
+                Err(e) => command::usage_error(e),
+            }
+        }
         Command::Bake(args) => bake(args, cli.quiet),
-        Command::Preview(args) => preview(args, cli.quiet),
+        Command::Preview(args) => {
+            command::preview::command(&args.paths, &args.output, args.load.options(), cli.quiet)
+        }
         Command::Codes { format } => {
-            emit(codes_table(format).as_bytes());
-            ExitCode::SUCCESS
+            command::emit(codes_table(format).as_bytes());
+            Status::Done
         }
         Command::Completions { shell } => {
             let mut out = Vec::new();
             clap_complete::generate(shell, &mut Cli::command(), "velvet", &mut out);
-            emit(&out);
-            ExitCode::SUCCESS
+            command::emit(&out);
+            Status::Done
         }
         Command::Man { dir } => man(dir),
         #[cfg(feature = "bench")]
         Command::Bench(cmd) => {
             match velvet::shading::bench::run(&cmd, &mut std::io::stdout().lock()) {
-                Ok(()) => ExitCode::SUCCESS,
-                Err(e) => usage_error(e),
+                Ok(()) => Status::Done,
+                Err(e) => command::usage_error(e),
             }
         }
-    }
+    };
+    ExitCode::from(status.code())
 }
 
 /// The output format a `velvet validate` command line asks for, read from the raw arguments
@@ -426,11 +408,11 @@ fn validate_format_asked(args: impl Iterator<Item = std::ffi::OsString>) -> Opti
     format
 }
 
-fn man(dir: Option<PathBuf>) -> ExitCode {
+fn man(dir: Option<PathBuf>) -> Status {
     match dir {
         Some(dir) => match cli_docs::write_man_pages(Cli::command(), &dir) {
-            Ok(()) => ExitCode::SUCCESS,
-            Err(e) => usage_error(format!(
+            Ok(()) => Status::Done,
+            Err(e) => command::usage_error(format!(
                 "cannot write man pages into {}: {e}",
                 dir.display()
             )),
@@ -438,10 +420,10 @@ fn man(dir: Option<PathBuf>) -> ExitCode {
         // The page lists the pages --dir writes: no velvet-help(1), which it does not.
         None => match cli_docs::man_page(Cli::command().disable_help_subcommand(true)) {
             Ok(page) => {
-                emit(&page);
-                ExitCode::SUCCESS
+                command::emit(&page);
+                Status::Done
             }
-            Err(e) => usage_error(e),
+            Err(e) => command::usage_error(e),
         },
     }
 }
@@ -471,111 +453,6 @@ fn codes_table(format: CodesFormat) -> String {
     }
 }
 
-fn resolver(args: &SettingsArgs) -> Result<Resolver, config::ConfigError> {
-    let fail_on = args.fail_on.map(|f| match f {
-        FailOnArg::Error => FailOn::Error,
-        FailOnArg::Warning => FailOn::Warning,
-        FailOnArg::Info => FailOn::Info,
-        FailOnArg::Hint => FailOn::Hint,
-    });
-    let layer = Layer::command_line(
-        args.max_issues,
-        &args.ignore,
-        &args.only,
-        &args.overrides,
-        fail_on,
-    )?;
-    Resolver::new(args.config.as_deref(), layer)
-}
-
-fn show_config(path: Option<PathBuf>, args: SettingsArgs) -> ExitCode {
-    let path = path.unwrap_or_else(|| PathBuf::from("."));
-    let config = match resolver(&args).and_then(|mut r| r.for_path(&path)) {
-        Ok(c) => c,
-        Err(e) => return usage_error(e),
-    };
-    let mut text = String::new();
-    if config.excludes(&config::absolute(&path)) {
-        text += &format!(
-            "# {} is excluded by this configuration\n",
-            report::display_path(&path)
-        );
-    }
-    text += &config.to_toml();
-    emit(text.as_bytes());
-    ExitCode::SUCCESS
-}
-
-fn validate(args: ValidateArgs, color: ColorChoice, quiet: bool) -> ExitCode {
-    // One report object for a run over one file named on the command line; an array for
-    // anything else (folders, several files, a list, a shard), whatever it finds.
-    let one_file = args.input.files_from.is_none()
-        && args.input.shard.is_none()
-        && matches!(args.input.paths.as_slice(), [path] if path.is_file());
-    // A run that cannot start still writes a report in its format, recording why (every
-    // such error comes before the first report is written).
-    let failed = |message: String| {
-        emit(report::failed_run(args.format, &message, !one_file).as_bytes());
-        usage_error(message)
-    };
-    let paths = match args.input.resolve() {
-        Ok(p) => p,
-        Err(e) => return failed(e.to_string()),
-    };
-    let mut resolver = match resolver(&args.settings) {
-        Ok(r) => r,
-        Err(e) => return failed(e.to_string()),
-    };
-    let validator = match &args.schema_dir {
-        Some(dir) => match Schemas::with_overrides(dir) {
-            Ok(schemas) => Validator::new(schemas, Settings::default()),
-            Err(e) => return failed(e.to_string()),
-        },
-        None => Validator::builtin(Settings::default()),
-    };
-    let validator = validator
-        .with_load_options(args.load.options())
-        .with_positions(args.format.shows_positions());
-    let progress = report::progress_bar(quiet);
-    let options = report::Options {
-        color: args.format == Format::Text && color.for_stdout(),
-        quiet,
-        no_fold: args.no_fold,
-    };
-    // Each file's report is written as soon as it is done (see report::Stream).
-    let stdout = std::io::BufWriter::new(std::io::stdout().lock());
-    let mut stream = report::Stream::new(args.format, options, stdout).json_array(!one_file);
-    let outcome = match velvet::run::validate_shard_each(
-        &validator,
-        &paths,
-        args.input.shard,
-        &mut resolver,
-        progress.as_ref(),
-        &mut |r| match &progress {
-            // The bar is cleared while the report is written, so the two do not mix.
-            Some(bar) => bar.suspend(|| {
-                stream.push(r);
-                stream.flush();
-            }),
-            None => stream.push(r),
-        },
-    ) {
-        Ok(o) => o,
-        Err(e) => {
-            // Nothing has been written (configurations are resolved first); the stream holds
-            // standard output, so it goes before the failure's report is written.
-            drop(stream);
-            return failed(e.to_string());
-        }
-    };
-    stream.finish();
-    if outcome.failed {
-        ExitCode::from(1)
-    } else {
-        ExitCode::SUCCESS
-    }
-}
-
 #[derive(clap::Args)]
 #[command(
     after_help = "Exit status: 0 done, 1 a file failed (the others are still migrated) or, with --check, a file would change, 2 usage error (nothing written), 130 / 143 stopped by SIGINT / SIGTERM (finished files complete, nothing left of the others)."
@@ -583,15 +460,8 @@ fn validate(args: ValidateArgs, color: ColorChoice, quiet: bool) -> ExitCode {
 struct MigrateArgs {
     #[command(flatten)]
     input: InputArgs,
-    /// Write the one input's output here (same container as the input).
-    #[arg(short = 'o', long = "output", value_name = "FILE", conflicts_with_all = ["out_dir", "in_place"])]
-    output: Option<PathBuf>,
-    /// Write outputs under DIR, mirroring each input folder's tree.
-    #[arg(long, value_name = "DIR", conflicts_with = "in_place")]
-    out_dir: Option<PathBuf>,
-    /// Overwrite the inputs (files with nothing to migrate are not written).
-    #[arg(long)]
-    in_place: bool,
+    #[command(flatten)]
+    destination: DestinationArgs,
     /// Print what would change per material; write nothing.
     #[arg(long)]
     dry_run: bool,
@@ -599,8 +469,8 @@ struct MigrateArgs {
     #[arg(long, conflicts_with_all = ["output", "out_dir", "in_place"])]
     check: bool,
     /// Output format.
-    #[arg(long, value_enum, default_value_t = MigrateFormat::Text)]
-    format: MigrateFormat,
+    #[arg(long, value_enum, default_value_t = ReportFormat::Text)]
+    format: ReportFormat,
     /// Decode sheen colour textures to measure what the fast conversion changes (and show
     /// every material's notes, as --verbose).
     #[arg(long)]
@@ -652,32 +522,59 @@ enum RoughnessArg {
     Identity,
 }
 
-#[derive(Clone, Copy, ValueEnum)]
-enum MigrateFormat {
-    /// A line per file, then a summary.
-    Text,
-    /// One JSON document: every file with its materials, edits and notes.
-    Json,
+impl SettingsArgs {
+    fn flags(self) -> config::Flags {
+        config::Flags {
+            config: self.config,
+            max_issues: self.max_issues,
+            ignore: self.ignore,
+            only: self.only,
+            overrides: self.overrides,
+            fail_on: self.fail_on.map(|f| match f {
+                FailOnArg::Error => FailOn::Error,
+                FailOnArg::Warning => FailOn::Warning,
+                FailOnArg::Info => FailOn::Info,
+                FailOnArg::Hint => FailOn::Hint,
+            }),
+        }
+    }
 }
 
-fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
-    use velvet::migrate;
-    // Before anything is read or written: a signal from here on stops the run cleanly.
-    velvet::output::interrupt::install();
-    use velvet::output::{paths::Destination, summary::Detail};
-    let paths = match args.input.resolve() {
+/// How much a migrate or bake text report says: `-q`, the default, or `-v` (which `also`
+/// implies: `--report`, and for bake `--dry-run`).
+fn detail(quiet: bool, verbose: bool, also: bool) -> Detail {
+    if quiet {
+        Detail::Quiet
+    } else if verbose || also {
+        Detail::Verbose
+    } else {
+        Detail::Normal
+    }
+}
+
+fn validate(args: ValidateArgs, color: ColorChoice, quiet: bool) -> Status {
+    command::validate::command(&command::validate::Request {
+        paths: args.input.paths,
+        files_from: args.input.files_from,
+        shard: args.input.shard,
+        settings: args.settings.flags(),
+        schema_dir: args.schema_dir,
+        load: args.load.options(),
+        format: args.format,
+        color,
+        quiet,
+        no_fold: args.no_fold,
+    })
+}
+
+fn migrate(args: MigrateArgs, quiet: bool) -> Status {
+    let inputs = match args.input.resolve() {
         Ok(p) => p,
-        Err(e) => return usage_error(e),
+        Err(e) => return command::usage_error(e),
     };
-    let destination = match (args.output, args.out_dir, args.in_place) {
-        (Some(file), _, _) => Destination::File(file),
-        (_, Some(dir), _) => Destination::Dir(dir),
-        (_, _, true) => Destination::InPlace,
-        _ => Destination::None,
-    };
-    let request = migrate::Request {
-        inputs: paths,
-        destination,
+    let request = command::migrate::Request {
+        inputs,
+        destination: args.destination.destination(),
         options: migrate::Options {
             refresh_fallback: args.refresh_fallback,
             report: args.report,
@@ -695,97 +592,24 @@ fn migrate(args: MigrateArgs, quiet: bool) -> ExitCode {
         dry_run: args.dry_run || args.check,
         progress: !quiet,
     };
-    // The sheets are rendered from the inputs before they are migrated (--in-place overwrites
-    // them), and written after.
-    let previews = args.preview.as_ref().map(|_| {
-        let inputs: Vec<PathBuf> = match args.input.shard {
-            None => request.inputs.clone(),
-            Some(shard) => discover::find(&request.inputs, Some(shard))
-                .0
-                .into_iter()
-                .map(|f| f.path)
-                .collect(),
-        };
-        velvet::preview::render(&inputs, &request.options)
-    });
-    // A list that names no asset (a change that touched none) is nothing to do, not an error.
-    let report = if request.inputs.is_empty() {
-        migrate::RunReport {
-            dry_run: request.dry_run,
-            files: Vec::new(),
-            summary: migrate::Summary::default(),
-        }
-    } else {
-        match migrate::run_shard(&request, args.input.shard) {
-            Ok(report) => report,
-            Err(e) => return usage_error(e),
-        }
+    let view = command::migrate::View {
+        format: args.format,
+        detail: detail(quiet, args.verbose, args.report),
+        check: args.check,
+        preview: args.preview,
     };
-    if let Some(stopped) = stopped(
-        report
-            .files
-            .iter()
-            .map(|f| !matches!(f.outcome, migrate::FileOutcome::Failed { .. })),
-    ) {
-        return stopped;
-    }
-    print!(
-        "{}",
-        match args.format {
-            MigrateFormat::Text => migrate::render::text(
-                &report,
-                if quiet {
-                    Detail::Quiet
-                } else if args.verbose || args.report {
-                    Detail::Verbose
-                } else {
-                    Detail::Normal
-                }
-            ),
-            MigrateFormat::Json => migrate::render::json(&report),
-        }
-    );
-    let mut preview_failed = false;
-    if let (Some(dir), Some(previews)) = (&args.preview, &previews) {
-        for f in &previews.failures {
-            eprintln!("velvet: preview: {}: {}", f.file.display(), f.message);
-        }
-        preview_failed = !previews.failures.is_empty();
-        if let Err(e) = velvet::preview::write(previews, dir) {
-            eprintln!("velvet: preview: {e}");
-            preview_failed = true;
-        }
-    }
-    let failed =
-        report.failed() || preview_failed || (args.check && report.summary.would_change > 0);
-    // The process ends next: a library's report (a plan for every material) is left to the
-    // exit rather than freed value by value.
-    std::mem::forget(report);
-    if failed {
-        ExitCode::from(1)
-    } else {
-        ExitCode::SUCCESS
-    }
+    command::migrate::command(&request, args.input.shard, &view)
 }
 
-fn bake(args: BakeArgs, quiet: bool) -> ExitCode {
-    use velvet::command::bake::{self as command, Options, Request};
-    // Before anything is read or written: a signal from here on stops the run cleanly.
-    velvet::output::interrupt::install();
-    use velvet::output::{paths::Destination, summary::Detail};
-    let paths = match args.input.resolve() {
+fn bake(args: BakeArgs, quiet: bool) -> Status {
+    use velvet::command::bake::{Options, Request, View};
+    let inputs = match args.input.resolve() {
         Ok(p) => p,
-        Err(e) => return usage_error(e),
-    };
-    let destination = match (args.output, args.out_dir, args.in_place) {
-        (Some(file), _, _) => Destination::File(file),
-        (_, Some(dir), _) => Destination::Dir(dir),
-        (_, _, true) => Destination::InPlace,
-        _ => Destination::None,
+        Err(e) => return command::usage_error(e),
     };
     let request = Request {
-        inputs: paths,
-        destination,
+        inputs,
+        destination: args.destination.destination(),
         dry_run: args.dry_run,
         options: Options {
             plan: velvet::bake::plan::PlanOptions {
@@ -805,90 +629,9 @@ fn bake(args: BakeArgs, quiet: bool) -> ExitCode {
         },
         progress: !quiet,
     };
-    // A list that names no asset (a change that touched none) is nothing to do, not an error.
-    let results = if request.inputs.is_empty() {
-        Vec::new()
-    } else {
-        match command::run_shard(&request, args.input.shard) {
-            Ok(r) => r,
-            Err(e) => return usage_error(e),
-        }
+    let view = View {
+        format: args.format,
+        detail: detail(quiet, args.verbose, args.report || args.dry_run),
     };
-    if let Some(stopped) = stopped(results.iter().map(|r| !r.failed())) {
-        return stopped;
-    }
-    match args.format {
-        BakeFormat::Text => print!(
-            "{}",
-            command::render_text(
-                &results,
-                args.dry_run,
-                if quiet {
-                    Detail::Quiet
-                } else if args.verbose || args.report || args.dry_run {
-                    Detail::Verbose
-                } else {
-                    Detail::Normal
-                }
-            )
-        ),
-        BakeFormat::Json => print!("{}", command::render_json(&results)),
-    }
-    if results.iter().any(|r| r.failed()) {
-        ExitCode::from(1)
-    } else {
-        ExitCode::SUCCESS
-    }
-}
-
-fn preview(args: PreviewArgs, quiet: bool) -> ExitCode {
-    if let Err(e) = discover::check_inputs(&args.paths) {
-        return usage_error(e);
-    }
-    let previews = velvet::preview::render(
-        &args.paths,
-        &migrate::Options {
-            load: args.load.options(),
-            ..migrate::Options::default()
-        },
-    );
-    let mut failed = !previews.failures.is_empty();
-    for f in &previews.failures {
-        eprintln!("velvet: {}: {}", f.file.display(), f.message);
-    }
-    match velvet::preview::write(&previews, &args.output) {
-        Ok(written) => {
-            if !quiet {
-                let mut out = String::new();
-                for (sheet, path) in previews.sheets.iter().zip(&written) {
-                    out += &format!(
-                        "{}: {} ({})\n",
-                        path.display(),
-                        sheet.summary.title,
-                        sheet.summary.verdict.text()
-                    );
-                }
-                for f in &previews.without_layers {
-                    out += &format!("{}: no material with a sheen or fuzz layer\n", f.display());
-                }
-                if let Some(index) = written.last() {
-                    out += &format!(
-                        "{} sheet(s); index: {}\n",
-                        previews.sheets.len(),
-                        index.display()
-                    );
-                }
-                emit(out.as_bytes());
-            }
-        }
-        Err(e) => {
-            eprintln!("velvet: {e}");
-            failed = true;
-        }
-    }
-    if failed {
-        ExitCode::from(1)
-    } else {
-        ExitCode::SUCCESS
-    }
+    command::bake::command(&request, args.input.shard, view)
 }

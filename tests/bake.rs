@@ -229,7 +229,7 @@ fn gltf_colour_and_roughness_of_one_image_are_baked_once_into_one_file() {
         out["images"],
         json!([{"name": "fabric.sheenColor.sheenRoughness", "uri": named(&out_dir, "fabric.sheenColor.sheenRoughness", "png")}])
     );
-    assert_eq!(result.dropped_images, vec![0]);
+    assert_eq!(result.detail.dropped_images, vec![0]);
 
     let baked = decode(
         &std::fs::read(out_dir.join(named(&out_dir, "fabric.sheenColor.sheenRoughness", "png")))
@@ -324,7 +324,7 @@ fn materials_sharing_a_combination_share_one_output_and_a_new_combination_gets_i
             ..Options::default()
         },
     );
-    assert_eq!(result.outputs.len(), 2);
+    assert_eq!(result.detail.outputs.len(), 2);
     let out = read_json(&output);
     let index = |m: usize| {
         out["materials"][m]["extensions"]["KHR_materials_sheen"]["sheenColorTexture"]["index"]
@@ -416,17 +416,19 @@ fn glb_images_go_to_aligned_buffer_views_and_a_dropped_source_leaves_the_bin() {
     );
     assert_eq!(result.outcome, Outcome::Changed, "{result:?}");
     // Image 0 stays (base colour still reads it); image 1 only fed sheen and fuzz roughness.
-    assert_eq!(result.dropped_images, vec![1]);
+    assert_eq!(result.detail.dropped_images, vec![1]);
     assert!(
-        result.dropped_bin_bytes >= sheen.len() - 3,
+        result.detail.dropped_bin_bytes >= sheen.len() - 3,
         "{}",
-        result.dropped_bin_bytes
+        result.detail.dropped_bin_bytes
     );
     assert!(result
+        .detail
         .outputs
         .iter()
         .all(|o| o.max_error.is_some_and(|e| e <= 0.5)));
     let stored: Vec<(Option<usize>, &str)> = result
+        .detail
         .outputs
         .iter()
         .map(|o| (o.image, o.stored.as_str()))
@@ -549,6 +551,7 @@ fn out_of_range_factors_are_reported_and_baked_clamped_only_when_allowed() {
     let refused = run_one(&input, &output, Options::default());
     assert_eq!(refused.outcome, Outcome::Copied);
     assert!(refused
+        .detail
         .notes
         .iter()
         .any(|n| n.message.contains("outside [0, 1]")
@@ -567,7 +570,7 @@ fn out_of_range_factors_are_reported_and_baked_clamped_only_when_allowed() {
         .filter(|&&a| 2.0 * f64::from(a) / 255.0 > 1.0)
         .count() as u64;
     assert!(clamped > 0);
-    assert_eq!(baked.outputs[0].clamped, clamped);
+    assert_eq!(baked.detail.outputs[0].clamped, clamped);
     let out = read_json(&output);
     let image =
         decode(&std::fs::read(dir.path().join(out["images"][0]["uri"].as_str().unwrap())).unwrap());
@@ -605,8 +608,9 @@ fn ktx2_textures_are_left_alone_with_a_warning_and_switched_off_layers_are_skipp
     .unwrap();
     let r = &results[0];
     assert_eq!(r.outcome, Outcome::Planned { changes: false });
-    assert!(r.slots.is_empty());
+    assert!(r.detail.slots.is_empty());
     let messages: Vec<(&str, &str)> = r
+        .detail
         .notes
         .iter()
         .map(|n| (n.pointer.as_str(), n.message.as_str()))
@@ -834,7 +838,7 @@ fn one_failing_file_does_not_stop_the_others_and_leaves_no_output() {
         validation_errors(&out.join("good.gltf")),
         Vec::<String>::new()
     );
-    assert_eq!(command::summary(&results).failed, 1);
+    assert_eq!(command::summary(&results).totals.failed, 1);
 }
 
 #[test]

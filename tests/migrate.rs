@@ -7,10 +7,13 @@ use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use velvet::asset::glb;
+use velvet::command::migrate::{self as migrating, render, FileOutcome, Request};
 use velvet::diagnostics::Severity;
+use velvet::migrate::apply::{self, WriteStrategy};
 use velvet::migrate::roughness::{self, Direction, RoughnessMapping};
-use velvet::migrate::{self, render, Conversion, FileOutcome, Note, Options, Request, Skip};
-use velvet::output::paths::Destination;
+use velvet::migrate::{self, Conversion, Note, Options, Skip};
+use velvet::output::files::Claims;
+use velvet::output::paths::{Destination, Job};
 use velvet::output::summary::Detail;
 use velvet::output::UsageError;
 use velvet::rules::schema::Schemas;
@@ -84,8 +87,8 @@ fn request(inputs: Vec<PathBuf>, destination: Destination, options: Options) -> 
 }
 
 /// Migrates `input` into the file `output` with the default options.
-fn migrate_to(input: &Path, output: &Path) -> migrate::RunReport {
-    migrate::run(&request(
+fn migrate_to(input: &Path, output: &Path) -> migrating::RunReport {
+    migrating::run(&request(
         vec![input.to_path_buf()],
         Destination::File(output.to_path_buf()),
         Options::default(),
@@ -119,20 +122,20 @@ fn golden(path: &Path, actual: &[u8]) {
 }
 
 /// Migrates one fixture into a temporary folder; returns (folder, output path, result).
-fn migrate_case(case: &Path) -> (tempfile::TempDir, PathBuf, migrate::FileResult) {
+fn migrate_case(case: &Path) -> (tempfile::TempDir, PathBuf, migrating::FileResult) {
     migrate_case_with(case, options_for(case))
 }
 
 fn migrate_case_with(
     case: &Path,
     options: Options,
-) -> (tempfile::TempDir, PathBuf, migrate::FileResult) {
+) -> (tempfile::TempDir, PathBuf, migrating::FileResult) {
     let dir = tempfile::tempdir().unwrap();
     let input = dir.path().join("in").join(case.file_name().unwrap());
     std::fs::create_dir_all(input.parent().unwrap()).unwrap();
     std::fs::copy(case, &input).unwrap();
     let out_dir = dir.path().join("out");
-    let report = migrate::run(&request(
+    let report = migrating::run(&request(
         vec![input.parent().unwrap().to_path_buf()],
         Destination::Dir(out_dir.clone()),
         options,
@@ -242,7 +245,7 @@ fn again_changes_nothing(case: &Path, first: Options, refreshes: &[bool]) {
             };
             // Beside the first output, whose baked images it shares.
             let again = output.with_file_name(format!("again-{refresh_fallback}.gltf"));
-            let report = migrate::run(&request(
+            let report = migrating::run(&request(
                 vec![output.clone()],
                 Destination::File(again.clone()),
                 options,
@@ -300,6 +303,7 @@ fn material_outcomes_name_conversions_and_skips() {
     let case = fixtures().join("legacy.gltf");
     let (_dir, _, result) = migrate_case(&case);
     let outcomes: Vec<(Vec<Conversion>, Option<Skip>)> = result
+        .detail
         .materials
         .iter()
         .map(|m| (m.conversions.clone(), m.skipped))
@@ -323,11 +327,13 @@ fn material_outcomes_name_conversions_and_skips() {
             ),
         ]
     );
-    assert!(result.materials[0].notes.contains(&Note::LegacyClamped {
-        product: [1.6, 1.0, 0.4],
-        clamped: [1.0, 1.0, 0.4]
-    }));
-    assert!(result.materials[2].notes.contains(&Note::SheenOff));
+    assert!(result.detail.materials[0]
+        .notes
+        .contains(&Note::LegacyClamped {
+            product: [1.6, 1.0, 0.4],
+            clamped: [1.0, 1.0, 0.4]
+        }));
+    assert!(result.detail.materials[2].notes.contains(&Note::SheenOff));
 }
 
 #[test]
@@ -372,7 +378,7 @@ fn glb_with_nothing_to_migrate_is_copied_byte_identical() {
     let original = glb::join(&json, Some(&[9, 9, 9, 9]));
     std::fs::write(&input, &original).unwrap();
     let output = dir.path().join("copy.glb");
-    let report = migrate::run(&request(
+    let report = migrating::run(&request(
         vec![input],
         Destination::File(output.clone()),
         Options::default(),
@@ -394,7 +400,7 @@ fn in_place_with_nothing_to_migrate_does_not_write() {
         .unwrap()
         .set_modified(old)
         .unwrap();
-    let report = migrate::run(&request(
+    let report = migrating::run(&request(
         vec![input.clone()],
         Destination::InPlace,
         Options::default(),
@@ -417,7 +423,7 @@ fn in_place_rewrites_the_input_with_its_migration() {
     let dir = tempfile::tempdir().unwrap();
     let input = dir.path().join("sheen-factors.gltf");
     std::fs::copy(fixtures().join("sheen-factors.gltf"), &input).unwrap();
-    let report = migrate::run(&request(
+    let report = migrating::run(&request(
         vec![input.clone()],
         Destination::InPlace,
         Options::default(),
@@ -548,7 +554,7 @@ fn refused_requests_write_nothing() {
         ),
     ];
     for (req, expected) in cases {
-        assert_eq!(migrate::run(&req).unwrap_err(), expected);
+        assert_eq!(migrating::run(&req).unwrap_err(), expected);
     }
     assert_eq!(snapshot(dir.path()), before, "nothing was written");
 }
@@ -571,7 +577,7 @@ fn a_failing_file_does_not_stop_the_batch_and_leaves_outputs_and_inputs_intact()
     std::fs::create_dir_all(out.join("c.gltf/occupied")).unwrap();
     let inputs_before = snapshot(&inputs);
 
-    let report = migrate::run(&request(
+    let report = migrating::run(&request(
         vec![inputs.clone()],
         Destination::Dir(out.clone()),
         Options::default(),
@@ -611,7 +617,10 @@ fn a_failing_file_does_not_stop_the_batch_and_leaves_outputs_and_inputs_intact()
         "{error}"
     );
     assert!(report.failed());
-    assert_eq!((report.summary.changed, report.summary.failed), (2, 2));
+    assert_eq!(
+        (report.summary.totals.changed, report.summary.totals.failed),
+        (2, 2)
+    );
 
     let expected = std::fs::read(fixtures().join("sheen-factors.expected.gltf")).unwrap();
     assert_file(&out.join("a.gltf"), &expected);
@@ -635,7 +644,7 @@ fn in_place_batch_with_a_broken_file_migrates_the_others() {
     let sheen = std::fs::read(fixtures().join("sheen-factors.gltf")).unwrap();
     std::fs::write(dir.path().join("a.gltf"), &sheen).unwrap();
     std::fs::write(dir.path().join("b.glb"), b"glTF\x02\0\0\0\x10\0\0\0").unwrap();
-    let report = migrate::run(&request(
+    let report = migrating::run(&request(
         vec![dir.path().to_path_buf()],
         Destination::InPlace,
         Options::default(),
@@ -690,7 +699,7 @@ fn rewrite_uris_makes_outputs_in_another_folder_refer_to_the_inputs_resources() 
         rewrite_uris: true,
         ..Options::default()
     };
-    let report = migrate::run(&request(
+    let report = migrating::run(&request(
         vec![dir.path().join("assets")],
         Destination::Dir(out.clone()),
         options,
@@ -706,7 +715,7 @@ fn rewrite_uris_makes_outputs_in_another_folder_refer_to_the_inputs_resources() 
             "data:image/png;base64,AAAA"
         ]
     );
-    assert!(report.files[0].notes.contains(&Note::UrisRewritten {
+    assert!(report.files[0].detail.notes.contains(&Note::UrisRewritten {
         count: 2,
         leaves_folder: true
     }));
@@ -737,7 +746,7 @@ fn outputs_in_another_folder_keep_their_uris_and_get_copies_of_the_files() {
     let input = asset_with_resources(dir.path());
     let output = dir.path().join("elsewhere/chair.gltf");
     let options = Options::default();
-    let report = migrate::run(&request(
+    let report = migrating::run(&request(
         vec![input],
         Destination::File(output.clone()),
         options,
@@ -761,6 +770,7 @@ fn outputs_in_another_folder_keep_their_uris_and_get_copies_of_the_files() {
         b"png bytes"
     );
     assert!(report.files[0]
+        .detail
         .notes
         .contains(&Note::ResourcesCopied { count: 2 }));
 }
@@ -770,7 +780,7 @@ fn output_beside_the_input_keeps_uris_as_they_are() {
     let dir = tempfile::tempdir().unwrap();
     let input = asset_with_resources(dir.path());
     let output = input.with_file_name("chair.fuzz.gltf");
-    migrate::run(&request(
+    migrating::run(&request(
         vec![input],
         Destination::File(output.clone()),
         Options::default(),
@@ -808,7 +818,7 @@ fn textures_are_decoded_only_for_the_report() {
             },
         );
         req.dry_run = true;
-        migrate::run(&req).unwrap().files[0].materials[0]
+        migrating::run(&req).unwrap().files[0].detail.materials[0]
             .notes
             .clone()
     };
@@ -836,7 +846,7 @@ fn dry_run_prints_the_plan_and_writes_nothing() {
         Options::default(),
     );
     req.dry_run = true;
-    let report = migrate::run(&req).unwrap();
+    let report = migrating::run(&req).unwrap();
     assert!(!dir.path().join("out").exists());
     assert_eq!(
         report.files[0].outcome,
@@ -965,11 +975,11 @@ fn migrate_document(
     json: Value,
     output: &str,
     options: Options,
-) -> (PathBuf, Value, migrate::FileResult) {
+) -> (PathBuf, Value, migrating::FileResult) {
     let input = dir.join(format!("{name}.gltf"));
     std::fs::write(&input, serde_json::to_vec_pretty(&json).unwrap()).unwrap();
     let output = dir.join(output);
-    let report = migrate::run(&request(
+    let report = migrating::run(&request(
         vec![input],
         Destination::File(output.clone()),
         options,
@@ -1046,9 +1056,10 @@ fn exact_mode_bakes_the_sheen_strength_and_normalised_colour_texel_by_texel() {
             ..Options::default()
         },
     );
-    assert!(result.materials[0].notes.contains(&Note::ExactBaked));
+    assert!(result.detail.materials[0].notes.contains(&Note::ExactBaked));
     // Each baked image states its quantisation error: at most half a code.
     let errors_in_codes: Vec<(String, f64)> = result
+        .detail
         .notes
         .iter()
         .filter_map(|n| match n {
@@ -1345,7 +1356,7 @@ fn a_glb_keeps_baked_textures_in_its_bin_chunk() {
     )
     .unwrap();
     let output = dir.path().join("out.glb");
-    let report = migrate::run(&request(
+    let report = migrating::run(&request(
         vec![input],
         Destination::File(output.clone()),
         Options {
@@ -1422,7 +1433,7 @@ fn a_fallback_sheen_roughness_texture_holds_the_mapped_roughness_unless_fast() {
         );
         measured = measured.max((factor * pixels[k][3] as f64 / 255.0 - exact).abs());
     }
-    let reported = result.materials[0]
+    let reported = result.detail.materials[0]
         .notes
         .iter()
         .find_map(|n| match n {
@@ -1460,7 +1471,7 @@ fn a_fallback_sheen_roughness_texture_holds_the_mapped_roughness_unless_fast() {
         sheen["sheenRoughnessTexture"],
         serde_json::json!({"index": 0})
     );
-    assert!(result.materials[0]
+    assert!(result.detail.materials[0]
         .notes
         .contains(&Note::RoughnessTextureFast { mapping: "fitted" }));
     assert_eq!(doc["images"].as_array().unwrap().len(), 1, "nothing baked");
@@ -1499,10 +1510,10 @@ fn black_fuzz_with_an_intensity_texture_bakes_nothing_and_is_left_as_it_is() {
     let report = migrate_to(&input, &output);
     let result = &report.files[0];
     assert_eq!(result.outcome, FileOutcome::Copied);
-    assert_eq!(result.materials[0].skipped, Some(Skip::BlackFuzz));
-    assert!(result.materials[0].bakes.is_empty());
+    assert_eq!(result.detail.materials[0].skipped, Some(Skip::BlackFuzz));
+    assert!(result.detail.materials[0].bakes.is_empty());
     assert_eq!(
-        result.materials[0].notes,
+        result.detail.materials[0].notes,
         [
             Note::FuzzRoughnessDefault { assumed: 0.5 },
             Note::DarkFuzz {
@@ -1631,7 +1642,7 @@ fn an_out_dir_tree_moved_elsewhere_validates_clean() {
     let dir = tempfile::tempdir().unwrap();
     let lib = library(dir.path());
     let out = dir.path().join("out");
-    let report = migrate::run(&request(
+    let report = migrating::run(&request(
         vec![lib],
         Destination::Dir(out.clone()),
         Options::default(),
@@ -1712,7 +1723,7 @@ fn a_link_to_a_file_outside_the_input_folder_is_refused_and_nothing_of_it_is_wri
     std::os::unix::fs::symlink("sub/real.bin", lib.join("mesh.bin")).unwrap();
     let out = dir.path().join("out");
     for fast in [false, true] {
-        let report = migrate::run(&request(
+        let report = migrating::run(&request(
             vec![lib.clone()],
             Destination::Dir(out.clone()),
             Options {
@@ -1722,7 +1733,7 @@ fn a_link_to_a_file_outside_the_input_folder_is_refused_and_nothing_of_it_is_wri
         ))
         .unwrap();
         assert_eq!(
-            report.summary.failed,
+            report.summary.totals.failed,
             6,
             "{}",
             render::text(&report, Detail::Verbose)
@@ -1815,10 +1826,10 @@ fn the_roughness_plan_shares_a_texture_within_the_budget_and_bakes_per_material_
                 ..Options::default()
             },
         );
-        assert_eq!(result.textures_added, added, "{budget:?}");
+        assert_eq!(result.detail.textures_added, added, "{budget:?}");
         assert_eq!(doc["images"].as_array().unwrap().len(), 1 + added);
         for (m, &f) in factors.iter().enumerate() {
-            let (plan_of, reported) = result.materials[m]
+            let (plan_of, reported) = result.detail.materials[m]
                 .notes
                 .iter()
                 .find_map(|n| match n {
@@ -1888,7 +1899,7 @@ fn a_migration_with_bakes_leaves_every_other_part_of_the_text_as_it_was() {
     let output = dir.path().join("out/chair.gltf");
     let report = migrate_to(&input, &output);
     assert_eq!(report.files[0].outcome, FileOutcome::Changed);
-    assert_eq!(report.files[0].textures_added, 1);
+    assert_eq!(report.files[0].detail.textures_added, 1);
     let written = std::fs::read_to_string(&output).unwrap();
     for kept in [other, mesh, "{\"source\": 0}", "{\"uri\": \"rough.png\"}"] {
         assert!(
@@ -1952,7 +1963,7 @@ fn a_large_file_is_migrated_in_place_as_the_library_migrates_its_bytes() {
     let reference_dir = tempfile::tempdir().unwrap();
     let reference = reference_dir.path().join("large.gltf");
     std::fs::write(&reference, &text).unwrap();
-    let report = migrate::run(&request(
+    let report = migrating::run(&request(
         vec![reference.clone()],
         Destination::InPlace,
         Options::default(),
@@ -2021,7 +2032,7 @@ fn every_number_the_plan_sets_is_the_number_the_written_file_holds() {
                 continue;
             }
             let written: Value = serde_json::from_slice(&std::fs::read(&output).unwrap()).unwrap();
-            for material in &result.materials {
+            for material in &result.detail.materials {
                 baked += material.bakes.len();
                 for edit in &material.edits {
                     let velvet::edit::Edit::Set { pointer, value } = edit else {
@@ -2049,4 +2060,97 @@ fn every_number_the_plan_sets_is_the_number_the_written_file_holds() {
     }
     assert!(compared > 200, "{compared} values compared");
     assert!(baked > 10, "{baked} bakes among them");
+}
+
+/// Writes `input` to `output` through migrate's one-file path, by the strategy the spine
+/// chooses or, with `rewrite`, by the rewrite; returns the strategy that wrote it.
+fn written_by(input: &Path, output: &Path, options: &Options, rewrite: bool) -> WriteStrategy {
+    let job = Job {
+        input: input.to_path_buf(),
+        output: Some(output.to_path_buf()),
+    };
+    let mut plan = apply::plan_file(&job, options).unwrap();
+    let (_, strategy) = apply::execute_by(&mut plan, &Claims::default(), rewrite)
+        .unwrap_or_else(|e| panic!("{}: {e}", input.display()));
+    strategy
+}
+
+#[test]
+fn every_write_strategy_writes_the_document_the_rewrite_writes() {
+    let dir = tempfile::tempdir().unwrap();
+    // A roughness texture to bake: as files next to a .gltf the bake is applied to a part of
+    // the document; embedded (--embed) the whole document is rewritten.
+    let src = dir.path().join("src");
+    std::fs::create_dir_all(&src).unwrap();
+    let data: Vec<u8> = [0u8, 26, 128, 255]
+        .iter()
+        .flat_map(|&a| [200, 100, 50, a])
+        .collect();
+    png_file(&src.join("rough.png"), 2, 2, image::ColorType::Rgba8, &data);
+    let baked = src.join("baked.gltf");
+    std::fs::write(
+        &baked,
+        serde_json::to_string_pretty(&serde_json::json!({
+            "asset": {"version": "2.0"},
+            "extensionsUsed": ["KHR_materials_sheen"],
+            "materials": [{"extensions": {"KHR_materials_sheen": {
+                "sheenColorFactor": [1, 1, 1], "sheenRoughnessFactor": 0.5,
+                "sheenRoughnessTexture": {"index": 0}
+            }}}],
+            "textures": [{"source": 0}],
+            "images": [{"uri": "rough.png"}]
+        }))
+        .unwrap(),
+    )
+    .unwrap();
+    let mut runs: Vec<(PathBuf, Options)> = cases()
+        .into_iter()
+        .map(|case| {
+            let options = options_for(&case);
+            (case, options)
+        })
+        .collect();
+    runs.push((baked.clone(), Options::default()));
+    runs.push((
+        baked,
+        Options {
+            embed: true,
+            ..Options::default()
+        },
+    ));
+    let mut chosen = std::collections::BTreeSet::new();
+    for (n, (input, options)) in runs.iter().enumerate() {
+        let name = input.file_name().unwrap();
+        let (by_choice, by_rewrite) = (
+            dir.path().join(format!("{n}a")),
+            dir.path().join(format!("{n}b")),
+        );
+        let strategy = written_by(input, &by_choice.join(name), options, false);
+        assert_eq!(
+            written_by(input, &by_rewrite.join(name), options, true),
+            WriteStrategy::Rewrite
+        );
+        chosen.insert(format!("{strategy:?}"));
+        let (a, b) = (tree(&by_choice), tree(&by_rewrite));
+        assert_eq!(
+            a.keys().collect::<Vec<_>>(),
+            b.keys().collect::<Vec<_>>(),
+            "{}: the same files",
+            input.display()
+        );
+        for (path, bytes) in &a {
+            if path.extension().is_some_and(|e| e == "gltf") {
+                let doc: Value = serde_json::from_slice(bytes).unwrap();
+                let rewritten: Value = serde_json::from_slice(&b[path]).unwrap();
+                assert_eq!(doc, rewritten, "{} by {strategy:?}", input.display());
+            } else {
+                assert!(bytes == &b[path], "{}: {}", input.display(), path.display());
+            }
+        }
+    }
+    assert_eq!(
+        chosen.into_iter().collect::<Vec<_>>(),
+        ["BakePart", "Rewrite", "Splice"],
+        "each strategy is chosen for one of the runs"
+    );
 }

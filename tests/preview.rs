@@ -541,7 +541,7 @@ fn switched_off_layers_alone_get_no_sheet() {
 /// Migrates `path` with `options` into a folder of `dir` and returns the written document.
 fn migrated_file(dir: &Path, path: &Path, options: &velvet::migrate::Options) -> serde_json::Value {
     let out = dir.join(format!("out-{:?}", options.roughness));
-    let report = velvet::migrate::run(&velvet::migrate::Request {
+    let report = velvet::command::migrate::run(&velvet::command::migrate::Request {
         inputs: vec![path.to_path_buf()],
         destination: velvet::output::paths::Destination::Dir(out.clone()),
         options: options.clone(),

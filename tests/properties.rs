@@ -19,8 +19,9 @@ use proptest::prelude::*;
 use serde_json::{json, Map, Value};
 use std::path::{Path, PathBuf};
 use velvet::command::bake;
+use velvet::command::migrate::{self as migrating, FileOutcome};
 use velvet::diagnostics::{Settings, Severity};
-use velvet::migrate::{self, FileOutcome, Options};
+use velvet::migrate::{self, Options};
 use velvet::output::paths::Destination;
 use velvet::rules::schema::Schemas;
 use velvet::validate::Validator;
@@ -306,7 +307,7 @@ fn validation_errors(path: &Path) -> Vec<String> {
 }
 
 fn migrate_file(input: &Path, output: &Path) -> FileOutcome {
-    let report = migrate::run(&migrate::Request {
+    let report = migrating::run(&migrating::Request {
         inputs: vec![input.to_path_buf()],
         destination: Destination::File(output.to_path_buf()),
         options: Options::default(),
@@ -506,7 +507,7 @@ proptest! {
         let options = migrate_options(which);
         let (dir, input) = written(&doc);
         let output = dir.path().join("out.gltf");
-        let report = migrate::run(&migrate::Request {
+        let report = migrating::run(&migrating::Request {
             inputs: vec![input.clone()],
             destination: Destination::File(output.clone()),
             options: options.clone(),
@@ -520,7 +521,7 @@ proptest! {
             "{:?}", result.outcome
         );
         let file: Value = serde_json::from_slice(&std::fs::read(&output).unwrap()).unwrap();
-        for material in &result.materials {
+        for material in &result.detail.materials {
             for edit in &material.edits {
                 let velvet::edit::Edit::Set { pointer, value } = edit else { continue };
                 let mut planned = Vec::new();

@@ -171,6 +171,17 @@ pub enum InputError {
     ListTooLong { list: PathBuf },
 }
 
+/// The paths named on the command line and in a `--files-from` list (`-`: standard input),
+/// checked: a path that does not exist, or a folder without any asset, is an error.
+pub fn resolve(paths: &[PathBuf], files_from: Option<&Path>) -> Result<Vec<PathBuf>, InputError> {
+    let mut paths = paths.to_vec();
+    if let Some(list) = files_from {
+        paths.extend(read_list(list)?);
+    }
+    check_inputs(&paths)?;
+    Ok(paths)
+}
+
 /// Refuses a path that does not exist, one that is neither a regular file nor a folder (a FIFO
 /// would block the run until something writes to it, a device would be read without end), and
 /// a folder with no asset in it or below. A link named on the command line is taken even when

@@ -29,6 +29,7 @@ use crate::output::files::{copy_resources, create_parent, file_sink, stage_new_f
 use crate::output::files::{Claims, FileNames};
 use crate::output::interrupt;
 use crate::output::paths::{check_links, relocate, Destination, Job, Relocation};
+use crate::output::result::{Account, Totals};
 use crate::output::staging::Staging;
 use crate::output::summary::{added, bytes, files_line, plural, Detail};
 use crate::output::{run_each, Scope, UsageError};
@@ -87,16 +88,9 @@ pub struct SlotReport {
     pub outputs: Vec<String>,
 }
 
-/// The report for one file.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct FileResult {
-    /// The input.
-    pub input: PathBuf,
-    /// The output, if any.
-    pub output: Option<PathBuf>,
-    /// What happened.
-    #[serde(flatten)]
-    pub outcome: Outcome,
+/// What `velvet bake` says of one file besides its outcome.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct BakeDetail {
     /// Slots baked (or planned).
     pub slots: Vec<SlotReport>,
     /// Outputs written (empty in a dry run).
@@ -109,23 +103,34 @@ pub struct FileResult {
     pub notes: Vec<Note>,
 }
 
-impl FileResult {
-    fn new(input: &Path, output: Option<&Path>, outcome: Outcome) -> FileResult {
-        FileResult {
-            input: input.to_path_buf(),
-            output: output.map(Path::to_path_buf),
-            outcome,
-            slots: Vec::new(),
-            outputs: Vec::new(),
-            dropped_images: Vec::new(),
-            dropped_bin_bytes: 0,
-            notes: Vec::new(),
+impl Account for BakeDetail {
+    fn added(&self, outcome: &Outcome) -> (usize, usize) {
+        if matches!(outcome, Outcome::Planned { .. }) {
+            // Slots that share a combination share its output.
+            let planned = self.slots.iter().flat_map(|s| &s.outputs);
+            return (planned.collect::<HashSet<_>>().len(), 0);
         }
+        let written = self.outputs.iter().filter(|o| o.image.is_some());
+        (written.clone().count(), written.map(|o| o.bytes).sum())
     }
 
-    /// Whether the file failed.
-    pub fn failed(&self) -> bool {
-        matches!(self.outcome, Outcome::Failed { .. })
+    fn warnings(&self) -> usize {
+        self.notes
+            .iter()
+            .filter(|n| n.level == crate::bake::plan::Level::Warning)
+            .count()
+    }
+}
+
+/// The report for one file.
+pub type FileResult = crate::output::result::FileResult<BakeDetail>;
+
+fn file_result(input: &Path, output: Option<&Path>, outcome: Outcome) -> FileResult {
+    FileResult {
+        input: input.to_path_buf(),
+        output: output.map(Path::to_path_buf),
+        outcome,
+        detail: BakeDetail::default(),
     }
 }
 
@@ -177,21 +182,21 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
         _ => Relocation::default(),
     };
     if request.dry_run {
-        let mut result = FileResult::new(
+        let mut result = file_result(
             input,
             job.output.as_deref(),
             Outcome::Planned {
                 changes: !plan.is_empty(),
             },
         );
-        result.slots = slot_reports(&plan, &planned_names);
-        result.notes = plan.notes;
+        result.detail.slots = slot_reports(&plan, &planned_names);
+        result.detail.notes = plan.notes;
         return Ok(result);
     }
     let output = job.output.as_deref().ok_or("no output path")?;
     if plan.is_empty() {
-        let mut result = FileResult::new(input, Some(output), Outcome::Untouched);
-        result.notes = plan.notes;
+        let mut result = file_result(input, Some(output), Outcome::Untouched);
+        result.detail.notes = plan.notes;
         if output == input {
             return Ok(result);
         }
@@ -281,15 +286,15 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
     snapshot.unchanged(input)?;
     staging.commit()?;
     let names: Vec<String> = applied.outputs.iter().map(|o| o.name.clone()).collect();
-    let mut result = FileResult::new(input, Some(output), Outcome::Changed);
-    result.slots = slot_reports(&plan, &names);
-    result.outputs = applied.outputs;
+    let mut result = file_result(input, Some(output), Outcome::Changed);
+    result.detail.slots = slot_reports(&plan, &names);
+    result.detail.outputs = applied.outputs;
     let Dropped {
         images, bin_bytes, ..
     } = applied.dropped;
-    result.dropped_images = images;
-    result.dropped_bin_bytes = bin_bytes;
-    result.notes = plan.notes.into_iter().chain(applied.notes).collect();
+    result.detail.dropped_images = images;
+    result.detail.dropped_bin_bytes = bin_bytes;
+    result.detail.notes = plan.notes.into_iter().chain(applied.notes).collect();
     Ok(result)
 }
 
@@ -310,7 +315,7 @@ pub fn run_shard(request: &Request, shard: Option<Shard>) -> Result<Vec<FileResu
     run_each(
         &scope,
         |path, e| {
-            FileResult::new(
+            file_result(
                 &path,
                 None,
                 Outcome::Failed {
@@ -320,58 +325,31 @@ pub fn run_shard(request: &Request, shard: Option<Shard>) -> Result<Vec<FileResu
         },
         |job, claims| {
             bake_file(job, request, claims).unwrap_or_else(|error| {
-                FileResult::new(&job.input, job.output.as_deref(), Outcome::Failed { error })
+                file_result(&job.input, job.output.as_deref(), Outcome::Failed { error })
             })
         },
     )
 }
 
-/// Totals over a run.
+/// Totals over a run: those every file command counts, and the slots baked.
 #[derive(Clone, Debug, Default, PartialEq, Eq, Serialize)]
 pub struct Summary {
-    /// Files seen.
-    pub files: usize,
-    /// Files baked and written.
-    pub changed: usize,
-    /// Files with nothing to bake.
-    pub unchanged: usize,
-    /// Files that failed.
-    pub failed: usize,
-    /// Slots baked.
+    #[serde(flatten)]
+    pub totals: Totals,
+    /// Slots baked (or planned).
     pub slots: usize,
-    /// New textures written (in a dry run, planned).
-    pub textures: usize,
-    /// Their encoded size in bytes (0 in a dry run).
-    pub bytes: usize,
 }
 
 /// Sums up results.
 pub fn summary(results: &[FileResult]) -> Summary {
-    let mut s = Summary {
-        files: results.len(),
-        ..Summary::default()
-    };
-    for r in results {
-        match &r.outcome {
-            Outcome::Changed => s.changed += 1,
-            Outcome::Planned { changes: true } => s.changed += 1,
-            Outcome::Failed { .. } => s.failed += 1,
-            _ => s.unchanged += 1,
-        }
-        s.slots += r.slots.len();
-        let written: Vec<_> = r.outputs.iter().filter(|o| o.image.is_some()).collect();
-        s.textures += if matches!(r.outcome, Outcome::Planned { .. }) {
-            r.slots
-                .iter()
-                .flat_map(|slot| &slot.outputs)
-                .collect::<HashSet<_>>()
-                .len()
-        } else {
-            written.len()
-        };
-        s.bytes += written.iter().map(|o| o.bytes).sum::<usize>();
+    Summary {
+        totals: Totals::of(results),
+        slots: results
+            .iter()
+            .filter(|r| !r.is_failed())
+            .map(|r| r.detail.slots.len())
+            .sum(),
     }
-    s
 }
 
 /// The text report, worded as `velvet migrate`'s: a line per file (slots, textures added,
@@ -381,7 +359,7 @@ pub fn render_text(results: &[FileResult], dry_run: bool, detail: Detail) -> Str
     use std::fmt::Write as _;
     let mut out = String::new();
     for r in results {
-        if detail == Detail::Quiet && !r.failed() {
+        if detail == Detail::Quiet && !r.is_failed() {
             continue;
         }
         let target = r
@@ -390,29 +368,11 @@ pub fn render_text(results: &[FileResult], dry_run: bool, detail: Detail) -> Str
             .filter(|o| **o != r.input)
             .map(|o| format!(" → {}", o.display()))
             .unwrap_or_default();
-        let warnings = r
-            .notes
-            .iter()
-            .filter(|n| n.level == crate::bake::plan::Level::Warning)
-            .count();
-        let added_bytes = r
-            .outputs
-            .iter()
-            .filter(|o| o.image.is_some())
-            .map(|o| o.bytes)
-            .sum();
-        let textures = if dry_run {
-            r.slots
-                .iter()
-                .flat_map(|s| &s.outputs)
-                .collect::<HashSet<_>>()
-                .len()
-        } else {
-            r.outputs.iter().filter(|o| o.image.is_some()).count()
-        };
+        let warnings = r.detail.warnings();
+        let (textures, added_bytes) = r.added();
         let counts = format!(
             " ({}, {}, {})",
-            plural(r.slots.len(), "slot", "slots"),
+            plural(r.detail.slots.len(), "slot", "slots"),
             added(textures, added_bytes, dry_run),
             plural(warnings, "warning", "warnings")
         );
@@ -436,7 +396,7 @@ pub fn render_text(results: &[FileResult], dry_run: bool, detail: Detail) -> Str
         if detail != Detail::Verbose {
             continue;
         }
-        for s in &r.slots {
+        for s in &r.detail.slots {
             push_line(
                 &mut out,
                 &format!(
@@ -447,7 +407,7 @@ pub fn render_text(results: &[FileResult], dry_run: bool, detail: Detail) -> Str
                 ),
             );
         }
-        for o in &r.outputs {
+        for o in &r.detail.outputs {
             let mut line = format!(
                 "  output {}: {}x{} {}-bit {}, {}, {}",
                 o.name,
@@ -475,17 +435,17 @@ pub fn render_text(results: &[FileResult], dry_run: bool, detail: Detail) -> Str
             }
             push_line(&mut out, &line);
         }
-        if !r.dropped_images.is_empty() {
+        if !r.detail.dropped_images.is_empty() {
             push_line(
                 &mut out,
                 &format!(
                     "  dropped images {:?} ({} cut from the BIN chunk)",
-                    r.dropped_images,
-                    bytes(r.dropped_bin_bytes)
+                    r.detail.dropped_images,
+                    bytes(r.detail.dropped_bin_bytes)
                 ),
             );
         }
-        for n in &r.notes {
+        for n in &r.detail.notes {
             let level = match n.level {
                 crate::bake::plan::Level::Info => "info",
                 crate::bake::plan::Level::Warning => "warning",
@@ -496,18 +456,18 @@ pub fn render_text(results: &[FileResult], dry_run: bool, detail: Detail) -> Str
     if detail == Detail::Quiet {
         return out;
     }
-    let s = summary(results);
+    let s = summary(results).totals;
     let _ = writeln!(
         out,
         "{}; {}",
         files_line(
             s.files,
-            s.changed,
+            s.done(),
             if dry_run { "would bake" } else { "baked" },
             s.unchanged,
             s.failed
         ),
-        added(s.textures, s.bytes, dry_run)
+        added(s.textures_added, s.bytes_added, dry_run)
     );
     out
 }
@@ -519,4 +479,37 @@ pub fn render_json(results: &[FileResult]) -> String {
         "summary": summary(results),
     });
     serde_json::to_string_pretty(&report).expect("reports serialise") + "\n"
+}
+
+/// How a bake run is shown besides what it writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct View {
+    pub format: super::ReportFormat,
+    pub detail: Detail,
+}
+
+/// Runs `velvet bake`: the files of `shard`, then the report on standard output.
+pub fn command(request: &Request, shard: Option<Shard>, view: View) -> super::Status {
+    // Before anything is read or written: a signal from here on stops the run cleanly.
+    interrupt::install();
+    // A list that names no asset (a change that touched none) is nothing to do, not an error.
+    let results = if request.inputs.is_empty() {
+        Vec::new()
+    } else {
+        match run_shard(request, shard) {
+            Ok(r) => r,
+            Err(e) => return super::usage_error(e),
+        }
+    };
+    if let Some(stopped) = super::stopped(results.iter().map(|r| !r.is_failed())) {
+        return stopped;
+    }
+    super::emit(
+        match view.format {
+            super::ReportFormat::Text => render_text(&results, request.dry_run, view.detail),
+            super::ReportFormat::Json => render_json(&results),
+        }
+        .as_bytes(),
+    );
+    super::Status::failed_if(results.iter().any(|r| r.is_failed()))
 }

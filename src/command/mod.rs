@@ -1,6 +1,118 @@
-//! The bodies of velvet's file commands that run over many files on top of the engines:
-//! `velvet bake` ([`bake`]), which plans and applies bakes with the bake engine and writes its
-//! outputs through [`crate::output`]. The engines below (bake, edit, asset) know nothing of
-//! commands, destinations or reports.
+//! The file commands as the command line runs them, on one spine: find → load → plan →
+//! (check | dry run | preview | write) → result → report → exit status. `main.rs` parses the
+//! arguments into the requests here and maps the [`Status`] a command returns to the process's
+//! exit status; everything between is here, callable from tests without a process.
+//!
+//! [`validate`] runs the rules over many files and streams their reports; [`migrate`] and
+//! [`bake`] are two planners on the same spine: each file goes through
+//! [`crate::output::run_each`] (destinations, name claims, progress), becomes one
+//! [`crate::output::result::FileResult`] with one [`crate::output::Outcome`], and the run is
+//! summed up by one [`crate::output::result::Totals`] in the words of
+//! [`crate::output::summary`]. [`preview`] draws what migrate's plan writes. The engines
+//! below (migrate's planner, bake, edit, asset) know nothing of commands or reports.
 
 pub mod bake;
+pub mod migrate;
+pub mod preview;
+pub mod validate;
+
+use std::io::Write;
+
+/// How a command ended; `main` makes it the process's exit status ([`Status::code`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Status {
+    /// 0: done; nothing at or above `--fail-on`.
+    Done,
+    /// 1: a finding at or above `--fail-on`, a file that failed, or under `--check` a file that
+    /// would change.
+    Failed,
+    /// 2: a usage or configuration error; nothing was written.
+    Usage,
+    /// 128 + the signal: stopped by SIGINT or SIGTERM (finished outputs complete, nothing left
+    /// of the others).
+    Stopped(i32),
+}
+
+impl Status {
+    /// The process's exit status.
+    pub fn code(self) -> u8 {
+        match self {
+            Status::Done => 0,
+            Status::Failed => 1,
+            Status::Usage => 2,
+            Status::Stopped(signal) => (128 + signal).clamp(0, 255) as u8,
+        }
+    }
+
+    /// [`Status::Failed`] when `failed`, else [`Status::Done`].
+    pub fn failed_if(failed: bool) -> Status {
+        if failed {
+            Status::Failed
+        } else {
+            Status::Done
+        }
+    }
+}
+
+/// A request refused before anything was read or written: the message on standard error.
+pub fn usage_error(message: impl std::fmt::Display) -> Status {
+    eprintln!("velvet: {message}");
+    Status::Usage
+}
+
+/// Writes to standard output; a closed pipe (`velvet … | head`) is not an error.
+pub fn emit(text: &[u8]) {
+    let _ = std::io::stdout().lock().write_all(text);
+}
+
+/// When SIGINT or SIGTERM stopped a migrate or bake run: the one line saying what was finished
+/// (`finished` says it of each file) and the status, 128 + the signal. Files that failed for
+/// another reason are counted with those not finished: nothing of either was written.
+fn stopped(finished: impl Iterator<Item = bool>) -> Option<Status> {
+    let signal = crate::output::interrupt::requested()?;
+    let (mut done, mut total) = (0usize, 0usize);
+    for finished in finished {
+        total += 1;
+        done += usize::from(finished);
+    }
+    eprintln!(
+        "velvet: stopped by {}: {done} of {total} {} finished (their outputs are complete); \
+         nothing was written for the other {}",
+        crate::output::interrupt::name(signal),
+        if total == 1 { "file" } else { "files" },
+        total - done
+    );
+    Some(Status::Stopped(signal))
+}
+
+/// The report format of `velvet migrate` and `velvet bake`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum ReportFormat {
+    /// A line per file, then a summary.
+    #[default]
+    Text,
+    /// One JSON document: every file with what was planned and done, and the summary.
+    Json,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Status;
+
+    #[test]
+    fn each_status_is_its_documented_exit_code() {
+        assert_eq!(
+            [
+                Status::Done,
+                Status::Failed,
+                Status::Usage,
+                Status::Stopped(2),
+                Status::Stopped(15)
+            ]
+            .map(Status::code),
+            [0, 1, 2, 130, 143]
+        );
+        assert_eq!(Status::failed_if(true), Status::Failed);
+        assert_eq!(Status::failed_if(false), Status::Done);
+    }
+}

@@ -14,6 +14,8 @@ use super::textures;
 use super::Options;
 use crate::asset::{self, Asset, FileBytes, Snapshot};
 use crate::bake::apply::{apply as bake_apply, ApplyOptions, OutputReport};
+use crate::bake::engine::Baked;
+use crate::bake::plan::BakePlan;
 use crate::bake::{bake_into, BakeOptions, KernelOptions};
 use crate::diagnostics::Severity;
 use crate::edit;
@@ -169,11 +171,59 @@ fn dangling_layer_texture(asset: &Asset, document: &DocumentPlan) -> Option<Stri
         })
 }
 
-/// Applies a file's plan and writes its output (and resource copies). On failure the output
-/// is as it was: every write goes through a temporary file renamed into place. The document is
-/// edited where it lies (a large one is not copied), so the plan's asset holds the edited
-/// document afterwards.
+/// How a file's plan is written. The spine chooses one per file ([`WriteStrategy::choose`]);
+/// a strategy that cannot take a plan hands it to [`WriteStrategy::Rewrite`], which takes any.
+/// Each writes the same document (tests compare them), differing in what they read and in
+/// which bytes they keep.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum WriteStrategy {
+    /// No textures to bake: the edits as splices into the loaded text, reading only the
+    /// values they touch; every other byte is kept.
+    Splice,
+    /// Bakes whose new images are files already: the bake applied to the part of the document
+    /// it reads and changes ([`BakePart`]), then spliced like the edits.
+    BakePart,
+    /// The plan applied to the whole document, written anew in the input's own style: for a
+    /// bake that drops a texture, a GLB, `--embed`, or a text the splicer does not take.
+    Rewrite,
+}
+
+impl WriteStrategy {
+    /// The strategy for a plan with `bakes`, once they are baked (`baked`): `streamed` says new
+    /// images are files next to a .gltf, written as they are encoded.
+    pub fn choose(bakes: &BakePlan, streamed: bool, baked: &[Baked]) -> WriteStrategy {
+        if bakes.is_empty() {
+            WriteStrategy::Splice
+        } else if streamed
+            && baked
+                .iter()
+                .all(|b| b.stored.is_some() || b.encoded.is_none())
+        {
+            WriteStrategy::BakePart
+        } else {
+            WriteStrategy::Rewrite
+        }
+    }
+}
+
+/// Applies a file's plan and writes its output (and resource copies), by the strategy the
+/// spine chooses. On failure the output is as it was: every file written for it is staged and
+/// put in place with the document (see output::staging). The document is edited where it lies
+/// (a large one is not copied), so the plan's asset holds the edited document afterwards when
+/// it was rewritten.
 pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> {
+    execute_by(plan, claims, false).map(|(written, _)| written)
+}
+
+/// [`execute`], by [`WriteStrategy::Rewrite`] whatever the choice when `rewrite` is set (which
+/// tests compare the chosen strategies with); returns what was written and the strategy that
+/// wrote it.
+pub fn execute_by(
+    plan: &mut FilePlan,
+    claims: &Claims,
+    rewrite: bool,
+) -> Result<(Written, WriteStrategy), String> {
     let Some(output) = plan.output.clone() else {
         return Err(format!("{}: no output path", plan.input.display()));
     };
@@ -236,67 +286,74 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
         }
     }
     let mut names = names.into_inner().unwrap_or_else(|e| e.into_inner());
-    let names_dir = names.dir().to_path_buf();
-    let input = plan.input.clone();
-    let snapshot = plan.snapshot;
-    let in_place = plan.in_place();
-    let fail = |e: edit::EditError| format!("{}: {e}", input.display());
-    // Without bakes the edits are written as splices straight into the loaded text, reading
-    // only the materials they touch. With bakes whose images are files already, the bake is
-    // applied to the part of the document it reads and changes, and the edits go there too
-    // (see `baked_by_part`). Otherwise, or for a plan neither takes, everything is applied to
-    // the whole document.
-    let spliced: Option<PartWritten> = if bake_plan.is_empty() {
-        let edits = plan.document.edits().chain(&plan.relocation.edits);
-        write::spliced_bytes(&plan.asset, edits)
-            .map_err(fail)?
-            .map(|(out, changed)| (out, changed, Vec::new()))
-    } else if streamed
-        && baked
-            .iter()
-            .all(|b| b.stored.is_some() || b.encoded.is_none())
-    {
-        baked_by_part(
+    let strategy = match rewrite {
+        true => WriteStrategy::Rewrite,
+        false => WriteStrategy::choose(&bake_plan, streamed, &baked),
+    };
+    let fail = |e: edit::EditError| format!("{}: {e}", plan.input.display());
+    let spliced: Option<PartWritten> = match strategy {
+        WriteStrategy::Splice => {
+            let edits = plan.document.edits().chain(&plan.relocation.edits);
+            write::spliced_bytes(&plan.asset, edits)
+                .map_err(fail)?
+                .map(|(out, changed)| (out, changed, Vec::new()))
+        }
+        WriteStrategy::BakePart => baked_by_part(
             &plan.asset,
             &plan.document,
             &plan.relocation,
-            &input,
+            &plan.input,
             plan.embed,
             &bake_plan,
             &mut baked,
             &mut names,
             &staging,
-        )?
-    } else {
-        None
+        )?,
+        WriteStrategy::Rewrite => None,
     };
-    if let Some((out, changed, outputs)) = spliced {
-        if !changed && in_place {
-            return Ok(Written::Untouched);
-        }
-        create_parent(&output)?;
-        let out = if bake_plan.is_empty() {
-            // Without bakes no edit touches a URI that is copied (resources are copied or
-            // their URIs rewritten, never both), so the document as loaded names what the
-            // output uses.
-            copy_resources(&plan.relocation, plan.asset.root(), &staging)?;
-            match changed {
-                true => out,
-                false => Output::Bytes(input_bytes(plan)?),
-            }
-        } else {
-            out
-        };
-        staging.stage_document(&output, &out)?;
-        snapshot.unchanged(&input)?;
-        staging.commit()?;
-        plan.baked = outputs;
-        return Ok(if changed {
-            Written::Changed
-        } else {
-            Written::Copied
-        });
+    let Some((out, changed, outputs)) = spliced else {
+        let written = write_rewritten(plan, &output, &bake_plan, baked, names, staging)?;
+        return Ok((written, WriteStrategy::Rewrite));
+    };
+    // A spliced output is put in place (with, without bakes, the resource copies it needs).
+    if !changed && plan.in_place() {
+        return Ok((Written::Untouched, strategy));
     }
+    create_parent(&output)?;
+    let out = if bake_plan.is_empty() {
+        // Without bakes no edit touches a URI that is copied (resources are copied or their
+        // URIs rewritten, never both), so the document as loaded names what the output uses.
+        copy_resources(&plan.relocation, plan.asset.root(), &staging)?;
+        match changed {
+            true => out,
+            false => Output::Bytes(input_bytes(plan)?),
+        }
+    } else {
+        out
+    };
+    staging.stage_document(&output, &out)?;
+    plan.snapshot.unchanged(&plan.input)?;
+    staging.commit()?;
+    plan.baked = outputs;
+    let written = if changed {
+        Written::Changed
+    } else {
+        Written::Copied
+    };
+    Ok((written, strategy))
+}
+
+/// Applies the plan (and its bakes) to the whole document and writes it anew.
+fn write_rewritten(
+    plan: &mut FilePlan,
+    output: &std::path::Path,
+    bake_plan: &BakePlan,
+    mut baked: Vec<Baked>,
+    mut names: FileNames,
+    staging: Staging,
+) -> Result<Written, String> {
+    let input = plan.input.clone();
+    let fail = |e: edit::EditError| format!("{}: {e}", input.display());
     // The edits are applied where they lie in the plan (a large document's are not copied).
     let mut changed = false;
     let groups = plan
@@ -311,14 +368,14 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
     for edits in groups {
         changed |= edit::apply(plan.asset.json_mut(), edits).map_err(fail)?;
     }
-    if !changed && in_place {
+    if !changed && plan.in_place() {
         return Ok(Written::Untouched);
     }
     if changed {
         // The input's bytes are written only when nothing changed.
         plan.bytes = None;
     }
-    create_parent(&output)?;
+    create_parent(output)?;
     let bytes = if bake_plan.is_empty() {
         copy_resources(&plan.relocation, plan.asset.root(), &staging)?;
         match changed {
@@ -330,12 +387,13 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
             false => input_bytes(plan)?,
         }
     } else {
+        let names_dir = names.dir().to_path_buf();
         let json = plan.asset.take_json();
         let applied = bake_apply(
             json,
             plan.asset.bin.take(),
             plan.asset.container,
-            &bake_plan,
+            bake_plan,
             &mut baked,
             ApplyOptions { embed: plan.embed },
             &mut names,
@@ -352,8 +410,8 @@ pub fn execute(plan: &mut FilePlan, claims: &Claims) -> Result<Written, String> 
         plan.baked = applied.outputs;
         bytes
     };
-    staging.stage_document(&output, &Output::Bytes(bytes))?;
-    snapshot.unchanged(&input)?;
+    staging.stage_document(output, &Output::Bytes(bytes))?;
+    plan.snapshot.unchanged(&plan.input)?;
     staging.commit()?;
     Ok(if changed {
         Written::Changed

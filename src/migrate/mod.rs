@@ -4,15 +4,14 @@
 //! The flow is one way. [`plan`] decides, per material, which conversion applies and turns it
 //! into [`Edit`]s and [`Note`]s (plain values: a dry run prints them, tests compare them);
 //! [`crate::output::paths`] decides where each output goes and which relative URIs or resources
-//! must follow it; [`apply`] executes a file's plan and writes it atomically; [`batch`] runs
-//! many files in parallel and sums up. Each conversion rule is one file: [`sheen_to_fuzz`],
+//! must follow it; [`apply`] executes a file's plan and writes it atomically; the `velvet migrate`
+//! command (`crate::command::migrate`) runs many files on the spine every file command shares. Each conversion rule is one file: [`sheen_to_fuzz`],
 //! [`fallback`], [`legacy`]. The roughness choice between the layers lives in [`roughness`]
 //! alone. Textures that a conversion must bake are planned in [`textures`] and made by the bake
 //! engine, then applied to the part of the document they change ([`bake_part`]).
 
 pub mod apply;
 pub mod bake_part;
-pub mod batch;
 pub mod budget;
 pub mod fallback;
 pub mod legacy;
@@ -20,12 +19,10 @@ pub mod material;
 pub mod measure;
 pub mod note;
 pub mod plan;
-pub mod render;
 pub mod roughness;
 pub mod sheen_to_fuzz;
 pub mod textures;
 
-pub use batch::{run, run_shard, FileOutcome, FileResult, Request, RunReport, Summary};
 pub use note::{Conversion, Level, Note, Skip};
 pub use plan::{plan_document, DocumentPlan, MaterialPlan};
 

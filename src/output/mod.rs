@@ -13,6 +13,7 @@
 pub mod files;
 pub mod interrupt;
 pub mod paths;
+pub mod result;
 pub mod staging;
 pub mod summary;
 

@@ -47,6 +47,20 @@ pub enum Destination {
     Dir(PathBuf),
 }
 
+impl Destination {
+    /// The destination the command line names, the same for every file command: `-o FILE`,
+    /// else `--out-dir DIR`, else `--in-place`, else none (a dry run or a check; a real run
+    /// without one is refused as [`super::UsageError::NoDestination`]).
+    pub fn from_flags(output: Option<PathBuf>, out_dir: Option<PathBuf>, in_place: bool) -> Self {
+        match (output, out_dir, in_place) {
+            (Some(file), _, _) => Destination::File(file),
+            (_, Some(dir), _) => Destination::Dir(dir),
+            (_, _, true) => Destination::InPlace,
+            _ => Destination::None,
+        }
+    }
+}
+
 /// One input and where its output goes (`None` in a dry run without a destination).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Job {

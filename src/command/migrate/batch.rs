@@ -2,14 +2,15 @@
 //! (rayon), each independently — one failing file does not stop the others — with a progress
 //! bar on a terminal, and sum up what happened.
 
-use super::apply::{execute, plan_file, Written};
-use super::material::MaterialPlan;
-use super::note::{Conversion, Level, Note, Skip};
-use super::Options;
 use crate::asset::discover::Shard;
 use crate::edit::Edit;
+use crate::migrate::apply::{execute, plan_file, Written};
+use crate::migrate::material::MaterialPlan;
+use crate::migrate::note::{Conversion, Level, Note, Skip};
+use crate::migrate::Options;
 use crate::output::files::Claims;
 use crate::output::paths::{Destination, Job, ResourceCopy};
+use crate::output::result::{Account, Totals};
 use crate::output::{run_each, Scope, UsageError};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -30,18 +31,15 @@ pub struct Request {
 /// What became of one file: the outcome `velvet bake` reports too.
 pub use crate::output::Outcome as FileOutcome;
 
-/// The report for one file.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct FileResult {
-    pub input: PathBuf,
-    pub output: Option<PathBuf>,
-    #[serde(flatten)]
-    pub outcome: FileOutcome,
+/// What `velvet migrate` says of one file besides its outcome: the plan it carried out (or, in
+/// a dry run, would carry out).
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct MigrateDetail {
     pub materials: Vec<MaterialPlan>,
     /// Edits outside the materials: declarations and URI rewrites.
     pub edits: Vec<Edit>,
     pub copies: Vec<ResourceCopy>,
-    #[serde(serialize_with = "super::material::notes_json")]
+    #[serde(serialize_with = "crate::migrate::material::notes_json")]
     pub notes: Vec<Note>,
     /// New textures (distinct baked images) the output gains; in a dry run, those planned.
     pub textures_added: usize,
@@ -49,38 +47,29 @@ pub struct FileResult {
     pub bytes_added: usize,
 }
 
-impl FileResult {
-    fn failed(job: &Job, error: String) -> FileResult {
-        FileResult {
-            input: job.input.clone(),
-            output: job.output.clone(),
-            outcome: FileOutcome::Failed { error },
-            materials: Vec::new(),
-            edits: Vec::new(),
-            copies: Vec::new(),
-            notes: Vec::new(),
-            textures_added: 0,
-            bytes_added: 0,
-        }
+impl Account for MigrateDetail {
+    fn added(&self, _: &FileOutcome) -> (usize, usize) {
+        (self.textures_added, self.bytes_added)
+    }
+
+    fn warnings(&self) -> usize {
+        let warning = |n: &&Note| n.level() == Level::Warning;
+        let of_materials = self.materials.iter().flat_map(|m| &m.notes);
+        self.notes.iter().filter(warning).count() + of_materials.filter(warning).count()
     }
 }
 
-/// Totals over a run.
+/// The report for one file.
+pub type FileResult = crate::output::result::FileResult<MigrateDetail>;
+
+/// Totals over a run: those every file command counts, and the materials' conversions.
 #[derive(Debug, Clone, Default, PartialEq, Eq, Serialize)]
 pub struct Summary {
-    pub files: usize,
-    pub changed: usize,
-    pub unchanged: usize,
-    pub failed: usize,
-    /// Dry run: files that would change.
-    pub would_change: usize,
+    #[serde(flatten)]
+    pub totals: Totals,
     pub materials_migrated: usize,
     pub conversions: BTreeMap<Conversion, usize>,
     pub skipped: BTreeMap<Skip, usize>,
-    pub warnings: usize,
-    /// New textures over all files, and their bytes.
-    pub textures_added: usize,
-    pub bytes_added: usize,
 }
 
 /// The outcome of a run: every file in input order, and the totals.
@@ -94,17 +83,17 @@ pub struct RunReport {
 impl RunReport {
     /// True when a file failed (exit status 1).
     pub fn failed(&self) -> bool {
-        self.summary.failed > 0
+        self.summary.totals.failed > 0
     }
 }
 
 fn migrate_one(job: &Job, options: &Options, dry_run: bool, claims: &Claims) -> FileResult {
     if let Err(stopped) = crate::output::interrupt::check() {
-        return FileResult::failed(job, stopped);
+        return FileResult::failed(&job.input, job.output.as_deref(), stopped);
     }
     let mut plan = match plan_file(job, options) {
         Ok(plan) => plan,
-        Err(error) => return FileResult::failed(job, error),
+        Err(error) => return FileResult::failed(&job.input, job.output.as_deref(), error),
     };
     let outcome = if dry_run {
         FileOutcome::Planned {
@@ -120,8 +109,9 @@ fn migrate_one(job: &Job, options: &Options, dry_run: bool, claims: &Claims) -> 
     };
     let written: Vec<_> = plan.baked.iter().filter(|o| o.image.is_some()).collect();
     let (textures_added, bytes_added) = if dry_run {
-        let planned =
-            super::textures::bake_plan(plan.document.materials.iter().flat_map(|m| &m.bakes));
+        let planned = crate::migrate::textures::bake_plan(
+            plan.document.materials.iter().flat_map(|m| &m.bakes),
+        );
         (planned.map_or(0, |p| p.recipes.len()), 0)
     } else {
         (written.len(), written.iter().map(|o| o.bytes).sum())
@@ -156,18 +146,20 @@ fn migrate_one(job: &Job, options: &Options, dry_run: bool, claims: &Claims) -> 
         input: plan.input.clone(),
         output: plan.output.clone(),
         outcome,
-        edits: plan
-            .document
-            .declarations
-            .iter()
-            .chain(&plan.relocation.edits)
-            .cloned()
-            .collect(),
-        materials: plan.document.materials,
-        copies: plan.relocation.copies,
-        notes,
-        textures_added,
-        bytes_added,
+        detail: MigrateDetail {
+            edits: plan
+                .document
+                .declarations
+                .iter()
+                .chain(&plan.relocation.edits)
+                .cloned()
+                .collect(),
+            materials: plan.document.materials,
+            copies: plan.relocation.copies,
+            notes,
+            textures_added,
+            bytes_added,
+        },
     }
 }
 
@@ -189,10 +181,8 @@ pub fn run_shard(request: &Request, shard: Option<Shard>) -> Result<RunReport, U
         &scope,
         |path, e| {
             FileResult::failed(
-                &Job {
-                    input: path.clone(),
-                    output: None,
-                },
+                &path,
+                None,
                 format!("cannot read folder {}: {e}", path.display()),
             )
         },
@@ -208,34 +198,11 @@ pub fn run_shard(request: &Request, shard: Option<Shard>) -> Result<RunReport, U
 
 fn summarise(files: &[FileResult]) -> Summary {
     let mut s = Summary {
-        files: files.len(),
+        totals: Totals::of(files),
         ..Summary::default()
     };
-    for file in files {
-        match &file.outcome {
-            FileOutcome::Changed => s.changed += 1,
-            FileOutcome::Copied
-            | FileOutcome::Untouched
-            | FileOutcome::Planned { changes: false } => s.unchanged += 1,
-            FileOutcome::Planned { changes: true } => s.would_change += 1,
-            FileOutcome::Failed { .. } => s.failed += 1,
-        }
-        if matches!(file.outcome, FileOutcome::Failed { .. }) {
-            continue;
-        }
-        s.textures_added += file.textures_added;
-        s.bytes_added += file.bytes_added;
-        s.warnings += file
-            .notes
-            .iter()
-            .filter(|n| n.level() == Level::Warning)
-            .count();
-        for material in &file.materials {
-            s.warnings += material
-                .notes
-                .iter()
-                .filter(|n| n.level() == Level::Warning)
-                .count();
+    for file in files.iter().filter(|f| !f.is_failed()) {
+        for material in &file.detail.materials {
             if material.migrated() {
                 s.materials_migrated += 1;
             }

@@ -6,8 +6,9 @@
 //! [`crate::output::summary`].
 
 use super::batch::{FileOutcome, FileResult, RunReport, Summary};
-use super::material::MaterialPlan;
-use super::note::Level;
+use crate::migrate::material::MaterialPlan;
+use crate::migrate::note::Level;
+use crate::output::result::Account;
 use crate::output::summary::{added, files_line, plural, Detail};
 use crate::report::escape::push_line;
 use std::fmt::Write;
@@ -45,20 +46,15 @@ fn file_line(f: &FileResult, dry_run: bool) -> String {
         Some(o) if o != &f.input => format!(" → {}", o.display()),
         _ => String::new(),
     };
-    let migrated = f.materials.iter().filter(|m| m.migrated()).count();
-    let warnings = f
-        .materials
-        .iter()
-        .flat_map(|m| &m.notes)
-        .chain(&f.notes)
-        .filter(|n| n.level() == Level::Warning)
-        .count();
+    let migrated = f.detail.materials.iter().filter(|m| m.migrated()).count();
+    let warnings = f.detail.warnings();
+    let (textures, bytes) = f.added();
     let counts = format!(
         " ({}, {}, {})",
         plural(migrated, "material", "materials"),
         added(
-            f.textures_added,
-            f.bytes_added,
+            textures,
+            bytes,
             matches!(f.outcome, FileOutcome::Planned { .. })
         ),
         plural(warnings, "warning", "warnings")
@@ -85,7 +81,7 @@ fn file_line(f: &FileResult, dry_run: bool) -> String {
 pub fn file_text(f: &FileResult, plan: bool) -> String {
     let mut out = String::new();
     push_line(&mut out, &file_line(f, plan));
-    for m in &f.materials {
+    for m in &f.detail.materials {
         if !plan && m.notes.is_empty() {
             continue;
         }
@@ -105,17 +101,17 @@ pub fn file_text(f: &FileResult, plan: bool) -> String {
             }
         }
     }
-    for note in &f.notes {
+    for note in &f.detail.notes {
         push_line(
             &mut out,
             &format!("  {}: {}", level(note.level()), note.message()),
         );
     }
     if plan {
-        for edit in &f.edits {
+        for edit in &f.detail.edits {
             push_line(&mut out, &format!("  {edit}"));
         }
-        for copy in &f.copies {
+        for copy in &f.detail.copies {
             push_line(
                 &mut out,
                 &format!("  copy {} → {}", copy.from.display(), copy.to.display()),
@@ -137,19 +133,12 @@ fn counted<K: Copy>(
 }
 
 /// The closing summary.
-pub fn summary_text(s: &Summary, dry_run: bool) -> String {
-    let mut out = if dry_run {
-        files_line(
-            s.files,
-            s.would_change,
-            "would change",
-            s.unchanged,
-            s.failed,
-        )
-    } else {
-        files_line(s.files, s.changed, "migrated", s.unchanged, s.failed)
-    };
-    let _ = writeln!(out, "; {}", added(s.textures_added, s.bytes_added, dry_run));
+pub fn summary_text(summary: &Summary, dry_run: bool) -> String {
+    let t = &summary.totals;
+    let done = if dry_run { "would change" } else { "migrated" };
+    let mut out = files_line(t.files, t.done(), done, t.unchanged, t.failed);
+    let _ = writeln!(out, "; {}", added(t.textures_added, t.bytes_added, dry_run));
+    let s = summary;
     let _ = write!(out, "materials: {} migrated", s.materials_migrated);
     if !s.conversions.is_empty() {
         let _ = write!(out, " ({})", counted(&s.conversions, |c| c.as_str()));
@@ -159,7 +148,7 @@ pub fn summary_text(s: &Summary, dry_run: bool) -> String {
     if skipped > 0 {
         let _ = write!(out, " ({})", counted(&s.skipped, |k| k.as_str()));
     }
-    let _ = writeln!(out, "; {}", plural(s.warnings, "warning", "warnings"));
+    let _ = writeln!(out, "; {}", plural(t.warnings, "warning", "warnings"));
     out
 }
 

@@ -1,0 +1,99 @@
+//! `velvet validate` as the command line runs it: the files found, each checked under its own
+//! configuration, each report written as soon as it is done, the exit status from every
+//! finding. A run that cannot start (a missing path, a bad velvet.toml or schema folder)
+//! still writes a report in the format asked for, recording why.
+
+use super::Status;
+use crate::asset::discover::{self, Shard};
+use crate::asset::LoadOptions;
+use crate::config::Flags;
+use crate::diagnostics::Settings;
+use crate::report::{self, ColorChoice, Format};
+use crate::rules::schema::Schemas;
+use crate::validate::Validator;
+use std::path::PathBuf;
+
+/// One `velvet validate` invocation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Request {
+    pub paths: Vec<PathBuf>,
+    /// `--files-from FILE` (`-`: standard input).
+    pub files_from: Option<PathBuf>,
+    pub shard: Option<Shard>,
+    pub settings: Flags,
+    /// `--schema-dir DIR`: schema files read from there instead of the built-in ones.
+    pub schema_dir: Option<PathBuf>,
+    pub load: LoadOptions,
+    pub format: Format,
+    pub color: ColorChoice,
+    pub quiet: bool,
+    /// Text: every finding, none folded.
+    pub no_fold: bool,
+}
+
+/// Runs `velvet validate`, its reports on standard output.
+pub fn command(request: &Request) -> Status {
+    // One report object for a run over one file named on the command line; an array for
+    // anything else (folders, several files, a list, a shard), whatever it finds.
+    let one_file = request.files_from.is_none()
+        && request.shard.is_none()
+        && matches!(request.paths.as_slice(), [path] if path.is_file());
+    // A run that cannot start still writes a report in its format, recording why (every
+    // such error comes before the first report is written).
+    let failed = |message: String| {
+        super::emit(report::failed_run(request.format, &message, !one_file).as_bytes());
+        super::usage_error(message)
+    };
+    let paths = match discover::resolve(&request.paths, request.files_from.as_deref()) {
+        Ok(p) => p,
+        Err(e) => return failed(e.to_string()),
+    };
+    let mut resolver = match request.settings.resolver() {
+        Ok(r) => r,
+        Err(e) => return failed(e.to_string()),
+    };
+    let validator = match &request.schema_dir {
+        Some(dir) => match Schemas::with_overrides(dir) {
+            Ok(schemas) => Validator::new(schemas, Settings::default()),
+            Err(e) => return failed(e.to_string()),
+        },
+        None => Validator::builtin(Settings::default()),
+    };
+    let validator = validator
+        .with_load_options(request.load)
+        .with_positions(request.format.shows_positions());
+    let progress = report::progress_bar(request.quiet);
+    let options = report::Options {
+        color: request.format == Format::Text && request.color.for_stdout(),
+        quiet: request.quiet,
+        no_fold: request.no_fold,
+    };
+    // Each file's report is written as soon as it is done (see report::Stream).
+    let stdout = std::io::BufWriter::new(std::io::stdout().lock());
+    let mut stream = report::Stream::new(request.format, options, stdout).json_array(!one_file);
+    let outcome = match crate::run::validate_shard_each(
+        &validator,
+        &paths,
+        request.shard,
+        &mut resolver,
+        progress.as_ref(),
+        &mut |r| match &progress {
+            // The bar is cleared while the report is written, so the two do not mix.
+            Some(bar) => bar.suspend(|| {
+                stream.push(r);
+                stream.flush();
+            }),
+            None => stream.push(r),
+        },
+    ) {
+        Ok(o) => o,
+        Err(e) => {
+            // Nothing has been written (configurations are resolved first); the stream holds
+            // standard output, so it goes before the failure's report is written.
+            drop(stream);
+            return failed(e.to_string());
+        }
+    };
+    stream.finish();
+    Status::failed_if(outcome.failed)
+}
