@@ -23,7 +23,6 @@ use crate::bake::engine::{bake_into, BakeOptions, MaxImagePixels};
 use crate::bake::kernel::KernelOptions;
 use crate::bake::plan::{plan, BakePlan, Note, PlanOptions};
 use crate::bake::prune::Dropped;
-use crate::diagnostics::Severity;
 use crate::edit::write;
 use crate::output::files::{copy_resources, create_parent, file_sink, stage_new_files};
 use crate::output::files::{Claims, FileNames};
@@ -32,7 +31,7 @@ use crate::output::paths::{check_links, relocate, Destination, Job, Relocation};
 use crate::output::result::{Account, Totals};
 use crate::output::staging::Staging;
 use crate::output::summary::{added, bytes, files_line, plural, Detail};
-use crate::output::{run_each, Scope, UsageError};
+use crate::output::{load_input, run_each, Input, Scope, UsageError};
 use crate::report::escape::push_line;
 
 /// What a run does besides where it writes.
@@ -155,21 +154,11 @@ fn bake_file(job: &Job, request: &Request, claims: &Claims) -> Result<FileResult
     interrupt::check()?;
     let input = job.input.as_path();
     let options = request.options;
-    let (bytes, snapshot) = asset::read_for_writing(input, &options.load)
-        .map_err(|e| format!("cannot be baked: {e}"))?;
-    // A .gltf's bytes become the asset's text as they are; a GLB's come back, for copying one
-    // with nothing to bake.
-    let (loaded, bytes) = asset::load_read(input, bytes, &options.load);
-    let errors: Vec<String> = loaded
-        .diagnostics
-        .iter()
-        .filter(|d| d.severity == Severity::Error)
-        .map(|d| format!("{} ({})", d.message, d.code))
-        .collect();
-    let mut asset = match loaded.asset {
-        Some(asset) if errors.is_empty() => asset,
-        _ => return Err(format!("cannot be baked: {}", errors.join("; "))),
-    };
+    let Input {
+        mut asset,
+        bytes,
+        snapshot,
+    } = load_input(input, &options.load, "baked")?;
     check_links(&asset)?;
     let plan = plan(&asset, options.plan);
     let planned_names: Vec<String> = plan

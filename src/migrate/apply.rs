@@ -17,7 +17,6 @@ use crate::bake::apply::{apply as bake_apply, ApplyOptions, OutputReport};
 use crate::bake::engine::Baked;
 use crate::bake::plan::BakePlan;
 use crate::bake::{bake_into, BakeOptions, KernelOptions};
-use crate::diagnostics::Severity;
 use crate::edit;
 use crate::edit::write;
 use crate::edit::write::Output;
@@ -26,6 +25,7 @@ use crate::output::files::{Claims, FileNames};
 use crate::output::interrupt;
 use crate::output::paths::{check_links, relocate, Job, Relocation};
 use crate::output::staging::Staging;
+use crate::output::{load_input, Input};
 use std::borrow::Cow;
 use std::path::PathBuf;
 use std::sync::Mutex;
@@ -72,27 +72,12 @@ pub enum Written {
 
 /// Loads and plans one file. Errors name the file and what is wrong.
 pub fn plan_file(job: &Job, options: &Options) -> Result<FilePlan, String> {
-    let (bytes, snapshot) = asset::read_for_writing(&job.input, &options.load)
-        .map_err(|e| format!("{} cannot be migrated: {e}", job.input.display()))?;
-    // A .gltf's bytes become the asset's text as they are: a copy of a large document cost as
-    // much as reading it (a page fault per 4 KiB on first touch).
-    let (loaded, bytes) = asset::load_read(&job.input, bytes, &options.load);
-    let errors: Vec<String> = loaded
-        .diagnostics
-        .iter()
-        .filter(|d| d.severity == Severity::Error)
-        .map(|d| format!("{} ({})", d.message, d.code))
-        .collect();
-    let asset = match loaded.asset {
-        Some(asset) if errors.is_empty() => asset,
-        _ => {
-            return Err(format!(
-                "{} cannot be migrated: {}",
-                job.input.display(),
-                errors.join("; ")
-            ))
-        }
-    };
+    let Input {
+        asset,
+        bytes,
+        snapshot,
+    } = load_input(&job.input, &options.load, "migrated")
+        .map_err(|e| format!("{} {e}", job.input.display()))?;
     check_links(&asset).map_err(|e| format!("{}: {e}", job.input.display()))?;
     let document = plan_document(&asset, options);
     if let Some(dangling) = dangling_layer_texture(&asset, &document) {

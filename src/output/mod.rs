@@ -18,6 +18,7 @@ pub mod staging;
 pub mod summary;
 
 use crate::asset::discover::Shard;
+use crate::asset::{Asset, FileBytes, LoadOptions, Snapshot};
 use rayon::prelude::*;
 use std::path::PathBuf;
 
@@ -140,4 +141,44 @@ pub enum UsageError {
         target: String,
         root: String,
     },
+}
+
+/// An input loaded by a command that writes an output for it.
+pub struct Input {
+    pub asset: Asset,
+    /// The file's bytes where the loader kept them (a GLB's, for an output with nothing to
+    /// change, written as they are); a .gltf's are the asset's text.
+    pub bytes: Option<FileBytes>,
+    /// The file as it was read, compared before anything is written for it.
+    pub snapshot: Snapshot,
+}
+
+/// Reads and loads `path` for a command that writes its output (`verb`: "migrated", "baked").
+/// A file the loader reports errors for is refused, naming them: rewriting it would hide the
+/// fault (a truncated BIN chunk would come out "fixed"). The error reads "cannot be `verb`:
+/// …", for the caller to put after the file's name.
+pub fn load_input(
+    path: &std::path::Path,
+    options: &LoadOptions,
+    verb: &str,
+) -> Result<Input, String> {
+    let (bytes, snapshot) = crate::asset::read_for_writing(path, options)
+        .map_err(|e| format!("cannot be {verb}: {e}"))?;
+    // A .gltf's bytes become the asset's text as they are: a copy of a large document cost as
+    // much as reading it (a page fault per 4 KiB on first touch).
+    let (loaded, bytes) = crate::asset::load_read(path, bytes, options);
+    let errors: Vec<String> = loaded
+        .diagnostics
+        .iter()
+        .filter(|d| d.severity == crate::diagnostics::Severity::Error)
+        .map(|d| format!("{} ({})", d.message, d.code))
+        .collect();
+    match loaded.asset {
+        Some(asset) if errors.is_empty() => Ok(Input {
+            asset,
+            bytes,
+            snapshot,
+        }),
+        _ => Err(format!("cannot be {verb}: {}", errors.join("; "))),
+    }
 }
