@@ -278,15 +278,19 @@ struct BakeArgs {
 
 #[derive(clap::Args)]
 #[command(
-    after_help = "Exit status: 0 done, 1 a file could not be previewed or an output not written (the other sheets are still written), 2 usage error (nothing written)."
+    after_help = "Exit status: 0 done, 1 a file could not be previewed or an output not written (the other sheets are still written), 2 usage error (nothing written), 130 / 143 stopped by SIGINT / SIGTERM (the sheets written are complete, no index)."
 )]
 struct PreviewArgs {
     /// Files and folders (folders are searched for *.gltf and *.glb, in any letter case).
     #[arg(required = true)]
     paths: Vec<PathBuf>,
-    /// The folder the sheets and index.html are written into.
+    /// The folder the sheets and index pages are written into.
     #[arg(short, long, value_name = "DIR", default_value = "velvet-preview")]
     output: PathBuf,
+    /// Draw only the N sheets whose migration moves the look most, by the plan's numbers
+    /// (found before anything is drawn); the index lists the others.
+    #[arg(long, value_name = "N")]
+    worst: Option<usize>,
     #[command(flatten)]
     load: LoadArgs,
 }
@@ -355,9 +359,13 @@ fn main() -> ExitCode {
             }
         }
         Command::Bake(args) => bake(args, cli.quiet),
-        Command::Preview(args) => {
-            command::preview::command(&args.paths, &args.output, args.load.options(), cli.quiet)
-        }
+        Command::Preview(args) => command::preview::command(&command::preview::Request {
+            inputs: args.paths,
+            output: args.output,
+            worst: args.worst,
+            load: args.load.options(),
+            quiet: cli.quiet,
+        }),
         Command::Codes { format } => {
             command::emit(codes_table(format).as_bytes());
             Status::Done

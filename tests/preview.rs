@@ -640,3 +640,195 @@ fn the_migrated_column_is_the_fuzz_migrate_writes_for_each_roughness_option() {
         "--roughness identity shows another sheet"
     );
 }
+
+// ---------------------------------------------------------------- a library: sharing, ranking
+
+fn run_velvet(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_velvet"))
+        .args(args)
+        .output()
+        .expect("run velvet")
+}
+
+/// A sheen material named `name` with colour `c` and roughness `r`.
+fn sheen(name: &str, c: f64, r: f64) -> String {
+    format!(
+        r#"{{"name": "{name}", "extensions": {{"KHR_materials_sheen": {{"sheenColorFactor": [{c}, {c}, {c}], "sheenRoughnessFactor": {r}}}}}}}"#
+    )
+}
+
+/// The PNG files in `dir`, sorted.
+fn pngs(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".png"))
+        .collect();
+    names.sort();
+    names
+}
+
+#[test]
+fn materials_with_the_same_values_share_one_sheet_which_lists_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let materials = [
+        sheen("first", 0.8, 0.4),
+        sheen("other", 0.3, 0.9),
+        sheen("second", 0.8, 0.4),
+    ]
+    .join(", ");
+    let input = write(dir.path(), "shared.gltf", &gltf(&materials));
+    let plan = velvet::preview::plan(
+        std::slice::from_ref(&input),
+        &velvet::migrate::Options::default(),
+    );
+    assert_eq!(plan.entries.len(), 3);
+    assert_eq!(plan.sheets.len(), 2);
+    assert_eq!(plan.entries[0].sheet, plan.entries[2].sheet);
+    assert_ne!(plan.entries[0].sheet, plan.entries[1].sheet);
+    let shared = &plan.sheets[plan.entries[0].sheet];
+    assert_eq!(shared.entries, [0, 2]);
+    assert_eq!(shared.name, "shared-m0-first.png");
+    assert_eq!(
+        shared.title,
+        "shared.gltf: material 0 \"first\" and 1 other material with the same values"
+    );
+    let out = dir.path().join("out");
+    let o = run_velvet(&["preview", input.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(pngs(&out), ["shared-m0-first.png", "shared-m1-other.png"]);
+    let index = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert!(index.contains("<li>shared.gltf: material 2 &quot;second&quot;</li>"), "{index}");
+    let summary = format!(
+        "3 material(s) on 2 sheet(s), 2 drawn; index: {}\n",
+        out.join("index.html").display()
+    );
+    assert!(String::from_utf8_lossy(&o.stdout).ends_with(&summary));
+}
+
+#[test]
+fn worst_n_draws_exactly_the_n_sheets_the_plans_metric_ranks_highest() {
+    let dir = tempfile::tempdir().unwrap();
+    // Roughness from very low (held at migrate's floor: a large difference) to high.
+    let roughness = [0.9, 0.02, 0.5, 0.05, 0.3, 0.7, 0.1, 0.2];
+    let materials: Vec<String> = roughness
+        .iter()
+        .enumerate()
+        .map(|(i, r)| sheen(&format!("s{i}"), 0.9, *r))
+        .collect();
+    let input = write(dir.path(), "ranked.gltf", &gltf(&materials.join(", ")));
+    // The metric of each material, computed here from its own columns.
+    let asset = load(&input);
+    let mut by_metric: Vec<(f64, String)> = materials_of(&asset)
+        .iter()
+        .map(|m| {
+            (
+                m.plan_metric(),
+                format!("ranked-m{}-{}.png", m.index, m.name.as_deref().unwrap()),
+            )
+        })
+        .collect();
+    by_metric.sort_by(|a, b| b.0.total_cmp(&a.0));
+    assert!(by_metric[2].0 > by_metric[3].0, "{by_metric:?}: no tie at the cut");
+    let mut worst: Vec<String> = by_metric[..3].iter().map(|(_, n)| n.clone()).collect();
+    worst.sort();
+    let out = dir.path().join("out");
+    let o = run_velvet(&[
+        "preview",
+        input.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--worst",
+        "3",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(pngs(&out), worst);
+    // The index shows them worst first, and lists the five left undrawn.
+    let index = std::fs::read_to_string(out.join("index.html")).unwrap();
+    let at = |name: &str| index.find(&format!("<img src=\"{name}\"")).unwrap();
+    assert!(at(&by_metric[0].1) < at(&by_metric[1].1) && at(&by_metric[1].1) < at(&by_metric[2].1));
+    assert!(index.contains("<p>5 sheet(s) rank below those drawn"), "{index}");
+}
+
+#[test]
+fn a_library_larger_than_a_page_gets_pages_linked_from_the_first() {
+    let dir = tempfile::tempdir().unwrap();
+    let materials: Vec<String> = (0..velvet::preview::index::PAGE + 5)
+        .map(|i| sheen(&format!("m{i}"), 0.9, 0.3 + 0.6 * i as f64 / 200.0))
+        .collect();
+    let input = write(dir.path(), "lib.gltf", &gltf(&materials.join(", ")));
+    let plan = velvet::preview::plan(&[input], &velvet::migrate::Options::default());
+    let written = velvet::preview::write(&plan, &dir.path().join("out"), None, false).unwrap();
+    assert_eq!(written.drawn.len(), velvet::preview::index::PAGE + 5);
+    let names: Vec<_> = written
+        .pages
+        .iter()
+        .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(names, ["index.html", "index-2.html"]);
+    let first = std::fs::read_to_string(&written.pages[0]).unwrap();
+    assert!(first.contains("<a href=\"index-2.html\">2</a>"));
+    let second = std::fs::read_to_string(&written.pages[1]).unwrap();
+    assert_eq!(second.matches("<section>").count(), 5);
+    // Worst first across the pages.
+    let metrics: Vec<f64> = written.drawn.iter().map(|d| plan.sheets[d.sheet].metric).collect();
+    assert!(metrics.windows(2).all(|w| w[0] >= w[1]));
+}
+
+#[test]
+fn an_interrupted_preview_leaves_the_sheets_written_so_far_and_no_partial_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let materials: Vec<String> = (0..400)
+        .map(|i| sheen(&format!("m{i}"), 0.9, 0.1 + 0.8 * i as f64 / 400.0))
+        .collect();
+    let input = write(dir.path(), "lib.gltf", &gltf(&materials.join(", ")));
+    let mut stopped = 0;
+    for (k, (signal, delay_ms)) in [(libc::SIGINT, 400), (libc::SIGTERM, 900)]
+        .into_iter()
+        .enumerate()
+    {
+        let out = dir.path().join(format!("out-{k}"));
+        let child = Command::new(env!("CARGO_BIN_EXE_velvet"))
+            .args(["preview", input.to_str().unwrap(), "-o", out.to_str().unwrap()])
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(std::time::Duration::from_millis(delay_ms));
+        // SAFETY: kill(2) on the child's id, which it holds until it is waited for.
+        unsafe { libc::kill(child.id() as libc::pid_t, signal) };
+        let output = child.wait_with_output().unwrap();
+        let err = String::from_utf8_lossy(&output.stderr);
+        let files: Vec<String> = std::fs::read_dir(&out)
+            .map(|d| {
+                d.map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+                    .collect()
+            })
+            .unwrap_or_default();
+        // Every file there is a complete sheet (or, after a finished run, an index page).
+        for name in &files {
+            let path = out.join(name);
+            if name.ends_with(".png") {
+                image::open(&path).unwrap_or_else(|e| panic!("{name} is not whole: {e}"));
+            } else {
+                assert!(name.starts_with("index") && name.ends_with(".html"), "{name}");
+            }
+        }
+        match output.status.code() {
+            Some(0) => assert_eq!(pngs(&out).len(), 400),
+            Some(code) => {
+                assert_eq!(code, 128 + signal, "{err}");
+                assert!(
+                    err.starts_with("velvet: stopped by SIG")
+                        && err.contains("sheets written (each complete); no index written"),
+                    "{err}"
+                );
+                assert!(files.iter().all(|n| n.ends_with(".png")), "{files:?}");
+                assert!(pngs(&out).len() < 400);
+                stopped += 1;
+            }
+            None => panic!("killed by a signal: {err}"),
+        }
+    }
+    assert!(stopped > 0, "no run was stopped before it finished");
+}

@@ -1,56 +1,101 @@
-//! `velvet preview` as the command line runs it: the sheets of every sheen or fuzz material
-//! of the inputs, drawn from migrate's plan with its default options, written into a folder
-//! with an index, and a line per sheet.
+//! `velvet preview` as the command line runs it: the plan of every sheen or fuzz material of
+//! the inputs (migrate's plan with its default options), the chosen sheets drawn and written
+//! into a folder as they are drawn, worst first, with index pages, and a line per sheet.
 
 use super::Status;
 use crate::asset::{discover, LoadOptions};
 use std::path::{Path, PathBuf};
 
-/// Renders and writes the sheets of `inputs` into `output`; `quiet` prints nothing but errors.
-pub fn command(inputs: &[PathBuf], output: &Path, load: LoadOptions, quiet: bool) -> Status {
-    if let Err(e) = discover::check_inputs(inputs) {
+/// One `velvet preview` invocation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Request {
+    pub inputs: Vec<PathBuf>,
+    /// The folder the sheets and index pages are written into.
+    pub output: PathBuf,
+    /// `--worst N`: draw only the N sheets the plan ranks worst.
+    pub worst: Option<usize>,
+    pub load: LoadOptions,
+    /// No line per sheet, no progress bar.
+    pub quiet: bool,
+}
+
+/// Plans, draws and writes the sheets of `request.inputs`.
+pub fn command(request: &Request) -> Status {
+    if let Err(e) = discover::check_inputs(&request.inputs) {
         return super::usage_error(e);
     }
-    let previews = crate::preview::render(
-        inputs,
+    // Before anything is written: a signal from here on stops the run between sheets.
+    crate::output::interrupt::install();
+    let plan = crate::preview::plan(
+        &request.inputs,
         &crate::migrate::Options {
-            load,
+            load: request.load,
             ..crate::migrate::Options::default()
         },
     );
-    let mut failed = !previews.failures.is_empty();
-    for f in &previews.failures {
-        eprintln!("velvet: {}: {}", f.file.display(), f.message);
+    let failed = report_failures(&plan, "");
+    match write(&plan, &request.output, request.worst, request.quiet) {
+        Some(status) => status,
+        None => Status::failed_if(failed),
     }
-    match crate::preview::write(&previews, output) {
-        Ok(written) => {
-            if !quiet {
-                let mut out = String::new();
-                for (sheet, path) in previews.sheets.iter().zip(&written) {
-                    out += &format!(
-                        "{}: {} ({})\n",
-                        path.display(),
-                        sheet.summary.title,
-                        sheet.summary.verdict.text()
-                    );
-                }
-                for f in &previews.without_layers {
-                    out += &format!("{}: no material with a sheen or fuzz layer\n", f.display());
-                }
-                if let Some(index) = written.last() {
-                    out += &format!(
-                        "{} sheet(s); index: {}\n",
-                        previews.sheets.len(),
-                        index.display()
-                    );
-                }
-                super::emit(out.as_bytes());
-            }
-        }
+}
+
+/// Prints the files that could not be previewed (each line after `prefix`); true if any.
+pub(super) fn report_failures(plan: &crate::preview::Plan, prefix: &str) -> bool {
+    for f in &plan.failures {
+        eprintln!("velvet: {prefix}{}: {}", f.file.display(), f.message);
+    }
+    !plan.failures.is_empty()
+}
+
+/// Draws and writes `plan`'s sheets into `output` and says what was written; `Some` status
+/// when the run failed to write or was stopped.
+pub(super) fn write(
+    plan: &crate::preview::Plan,
+    output: &Path,
+    worst: Option<usize>,
+    quiet: bool,
+) -> Option<Status> {
+    let written = match crate::preview::write(plan, output, worst, !quiet) {
+        Ok(written) => written,
         Err(e) => {
             eprintln!("velvet: {e}");
-            failed = true;
+            return Some(Status::Failed);
         }
+    };
+    if written.stopped {
+        let signal = crate::output::interrupt::requested().unwrap_or(2);
+        eprintln!(
+            "velvet: stopped by {}: {} of {} sheets written (each complete); no index written",
+            crate::output::interrupt::name(signal),
+            written.drawn.len(),
+            worst.map_or(plan.sheets.len(), |n| n.min(plan.sheets.len()))
+        );
+        return Some(Status::Stopped(signal));
     }
-    Status::failed_if(failed)
+    if !quiet {
+        let mut out = String::new();
+        for d in &written.drawn {
+            out += &format!(
+                "{}: {} ({})\n",
+                d.path.display(),
+                d.summary.title,
+                d.summary.verdict.text()
+            );
+        }
+        for f in &plan.without_layers {
+            out += &format!("{}: no material with a sheen or fuzz layer\n", f.display());
+        }
+        if let Some(index) = written.pages.first() {
+            out += &format!(
+                "{} material(s) on {} sheet(s), {} drawn; index: {}\n",
+                plan.entries.len(),
+                plan.sheets.len(),
+                written.drawn.len(),
+                index.display()
+            );
+        }
+        super::emit(out.as_bytes());
+    }
+    None
 }

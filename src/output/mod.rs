@@ -76,7 +76,7 @@ pub fn run_each<R: Send>(
         }
     }
     let claims = files::Claims::default();
-    let bar = progress_bar(scope.progress, jobs.len());
+    let bar = progress_bar(scope.progress, jobs.len(), "files");
     let mut results: Vec<R> = walk_errors
         .into_iter()
         .map(|(path, e)| unreadable(path, e))
@@ -94,14 +94,14 @@ pub fn run_each<R: Send>(
     Ok(results)
 }
 
-/// The progress bar of a run over `files` files, when `wanted`: on a terminal only (logs and
-/// pipes never see one), and only for more than one file.
-fn progress_bar(wanted: bool, files: usize) -> Option<indicatif::ProgressBar> {
+/// The progress bar of a run over `count` things (`noun`: "files", "sheets"), when `wanted`:
+/// on a terminal only (logs and pipes never see one), and only for more than one.
+pub fn progress_bar(wanted: bool, count: usize, noun: &str) -> Option<indicatif::ProgressBar> {
     use std::io::IsTerminal;
-    (wanted && files > 1 && std::io::stderr().is_terminal()).then(|| {
-        let bar = indicatif::ProgressBar::new(files as u64);
+    (wanted && count > 1 && std::io::stderr().is_terminal()).then(|| {
+        let bar = indicatif::ProgressBar::new(count as u64);
         if let Ok(style) =
-            indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} files {msg}")
+            indicatif::ProgressStyle::with_template(&format!("{{bar:40}} {{pos}}/{{len}} {noun} {{msg}}"))
         {
             bar.set_style(style);
         }

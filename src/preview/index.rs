@@ -1,8 +1,22 @@
-//! The index page of a preview run: one static HTML file (no scripts, no external resources)
-//! that shows every sheet with its title, the report's figures and the verdict as text, and
-//! lists the files without sheen or fuzz and the files that failed.
+//! The index pages of a preview run: static HTML (no scripts, no external resources), the
+//! sheets worst first by the plan's measure, [`PAGE`] to a page with links between the pages.
+//! Each sheet is shown with its title, the materials that share it, the report's figures and
+//! the verdict as text; the first page also lists the sheets left undrawn (`--worst N`), the
+//! files without sheen or fuzz and the files that failed.
 
-use super::Previews;
+use super::{Drawn, Plan};
+
+/// Sheets on one page.
+pub const PAGE: usize = 100;
+
+/// The file name of page `page` (0-based): index.html, index-2.html, ….
+pub fn page_name(page: usize) -> String {
+    if page == 0 {
+        "index.html".to_string()
+    } else {
+        format!("index-{}.html", page + 1)
+    }
+}
 
 /// `text` with the five HTML special characters escaped.
 pub fn escape(text: &str) -> String {
@@ -20,34 +34,85 @@ pub fn escape(text: &str) -> String {
     out
 }
 
-/// The index page for `previews`.
-pub fn html(previews: &Previews) -> String {
+/// The index pages of `plan` with the sheets `drawn` (worst first): at least one page, each
+/// with [`PAGE`] sheets at most.
+pub fn pages(plan: &Plan, drawn: &[Drawn]) -> Vec<String> {
+    let chunks: Vec<&[Drawn]> = if drawn.is_empty() {
+        vec![&[]]
+    } else {
+        drawn.chunks(PAGE).collect()
+    };
+    let total = chunks.len();
+    chunks
+        .iter()
+        .enumerate()
+        .map(|(page, sheets)| html(plan, sheets, page, total, drawn.len()))
+        .collect()
+}
+
+fn nav(page: usize, total: usize) -> String {
+    if total == 1 {
+        return String::new();
+    }
+    let mut h = String::from("<p class=\"nav\">pages:");
+    for p in 0..total {
+        if p == page {
+            h += &format!(" <b>{}</b>", p + 1);
+        } else {
+            h += &format!(" <a href=\"{}\">{}</a>", page_name(p), p + 1);
+        }
+    }
+    h + "</p>\n"
+}
+
+fn html(plan: &Plan, sheets: &[Drawn], page: usize, total: usize, drawn: usize) -> String {
     let mut h = String::from(
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
          <title>velvet preview</title>\n<style>\n\
          body { font-family: sans-serif; background: #111; color: #ddd; margin: 2em; }\n\
-         section { margin-bottom: 3em; }\n img { max-width: 100%; image-rendering: pixelated; }\n\
+         section { margin-bottom: 3em; }\n img { max-width: 100%; }\n\
          .verdict { font-weight: bold; }\n a { color: #9cf; }\n</style>\n</head>\n<body>\n\
          <h1>velvet preview</h1>\n",
     );
     h += &format!(
-        "<p>{} sheet(s). Each shows the material as authored, as migrated and as a loader \
-         without KHR_materials_fuzz sees it, in a white furnace (top row of each pair) and \
-         under one directional light with a dim ambient; the last column is the difference \
-         between the first two, amplified {}&times;.</p>\n",
-        previews.sheets.len(),
+        "<p>{} material(s) on {} sheet(s) (materials with the same values share one), {drawn} \
+         drawn, worst first: ranked by the largest difference |max3&middot;E &minus; w&middot;R| \
+         between the layer as authored and as migrated, at views with &mu; &ge; 0.1. Each sheet \
+         shows the material as authored, as migrated and as a loader without \
+         KHR_materials_fuzz sees it, in a white furnace (top row of each pair) and under one \
+         directional light with a dim ambient; the last column is the difference between the \
+         first two, amplified {}&times;.</p>\n",
+        plan.entries.len(),
+        plan.sheets.len(),
         super::sheet::DIFF_GAIN
     );
-    for s in &previews.sheets {
-        let sum = &s.summary;
+    h += &nav(page, total);
+    for d in sheets {
+        let planned = &plan.sheets[d.sheet];
+        let sum = &d.summary;
+        let name = d
+            .path
+            .file_name()
+            .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
         h += "<section>\n";
-        h += &format!("<h2>{}</h2>\n", escape(&sum.title));
-        h += &format!("<p>{}</p>\n", escape(sum.kind));
         h += &format!(
-            "<a href=\"{0}\"><img src=\"{0}\" alt=\"{1}\"></a>\n",
-            escape(&s.name),
+            "<h2>{}. {}</h2>\n",
+            d.sheet + 1,
             escape(&sum.title)
         );
+        h += &format!("<p>{} (plan measure {:.4})</p>\n", escape(sum.kind), planned.metric);
+        h += &format!(
+            "<a href=\"{0}\"><img src=\"{0}\" alt=\"{1}\"></a>\n",
+            escape(&name),
+            escape(&sum.title)
+        );
+        if planned.entries.len() > 1 {
+            h += "<details><summary>materials on this sheet</summary><ul>\n";
+            for &e in &planned.entries {
+                h += &format!("<li>{}</li>\n", escape(&plan.entries[e].title()));
+            }
+            h += "</ul></details>\n";
+        }
         h += "<ul>\n";
         for f in &sum.figures {
             h += &format!("<li>{}</li>\n", escape(f));
@@ -59,23 +124,41 @@ pub fn html(previews: &Previews) -> String {
         }
         h += "</section>\n";
     }
-    if !previews.without_layers.is_empty() {
-        h += "<h2>Files without a sheen or fuzz layer</h2>\n<ul>\n";
-        for f in &previews.without_layers {
-            h += &format!("<li>{}</li>\n", escape(&f.display().to_string()));
-        }
-        h += "</ul>\n";
-    }
-    if !previews.failures.is_empty() {
-        h += "<h2>Files that could not be previewed</h2>\n<ul>\n";
-        for f in &previews.failures {
+    h += &nav(page, total);
+    if page == 0 {
+        if drawn < plan.sheets.len() {
             h += &format!(
-                "<li>{}: {}</li>\n",
-                escape(&f.file.display().to_string()),
-                escape(&f.message)
+                "<h2>Sheets not drawn</h2>\n<p>{} sheet(s) rank below those drawn (run without \
+                 --worst to draw them):</p>\n<ul>\n",
+                plan.sheets.len() - drawn
             );
+            for s in &plan.sheets[drawn..] {
+                h += &format!(
+                    "<li>{} (plan measure {:.4})</li>\n",
+                    escape(&s.title),
+                    s.metric
+                );
+            }
+            h += "</ul>\n";
         }
-        h += "</ul>\n";
+        if !plan.without_layers.is_empty() {
+            h += "<h2>Files without a sheen or fuzz layer</h2>\n<ul>\n";
+            for f in &plan.without_layers {
+                h += &format!("<li>{}</li>\n", escape(&f.display().to_string()));
+            }
+            h += "</ul>\n";
+        }
+        if !plan.failures.is_empty() {
+            h += "<h2>Files that could not be previewed</h2>\n<ul>\n";
+            for f in &plan.failures {
+                h += &format!(
+                    "<li>{}: {}</li>\n",
+                    escape(&f.file.display().to_string()),
+                    escape(&f.message)
+                );
+            }
+            h += "</ul>\n";
+        }
     }
     h += "</body>\n</html>\n";
     h
@@ -94,9 +177,18 @@ mod tests {
     }
 
     #[test]
-    fn an_empty_run_is_a_valid_page_that_says_so() {
-        let page = html(&Previews::default());
-        assert!(page.starts_with("<!DOCTYPE html>") && page.ends_with("</html>\n"));
-        assert!(page.contains("<p>0 sheet(s)."));
+    fn an_empty_run_is_one_valid_page_that_says_so() {
+        let pages = pages(&Plan::default(), &[]);
+        assert_eq!(pages.len(), 1);
+        assert!(pages[0].starts_with("<!DOCTYPE html>") && pages[0].ends_with("</html>\n"));
+        assert!(pages[0].contains("<p>0 material(s) on 0 sheet(s)"));
+    }
+
+    #[test]
+    fn pages_are_named_index_then_numbered_from_two() {
+        assert_eq!(
+            [0, 1, 9].map(page_name),
+            ["index.html", "index-2.html", "index-10.html"]
+        );
     }
 }

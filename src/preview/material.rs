@@ -91,6 +91,54 @@ pub struct Material {
     pub mapping: RoughnessMapping,
 }
 
+impl Material {
+    /// Everything the material's sheet is drawn from but its index and name, as text (an f64
+    /// is written as the shortest decimal that reads back as it, so equal texts are equal
+    /// values): materials with equal texts draw equal sheets, and share one.
+    pub fn appearance(&self) -> String {
+        format!(
+            "{:?}",
+            (
+                self.kind,
+                self.base,
+                &self.factors,
+                &self.swatches,
+                &self.notes,
+                self.fuzz_roughness_assumed,
+                self.mapping
+            )
+        )
+    }
+
+    /// How far the migration moves the material's look, from the plan's numbers alone (nothing
+    /// rendered), to rank a library's materials before any sheet is drawn: the largest
+    /// |max3·E − w·R| between the authored layer and the one the migrated file adds or keeps
+    /// for loaders without fuzz (columns 0 and 1), at the factors, over views with μ ≥ 0.1 (the
+    /// report's "max_ordinary"). E and R come from their tables (a few ns each where
+    /// quadrature takes tens of µs, so a 20,000-material library is ranked in well under a
+    /// second); there the tables are within 6e-3 (E, r ≥ 0.25) and 1e-3 (R) of quadrature
+    /// (docs/shading.md), while at grazing views and small roughness the E table's error
+    /// reaches units, which is why grazing views are left out. 0 when the columns hold no
+    /// sheen–fuzz pair.
+    pub fn plan_metric(&self) -> f64 {
+        use crate::shading::layering::{FuzzReflectance, SheenAlbedo};
+        use crate::shading::{AlbedoMethod, ReflectanceMethod};
+        let cols = columns(self, &self.factors);
+        match cols.get(1).and_then(|c| layer_pair(&cols[0].look.layer, &c.look.layer)) {
+            Some((sheen, fuzz)) => {
+                crate::shading::mapping::layer_match_with(
+                    sheen,
+                    fuzz,
+                    &SheenAlbedo(AlbedoMethod::Lut32),
+                    &FuzzReflectance(ReflectanceMethod::Table),
+                )
+                .max_ordinary
+            }
+            None => 0.0,
+        }
+    }
+}
+
 /// One column of a sheet: a label of two lines and the look it shows.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Column {

@@ -1,17 +1,21 @@
 //! `velvet preview`: contact sheets that show, per material that has or gets a sheen or fuzz
 //! layer, the material as authored, as migrated (fuzz with the fitted and with the copied
 //! roughness) and as a loader without KHR_materials_fuzz sees it, under a white furnace and a
-//! directional light, with the difference image, the report's figures and a verdict; and an
-//! index page (`index.html`) that links them for a whole file or folder.
+//! directional light, with the difference image, the report's figures and a verdict; and index
+//! pages (`index.html`, `index-2.html`, …) that list them worst first, for a file or a library.
 //!
 //! This module owns the previews from reading a material to writing its PNG: [`material`]
-//! reads a material's values and decides the columns (what migrate would produce),
-//! [`shade`] shades a sphere exactly from `shading`'s formulas, [`sheet`] lays out and encodes a
-//! sheet with the built-in [`font`], and [`index`] writes the HTML index. [`render`] is pure
-//! (files in, images and words out) and runs the materials of a whole library in parallel;
-//! [`write()`] alone touches the output folder, every file through `edit::write::write_atomic`.
-//! The same inputs give the same bytes at any thread count: every value is computed by one
-//! task from its inputs alone, and names come from the inputs.
+//! reads a material's values and decides the columns (what migrate writes), [`shade`] shades a
+//! sphere exactly from `shading`'s formulas, [`sheet`] lays out and encodes a sheet with the
+//! built-in [`font`], and [`index`] writes the HTML pages. A run is planned first ([`plan`]:
+//! every material read, materials with the same appearance sharing one sheet, the sheets
+//! ranked by the plan's own measure of how far the migration moves them), so `--worst N` picks
+//! its sheets before anything is drawn; [`write`] then draws the chosen sheets in parallel and
+//! writes each as soon as it is drawn (memory holds the sheets in flight, one per thread), every
+//! file through `edit::write::write_atomic`. A stop (SIGINT, SIGTERM) ends the run between
+//! sheets: those written stay, complete, and no partial file is left. The same inputs give the
+//! same bytes at any thread count: every value is computed by one task from its inputs alone,
+//! and names come from the inputs.
 
 pub mod font;
 pub mod index;
@@ -24,17 +28,6 @@ use crate::edit::write::write_atomic;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
-/// One sheet ready to be written.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Rendered {
-    /// The asset it comes from.
-    pub file: PathBuf,
-    /// The PNG's file name inside the output folder.
-    pub name: String,
-    pub png: Vec<u8>,
-    pub summary: sheet::Summary,
-}
-
 /// A file that could not be previewed, with the reason.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Failure {
@@ -42,13 +35,71 @@ pub struct Failure {
     pub message: String,
 }
 
-/// Everything a run produces before anything is written.
+/// One material of the run: where it is and which sheet shows it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Entry {
+    pub file: PathBuf,
+    /// The asset's label (see [`label`]).
+    pub label: String,
+    pub index: usize,
+    pub name: Option<String>,
+    /// The sheet that shows it, an index into [`Plan::sheets`].
+    pub sheet: usize,
+}
+
+impl Entry {
+    /// "label: material 3 \"Velvet\"".
+    pub fn title(&self) -> String {
+        match &self.name {
+            Some(n) => format!("{}: material {} \"{n}\"", self.label, self.index),
+            None => format!("{}: material {}", self.label, self.index),
+        }
+    }
+}
+
+/// One sheet to draw: the material it is drawn from (the first of those that share it), its
+/// file name, its title and the plan's measure of how far the migration moves it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SheetPlan {
+    pub name: String,
+    pub title: String,
+    pub material: material::Material,
+    /// The entries it shows, in input order.
+    pub entries: Vec<usize>,
+    /// [`material::Material::plan_metric`].
+    pub metric: f64,
+}
+
+/// What a preview run draws, decided before anything is drawn.
 #[derive(Clone, Debug, Default, PartialEq)]
-pub struct Previews {
-    pub sheets: Vec<Rendered>,
+pub struct Plan {
+    /// Every material with a sheen or fuzz layer, in input then document order.
+    pub entries: Vec<Entry>,
+    /// One per distinct appearance, worst first (by metric, then input order).
+    pub sheets: Vec<SheetPlan>,
     /// Files read that have no material with a sheen or fuzz layer.
     pub without_layers: Vec<PathBuf>,
     pub failures: Vec<Failure>,
+}
+
+/// A sheet drawn and written.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Drawn {
+    /// Its index in [`Plan::sheets`].
+    pub sheet: usize,
+    pub path: PathBuf,
+    pub summary: sheet::Summary,
+}
+
+/// What [`write`] did.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Written {
+    /// The sheets drawn and written, worst first.
+    pub drawn: Vec<Drawn>,
+    /// The index pages, first page first; none when the run was stopped.
+    pub pages: Vec<PathBuf>,
+    /// Stopped by SIGINT or SIGTERM before every chosen sheet was drawn.
+    pub stopped: bool,
 }
 
 /// The label of an asset in titles and file names: its path relative to the folder it was
@@ -77,21 +128,37 @@ fn file_safe(text: &str, max: usize) -> String {
         .collect()
 }
 
-/// Reads every asset under `inputs` and renders the sheets of their materials, in parallel;
-/// writes nothing. Each asset's migration is planned with `options` (`velvet preview`: the
-/// defaults; `migrate --preview`: the run's), and the sheets show what that plan writes.
-/// Sheets come in input order, then document order.
-pub fn render(inputs: &[PathBuf], options: &crate::migrate::Options) -> Previews {
+/// The sheet file name of an entry: "stem-m3-name.png".
+fn sheet_name(entry: &Entry) -> String {
+    let stem = entry
+        .label
+        .rsplit_once('.')
+        .map_or(entry.label.as_str(), |(stem, _)| stem);
+    let mut name = format!("{}-m{}", file_safe(stem, 80), entry.index);
+    if let Some(n) = &entry.name {
+        name += "-";
+        name += &file_safe(n, 40);
+    }
+    name + ".png"
+}
+
+/// Reads every asset under `inputs` and plans its sheets; draws and writes nothing. Each
+/// asset's migration is planned with `options` (`velvet preview`: the defaults; `migrate
+/// --preview`: the run's), and the sheets show what that plan writes. Materials whose
+/// appearance is the same ([`material::Material::appearance`]) share one sheet, named and
+/// titled after the first of them.
+pub fn plan(inputs: &[PathBuf], options: &crate::migrate::Options) -> Plan {
     let (found, walk_errors) = discover::find(inputs, None);
-    let mut previews = Previews::default();
+    let mut plan = Plan::default();
     for (path, e) in walk_errors {
-        previews.failures.push(Failure {
+        plan.failures.push(Failure {
             file: path,
             message: format!("cannot read this folder: {e}"),
         });
     }
     // Load and read the materials of each file (in parallel over files).
-    let files: Vec<(PathBuf, String, Result<Vec<material::Material>, String>)> = found
+    type Read = Result<Vec<material::Material>, String>;
+    let files: Vec<(PathBuf, String, Read)> = found
         .par_iter()
         .map(|f| {
             let loaded = crate::asset::load_with(&f.path, &options.load);
@@ -110,10 +177,10 @@ pub fn render(inputs: &[PathBuf], options: &crate::migrate::Options) -> Previews
             (f.path.clone(), label(f, inputs), result)
         })
         .collect();
-    let mut jobs = Vec::new();
+    let mut materials = Vec::new();
     for (path, label, result) in files {
         match result {
-            Err(message) => previews.failures.push(Failure {
+            Err(message) => plan.failures.push(Failure {
                 file: path,
                 message: if message.is_empty() {
                     "cannot be read".into()
@@ -121,39 +188,81 @@ pub fn render(inputs: &[PathBuf], options: &crate::migrate::Options) -> Previews
                     message
                 },
             }),
-            Ok(materials) if materials.is_empty() => previews.without_layers.push(path),
-            Ok(materials) => jobs.extend(
-                materials
-                    .into_iter()
-                    .map(|m| (path.clone(), label.clone(), m)),
-            ),
+            Ok(found) if found.is_empty() => plan.without_layers.push(path),
+            Ok(found) => {
+                for m in found {
+                    plan.entries.push(Entry {
+                        file: path.clone(),
+                        label: label.clone(),
+                        index: m.index,
+                        name: m.name.clone(),
+                        sheet: 0,
+                    });
+                    materials.push(m);
+                }
+            }
         }
     }
-    previews.sheets = jobs
+    // One sheet per appearance, in order of first use.
+    let appearances: Vec<String> = materials.par_iter().map(|m| m.appearance()).collect();
+    let mut by_appearance: std::collections::HashMap<&str, usize> = Default::default();
+    let mut first_uses: Vec<usize> = Vec::new();
+    for (e, appearance) in appearances.iter().enumerate() {
+        let sheet = *by_appearance.entry(appearance).or_insert_with(|| {
+            first_uses.push(e);
+            first_uses.len() - 1
+        });
+        plan.entries[e].sheet = sheet;
+    }
+    let mut sheets: Vec<SheetPlan> = first_uses
         .par_iter()
-        .map(|(path, label, m)| {
-            let sheet = sheet::render(label, m);
-            let stem = label
-                .rsplit_once('.')
-                .map_or(label.as_str(), |(stem, _)| stem);
-            let mut name = format!("{}-m{}", file_safe(stem, 80), m.index);
-            if let Some(n) = &m.name {
-                name += "-";
-                name += &file_safe(n, 40);
-            }
-            name += ".png";
-            Rendered {
-                file: path.clone(),
-                name,
-                png: sheet::to_png(&sheet),
-                summary: sheet.summary,
-            }
+        .map(|&e| SheetPlan {
+            name: sheet_name(&plan.entries[e]),
+            title: plan.entries[e].title(),
+            metric: materials[e].plan_metric(),
+            material: materials[e].clone(),
+            entries: Vec::new(),
         })
         .collect();
+    for (e, entry) in plan.entries.iter().enumerate() {
+        sheets[entry.sheet].entries.push(e);
+    }
+    for sheet in &mut sheets {
+        let others = sheet.entries.len() - 1;
+        if others > 0 {
+            sheet.title += &format!(
+                " and {others} other {} with the same values",
+                if others == 1 { "material" } else { "materials" }
+            );
+        }
+    }
+    // Worst first; a NaN metric (none is expected) ranks as the worst.
+    let mut order: Vec<usize> = (0..sheets.len()).collect();
+    order.sort_by(|&a, &b| {
+        let key = |s: &SheetPlan| if s.metric.is_nan() { f64::INFINITY } else { s.metric };
+        key(&sheets[b])
+            .total_cmp(&key(&sheets[a]))
+            .then(a.cmp(&b))
+    });
+    let mut renumbered = vec![0; sheets.len()];
+    for (rank, &old) in order.iter().enumerate() {
+        renumbered[old] = rank;
+    }
+    for entry in &mut plan.entries {
+        entry.sheet = renumbered[entry.sheet];
+    }
+    let mut slots: Vec<Option<SheetPlan>> = sheets.into_iter().map(Some).collect();
+    plan.sheets = order
+        .iter()
+        .map(|&old| slots[old].take().expect("each sheet once"))
+        .collect();
     // Two assets may reduce to one name (a/x.gltf and a_x.gltf, or x.gltf in two folders
-    // given): later ones get -2, -3, … in input order.
+    // given): later ones in input order get -2, -3, ….
+    let mut by_input: Vec<usize> = (0..plan.sheets.len()).collect();
+    by_input.sort_by_key(|&s| plan.sheets[s].entries[0]);
     let mut used = std::collections::HashSet::new();
-    for sheet in &mut previews.sheets {
+    for s in by_input {
+        let sheet = &mut plan.sheets[s];
         let stem = sheet.name.trim_end_matches(".png").to_string();
         let mut k = 1;
         while !used.insert(sheet.name.clone()) {
@@ -161,25 +270,64 @@ pub fn render(inputs: &[PathBuf], options: &crate::migrate::Options) -> Previews
             sheet.name = format!("{stem}-{k}.png");
         }
     }
-    previews
+    plan
 }
 
-/// Writes the sheets and `index.html` into `out_dir` (created if needed), each atomically.
-/// Returns the paths written, in order, or the first write that failed.
-pub fn write(previews: &Previews, out_dir: &Path) -> Result<Vec<PathBuf>, String> {
+/// Draws the first `count` sheets of `plan` (the worst; all of them when `count` is `None`)
+/// in parallel, writing each into `out_dir` (created if needed) as soon as it is drawn, then
+/// the index pages. `progress` draws a bar on a terminal. A stop (SIGINT, SIGTERM) ends the
+/// run between sheets: the sheets written stay and no index is written. Returns what was
+/// written, or the first write that failed.
+pub fn write(
+    plan: &Plan,
+    out_dir: &Path,
+    count: Option<usize>,
+    progress: bool,
+) -> Result<Written, String> {
     std::fs::create_dir_all(out_dir)
         .map_err(|e| format!("cannot create the folder {}: {e}", out_dir.display()))?;
-    let mut written = Vec::new();
-    for sheet in &previews.sheets {
-        let path = out_dir.join(&sheet.name);
-        write_atomic(&path, &sheet.png)
-            .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-        written.push(path);
+    let chosen = count.map_or(plan.sheets.len(), |n| n.min(plan.sheets.len()));
+    let bar = crate::output::progress_bar(progress, chosen, "sheets");
+    let drawn: Vec<Result<Option<Drawn>, String>> = (0..chosen)
+        .into_par_iter()
+        .map(|s| {
+            if crate::output::interrupt::requested().is_some() {
+                return Ok(None);
+            }
+            let planned = &plan.sheets[s];
+            let sheet = sheet::render(&planned.title, &planned.material);
+            let path = out_dir.join(&planned.name);
+            write_atomic(&path, &sheet::to_png(&sheet))
+                .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+            if let Some(bar) = &bar {
+                bar.inc(1);
+            }
+            Ok(Some(Drawn {
+                sheet: s,
+                path,
+                summary: sheet.summary,
+            }))
+        })
+        .collect();
+    if let Some(bar) = bar {
+        bar.finish_and_clear();
     }
-    let path = out_dir.join("index.html");
-    write_atomic(&path, index::html(previews).as_bytes())
-        .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-    written.push(path);
+    let mut written = Written::default();
+    for d in drawn {
+        match d? {
+            Some(d) => written.drawn.push(d),
+            None => written.stopped = true,
+        }
+    }
+    if written.stopped {
+        return Ok(written);
+    }
+    for (page, html) in index::pages(plan, &written.drawn).into_iter().enumerate() {
+        let path = out_dir.join(index::page_name(page));
+        write_atomic(&path, html.as_bytes())
+            .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        written.pages.push(path);
+    }
     Ok(written)
 }
 

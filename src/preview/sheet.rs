@@ -249,8 +249,8 @@ fn figure_lines(material: &Material) -> (Vec<String>, bool) {
     (lines, poor)
 }
 
-/// Renders `material`'s sheet; `file` names the asset in the title.
-pub fn render(file: &str, material: &Material) -> Sheet {
+/// Renders `material`'s sheet under `title` (the asset and the material or materials it shows).
+pub fn render(title: &str, material: &Material) -> Sheet {
     // Every distinct look once, in parallel; the order of the list is fixed by the columns.
     let per_swatch: Vec<Vec<Column>> = material
         .swatches
@@ -318,10 +318,7 @@ pub fn render(file: &str, material: &Material) -> Sheet {
                 .to_string(),
         );
     }
-    let title = match &material.name {
-        Some(n) => format!("{file}: material {} \"{n}\"", material.index),
-        None => format!("{file}: material {}", material.index),
-    };
+    let title = title.to_string();
     let summary = Summary {
         title,
         kind: kind_text(material.kind),

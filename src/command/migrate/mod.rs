@@ -29,8 +29,8 @@ pub struct View {
 pub fn command(request: &Request, shard: Option<Shard>, view: &View) -> Status {
     // Before anything is read or written: a signal from here on stops the run cleanly.
     crate::output::interrupt::install();
-    // The sheets are rendered from the inputs before they are migrated (--in-place overwrites
-    // them), and written after.
+    // The sheets are planned from the inputs before they are migrated (--in-place overwrites
+    // them), and drawn after.
     let previews = view.preview.as_ref().map(|_| {
         let inputs: Vec<PathBuf> = match shard {
             None => request.inputs.clone(),
@@ -40,7 +40,7 @@ pub fn command(request: &Request, shard: Option<Shard>, view: &View) -> Status {
                 .map(|f| f.path)
                 .collect(),
         };
-        crate::preview::render(&inputs, &request.options)
+        crate::preview::plan(&inputs, &request.options)
     });
     // A list that names no asset (a change that touched none) is nothing to do, not an error.
     let report = if request.inputs.is_empty() {
@@ -67,13 +67,12 @@ pub fn command(request: &Request, shard: Option<Shard>, view: &View) -> Status {
     );
     let mut preview_failed = false;
     if let (Some(dir), Some(previews)) = (&view.preview, &previews) {
-        for f in &previews.failures {
-            eprintln!("velvet: preview: {}: {}", f.file.display(), f.message);
-        }
-        preview_failed = !previews.failures.is_empty();
-        if let Err(e) = crate::preview::write(previews, dir) {
-            eprintln!("velvet: preview: {e}");
-            preview_failed = true;
+        preview_failed = super::preview::report_failures(previews, "preview: ");
+        // The sheets are drawn from the plans made before the inputs were migrated.
+        match super::preview::write(previews, dir, None, true) {
+            Some(Status::Stopped(signal)) => return Status::Stopped(signal),
+            Some(_) => preview_failed = true,
+            None => {}
         }
     }
     let failed =
