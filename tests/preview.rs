@@ -234,9 +234,9 @@ fn sheen_migrates_to_fuzz_with_the_fitted_and_the_copied_roughness() {
     let written = velvet::migrate::roughness::written(alpha);
     assert_eq!(written, 0.5558);
     assert_eq!(cols[1].look.layer, fuzz(written));
-    assert_eq!(cols[1].detail, "A 0.556 FITTED");
+    assert_eq!(cols[1].detail, "α 0.556 fitted");
     assert_eq!(cols[2].look.layer, fuzz(0.5));
-    assert_eq!(cols[2].detail, "A 0.500 COPIED");
+    assert_eq!(cols[2].detail, "α 0.500 copied");
     // What a loader without fuzz sees: the sheen, kept.
     assert_eq!(cols[3].look, cols[0].look);
     let sheet = sheet::render("sheen.gltf", m);
@@ -298,7 +298,7 @@ fn a_textured_layer_gives_three_swatches_and_a_missing_texture_leaves_the_factor
     let path = write(dir.path(), "textured.gltf", &text);
     let m = &materials_of(&load(&path))[0];
     let labels: Vec<&str> = m.swatches.iter().map(|s| s.label).collect();
-    assert_eq!(labels, ["P5", "MEAN", "P95"]);
+    assert_eq!(labels, ["p5", "mean", "p95"]);
     let r: Vec<f64> = m
         .swatches
         .iter()
@@ -513,7 +513,7 @@ fn migrate_in_place_with_preview_shows_the_materials_as_they_were_before() {
     assert!(out.join("chair-m0-cloth.png").is_file());
     let index = std::fs::read_to_string(out.join("index.html")).unwrap();
     assert!(
-        index.contains("sheen -&gt; fuzz: migrate adds KHR_materials_fuzz"),
+        index.contains("sheen → fuzz: migrate adds KHR_materials_fuzz"),
         "{index}"
     );
 }
@@ -694,11 +694,24 @@ fn materials_with_the_same_values_share_one_sheet_which_lists_them() {
         "shared.gltf: material 0 \"first\" and 1 other material with the same values"
     );
     let out = dir.path().join("out");
-    let o = run_velvet(&["preview", input.to_str().unwrap(), "-o", out.to_str().unwrap()]);
-    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = run_velvet(&[
+        "preview",
+        input.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
     assert_eq!(pngs(&out), ["shared-m0-first.png", "shared-m1-other.png"]);
     let index = std::fs::read_to_string(out.join("index.html")).unwrap();
-    assert!(index.contains("<li>shared.gltf: material 2 &quot;second&quot;</li>"), "{index}");
+    assert!(
+        index.contains("<li>shared.gltf: material 2 &quot;second&quot;</li>"),
+        "{index}"
+    );
     let summary = format!(
         "3 material(s) on 2 sheet(s), 2 drawn; index: {}\n",
         out.join("index.html").display()
@@ -729,7 +742,10 @@ fn worst_n_draws_exactly_the_n_sheets_the_plans_metric_ranks_highest() {
         })
         .collect();
     by_metric.sort_by(|a, b| b.0.total_cmp(&a.0));
-    assert!(by_metric[2].0 > by_metric[3].0, "{by_metric:?}: no tie at the cut");
+    assert!(
+        by_metric[2].0 > by_metric[3].0,
+        "{by_metric:?}: no tie at the cut"
+    );
     let mut worst: Vec<String> = by_metric[..3].iter().map(|(_, n)| n.clone()).collect();
     worst.sort();
     let out = dir.path().join("out");
@@ -741,13 +757,21 @@ fn worst_n_draws_exactly_the_n_sheets_the_plans_metric_ranks_highest() {
         "--worst",
         "3",
     ]);
-    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
     assert_eq!(pngs(&out), worst);
     // The index shows them worst first, and lists the five left undrawn.
     let index = std::fs::read_to_string(out.join("index.html")).unwrap();
     let at = |name: &str| index.find(&format!("<img src=\"{name}\"")).unwrap();
     assert!(at(&by_metric[0].1) < at(&by_metric[1].1) && at(&by_metric[1].1) < at(&by_metric[2].1));
-    assert!(index.contains("<p>5 sheet(s) rank below those drawn"), "{index}");
+    assert!(
+        index.contains("<p>5 sheet(s) rank below those drawn"),
+        "{index}"
+    );
 }
 
 #[test]
@@ -771,7 +795,11 @@ fn a_library_larger_than_a_page_gets_pages_linked_from_the_first() {
     let second = std::fs::read_to_string(&written.pages[1]).unwrap();
     assert_eq!(second.matches("<section>").count(), 5);
     // Worst first across the pages.
-    let metrics: Vec<f64> = written.drawn.iter().map(|d| plan.sheets[d.sheet].metric).collect();
+    let metrics: Vec<f64> = written
+        .drawn
+        .iter()
+        .map(|d| plan.sheets[d.sheet].metric)
+        .collect();
     assert!(metrics.windows(2).all(|w| w[0] >= w[1]));
 }
 
@@ -789,7 +817,12 @@ fn an_interrupted_preview_leaves_the_sheets_written_so_far_and_no_partial_file()
     {
         let out = dir.path().join(format!("out-{k}"));
         let child = Command::new(env!("CARGO_BIN_EXE_velvet"))
-            .args(["preview", input.to_str().unwrap(), "-o", out.to_str().unwrap()])
+            .args([
+                "preview",
+                input.to_str().unwrap(),
+                "-o",
+                out.to_str().unwrap(),
+            ])
             .stdout(std::process::Stdio::piped())
             .stderr(std::process::Stdio::piped())
             .spawn()
@@ -811,7 +844,10 @@ fn an_interrupted_preview_leaves_the_sheets_written_so_far_and_no_partial_file()
             if name.ends_with(".png") {
                 image::open(&path).unwrap_or_else(|e| panic!("{name} is not whole: {e}"));
             } else {
-                assert!(name.starts_with("index") && name.ends_with(".html"), "{name}");
+                assert!(
+                    name.starts_with("index") && name.ends_with(".html"),
+                    "{name}"
+                );
             }
         }
         match output.status.code() {
@@ -831,4 +867,44 @@ fn an_interrupted_preview_leaves_the_sheets_written_so_far_and_no_partial_file()
         }
     }
     assert!(stopped > 0, "no run was stopped before it finished");
+}
+
+#[test]
+fn a_name_with_accents_and_arrows_is_drawn_with_those_glyphs_in_its_own_case() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = write(
+        dir.path(),
+        "names.gltf",
+        &gltf(&sheen("Velouté → Fuzz & co", 0.8, 0.5)),
+    );
+    let m = &materials_of(&load(&input))[0];
+    let title = "names.gltf: material 0 \"Velouté → Fuzz & co\"";
+    let sheet = sheet::render(title, m);
+    assert_eq!(sheet.summary.title, title);
+    // The title's line as the sheet has it, and the string drawn alone on the background.
+    let margin = sheet::MARGIN;
+    let rows = margin..margin + velvet::preview::font::LINE_HEIGHT;
+    let bg = f32::from(sheet::background_code());
+    let mut expected = vec![sheet::background_code(); 3 * sheet.width * rows.len()];
+    velvet::preview::font::draw(title, margin, 0, |x, y, coverage| {
+        if x < sheet.width && y < rows.len() {
+            for k in 0..3 {
+                let over = f32::from(sheet::TEXT[k]);
+                expected[3 * (y * sheet.width + x) + k] =
+                    (bg + (over - bg) * coverage).round() as u8;
+            }
+        }
+    });
+    let drawn = &sheet.rgb[3 * sheet.width * rows.start..3 * sheet.width * rows.end];
+    assert!(
+        drawn == &expected[..],
+        "the title's line is the string's own rendering"
+    );
+    // The accent, the arrow and the capitals are their own glyphs: the plain ASCII spelling
+    // draws another line.
+    let plain = sheet::render("names.gltf: material 0 \"veloute -> fuzz & co\"", m);
+    assert!(
+        plain.rgb[3 * plain.width * rows.start..3 * plain.width * rows.end] != *drawn,
+        "é, → and capitals differ from e, -> and lower case"
+    );
 }

@@ -100,9 +100,9 @@ pub fn progress_bar(wanted: bool, count: usize, noun: &str) -> Option<indicatif:
     use std::io::IsTerminal;
     (wanted && count > 1 && std::io::stderr().is_terminal()).then(|| {
         let bar = indicatif::ProgressBar::new(count as u64);
-        if let Ok(style) =
-            indicatif::ProgressStyle::with_template(&format!("{{bar:40}} {{pos}}/{{len}} {noun} {{msg}}"))
-        {
+        if let Ok(style) = indicatif::ProgressStyle::with_template(&format!(
+            "{{bar:40}} {{pos}}/{{len}} {noun} {{msg}}"
+        )) {
             bar.set_style(style);
         }
         bar

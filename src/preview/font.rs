@@ -1,112 +1,103 @@
-//! A 5×7 bitmap font for the figures and labels printed on a contact sheet: capital letters,
-//! digits and the punctuation the sheets use. Lower-case letters are drawn as capitals; any
-//! other character is drawn as `?`. Each glyph is seven rows of five bits, the leftmost pixel
-//! in bit 4.
+//! The text of a contact sheet: DejaVu Sans, an open-licensed TrueType font embedded in the
+//! binary (`assets/fonts/`, with its licence), laid out and rasterised by `ab_glyph` at
+//! [`SIZE`] pixels with its kerning, so names keep their own case and any character the font
+//! has (Latin, Greek and Cyrillic letters, accents, arrows, mathematical signs) is drawn as
+//! itself; a character it lacks is drawn as the font's box. Rasterising is a pure function of
+//! the text, so sheets stay byte-identical at any thread count.
 
-/// Glyph width and height in pixels.
-pub const GLYPH_W: usize = 5;
-pub const GLYPH_H: usize = 7;
-/// Horizontal advance per character and vertical advance per line.
-pub const ADVANCE: usize = GLYPH_W + 1;
-pub const LINE_HEIGHT: usize = GLYPH_H + 4;
+use ab_glyph::{point, Font, FontRef, GlyphId, PxScale, ScaleFont};
+use std::sync::OnceLock;
 
-const GLYPHS: &[(char, [u8; 7])] = &[
-    (' ', [0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00]),
-    ('A', [0x0E, 0x11, 0x11, 0x1F, 0x11, 0x11, 0x11]),
-    ('B', [0x1E, 0x11, 0x11, 0x1E, 0x11, 0x11, 0x1E]),
-    ('C', [0x0E, 0x11, 0x10, 0x10, 0x10, 0x11, 0x0E]),
-    ('D', [0x1E, 0x11, 0x11, 0x11, 0x11, 0x11, 0x1E]),
-    ('E', [0x1F, 0x10, 0x10, 0x1E, 0x10, 0x10, 0x1F]),
-    ('F', [0x1F, 0x10, 0x10, 0x1E, 0x10, 0x10, 0x10]),
-    ('G', [0x0E, 0x11, 0x10, 0x17, 0x11, 0x11, 0x0F]),
-    ('H', [0x11, 0x11, 0x11, 0x1F, 0x11, 0x11, 0x11]),
-    ('I', [0x0E, 0x04, 0x04, 0x04, 0x04, 0x04, 0x0E]),
-    ('J', [0x07, 0x02, 0x02, 0x02, 0x02, 0x12, 0x0C]),
-    ('K', [0x11, 0x12, 0x14, 0x18, 0x14, 0x12, 0x11]),
-    ('L', [0x10, 0x10, 0x10, 0x10, 0x10, 0x10, 0x1F]),
-    ('M', [0x11, 0x1B, 0x15, 0x15, 0x11, 0x11, 0x11]),
-    ('N', [0x11, 0x11, 0x19, 0x15, 0x13, 0x11, 0x11]),
-    ('O', [0x0E, 0x11, 0x11, 0x11, 0x11, 0x11, 0x0E]),
-    ('P', [0x1E, 0x11, 0x11, 0x1E, 0x10, 0x10, 0x10]),
-    ('Q', [0x0E, 0x11, 0x11, 0x11, 0x15, 0x12, 0x0D]),
-    ('R', [0x1E, 0x11, 0x11, 0x1E, 0x14, 0x12, 0x11]),
-    ('S', [0x0F, 0x10, 0x10, 0x0E, 0x01, 0x01, 0x1E]),
-    ('T', [0x1F, 0x04, 0x04, 0x04, 0x04, 0x04, 0x04]),
-    ('U', [0x11, 0x11, 0x11, 0x11, 0x11, 0x11, 0x0E]),
-    ('V', [0x11, 0x11, 0x11, 0x11, 0x11, 0x0A, 0x04]),
-    ('W', [0x11, 0x11, 0x11, 0x15, 0x15, 0x15, 0x0A]),
-    ('X', [0x11, 0x11, 0x0A, 0x04, 0x0A, 0x11, 0x11]),
-    ('Y', [0x11, 0x11, 0x0A, 0x04, 0x04, 0x04, 0x04]),
-    ('Z', [0x1F, 0x01, 0x02, 0x04, 0x08, 0x10, 0x1F]),
-    ('0', [0x0E, 0x11, 0x13, 0x15, 0x19, 0x11, 0x0E]),
-    ('1', [0x04, 0x0C, 0x04, 0x04, 0x04, 0x04, 0x0E]),
-    ('2', [0x0E, 0x11, 0x01, 0x02, 0x04, 0x08, 0x1F]),
-    ('3', [0x1F, 0x02, 0x04, 0x02, 0x01, 0x11, 0x0E]),
-    ('4', [0x02, 0x06, 0x0A, 0x12, 0x1F, 0x02, 0x02]),
-    ('5', [0x1F, 0x10, 0x1E, 0x01, 0x01, 0x11, 0x0E]),
-    ('6', [0x06, 0x08, 0x10, 0x1E, 0x11, 0x11, 0x0E]),
-    ('7', [0x1F, 0x01, 0x02, 0x04, 0x08, 0x08, 0x08]),
-    ('8', [0x0E, 0x11, 0x11, 0x0E, 0x11, 0x11, 0x0E]),
-    ('9', [0x0E, 0x11, 0x11, 0x0F, 0x01, 0x02, 0x0C]),
-    ('.', [0x00, 0x00, 0x00, 0x00, 0x00, 0x0C, 0x0C]),
-    (',', [0x00, 0x00, 0x00, 0x00, 0x0C, 0x04, 0x08]),
-    (':', [0x00, 0x0C, 0x0C, 0x00, 0x0C, 0x0C, 0x00]),
-    (';', [0x00, 0x0C, 0x0C, 0x00, 0x0C, 0x04, 0x08]),
-    ('-', [0x00, 0x00, 0x00, 0x1F, 0x00, 0x00, 0x00]),
-    ('+', [0x00, 0x04, 0x04, 0x1F, 0x04, 0x04, 0x00]),
-    ('=', [0x00, 0x00, 0x1F, 0x00, 0x1F, 0x00, 0x00]),
-    ('(', [0x02, 0x04, 0x08, 0x08, 0x08, 0x04, 0x02]),
-    (')', [0x08, 0x04, 0x02, 0x02, 0x02, 0x04, 0x08]),
-    ('[', [0x0E, 0x08, 0x08, 0x08, 0x08, 0x08, 0x0E]),
-    (']', [0x0E, 0x02, 0x02, 0x02, 0x02, 0x02, 0x0E]),
-    ('/', [0x00, 0x01, 0x02, 0x04, 0x08, 0x10, 0x00]),
-    ('|', [0x04, 0x04, 0x04, 0x04, 0x04, 0x04, 0x04]),
-    ('%', [0x18, 0x19, 0x02, 0x04, 0x08, 0x13, 0x03]),
-    ('<', [0x02, 0x04, 0x08, 0x10, 0x08, 0x04, 0x02]),
-    ('>', [0x08, 0x04, 0x02, 0x01, 0x02, 0x04, 0x08]),
-    ('_', [0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x1F]),
-    ('\'', [0x04, 0x04, 0x08, 0x00, 0x00, 0x00, 0x00]),
-    ('"', [0x0A, 0x0A, 0x00, 0x00, 0x00, 0x00, 0x00]),
-    ('*', [0x00, 0x04, 0x15, 0x0E, 0x15, 0x04, 0x00]),
-    ('#', [0x0A, 0x0A, 0x1F, 0x0A, 0x1F, 0x0A, 0x0A]),
-    ('!', [0x04, 0x04, 0x04, 0x04, 0x04, 0x00, 0x04]),
-    ('?', [0x0E, 0x11, 0x01, 0x02, 0x04, 0x00, 0x04]),
-];
+/// The font's bytes.
+const DEJAVU_SANS: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
 
-/// The rows of `c`'s glyph (lower case as upper case; unknown characters as `?`).
-pub fn glyph(c: char) -> [u8; 7] {
-    let c = c.to_ascii_uppercase();
-    GLYPHS
-        .iter()
-        .find(|(g, _)| *g == c)
-        .or_else(|| GLYPHS.iter().find(|(g, _)| *g == '?'))
-        .map(|(_, rows)| *rows)
-        .unwrap_or([0; 7])
+/// The text's size: pixels from the font's ascender to its descender.
+pub const SIZE: f32 = 15.0;
+/// Vertical advance per line, in pixels.
+pub const LINE_HEIGHT: usize = 19;
+
+fn font() -> &'static FontRef<'static> {
+    static FONT: OnceLock<FontRef<'static>> = OnceLock::new();
+    FONT.get_or_init(|| {
+        FontRef::try_from_slice(DEJAVU_SANS).expect("the embedded font is a valid TrueType font")
+    })
 }
 
-/// Splits `text` into lines of at most `width` characters at spaces (a word longer than a line
-/// is cut).
-pub fn wrap(text: &str, width: usize) -> Vec<String> {
-    let width = width.max(1);
+/// The glyphs of `text` with their pen positions (x from 0, kerning applied).
+fn layout(text: &str) -> Vec<(GlyphId, f32)> {
+    let scaled = font().as_scaled(PxScale::from(SIZE));
+    let mut x = 0.0;
+    let mut previous: Option<GlyphId> = None;
+    text.chars()
+        .map(|c| {
+            let id = scaled.glyph_id(c);
+            if let Some(p) = previous {
+                x += scaled.kern(p, id);
+            }
+            let at = x;
+            x += scaled.h_advance(id);
+            previous = Some(id);
+            (id, at)
+        })
+        .collect()
+}
+
+/// The width of `text` in pixels, rounded up.
+pub fn width(text: &str) -> usize {
+    let scaled = font().as_scaled(PxScale::from(SIZE));
+    let end = layout(text)
+        .last()
+        .map_or(0.0, |&(id, x)| x + scaled.h_advance(id));
+    end.ceil() as usize
+}
+
+/// Calls `plot(x, y, coverage)` for every pixel `text` covers when its line's top-left corner
+/// is at (`x`, `y`); coverage is in (0, 1].
+pub fn draw(text: &str, x: usize, y: usize, mut plot: impl FnMut(usize, usize, f32)) {
+    let f = font();
+    let scale = PxScale::from(SIZE);
+    let baseline = y as f32 + f.as_scaled(scale).ascent();
+    for (id, at) in layout(text) {
+        let glyph = id.with_scale_and_position(scale, point(x as f32 + at, baseline));
+        if let Some(outlined) = f.outline_glyph(glyph) {
+            let bounds = outlined.px_bounds();
+            outlined.draw(|gx, gy, coverage| {
+                let (px, py) = (bounds.min.x + gx as f32, bounds.min.y + gy as f32);
+                if coverage > 0.0 && px >= 0.0 && py >= 0.0 {
+                    plot(px as usize, py as usize, coverage.min(1.0));
+                }
+            });
+        }
+    }
+}
+
+/// Splits `text` into lines at most `max_width` pixels wide, at spaces; a word wider than a
+/// line is cut between characters.
+pub fn wrap(text: &str, max_width: usize) -> Vec<String> {
     let mut lines = Vec::new();
     let mut line = String::new();
     for word in text.split(' ') {
-        let mut word: Vec<char> = word.chars().collect();
-        while word.len() > width {
-            if !line.is_empty() {
-                lines.push(std::mem::take(&mut line));
-            }
-            lines.push(word.drain(..width).collect());
-        }
-        let word: String = word.into_iter().collect();
-        let len = line.chars().count();
-        if len > 0 && len + 1 + word.chars().count() > width {
-            lines.push(std::mem::take(&mut line));
+        let candidate = if line.is_empty() {
+            word.to_string()
+        } else {
+            format!("{line} {word}")
+        };
+        if width(&candidate) <= max_width {
+            line = candidate;
+            continue;
         }
         if !line.is_empty() {
-            line.push(' ');
+            lines.push(std::mem::take(&mut line));
         }
-        line.push_str(&word);
+        // The word alone, cut where it must be.
+        for c in word.chars() {
+            line.push(c);
+            if width(&line) > max_width && line.chars().count() > 1 {
+                line.pop();
+                lines.push(std::mem::take(&mut line));
+                line.push(c);
+            }
+        }
     }
     if !line.is_empty() || lines.is_empty() {
         lines.push(line);
@@ -119,28 +110,30 @@ mod tests {
     use super::*;
 
     #[test]
-    fn every_glyph_fits_five_columns_and_is_unique() {
-        for (c, rows) in GLYPHS {
-            assert!(rows.iter().all(|r| *r < 32), "{c}");
-        }
-        for (i, (a, ra)) in GLYPHS.iter().enumerate() {
-            for (b, rb) in &GLYPHS[i + 1..] {
-                assert_ne!(a, b);
-                assert!(ra != rb || *a == ' ', "{a} and {b} look alike");
-            }
-        }
+    fn wrap_breaks_at_spaces_within_the_width_and_cuts_long_words() {
+        let text = "the quick brown fox jumps over the lazy dog";
+        let lines = wrap(text, width("the quick brown"));
+        assert_eq!(lines.join(" "), text);
+        assert!(lines.iter().all(|l| width(l) <= width("the quick brown")));
+        assert_eq!(lines[0], "the quick brown");
+        let cut = wrap("abcdefghij", width("abcd"));
+        assert_eq!(cut.concat(), "abcdefghij");
+        assert!(cut.len() >= 3 && cut.iter().all(|l| width(l) <= width("abcd")));
+        assert_eq!(wrap("", 100), [""]);
     }
 
     #[test]
-    fn lower_case_is_upper_case_and_unknown_is_a_question_mark() {
-        assert_eq!(glyph('a'), glyph('A'));
-        assert_eq!(glyph('μ'), glyph('?'));
-    }
-
-    #[test]
-    fn wrap_breaks_at_spaces_and_cuts_long_words() {
-        assert_eq!(wrap("ab cd ef", 5), vec!["ab cd", "ef"]);
-        assert_eq!(wrap("abcdefgh", 3), vec!["abc", "def", "gh"]);
-        assert_eq!(wrap("", 4), vec![""]);
+    fn accents_and_arrows_are_glyphs_of_their_own_and_case_is_kept() {
+        let ink = |text: &str| {
+            let mut pixels = Vec::new();
+            draw(text, 0, 0, |x, y, c| pixels.push((x, y, (c * 255.0) as u8)));
+            pixels
+        };
+        assert_ne!(ink("é"), ink("e"));
+        assert_ne!(ink("a"), ink("A"));
+        assert_ne!(ink("→"), ink("?"));
+        assert!(!ink("→").is_empty());
+        // Kerning: "AV" is narrower than "A" and "V" side by side.
+        assert!(width("AV") < width("A") + width("V"));
     }
 }

@@ -95,12 +95,12 @@ fn html(plan: &Plan, sheets: &[Drawn], page: usize, total: usize, drawn: usize) 
             .file_name()
             .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
         h += "<section>\n";
+        h += &format!("<h2>{}. {}</h2>\n", d.sheet + 1, escape(&sum.title));
         h += &format!(
-            "<h2>{}. {}</h2>\n",
-            d.sheet + 1,
-            escape(&sum.title)
+            "<p>{} (plan measure {:.4})</p>\n",
+            escape(sum.kind),
+            planned.metric
         );
-        h += &format!("<p>{} (plan measure {:.4})</p>\n", escape(sum.kind), planned.metric);
         h += &format!(
             "<a href=\"{0}\"><img src=\"{0}\" alt=\"{1}\"></a>\n",
             escape(&name),

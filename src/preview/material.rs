@@ -49,7 +49,7 @@ pub struct FuzzValues {
 /// The material's values at one swatch.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Swatch {
-    /// "FACTORS", "P5", "MEAN" or "P95".
+    /// "factors", "p5", "mean" or "p95".
     pub label: &'static str,
     /// The layers as authored.
     pub sheen: Option<SheenValues>,
@@ -124,7 +124,10 @@ impl Material {
         use crate::shading::layering::{FuzzReflectance, SheenAlbedo};
         use crate::shading::{AlbedoMethod, ReflectanceMethod};
         let cols = columns(self, &self.factors);
-        match cols.get(1).and_then(|c| layer_pair(&cols[0].look.layer, &c.look.layer)) {
+        match cols
+            .get(1)
+            .and_then(|c| layer_pair(&cols[0].look.layer, &c.look.layer))
+        {
             Some((sheen, fuzz)) => {
                 crate::shading::mapping::layer_match_with(
                     sheen,
@@ -337,14 +340,14 @@ fn read(
             value(&written_textured, slot)
         })
     };
-    let factors = swatch_values("FACTORS", &views, &|_| None, &|_| None);
+    let factors = swatch_values("factors", &views, &|_| None, &|_| None);
     let swatches = if textured.is_empty() && written_textured.is_empty() {
         vec![factors.clone()]
     } else {
         vec![
-            at(|s| &s.p5, "P5"),
-            at(|s| &s.mean, "MEAN"),
-            at(|s| &s.p95, "P95"),
+            at(|s| &s.p5, "p5"),
+            at(|s| &s.mean, "mean"),
+            at(|s| &s.p95, "p95"),
         ]
     };
     Some(Material {
@@ -635,8 +638,8 @@ fn rough(x: f64) -> String {
 /// The detail word for a roughness mapping.
 fn mapping_word(mapping: RoughnessMapping) -> &'static str {
     match mapping {
-        RoughnessMapping::Fitted => "FITTED",
-        RoughnessMapping::Identity => "COPIED",
+        RoughnessMapping::Fitted => "fitted",
+        RoughnessMapping::Identity => "copied",
     }
 }
 
@@ -691,27 +694,27 @@ pub fn columns(material: &Material, swatch: &Swatch) -> Vec<Column> {
             let kept = swatch.written_sheen.unwrap_or(s);
             vec![
                 Column {
-                    title: "AUTHORED: SHEEN".into(),
-                    detail: format!("R {}", rough(s.roughness)),
+                    title: "authored: sheen".into(),
+                    detail: format!("r {}", rough(s.roughness)),
                     look: look(sheen_layer(s)),
                 },
                 Column {
-                    title: "MIGRATED: FUZZ".into(),
-                    detail: format!("A {} {}", rough(migrated.roughness), mapping_word(mapping)),
+                    title: "migrated: fuzz".into(),
+                    detail: format!("α {} {}", rough(migrated.roughness), mapping_word(mapping)),
                     look: look(fuzz_layer(migrated)),
                 },
                 Column {
-                    title: format!("IF {}: FUZZ", mapping_word(other(mapping))),
+                    title: format!("if {}: fuzz", mapping_word(other(mapping))),
                     detail: format!(
-                        "A {} {}",
+                        "α {} {}",
                         rough(alternative.roughness),
                         mapping_word(other(mapping))
                     ),
                     look: look(fuzz_layer(alternative)),
                 },
                 Column {
-                    title: "NO FUZZ: SHEEN".into(),
-                    detail: format!("KEPT, R {}", rough(kept.roughness)),
+                    title: "no fuzz: sheen".into(),
+                    detail: format!("kept, r {}", rough(kept.roughness)),
                     look: look(sheen_layer(kept)),
                 },
             ]
@@ -728,8 +731,8 @@ pub fn columns(material: &Material, swatch: &Swatch) -> Vec<Column> {
                 roughness: carried(f.roughness, Direction::FuzzToSheen, mapping),
             };
             let mut cols = vec![Column {
-                title: "AUTHORED: FUZZ".into(),
-                detail: format!("A {}", rough(f.roughness)),
+                title: "authored: fuzz".into(),
+                detail: format!("α {}", rough(f.roughness)),
                 look: look(fuzz_layer(f)),
             }];
             if material.kind == Kind::FuzzWithSheen {
@@ -738,15 +741,15 @@ pub fn columns(material: &Material, swatch: &Swatch) -> Vec<Column> {
                     .or(swatch.sheen)
                     .expect("a material with both layers has sheen values");
                 cols.push(Column {
-                    title: "NO FUZZ: SHEEN".into(),
-                    detail: format!("IN FILE, R {}", rough(in_file.roughness)),
+                    title: "no fuzz: sheen".into(),
+                    detail: format!("in file, r {}", rough(in_file.roughness)),
                     look: look(sheen_layer(in_file)),
                 });
                 for m in [mapping, other(mapping)] {
                     let s = fallback(m);
                     cols.push(Column {
-                        title: "REFRESHED: SHEEN".into(),
-                        detail: format!("R {} {}", rough(s.roughness), mapping_word(m)),
+                        title: "refreshed: sheen".into(),
+                        detail: format!("r {} {}", rough(s.roughness), mapping_word(m)),
                         look: look(sheen_layer(s)),
                     });
                 }
@@ -757,14 +760,14 @@ pub fn columns(material: &Material, swatch: &Swatch) -> Vec<Column> {
                     ..migrated
                 };
                 cols.push(Column {
-                    title: "NO FUZZ: SHEEN".into(),
-                    detail: format!("R {} {}", rough(migrated.roughness), mapping_word(mapping)),
+                    title: "no fuzz: sheen".into(),
+                    detail: format!("r {} {}", rough(migrated.roughness), mapping_word(mapping)),
                     look: look(sheen_layer(migrated)),
                 });
                 cols.push(Column {
-                    title: format!("IF {}: SHEEN", mapping_word(other(mapping))),
+                    title: format!("if {}: sheen", mapping_word(other(mapping))),
                     detail: format!(
-                        "R {} {}",
+                        "r {} {}",
                         rough(alternative.roughness),
                         mapping_word(other(mapping))
                     ),
@@ -843,7 +846,7 @@ mod tests {
             kind: Kind::FuzzFallback,
             base: [0.5; 3],
             factors: Swatch {
-                label: "FACTORS",
+                label: "factors",
                 sheen: None,
                 fuzz: Some(FuzzValues {
                     weight: 1.0,

@@ -239,10 +239,14 @@ pub fn plan(inputs: &[PathBuf], options: &crate::migrate::Options) -> Plan {
     // Worst first; a NaN metric (none is expected) ranks as the worst.
     let mut order: Vec<usize> = (0..sheets.len()).collect();
     order.sort_by(|&a, &b| {
-        let key = |s: &SheetPlan| if s.metric.is_nan() { f64::INFINITY } else { s.metric };
-        key(&sheets[b])
-            .total_cmp(&key(&sheets[a]))
-            .then(a.cmp(&b))
+        let key = |s: &SheetPlan| {
+            if s.metric.is_nan() {
+                f64::INFINITY
+            } else {
+                s.metric
+            }
+        };
+        key(&sheets[b]).total_cmp(&key(&sheets[a])).then(a.cmp(&b))
     });
     let mut renumbered = vec![0; sheets.len()];
     for (rank, &old) in order.iter().enumerate() {

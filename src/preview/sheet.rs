@@ -15,7 +15,7 @@
 //! "close", else "visible"; a sheen roughness below 0.1 (no fuzz roughness matches it) is
 //! flagged beside it.
 
-use super::font::{self, ADVANCE, GLYPH_H, LINE_HEIGHT};
+use super::font::{self, LINE_HEIGHT};
 use super::material::{columns, layer_pair, Column, Kind, Material};
 use super::shade::{render_sphere, Light, Look, Shaded, Sphere};
 use crate::bake::srgb;
@@ -74,8 +74,9 @@ pub const SPHERE: usize = 96;
 /// Width and height of one cell (a sphere and its padding).
 pub const CELL: usize = 112;
 /// Width of the row labels on the left.
-pub const LABEL_W: usize = 60;
-const MARGIN: usize = 8;
+pub const LABEL_W: usize = 72;
+/// Space around the sheet's contents; the title starts here, at (MARGIN, MARGIN).
+pub const MARGIN: usize = 8;
 /// Gain of the difference image: a difference of one code shows as DIFF_GAIN codes.
 pub const DIFF_GAIN: u32 = 8;
 /// At most this many codes between column 0 and column 1: "same to the eye".
@@ -84,7 +85,8 @@ pub const SAME_CODES: u8 = 2;
 pub const CLOSE_CODES: u8 = 10;
 /// Background behind the spheres, linear.
 const BACKGROUND: f64 = 0.03;
-const TEXT: [u8; 3] = [235, 235, 235];
+/// The colour of the text (sRGB codes), drawn over [`background_code`].
+pub const TEXT: [u8; 3] = [235, 235, 235];
 const DIM_TEXT: [u8; 3] = [170, 170, 170];
 
 /// What the picture says, in words.
@@ -163,13 +165,18 @@ pub struct Sheet {
 fn kind_text(kind: Kind) -> &'static str {
     match kind {
         Kind::SheenToFuzz => {
-            "sheen -> fuzz: migrate adds KHR_materials_fuzz and keeps the sheen as the fallback"
+            "sheen → fuzz: migrate adds KHR_materials_fuzz and keeps the sheen as the fallback"
         }
         Kind::FuzzFallback => "fuzz: migrate adds a fallback sheen for loaders without fuzz",
         Kind::FuzzWithSheen => {
             "fuzz and sheen: migrate leaves both; --refresh-fallback would write the refreshed sheen"
         }
     }
+}
+
+/// The sheet's background around the cells, an sRGB code (each channel).
+pub fn background_code() -> u8 {
+    encode(BACKGROUND) / 2
 }
 
 /// 8-bit sRGB codes of a sphere composited over the background.
@@ -224,12 +231,15 @@ fn figure_lines(material: &Material) -> (Vec<String>, bool) {
         .map(|(j, sheen, fuzz, m, a)| {
             poor |= m.poor_match;
             let mut line = format!(
-                "{} {} (sheen r {:.3}, max3 {:.3} / fuzz a {:.3}, w {:.3}): |max3*E - w*R| max {:.4} at mu {:.3}, rms {:.4}; base attenuation differs by at most {:.4} at mu {:.3}",
+                "{} ({}): sheen {:.4} → fuzz {:.4}, max3(sheenColor) {:.3}, w {:.3}: \
+                 |max3·E − w·R| over view angles max {:.4} at view cosine {:.3}, \
+                 cosine-weighted rms {:.4}; base attenuation differs by at most {:.4}, at view \
+                 cosine {:.3}",
                 cols[j].title,
                 cols[j].detail,
                 sheen.roughness,
-                sheen.color_max3,
                 fuzz.roughness,
+                sheen.color_max3,
                 fuzz.weight,
                 m.max,
                 m.at_mu,
@@ -312,7 +322,7 @@ pub fn render(title: &str, material: &Material) -> Sheet {
     let mut notes = material.notes.clone();
     if material.swatches.len() > 1 {
         notes.push(
-            "the column headings give the values at the factors; in rows P5, MEAN and P95 each \
+            "the column headings give the values at the factors; in rows p5, mean and p95 each \
              textured slot's factor is multiplied by its texture's 5th percentile, mean and 95th \
              percentile"
                 .to_string(),
@@ -324,7 +334,7 @@ pub fn render(title: &str, material: &Material) -> Sheet {
         kind: kind_text(material.kind),
         columns: headed
             .iter()
-            .map(|c| format!("{} {}", c.title.to_lowercase(), c.detail.to_lowercase()))
+            .map(|c| format!("{} {}", c.title, c.detail))
             .collect(),
         figures,
         max_codes,
@@ -335,29 +345,29 @@ pub fn render(title: &str, material: &Material) -> Sheet {
 
     // Layout.
     let width = LABEL_W + CELL * (ncols + 1) + MARGIN;
-    let chars = (width - 2 * MARGIN) / ADVANCE;
+    let text_width = width - 2 * MARGIN;
     let mut text: Vec<(String, [u8; 3])> = Vec::new();
     for f in &summary.figures {
-        for l in font::wrap(f, chars) {
+        for l in font::wrap(f, text_width) {
             text.push((l, TEXT));
         }
     }
-    for l in font::wrap(&summary.verdict_line(), chars) {
+    for l in font::wrap(&summary.verdict_line(), text_width) {
         text.push((l, TEXT));
     }
     for n in &summary.notes {
-        for l in font::wrap(&format!("note: {n}"), chars) {
+        for l in font::wrap(&format!("note: {n}"), text_width) {
             text.push((l, DIM_TEXT));
         }
     }
-    let title_lines = font::wrap(&summary.title, chars);
-    let kind_lines = font::wrap(summary.kind, chars);
+    let title_lines = font::wrap(&summary.title, text_width);
+    let kind_lines = font::wrap(summary.kind, text_width);
     let header = MARGIN + LINE_HEIGHT * (title_lines.len() + kind_lines.len()) + 4;
     let grid_top = header + 2 * LINE_HEIGHT;
     let height = grid_top + CELL * rows.len() + MARGIN + LINE_HEIGHT * text.len() + MARGIN;
     let mut canvas = Canvas::new(width, height, [0; 3]);
     let bg = encode(BACKGROUND);
-    canvas.fill(0, 0, width, height, [bg / 2, bg / 2, bg / 2]);
+    canvas.fill(0, 0, width, height, [background_code(); 3]);
 
     let mut y = MARGIN;
     for l in &title_lines {
@@ -369,19 +379,19 @@ pub fn render(title: &str, material: &Material) -> Sheet {
         y += LINE_HEIGHT;
     }
     let col_x = |j: usize| LABEL_W + CELL * j;
-    let label_chars = CELL / ADVANCE;
     let headings: Vec<(String, String)> = headed
         .iter()
         .map(|c| (c.title.clone(), c.detail.clone()))
         .chain(std::iter::once((
-            format!("DIFFERENCE X{DIFF_GAIN}"),
-            "COLUMNS 1 AND 2".to_string(),
+            format!("difference ×{DIFF_GAIN}"),
+            "columns 1 and 2".to_string(),
         )))
         .collect();
     for (j, (a, b)) in headings.iter().enumerate() {
         for (k, t) in [a, b].into_iter().enumerate() {
-            let t: String = t.chars().take(label_chars).collect();
-            let x = col_x(j) + (CELL - t.chars().count() * ADVANCE) / 2;
+            // A heading wider than its cell is cut to the cell.
+            let t = font::wrap(t, CELL - 4).remove(0);
+            let x = col_x(j) + (CELL - font::width(&t).min(CELL)) / 2;
             canvas.text(x, header + k * LINE_HEIGHT, &t, TEXT);
         }
     }
@@ -389,8 +399,8 @@ pub fn render(title: &str, material: &Material) -> Sheet {
     for (r, &(s, light)) in rows.iter().enumerate() {
         let top = grid_top + CELL * r;
         let name = match light {
-            Light::Furnace => "FURNACE",
-            Light::Directional => "LIGHT",
+            Light::Furnace => "furnace",
+            Light::Directional => "light",
         };
         canvas.text(MARGIN, top + CELL / 2 - LINE_HEIGHT, name, TEXT);
         canvas.text(MARGIN, top + CELL / 2, material.swatches[s].label, DIM_TEXT);
@@ -450,17 +460,19 @@ impl Canvas {
         }
     }
 
+    /// Draws `text` with its line's top-left corner at (`x`, `y`), each pixel blended over
+    /// what is there by the glyph's coverage.
     fn text(&mut self, x: usize, y: usize, text: &str, c: [u8; 3]) {
-        for (k, ch) in text.chars().enumerate() {
-            let rows = font::glyph(ch);
-            for (dy, row) in rows.iter().enumerate().take(GLYPH_H) {
-                for dx in 0..font::GLYPH_W {
-                    if row & (0x10 >> dx) != 0 {
-                        self.set(x + k * ADVANCE + dx, y + dy, c);
-                    }
+        font::draw(text, x, y, |px, py, coverage| {
+            if px < self.width && py < self.height {
+                let i = 3 * (py * self.width + px);
+                for k in 0..3 {
+                    let under = f32::from(self.rgb[i + k]);
+                    let over = f32::from(c[k]);
+                    self.rgb[i + k] = (under + (over - under) * coverage).round() as u8;
                 }
             }
-        }
+        });
     }
 }
 
