@@ -96,7 +96,7 @@ pub fn fuzz_for(
     Some(fuzz)
 }
 
-/// Writes, as [`write_compact`] writes it, `original` when it reads as `value` (its text kept,
+/// Writes, as [`crate::edit::splice::write_compact`] writes it, `original` when it reads as `value` (its text kept,
 /// as velvet writes it), else `value` rounded; `original` reads as `reads_as`.
 fn push_number_like(original: &Read, reads_as: f64, value: f64, out: &mut String) {
     if reads_as == value {

@@ -41,7 +41,7 @@ const WGK: [f64; 8] = [
     0.209_482_141_084_727_828_012_999_174_891_714,
 ];
 
-/// Gauss weights for the nodes XGK[1], XGK[3], XGK[5], XGK[7].
+/// Gauss weights for the nodes `XGK[1]`, `XGK[3]`, `XGK[5]`, `XGK[7]`.
 #[allow(clippy::excessive_precision)] // QUADPACK's published digits, kept as published.
 const WG: [f64; 4] = [
     0.129_484_966_168_869_693_270_611_432_679_082,
