@@ -11,17 +11,22 @@ use velvet::preview::sheet::{sphere_codes, SPHERE};
 
 fn sweep_document() -> String {
     let mut materials = Vec::new();
-    for i in 0..=20 {
-        let r = 0.03 + 0.97 * f64::from(i) / 20.0;
-        for c in [[1.0, 1.0, 1.0], [0.9, 0.3, 0.5], [0.2, 0.2, 0.2]] {
-            materials.push(format!(
-                r#"{{"name": "sheen r {r:.3} c {:.1}", "pbrMetallicRoughness": {{"baseColorFactor": [0.1, 0.1, 0.1, 1]}}, "extensions": {{"KHR_materials_sheen": {{"sheenColorFactor": [{}, {}, {}], "sheenRoughnessFactor": {r}}}}}}}"#,
-                c[1], c[0], c[1], c[2]
-            ));
-            materials.push(format!(
-                r#"{{"name": "fuzz a {r:.3} c {:.1}", "pbrMetallicRoughness": {{"baseColorFactor": [0.1, 0.1, 0.1, 1]}}, "extensions": {{"KHR_materials_fuzz": {{"fuzzColorFactor": [{}, {}, {}], "fuzzRoughnessFactor": {r}}}}}}}"#,
-                c[1], c[0], c[1], c[2]
-            ));
+    for i in 0..=10 {
+        let r = 0.03 + 0.97 * f64::from(i) / 10.0;
+        for base in [0.1, 0.5, 1.0] {
+            for c in [[1.0, 1.0, 1.0], [0.9, 0.3, 0.5], [0.2, 0.2, 0.2]] {
+                let pbr = format!(
+                    r#""pbrMetallicRoughness": {{"baseColorFactor": [{base}, {base}, {base}, 1]}}"#
+                );
+                materials.push(format!(
+                    r#"{{"name": "sheen r {r:.3} c {:.1} base {base}", {pbr}, "extensions": {{"KHR_materials_sheen": {{"sheenColorFactor": [{}, {}, {}], "sheenRoughnessFactor": {r}}}}}}}"#,
+                    c[1], c[0], c[1], c[2]
+                ));
+                materials.push(format!(
+                    r#"{{"name": "fuzz a {r:.3} c {:.1} base {base}", {pbr}, "extensions": {{"KHR_materials_fuzz": {{"fuzzFactor": 1, "fuzzColorFactor": [{}, {}, {}], "fuzzRoughnessFactor": {r}}}}}}}"#,
+                    c[1], c[0], c[1], c[2]
+                ));
+            }
         }
     }
     format!(
@@ -52,8 +57,16 @@ fn main() {
                     .map(|c| sphere_codes(&render_sphere(&Shaded::new(c.look), light, SPHERE)))
                     .collect();
                 let flat = |c: &Vec<[u8; 3]>| c.iter().flatten().copied().collect::<Vec<u8>>();
-                let a = nv_flip::FlipImageRgb8::with_data(SPHERE as u32, SPHERE as u32, &flat(&codes[0]));
-                let b = nv_flip::FlipImageRgb8::with_data(SPHERE as u32, SPHERE as u32, &flat(&codes[1]));
+                let a = nv_flip::FlipImageRgb8::with_data(
+                    SPHERE as u32,
+                    SPHERE as u32,
+                    &flat(&codes[0]),
+                );
+                let b = nv_flip::FlipImageRgb8::with_data(
+                    SPHERE as u32,
+                    SPHERE as u32,
+                    &flat(&codes[1]),
+                );
                 let error = nv_flip::flip(a, b, nv_flip::DEFAULT_PIXELS_PER_DEGREE);
                 let values = error.to_vec();
                 // Pixels on the sphere only.

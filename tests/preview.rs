@@ -908,3 +908,63 @@ fn a_name_with_accents_and_arrows_is_drawn_with_those_glyphs_in_its_own_case() {
         "é, → and capitals differ from e, -> and lower case"
     );
 }
+
+#[test]
+fn the_verdict_metric_is_0_for_identical_renders_and_grows_with_a_roughness_difference() {
+    let furnace = |roughness: f64| {
+        let look = Look {
+            base: [0.1; 3],
+            layer: Layer::Sheen {
+                color: [0.9; 3],
+                roughness,
+            },
+        };
+        render_sphere(&Shaded::new(look), Light::Furnace, sheet::SPHERE)
+    };
+    let reference = furnace(0.5);
+    let on: Vec<bool> = reference.coverage.iter().map(|&c| c > 0.5).collect();
+    let reference = sphere_codes(&reference);
+    assert_eq!(sheet::flip_p99(&reference, &reference, &on), 0.0);
+    let flips: Vec<f64> = [0.45, 0.4, 0.3, 0.2]
+        .iter()
+        .map(|&r| sheet::flip_p99(&reference, &sphere_codes(&furnace(r)), &on))
+        .collect();
+    assert!(flips[0] > 0.0, "{flips:?}");
+    assert!(flips.windows(2).all(|w| w[1] > w[0]), "{flips:?}");
+}
+
+#[test]
+fn the_verdict_sends_a_floored_fallback_to_look_and_passes_a_good_match() {
+    let dir = tempfile::tempdir().unwrap();
+    // Over a dark base, a sheen of roughness 0.03 migrates to a fuzz that cannot follow its
+    // sharp rim; one of 0.7 migrates to its fitted match.
+    let dark = |name: &str, r: f64| {
+        sheen(name, 1.0, r).replacen(
+            "{",
+            r#"{"pbrMetallicRoughness": {"baseColorFactor": [0.1, 0.1, 0.1, 1]}, "#,
+            1,
+        )
+    };
+    let input = write(
+        dir.path(),
+        "verdicts.gltf",
+        &gltf(&[dark("rough", 0.7), dark("sharp", 0.03)].join(", ")),
+    );
+    let m = materials_of(&load(&input));
+    let good = sheet::render("good", &m[0]).summary;
+    let sharp = sheet::render("sharp", &m[1]).summary;
+    assert_ne!(
+        good.verdict,
+        sheet::Verdict::Visible,
+        "{}",
+        good.verdict_line()
+    );
+    assert!(good.flip[0] <= sheet::CLOSE_FLIP);
+    assert_eq!(
+        sharp.verdict,
+        sheet::Verdict::Visible,
+        "{}",
+        sharp.verdict_line()
+    );
+    assert!(sharp.flip[0] > sheet::CLOSE_FLIP);
+}

@@ -9,11 +9,26 @@
 //! material's factors: `shading::mapping::layer_match_with` (|max3·E − w·R| over view angles,
 //! its maximum and cosine-weighted rms) and `shading::layering::compare_base_attenuation` (the
 //! largest base-attenuation difference and its view cosine), with E and R by quadrature as the
-//! report has them. The verdict reads the
-//! rendered pixels: the largest difference between column 0 and column 1 over both lights and
-//! every swatch, at most [`SAME_CODES`] codes "same to the eye", at most [`CLOSE_CODES`]
-//! "close", else "visible"; a sheen roughness below 0.1 (no fuzz roughness matches it) is
-//! flagged beside it.
+//! report has them.
+//!
+//! The verdict is NVIDIA's ꟻLIP (Andersson et al. 2020, an image-difference metric made for
+//! rendered images: per pixel an error in [0, 1] from colour and edge differences as a viewer
+//! sees them, here at ꟻLIP's default 67 pixels per degree), between the authored column and
+//! column 1 in the white furnace, pooled as the 99th percentile over the sphere's pixels (the
+//! largest over the swatches): a change over at least 1 % of the sphere counts, a stray pixel
+//! does not. At most [`SAME_FLIP`] is "same to the eye", at most [`CLOSE_FLIP`] "close", above
+//! it "visible". The furnace is what the layers' energy decides; under the directional light
+//! the Charlie sheen lobe and the fuzz lobe differ in shape for every pair, so its ꟻLIP is
+//! printed beside the verdict but does not decide it. The thresholds were calibrated on the
+//! public sample assets with `examples/verdict_calibration.rs` (docs/preview.md has the
+//! figures): conversions the mapping matches well stay at or below 0.22 (0.10–0.14 over a
+//! dark base, up to 0.216 for a white sheen over a white base, where the layers' different
+//! base attenuation moves 30 % of the sphere by 10–15 codes), while materials whose layer
+//! really changes (the fallback sheen held at migrate's roughness floor over a dark base, a
+//! dark fuzz colour whose fallback cannot darken the base alike, a broad change of energy)
+//! reach 0.25–0.73. Over a bright base the furnace hides a sharp rim (everything is near
+//! white there), which the light row shows. A sheen roughness below 0.1 (no fuzz roughness
+//! matches it) is flagged beside it.
 
 use super::font::{self, LINE_HEIGHT};
 use super::material::{columns, layer_pair, Column, Kind, Material};
@@ -79,10 +94,11 @@ pub const LABEL_W: usize = 72;
 pub const MARGIN: usize = 8;
 /// Gain of the difference image: a difference of one code shows as DIFF_GAIN codes.
 pub const DIFF_GAIN: u32 = 8;
-/// At most this many codes between column 0 and column 1: "same to the eye".
-pub const SAME_CODES: u8 = 2;
-/// At most this many codes: "close".
-pub const CLOSE_CODES: u8 = 10;
+/// At most this ꟻLIP (99th percentile over the sphere in the furnace) between column 0 and
+/// column 1: "same to the eye".
+pub const SAME_FLIP: f64 = 0.10;
+/// At most this ꟻLIP: "close".
+pub const CLOSE_FLIP: f64 = 0.22;
 /// Background behind the spheres, linear.
 const BACKGROUND: f64 = 0.03;
 /// The colour of the text (sRGB codes), drawn over [`background_code`].
@@ -98,10 +114,11 @@ pub enum Verdict {
 }
 
 impl Verdict {
-    pub fn from_codes(codes: u8) -> Verdict {
-        if codes <= SAME_CODES {
+    /// The verdict of a ꟻLIP value (see [`SAME_FLIP`], [`CLOSE_FLIP`]).
+    pub fn from_flip(flip: f64) -> Verdict {
+        if flip <= SAME_FLIP {
             Verdict::Same
-        } else if codes <= CLOSE_CODES {
+        } else if flip <= CLOSE_FLIP {
             Verdict::Close
         } else {
             Verdict::Visible
@@ -127,6 +144,9 @@ pub struct Summary {
     pub figures: Vec<String>,
     /// Largest difference between columns 0 and 1, in codes: furnace, directional light.
     pub max_codes: [u8; 2],
+    /// ꟻLIP between columns 0 and 1, the 99th percentile over the sphere (the largest over the
+    /// swatches): furnace (the verdict's), directional light.
+    pub flip: [f64; 2],
     pub verdict: Verdict,
     /// The sheen roughness lies below 0.1, where no fuzz roughness matches it.
     pub poor_match: bool,
@@ -137,10 +157,15 @@ impl Summary {
     /// The verdict line as printed.
     pub fn verdict_line(&self) -> String {
         let mut line = format!(
-            "verdict: {} ({} vs {}: at most {} codes in the furnace, {} under the light)",
+            "verdict: {} ({} vs {}: ꟻLIP {:.3} in the furnace, where at most {SAME_FLIP:.2} is \
+             the same and at most {CLOSE_FLIP:.2} close; {:.3} under the light, where the lobes' \
+             shapes differ for every pair; at most {} codes apart in the furnace, {} under the \
+             light)",
             self.verdict.text(),
             self.columns[0],
             self.columns.get(1).map_or("", String::as_str),
+            self.flip[0],
+            self.flip[1],
             self.max_codes[0],
             self.max_codes[1]
         );
@@ -316,6 +341,22 @@ pub fn render(title: &str, material: &Material) -> Sheet {
         })
         .collect();
 
+    // ꟻLIP of column 1 against column 0, per row, over the sphere's pixels.
+    let on_sphere: Vec<bool> = render_sphere(&shaded[0], Light::Furnace, SPHERE)
+        .coverage
+        .iter()
+        .map(|&c| c > 0.5)
+        .collect();
+    let flips: Vec<f64> = spheres
+        .par_iter()
+        .map(|row| flip_p99(&row[0], &row[1], &on_sphere))
+        .collect();
+    let mut flip = [0.0f64; 2];
+    for (&(_, light), f) in rows.iter().zip(&flips) {
+        let slot = usize::from(light == Light::Directional);
+        flip[slot] = flip[slot].max(*f);
+    }
+
     let ncols = per_swatch[0].len();
     // The headings name the values at the factors; textured rows scale them per swatch.
     let headed = columns(material, &material.factors);
@@ -338,7 +379,8 @@ pub fn render(title: &str, material: &Material) -> Sheet {
             .collect(),
         figures,
         max_codes,
-        verdict: Verdict::from_codes(max_codes[0].max(max_codes[1])),
+        flip,
+        verdict: Verdict::from_flip(flip[0]),
         poor_match,
         notes,
     };
@@ -421,6 +463,36 @@ pub fn render(title: &str, material: &Material) -> Sheet {
         rgb: canvas.rgb,
         summary,
     }
+}
+
+/// The ꟻLIP error of `test` against `reference` (square sRGB images, row by row), the 99th
+/// percentile (nearest rank) over the pixels `on` marks; 0 for identical images.
+pub fn flip_p99(reference: &[[u8; 3]], test: &[[u8; 3]], on: &[bool]) -> f64 {
+    if reference == test {
+        return 0.0;
+    }
+    let size = (reference.len() as f64).sqrt() as u32;
+    let image = |codes: &[[u8; 3]]| {
+        let flat: Vec<u8> = codes.iter().flatten().copied().collect();
+        nv_flip::FlipImageRgb8::with_data(size, size, &flat)
+    };
+    let error = nv_flip::flip(
+        image(reference),
+        image(test),
+        nv_flip::DEFAULT_PIXELS_PER_DEGREE,
+    );
+    let mut values: Vec<f32> = error
+        .to_vec()
+        .into_iter()
+        .zip(on)
+        .filter_map(|(v, &on)| on.then_some(v))
+        .collect();
+    if values.is_empty() {
+        return 0.0;
+    }
+    values.sort_by(f32::total_cmp);
+    let rank = ((values.len() as f64) * 0.99).ceil() as usize;
+    f64::from(values[rank.clamp(1, values.len()) - 1])
 }
 
 /// An 8-bit RGB image being drawn.
