@@ -422,6 +422,7 @@ fn identical_inputs_give_identical_bytes_at_one_and_two_threads() {
             "a-m0-sheen.png",
             "a-m2-fuzz.png",
             "index.html",
+            "overview.png",
             "sub_b-m0.png"
         ]
     );
@@ -657,12 +658,12 @@ fn sheen(name: &str, c: f64, r: f64) -> String {
     )
 }
 
-/// The PNG files in `dir`, sorted.
+/// The sheets (PNG files other than overview.png) in `dir`, sorted.
 fn pngs(dir: &Path) -> Vec<String> {
     let mut names: Vec<String> = std::fs::read_dir(dir)
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .filter(|n| n.ends_with(".png"))
+        .filter(|n| n.ends_with(".png") && n != "overview.png")
         .collect();
     names.sort();
     names
@@ -707,6 +708,9 @@ fn materials_with_the_same_values_share_one_sheet_which_lists_them() {
         String::from_utf8_lossy(&o.stderr)
     );
     assert_eq!(pngs(&out), ["shared-m0-first.png", "shared-m1-other.png"]);
+    // The overview: the histogram of the two sheets' verdicts and both sheets beside it.
+    let overview = image::open(out.join("overview.png")).unwrap();
+    assert!(overview.width() > 480 && overview.height() > 300);
     let index = std::fs::read_to_string(out.join("index.html")).unwrap();
     assert!(
         index.contains("<li>shared.gltf: material 2 &quot;second&quot;</li>"),
@@ -859,7 +863,12 @@ fn an_interrupted_preview_leaves_the_sheets_written_so_far_and_no_partial_file()
                         && err.contains("sheets written (each complete); no index written"),
                     "{err}"
                 );
-                assert!(files.iter().all(|n| n.ends_with(".png")), "{files:?}");
+                assert!(
+                    files
+                        .iter()
+                        .all(|n| n.ends_with(".png") && n != "overview.png"),
+                    "{files:?}"
+                );
                 assert!(pngs(&out).len() < 400);
                 stopped += 1;
             }

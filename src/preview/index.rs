@@ -86,6 +86,9 @@ fn html(plan: &Plan, sheets: &[Drawn], page: usize, total: usize, drawn: usize) 
         plan.sheets.len(),
         super::sheet::DIFF_GAIN
     );
+    if page == 0 && drawn > 0 {
+        h += "<p><a href=\"overview.png\"><img src=\"overview.png\" alt=\"histogram of the verdicts and the worst sheets\"></a></p>\n";
+    }
     h += &nav(page, total);
     for d in sheets {
         let planned = &plan.sheets[d.sheet];

@@ -7,7 +7,8 @@
 //! This module owns the previews from reading a material to writing its PNG: [`material`]
 //! reads a material's values and decides the columns (what migrate writes), [`shade`] shades a
 //! sphere exactly from `shading`'s formulas, [`sheet`] lays out and encodes a sheet with the
-//! built-in [`font`], and [`index`] writes the HTML pages. A run is planned first ([`plan`]:
+//! built-in [`font`], [`overview`] draws the run's histogram of verdicts with its worst sheets,
+//! and [`index`] writes the HTML pages. A run is planned first ([`plan`]:
 //! every material read, materials with the same appearance sharing one sheet, the sheets
 //! ranked by the plan's own measure of how far the migration moves them), so `--worst N` picks
 //! its sheets before anything is drawn; [`write`] then draws the chosen sheets in parallel and
@@ -20,6 +21,7 @@
 pub mod font;
 pub mod index;
 pub mod material;
+pub mod overview;
 pub mod shade;
 pub mod sheet;
 
@@ -98,6 +100,8 @@ pub struct Written {
     pub drawn: Vec<Drawn>,
     /// The index pages, first page first; none when the run was stopped.
     pub pages: Vec<PathBuf>,
+    /// `overview.png`; none when the run was stopped.
+    pub overview: Option<PathBuf>,
     /// Stopped by SIGINT or SIGTERM before every chosen sheet was drawn.
     pub stopped: bool,
 }
@@ -292,6 +296,7 @@ pub fn write(
         .map_err(|e| format!("cannot create the folder {}: {e}", out_dir.display()))?;
     let chosen = count.map_or(plan.sheets.len(), |n| n.min(plan.sheets.len()));
     let bar = crate::output::progress_bar(progress, chosen, "sheets");
+    let worst = overview::WorstSheets::default();
     let drawn: Vec<Result<Option<Drawn>, String>> = (0..chosen)
         .into_par_iter()
         .map(|s| {
@@ -303,6 +308,7 @@ pub fn write(
             let path = out_dir.join(&planned.name);
             write_atomic(&path, &sheet::to_png(&sheet))
                 .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+            worst.offer(s, &sheet);
             if let Some(bar) = &bar {
                 bar.inc(1);
             }
@@ -326,6 +332,11 @@ pub fn write(
     if written.stopped {
         return Ok(written);
     }
+    let flips: Vec<f64> = written.drawn.iter().map(|d| d.summary.flip[0]).collect();
+    let path = out_dir.join("overview.png");
+    write_atomic(&path, &overview::png(&flips, &worst.into_inner()))
+        .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    written.overview = Some(path);
     for (page, html) in index::pages(plan, &written.drawn).into_iter().enumerate() {
         let path = out_dir.join(index::page_name(page));
         write_atomic(&path, html.as_bytes())

@@ -496,14 +496,14 @@ pub fn flip_p99(reference: &[[u8; 3]], test: &[[u8; 3]], on: &[bool]) -> f64 {
 }
 
 /// An 8-bit RGB image being drawn.
-struct Canvas {
-    width: usize,
-    height: usize,
-    rgb: Vec<u8>,
+pub(super) struct Canvas {
+    pub(super) width: usize,
+    pub(super) height: usize,
+    pub(super) rgb: Vec<u8>,
 }
 
 impl Canvas {
-    fn new(width: usize, height: usize, color: [u8; 3]) -> Canvas {
+    pub(super) fn new(width: usize, height: usize, color: [u8; 3]) -> Canvas {
         Canvas {
             width,
             height,
@@ -511,14 +511,14 @@ impl Canvas {
         }
     }
 
-    fn set(&mut self, x: usize, y: usize, c: [u8; 3]) {
+    pub(super) fn set(&mut self, x: usize, y: usize, c: [u8; 3]) {
         if x < self.width && y < self.height {
             let i = 3 * (y * self.width + x);
             self.rgb[i..i + 3].copy_from_slice(&c);
         }
     }
 
-    fn fill(&mut self, x: usize, y: usize, w: usize, h: usize, c: [u8; 3]) {
+    pub(super) fn fill(&mut self, x: usize, y: usize, w: usize, h: usize, c: [u8; 3]) {
         for yy in y..y + h {
             for xx in x..x + w {
                 self.set(xx, yy, c);
@@ -534,7 +534,7 @@ impl Canvas {
 
     /// Draws `text` with its line's top-left corner at (`x`, `y`), each pixel blended over
     /// what is there by the glyph's coverage.
-    fn text(&mut self, x: usize, y: usize, text: &str, c: [u8; 3]) {
+    pub(super) fn text(&mut self, x: usize, y: usize, text: &str, c: [u8; 3]) {
         font::draw(text, x, y, |px, py, coverage| {
             if px < self.width && py < self.height {
                 let i = 3 * (py * self.width + px);
@@ -550,16 +550,42 @@ impl Canvas {
 
 /// The sheet as PNG bytes (deterministic: fixed filter and compression).
 pub fn to_png(sheet: &Sheet) -> Vec<u8> {
+    rgb_png(&sheet.rgb, sheet.width, sheet.height)
+}
+
+/// 8-bit RGB pixels as PNG bytes (deterministic: fixed filter and compression).
+pub fn rgb_png(rgb: &[u8], width: usize, height: usize) -> Vec<u8> {
     use image::codecs::png::{CompressionType, FilterType, PngEncoder};
     use image::ImageEncoder;
     let mut out = Vec::new();
     PngEncoder::new_with_quality(&mut out, CompressionType::Fast, FilterType::Adaptive)
         .write_image(
-            &sheet.rgb,
-            sheet.width as u32,
-            sheet.height as u32,
+            rgb,
+            width as u32,
+            height as u32,
             image::ExtendedColorType::Rgb8,
         )
         .expect("encoding an in-memory RGB8 image of matching size cannot fail");
     out
+}
+
+/// `sheet` scaled down by `factor` (each output pixel the mean of a factor × factor block).
+pub fn thumbnail(sheet: &Sheet, factor: usize) -> (Vec<u8>, usize, usize) {
+    let (w, h) = (sheet.width / factor, sheet.height / factor);
+    let mut out = Vec::with_capacity(3 * w * h);
+    for y in 0..h {
+        for x in 0..w {
+            for k in 0..3 {
+                let mut sum = 0u32;
+                for dy in 0..factor {
+                    for dx in 0..factor {
+                        let i = 3 * ((y * factor + dy) * sheet.width + x * factor + dx) + k;
+                        sum += u32::from(sheet.rgb[i]);
+                    }
+                }
+                out.push(((sum + (factor * factor / 2) as u32) / (factor * factor) as u32) as u8);
+            }
+        }
+    }
+    (out, w, h)
 }
