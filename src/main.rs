@@ -109,8 +109,10 @@ struct SettingsArgs {
 /// Limits for reading assets nobody checked; each refusal names the flag that raises it.
 #[derive(clap::Args)]
 struct LoadArgs {
-    /// Refuse a JSON document (a .gltf, or a .glb's JSON chunk) larger than this.
-    #[arg(long, value_name = "BYTES", default_value_t = velvet::asset::limits::DEFAULT_MAX_DOCUMENT_BYTES)]
+    /// Refuse a JSON document (a .gltf, or a .glb's JSON chunk) larger than this (K, M, G
+    /// suffixes: binary units).
+    #[arg(long, value_name = "BYTES", default_value_t = velvet::asset::limits::DEFAULT_MAX_DOCUMENT_BYTES,
+          value_parser = parse_bytes)]
     max_document_bytes: u64,
     /// Refuse JSON that nests arrays and objects deeper than this (at most 127).
     #[arg(long, value_name = "N", default_value_t = velvet::asset::limits::DEFAULT_MAX_JSON_DEPTH as u16,

@@ -2217,3 +2217,22 @@ fn a_validate_command_line_clap_refuses_still_writes_the_report_its_format_asks_
     assert_eq!(o.status.code(), Some(2));
     assert!(o.stdout.is_empty(), "only validate writes reports");
 }
+
+#[test]
+fn the_document_limit_takes_the_byte_suffixes_the_memory_budget_takes() {
+    // velvet-chair.gltf is 3,547 bytes: over 3K (3,072), within 4K.
+    let chair = "fixtures/sample/velvet-chair.gltf";
+    let refused = velvet(&["validate", "--max-document-bytes", "3K", chair]);
+    assert_eq!(refused.status.code(), Some(1));
+    assert!(
+        stdout(&refused).contains(
+            "error DOCUMENT_TOO_LARGE: the JSON document is 3547 bytes, over the limit of 3072"
+        ),
+        "{}",
+        stdout(&refused)
+    );
+    let taken = velvet(&["validate", "--max-document-bytes", "4K", chair]);
+    assert_eq!(taken.status.code(), Some(0), "{}", stdout(&taken));
+    let bad = velvet(&["validate", "--max-document-bytes", "4Q", chair]);
+    assert_eq!(bad.status.code(), Some(2));
+}
