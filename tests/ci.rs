@@ -2221,7 +2221,7 @@ fn a_validate_command_line_clap_refuses_still_writes_the_report_its_format_asks_
 #[test]
 fn the_document_limit_takes_the_byte_suffixes_the_memory_budget_takes() {
     // velvet-chair.gltf is 3,547 bytes: over 3K (3,072), within 4K.
-    let chair = "fixtures/sample/velvet-chair.gltf";
+    let chair = concat!(env!("CARGO_MANIFEST_DIR"), "/fixtures/sample/velvet-chair.gltf");
     let refused = velvet(&["validate", "--max-document-bytes", "3K", chair]);
     assert_eq!(refused.status.code(), Some(1));
     assert!(
