@@ -42,7 +42,9 @@
 //! at μv = 0.016 (metallic 1, roughness 0.3, where L meets the horizon across the lobe), and
 //! below 6e-4 for μv ≥ 0.1. The interpolation between nodes adds at most 1.2e-4 for μ ≥ 0.05
 //! (`base_furnace_interpolation_is_within_its_stated_error`). The cost is 65 nodes ×
-//! (96 + 96) × 24 evaluations per look. Under the directional light (irradiance [`SUN_IRRADIANCE`] from
+//! (96 + 96) × 24 evaluations per look with a sheen; without a layer or under the fuzz layer
+//! (whose attenuation depends on the view alone) the base's albedo is computed once per
+//! (metallic, roughness) and shared by the looks that have that base. Under the directional light (irradiance [`SUN_IRRADIANCE`] from
 //! [`SUN_DIRECTION`], plus the furnace scaled by [`AMBIENT`]) the lobe is the Charlie sheen
 //! D·V·NdotL (`shading::charlie`) or the fuzz model's single plus multiple scattering
 //! (`shading::fuzz`), and the base f_base·NdotL, evaluated exactly per pixel, times the
@@ -57,6 +59,8 @@ use crate::shading::layering::{fuzz_base_attenuation, max3, sheen_base_attenuati
 use crate::shading::{fuzz_reflectance, sheen_albedo, AlbedoMethod};
 use rayon::prelude::*;
 use std::cmp::Ordering;
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex, OnceLock};
 use std::f64::consts::PI;
 
 /// View cosines sampled per look: μ_i = (i / (CURVE_NODES − 1))².
@@ -178,26 +182,31 @@ impl Shaded {
             base_furnace: Vec::new(),
         };
         let (metallic, alpha) = base_params(&look);
-        let steps = Steps::default();
-        shaded.base_furnace = (0..CURVE_NODES)
-            .into_par_iter()
-            .map(|i| {
-                let mu_v = node_mu(i);
-                let av = shaded.attenuation_at(mu_v);
-                match look.layer {
-                    Layer::Sheen { .. } => base_furnace_terms(
+        shaded.base_furnace = match look.layer {
+            // The attenuation depends on the view alone: it scales the base's albedo.
+            Layer::None | Layer::Fuzz { .. } => base_albedo_curve(metallic, alpha)
+                .iter()
+                .enumerate()
+                .map(|(i, terms)| {
+                    let av = shaded.attenuation_at(node_mu(i));
+                    terms.map(|v| v * av)
+                })
+                .collect(),
+            Layer::Sheen { .. } => (0..CURVE_NODES)
+                .into_par_iter()
+                .map(|i| {
+                    let mu_v = node_mu(i);
+                    let av = shaded.attenuation_at(mu_v);
+                    base_furnace_terms(
                         mu_v,
                         metallic,
                         alpha,
                         &|mu_l| av.min(shaded.attenuation_at(mu_l)),
-                        steps,
-                    ),
-                    Layer::None | Layer::Fuzz { .. } => {
-                        base_furnace_terms(mu_v, metallic, alpha, &|_| av, steps)
-                    }
-                }
-            })
-            .collect();
+                        Steps::default(),
+                    )
+                })
+                .collect(),
+        };
         shaded
     }
 
@@ -347,6 +356,30 @@ pub fn base_brdf(
         (1.0 - metallic) * (1.0 - f_dielectric) / PI + metallic * (1.0 - w) * spec,
         ((1.0 - metallic) * f_dielectric + metallic * w) * spec,
     )
+}
+
+/// The base's directional albedo terms (no attenuation) at the curve nodes for (metallic, α).
+/// They are a function of those two numbers alone, so they are computed once per process and
+/// shared by every look with that base (which task computes them first does not change them).
+fn base_albedo_curve(metallic: f64, alpha: f64) -> Arc<Vec<[f64; 2]>> {
+    type Curves = HashMap<(u64, u64), Arc<Vec<[f64; 2]>>>;
+    static KNOWN: OnceLock<Mutex<Curves>> = OnceLock::new();
+    let known = KNOWN.get_or_init(|| Mutex::new(HashMap::new()));
+    let key = (metallic.to_bits(), alpha.to_bits());
+    if let Some(curve) = known.lock().unwrap_or_else(|e| e.into_inner()).get(&key) {
+        return Arc::clone(curve);
+    }
+    let curve: Arc<Vec<[f64; 2]>> = Arc::new(
+        (0..CURVE_NODES)
+            .into_par_iter()
+            .map(|i| base_furnace_terms(node_mu(i), metallic, alpha, &|_| 1.0, Steps::default()))
+            .collect(),
+    );
+    known
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .insert(key, Arc::clone(&curve));
+    curve
 }
 
 /// The step counts of the base's furnace integrals.

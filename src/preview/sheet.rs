@@ -213,7 +213,11 @@ pub fn sphere_codes_clamped(sphere: &Sphere) -> Vec<[u8; 3]> {
 /// 8-bit sRGB codes of a sphere as drawn: composited over the background, and each pixel the
 /// sphere covers whose linear value exceeds 1 in any channel marked with the [`MARK`] hatch.
 pub fn sphere_codes(sphere: &Sphere) -> Vec<[u8; 3]> {
-    let mut codes = sphere_codes_clamped(sphere);
+    marked(sphere, sphere_codes_clamped(sphere))
+}
+
+/// `codes` (the sphere's clamped codes) with the pixels above 1 marked.
+fn marked(sphere: &Sphere, mut codes: Vec<[u8; 3]>) -> Vec<[u8; 3]> {
     for (i, (rad, &c)) in sphere.radiance.iter().zip(&sphere.coverage).enumerate() {
         if c > 0.0 && above_one(*rad) {
             codes[i] = mark_at(sphere.size, i);
@@ -416,7 +420,8 @@ pub fn render(title: &str, material: &Material) -> Sheet {
 
     let spheres: Vec<Vec<Vec<[u8; 3]>>> = rendered
         .iter()
-        .map(|row| row.iter().map(sphere_codes).collect())
+        .zip(spheres)
+        .map(|(row, codes)| row.iter().zip(codes).map(|(s, c)| marked(s, c)).collect())
         .collect();
 
     let ncols = per_swatch[0].len();
