@@ -64,38 +64,123 @@ fn interior(size: usize) -> Vec<(usize, usize)> {
     v
 }
 
+/// glTF 2.0's metallic-roughness BRDF (Appendix B) for one channel of base colour `rho`, with
+/// N = +z, written out from the spec's formulas: mix(dielectric, metal, metallic).
+fn gltf_brdf(v: [f64; 3], l: [f64; 3], rho: f64, metallic: f64, roughness: f64) -> f64 {
+    if v[2] <= 0.0 || l[2] <= 0.0 {
+        return 0.0;
+    }
+    let hs = [v[0] + l[0], v[1] + l[1], v[2] + l[2]];
+    let len = (hs[0] * hs[0] + hs[1] * hs[1] + hs[2] * hs[2]).sqrt();
+    let h = hs.map(|c| c / len);
+    let (n_dot_v, n_dot_l, n_dot_h) = (v[2], l[2], h[2]);
+    let v_dot_h = v[0] * h[0] + v[1] * h[1] + v[2] * h[2];
+    let a2 = (roughness * roughness).powi(2);
+    let d = a2 / (PI * (n_dot_h * n_dot_h * (a2 - 1.0) + 1.0).powi(2));
+    let g = 2.0 * n_dot_l * n_dot_v
+        / (n_dot_v * (a2 + (1.0 - a2) * n_dot_l * n_dot_l).sqrt()
+            + n_dot_l * (a2 + (1.0 - a2) * n_dot_v * n_dot_v).sqrt());
+    let specular = d * g / (4.0 * n_dot_v * n_dot_l);
+    let fw = (1.0 - v_dot_h.abs()).powi(5);
+    let dielectric_fresnel = 0.04 + 0.96 * fw;
+    let dielectric = (1.0 - dielectric_fresnel) * rho / PI + dielectric_fresnel * specular;
+    let metal = (rho + (1.0 - rho) * fw) * specular;
+    (1.0 - metallic) * dielectric + metallic * metal
+}
+
+/// The light cosines of the rows of [`base_integrated_here`]'s grid: μl = cos θ at the
+/// midpoints of `n` steps of θ over [0, π/2].
+fn light_rows(n: usize) -> Vec<f64> {
+    (0..n)
+        .map(|i| ((i as f64 + 0.5) / n as f64 * PI / 2.0).cos())
+        .collect()
+}
+
+/// ∫ f(v, l)·a(μl)·μl dω over the light hemisphere for the view of cosine `mu`, by the midpoint
+/// rule in (θ, φ) (dω = sin θ dθ dφ), θ on the rows of [`light_rows`] and φ over the whole
+/// circle in three times as many steps; `attenuation[i]` is a on the i-th row.
+fn base_integrated_here(
+    mu: f64,
+    rho: f64,
+    metallic: f64,
+    roughness: f64,
+    attenuation: &[f64],
+) -> f64 {
+    let (nt, nphi) = (attenuation.len(), 3 * attenuation.len());
+    let v = [(1.0 - mu * mu).sqrt(), 0.0, mu];
+    let d_theta = PI / 2.0 / nt as f64;
+    let mut sum = 0.0;
+    for (i, a) in attenuation.iter().enumerate() {
+        let theta = (i as f64 + 0.5) * d_theta;
+        let (sl, ml) = theta.sin_cos();
+        let mut ring = 0.0;
+        for j in 0..nphi {
+            let phi = (j as f64 + 0.5) / nphi as f64 * 2.0 * PI;
+            let l = [sl * phi.cos(), sl * phi.sin(), ml];
+            ring += gltf_brdf(v, l, rho, metallic, roughness);
+        }
+        sum += ring * (2.0 * PI / nphi as f64) * ml * a * sl * d_theta;
+    }
+    sum
+}
+
 #[test]
-fn a_furnace_sphere_without_a_layer_is_uniform_at_the_base_colour() {
+fn a_furnace_sphere_without_a_layer_shows_the_bases_directional_albedo() {
+    // The base alone in a white furnace of radiance 1 reflects its directional albedo
+    // ∫ f·μl dω, which the spec's BRDF gives and is integrated here on another grid: within
+    // 2e-3 in linear value (both integrations' error), and 1 code once encoded.
     let base = [0.8, 0.35, 0.05];
     let size = 64;
-    let sphere = render_sphere(
-        &Shaded::new(Look {
+    let ones = vec![1.0; 120];
+    for (metallic, roughness) in [(0.0, 1.0), (0.0, 0.5), (1.0, 0.5), (1.0, 1.0)] {
+        let look = Look {
             base,
+            base_metallic: metallic,
+            base_roughness: roughness,
             layer: Layer::None,
-        }),
-        Light::Furnace,
-        size,
-    );
-    let codes = sphere_codes(&sphere);
-    let want = base.map(encode);
-    let inside = interior(size);
-    assert!(inside.len() > 2500);
-    for (x, y) in inside {
-        assert_eq!(codes[y * size + x], want, "pixel ({x}, {y})");
+        };
+        let shaded = Shaded::new(look);
+        // The BRDF is affine in the colour: integrate it for colours 0 and 1, once per view.
+        let here = |mu: f64| -> [f64; 3] {
+            let [zero, one] =
+                [0.0, 1.0].map(|rho| base_integrated_here(mu, rho, metallic, roughness, &ones));
+            base.map(|b| zero + b * (one - zero))
+        };
+        for mu in [0.1, 0.3, 0.6, 0.9, 1.0] {
+            let got = shaded.furnace(mu);
+            let want = here(mu);
+            for k in 0..3 {
+                assert!(
+                    (got[k] - want[k]).abs() < 2e-3,
+                    "metallic {metallic}, roughness {roughness}, μ={mu}, channel {k}: {got:?} vs {want:?}"
+                );
+            }
+        }
+        let sphere = render_sphere(&shaded, Light::Furnace, size);
+        let codes = sphere_codes(&sphere);
+        let inside = interior(size);
+        assert!(inside.len() > 2500);
+        for &(x, y) in inside.iter().step_by(211) {
+            let want = here(pixel_normal(size, x, y).unwrap()[2]).map(encode);
+            let got = codes[y * size + x];
+            for k in 0..3 {
+                assert!(got[k].abs_diff(want[k]) <= 1, "pixel ({x}, {y}): {got:?} vs {want:?}");
+            }
+        }
+        // A switched-off sheen (sheenColorFactor zero) is the same picture.
+        let off = render_sphere(
+            &Shaded::new(Look {
+                layer: Layer::Sheen {
+                    color: [0.0; 3],
+                    roughness: 0.5,
+                },
+                ..look
+            }),
+            Light::Furnace,
+            size,
+        );
+        assert_eq!(sphere_codes(&off), codes);
     }
-    // A switched-off sheen (sheenColorFactor zero) is the same picture.
-    let off = render_sphere(
-        &Shaded::new(Look {
-            base,
-            layer: Layer::Sheen {
-                color: [0.0; 3],
-                roughness: 0.5,
-            },
-        }),
-        Light::Furnace,
-        size,
-    );
-    assert_eq!(sphere_codes(&off), codes);
 }
 
 /// E(μ, r) = ∫ D·V·NdotL dω over the light hemisphere, by the midpoint rule in (t, φ) with
@@ -125,30 +210,31 @@ fn albedo_by_midpoints(mu: f64, r: f64) -> f64 {
 
 #[test]
 fn a_sheen_sphere_in_the_furnace_matches_the_layering_formula_integrated_here() {
-    // Outgoing radiance in a white furnace of radiance 1 for a Lambertian base ρ under a sheen
-    // (albedo scaling with both terms):
-    //   L(μ) = sheenColor·E(μ) + ρ/π ∫ min(1 − m·E(μ), 1 − m·E(μl)) μl dω
-    //        = sheenColor·E(μ) + ρ·2∫₀¹ min(a(μ), a(μl)) μl dμl,   m = max3(sheenColor).
+    // Outgoing radiance in a white furnace of radiance 1 for a metallic-roughness base f_base
+    // under a sheen (albedo scaling with both terms):
+    //   L(μ) = sheenColor·E(μ) + ∫ f_base(v, l)·min(1 − m·E(μ), 1 − m·E(μl)) μl dω,
+    //   m = max3(sheenColor), the attenuation inside the integral.
     let base = [0.45, 0.3, 0.2];
     let size = 128;
-    for (color, r) in [([0.9f64, 0.6, 0.3], 0.5f64), ([0.3, 0.8, 1.0], 0.3)] {
+    for (color, r, metallic, roughness) in [
+        ([0.9f64, 0.6, 0.3], 0.5f64, 0.0, 1.0),
+        ([0.3, 0.8, 1.0], 0.3, 1.0, 0.5),
+    ] {
         let m = color[0].max(color[1]).max(color[2]);
         let shaded = Shaded::new(Look {
             base,
+            base_metallic: metallic,
+            base_roughness: roughness,
             layer: Layer::Sheen {
                 color,
                 roughness: r,
             },
         });
         let codes = sphere_codes(&render_sphere(&shaded, Light::Furnace, size));
-        // The outer integral over μl = s², 2∫ min(..) s² 2s ds, midpoint rule.
-        let ns = 160;
-        let light_terms: Vec<(f64, f64)> = (0..ns)
-            .map(|k| {
-                let s = (k as f64 + 0.5) / ns as f64;
-                let a = (1.0 - m * albedo_by_midpoints(s * s, r)).clamp(0.0, 1.0);
-                (a, 4.0 * s * s * s / ns as f64)
-            })
+        // a(μl) on the light integral's rows.
+        let light_attenuation: Vec<f64> = light_rows(240)
+            .into_iter()
+            .map(|ml| (1.0 - m * albedo_by_midpoints(ml, r)).clamp(0.0, 1.0))
             .collect();
         // Pixels along the row through the centre: view cosines from about 0.25 to 1.
         let y = size / 2;
@@ -161,9 +247,10 @@ fn a_sheen_sphere_in_the_furnace_matches_the_layering_formula_integrated_here() 
             }
             let e = albedo_by_midpoints(mu, r);
             let av = (1.0 - m * e).clamp(0.0, 1.0);
-            let b: f64 = light_terms.iter().map(|&(al, w)| av.min(al) * w).sum();
+            let a: Vec<f64> = light_attenuation.iter().map(|al| av.min(*al)).collect();
             for k in 0..3 {
-                let want = encode(color[k] * e + base[k] * b);
+                let b = base_integrated_here(mu, base[k], metallic, roughness, &a);
+                let want = encode(color[k] * e + b);
                 let got = codes[y * size + x][k];
                 assert!(
                     got.abs_diff(want) <= 1,
@@ -195,6 +282,8 @@ fn the_fallback_of_a_black_fuzz_shows_no_layer() {
     assert_eq!(cols.len(), 3);
     let bare = Shaded::new(Look {
         base: m.base,
+        base_metallic: m.base_metallic,
+        base_roughness: m.base_roughness,
         layer: Layer::None,
     });
     for light in [Light::Furnace, Light::Directional] {
@@ -341,10 +430,15 @@ fn a_textured_layer_gives_three_swatches_and_a_missing_texture_leaves_the_factor
     let sheet = sheet::render("textured.gltf", m);
     // The sheet says what the inputs lacked, and how its rows read the textures.
     assert_eq!(sheet.summary.notes[..3], m.notes[..]);
-    assert_eq!(sheet.summary.notes.len(), 4);
     assert!(
         sheet.summary.notes[3].starts_with("the column headings give the values at the factors")
     );
+    // The p5 row's sheen roughness is 0, whose E exceeds 1 at grazing views: the notes after
+    // those say which columns have pixels above 1, marked.
+    assert!(sheet.summary.notes.len() > 4);
+    for n in &sheet.summary.notes[4..] {
+        assert!(n.starts_with("column ") && n.contains("above 1"), "{n}");
+    }
     // The headings and the verdict name the columns at the factors (r = 0.5).
     assert_eq!(sheet.summary.columns[0], "authored: sheen r 0.500");
     // Two lights for each of the three swatches.
@@ -921,8 +1015,11 @@ fn a_name_with_accents_and_arrows_is_drawn_with_those_glyphs_in_its_own_case() {
 #[test]
 fn the_verdict_metric_is_0_for_identical_renders_and_grows_with_a_roughness_difference() {
     let furnace = |roughness: f64| {
+        // A dielectric base of glTF's defaults but for its colour.
         let look = Look {
             base: [0.1; 3],
+            base_metallic: 0.0,
+            base_roughness: 1.0,
             layer: Layer::Sheen {
                 color: [0.9; 3],
                 roughness,
@@ -976,4 +1073,229 @@ fn the_verdict_sends_a_floored_fallback_to_look_and_passes_a_good_match() {
         sharp.verdict_line()
     );
     assert!(sharp.flip[0] > sheet::CLOSE_FLIP);
+}
+
+/// A material with a sheen over the base `pbr` (the JSON of pbrMetallicRoughness, or none).
+fn sheen_over(name: &str, pbr: &str, sheen_color: f64, sheen_roughness: f64) -> String {
+    let pbr = if pbr.is_empty() {
+        String::new()
+    } else {
+        format!(r#""pbrMetallicRoughness": {pbr}, "#)
+    };
+    format!(
+        r#"{{"name": "{name}", {pbr}"extensions": {{"KHR_materials_sheen": {{"sheenColorFactor": [{c}, {c}, {c}], "sheenRoughnessFactor": {sheen_roughness}}}}}}}"#,
+        c = sheen_color
+    )
+}
+
+#[test]
+fn the_base_reads_metallic_and_roughness_from_factors_defaults_and_texture_means() {
+    let dir = tempfile::tempdir().unwrap();
+    // Green (roughness) 128 and 64, blue (metallic) 255 and 0, linear: means 96/255 and 1/2.
+    let mr = png_data_uri(&[[0, 128, 255, 255], [0, 64, 0, 255]]);
+    let materials = [
+        sheen_over(
+            "metal",
+            r#"{"baseColorFactor": [0.8, 0.6, 0.2, 1], "metallicFactor": 1, "roughnessFactor": 0.2}"#,
+            0.5,
+            0.5,
+        ),
+        sheen_over(
+            "plastic",
+            r#"{"baseColorFactor": [0.8, 0.6, 0.2, 1], "metallicFactor": 0, "roughnessFactor": 0.2}"#,
+            0.5,
+            0.5,
+        ),
+        sheen_over("defaults", "", 0.5, 0.5),
+        sheen_over(
+            "textured",
+            r#"{"metallicFactor": 0.5, "roughnessFactor": 0.8, "metallicRoughnessTexture": {"index": 0}}"#,
+            0.5,
+            0.5,
+        ),
+        sheen_over(
+            "missing",
+            r#"{"metallicFactor": 0.25, "roughnessFactor": 0.75, "metallicRoughnessTexture": {"index": 1}}"#,
+            0.5,
+            0.5,
+        ),
+    ]
+    .join(", ");
+    let text = format!(
+        r#"{{"asset": {{"version": "2.0"}}, "extensionsUsed": ["KHR_materials_sheen"],
+            "images": [{{"uri": "{mr}"}}, {{"uri": "missing.png"}}],
+            "textures": [{{"source": 0}}, {{"source": 1}}],
+            "materials": [{materials}]}}"#
+    );
+    let path = write(dir.path(), "bases.gltf", &text);
+    let m = materials_of(&load(&path));
+    assert_eq!(m.len(), 5);
+    let params: Vec<(f64, f64)> = m
+        .iter()
+        .map(|m| (m.base_metallic, m.base_roughness))
+        .collect();
+    assert_eq!(params[0], (1.0, 0.2));
+    assert_eq!(params[1], (0.0, 0.2));
+    // The glTF 2.0 schema's defaults.
+    assert_eq!(params[2], (1.0, 1.0));
+    assert!((params[3].0 - 0.25).abs() < 1e-12, "{:?}", params[3]);
+    assert!((params[3].1 - 0.8 * 96.0 / 255.0).abs() < 1e-12, "{:?}", params[3]);
+    assert!(m[3].notes.is_empty(), "{:?}", m[3].notes);
+    // A texture that cannot be read leaves the factors, and a note says so.
+    assert_eq!(params[4], (0.25, 0.75));
+    assert!(m[4].notes.iter().any(|n| n
+        .starts_with("metallicRoughnessTexture not read")
+        && n.contains("missing.png")
+        && n.ends_with("the base is metallicFactor and roughnessFactor alone")));
+    // The base is part of the appearance: the metal and the plastic do not share a sheet.
+    assert_ne!(m[0].appearance(), m[1].appearance());
+    // Their spheres differ, under both lights, in every column.
+    let (metal, plastic) = (columns(&m[0], &m[0].factors), columns(&m[1], &m[1].factors));
+    assert_eq!(metal.len(), plastic.len());
+    for light in [Light::Furnace, Light::Directional] {
+        for (a, b) in metal.iter().zip(&plastic) {
+            let draw = |look| sphere_codes(&render_sphere(&Shaded::new(look), light, 48));
+            assert_ne!(draw(a.look), draw(b.look), "{} under {light:?}", a.title);
+        }
+    }
+}
+
+#[test]
+fn a_metal_base_reflects_its_colour_where_a_dielectric_diffuses_it() {
+    let colour = [0.8, 0.6, 0.2];
+    let bare = |metallic: f64| {
+        Shaded::new(Look {
+            base: colour,
+            base_metallic: metallic,
+            base_roughness: 0.2,
+            layer: Layer::None,
+        })
+    };
+    let (metal, dielectric) = (bare(1.0), bare(0.0));
+    // Normal incidence, roughness 0.2: the metal's albedo is F(f0 = colour) ≈ colour, within
+    // 5e-3 (Schlick's weight over the narrow lobe and the shadowing lose a little); the
+    // dielectric's is 0.04 of white specular plus the colour times the Fresnel-weighted diffuse
+    // 1 − F̄, F̄ the hemisphere's mean of F(0.04), between 0.04 and 0.1.
+    let (m, d) = (metal.furnace(1.0), dielectric.furnace(1.0));
+    let ones = vec![1.0; 400];
+    let here: Vec<[f64; 2]> = (0..3)
+        .map(|k| {
+            [1.0, 0.0].map(|metallic| base_integrated_here(1.0, colour[k], metallic, 0.2, &ones))
+        })
+        .collect();
+    for k in 0..3 {
+        assert!((m[k] - colour[k]).abs() < 5e-3, "metal {m:?}");
+        let diffuse = d[k] - 0.04;
+        assert!(
+            diffuse > 0.9 * colour[k] - 5e-3 && diffuse < 0.96 * colour[k] + 5e-3,
+            "dielectric {d:?}"
+        );
+        // The same values from the spec's BRDF integrated here.
+        for (i, shaded) in [&metal, &dielectric].into_iter().enumerate() {
+            let got = shaded.furnace(1.0)[k];
+            assert!((got - here[k][i]).abs() < 2e-3, "{got} vs {}", here[k][i]);
+        }
+    }
+    // The blue channel, dark in the colour: the metal keeps it dark, the dielectric's white
+    // specular adds to it at grazing views.
+    assert!(metal.furnace(0.1)[2] < dielectric.furnace(0.1)[2] + 0.3);
+    // Under the light the metal's highlight is far above the dielectric's.
+    let l = velvet::preview::shade::SUN_DIRECTION;
+    let h = {
+        let s = [l[0], l[1], l[2] + 1.0];
+        let n = (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt();
+        s.map(|c| c / n)
+    };
+    let (mh, dh) = (
+        metal.radiance(h, Light::Directional),
+        dielectric.radiance(h, Light::Directional),
+    );
+    assert!(mh[0] > 5.0 * dh[0], "{mh:?} vs {dh:?}");
+}
+
+#[test]
+fn smooth_bases_and_grazing_views_shade_without_nan() {
+    for metallic in [0.0, 1.0] {
+        for roughness in [0.0, 1e-9, 0.01] {
+            let shaded = Shaded::new(Look {
+                base: [0.9, 0.5, 0.1],
+                base_metallic: metallic,
+                base_roughness: roughness,
+                layer: Layer::Sheen {
+                    color: [1.0; 3],
+                    roughness: 0.07,
+                },
+            });
+            for light in [Light::Furnace, Light::Directional] {
+                let sphere = render_sphere(&shaded, light, 96);
+                assert!(sphere
+                    .radiance
+                    .iter()
+                    .flatten()
+                    .all(|v| v.is_finite() && *v >= 0.0));
+            }
+            for mu in [0.0, 1e-12, 1e-3] {
+                assert!(shaded.furnace(mu).iter().all(|v| v.is_finite()));
+            }
+        }
+    }
+}
+
+#[test]
+fn a_sheen_above_one_at_grazing_views_is_marked_and_noted() {
+    let dir = tempfile::tempdir().unwrap();
+    // Sheen roughness 0.07, white: E(0.045, 0.07) ≈ 1.20, over a dark rough dielectric.
+    let path = write(
+        dir.path(),
+        "bright.gltf",
+        &gltf(&sheen_over(
+            "bright rim",
+            r#"{"baseColorFactor": [0.05, 0.05, 0.05, 1], "metallicFactor": 0, "roughnessFactor": 1}"#,
+            1.0,
+            0.07,
+        )),
+    );
+    let m = &materials_of(&load(&path))[0];
+    let cols = columns(m, &m.factors);
+    let shaded = Shaded::new(cols[0].look);
+    assert!(shaded.reflectance_at(0.045) > 1.15);
+    let sphere = render_sphere(&shaded, Light::Furnace, sheet::SPHERE);
+    let (count, top) = sheet::pixels_above_one(&sphere);
+    assert!(count > 0 && top > 1.0, "{count} {top}");
+    // Each pixel above 1 is drawn with the hatch; no other pixel has the hatch's magenta.
+    let codes = sphere_codes(&sphere);
+    let clamped = sheet::sphere_codes_clamped(&sphere);
+    let mut marked = 0;
+    for (i, rad) in sphere.radiance.iter().enumerate() {
+        if sphere.coverage[i] > 0.0 && sheet::above_one(*rad) {
+            assert!(sheet::MARK.contains(&codes[i]), "pixel {i}: {:?}", codes[i]);
+            marked += 1;
+        } else {
+            assert_eq!(codes[i], clamped[i]);
+            assert_ne!(codes[i], sheet::MARK[0]);
+        }
+    }
+    assert_eq!(marked, count);
+    // The sheet says so, for column 1 in the furnace.
+    let sheet = sheet::render("bright.gltf", m);
+    let note = sheet
+        .summary
+        .notes
+        .iter()
+        .find(|n| n.starts_with("column 1 (authored: sheen r 0.070) in the furnace: "))
+        .unwrap_or_else(|| panic!("{:?}", sheet.summary.notes));
+    assert!(
+        note.contains(&format!("{count} pixel(s) above 1 in linear light"))
+            && note.ends_with("they are drawn with a magenta and black hatch, not clipped"),
+        "{note}"
+    );
+    // A base without a bright layer gets no such note.
+    let dull = Shaded::new(Look {
+        layer: Layer::None,
+        ..cols[0].look
+    });
+    assert_eq!(
+        sheet::pixels_above_one(&render_sphere(&dull, Light::Furnace, sheet::SPHERE)).0,
+        0
+    );
 }

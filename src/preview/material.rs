@@ -16,9 +16,14 @@
 //! Textures: a readable texture (PNG, JPEG, WebP, decoded to 8 bits per channel) is reduced to
 //! its mean and its 5th and 95th percentiles (nearest rank; a colour texture is ranked by the
 //! largest of its channels, and the percentile's colour is the mean of the texels at that
-//! rank), in linear values. Each textured slot enters a swatch at its own percentile. The base
-//! colour texture enters as its mean. A texture that cannot be read leaves its factor, and a
-//! note says so.
+//! rank), in linear values. Each textured slot enters a swatch at its own percentile.
+//!
+//! The base is glTF 2.0's metallic-roughness material (shaded as such in `shade.rs`): the
+//! base colour is baseColorFactor times the base colour texture's mean, and metallic and
+//! roughness are metallicFactor and roughnessFactor (default 1 and 1) times the means of the
+//! metallicRoughnessTexture's blue and green channels (linear). The base's textures enter as
+//! their means in every swatch. A texture that cannot be read leaves its factor, and a note says
+//! so.
 
 use crate::asset::Asset;
 use crate::bake::recipe::{Channel, ChannelRecipe, ImageId, Texel};
@@ -76,8 +81,14 @@ pub struct Material {
     pub index: usize,
     pub name: Option<String>,
     pub kind: Kind,
-    /// The Lambertian base albedo, linear.
+    /// The base colour, linear.
     pub base: [f64; 3],
+    /// The base's metallicFactor, times the metallic-roughness texture's mean (blue) when it is
+    /// readable, in [0, 1].
+    pub base_metallic: f64,
+    /// The base's roughnessFactor, times the metallic-roughness texture's mean (green) when it
+    /// is readable, in [0, 1].
+    pub base_roughness: f64,
     /// The values at the factors alone (what the figures are computed at).
     pub factors: Swatch,
     /// The swatches drawn: the factors alone, or P5, MEAN and P95 when a layer is textured.
@@ -101,6 +112,8 @@ impl Material {
             (
                 self.kind,
                 self.base,
+                self.base_metallic,
+                self.base_roughness,
                 &self.factors,
                 &self.swatches,
                 &self.notes,
@@ -277,6 +290,35 @@ fn read(
             )),
         }
     }
+    // metallicFactor and roughnessFactor (glTF 2.0 defaults 1 and 1) times the means of the
+    // metallic-roughness texture's blue and green channels (linear) when readable.
+    let factor = |key: &str| {
+        pbr.and_then(|p| p.get(key))
+            .and_then(Value::as_f64)
+            .unwrap_or(1.0)
+            .clamp(0.0, 1.0)
+    };
+    let mut base_metallic = factor("metallicFactor");
+    let mut base_roughness = factor("roughnessFactor");
+    if let Some(info) = pbr.and_then(|p| p.get("metallicRoughnessTexture")) {
+        let channel_means = image_index(asset, info).and_then(|image| {
+            let mut mean = |channel| {
+                image_stats(asset, image, Read::One(channel), Transfer::Linear, images)
+                    .map(|s| s.mean[0])
+            };
+            Ok((mean(2)?, mean(1)?))
+        });
+        match channel_means {
+            Ok((metallic, roughness)) => {
+                base_metallic *= metallic;
+                base_roughness *= roughness;
+            }
+            Err(e) => notes.push(format!(
+                "metallicRoughnessTexture not read ({e}): the base is metallicFactor and \
+                 roughnessFactor alone"
+            )),
+        }
+    }
 
     let fuzz_roughness_assumed = fuzz.as_ref().is_some_and(|f| f.roughness_factor.is_none());
     if fuzz_roughness_assumed {
@@ -355,6 +397,8 @@ fn read(
         name,
         kind,
         base,
+        base_metallic,
+        base_roughness,
         factors,
         swatches,
         notes,
@@ -661,8 +705,14 @@ fn carried(roughness: f64, direction: Direction, mapping: RoughnessMapping) -> f
 /// KHR_materials_fuzz sees. Column 1 is the one the difference image and the verdict compare
 /// with column 0.
 pub fn columns(material: &Material, swatch: &Swatch) -> Vec<Column> {
-    let base = material.base;
-    let look = |layer| Look { base, layer };
+    let (base, base_metallic, base_roughness) =
+        (material.base, material.base_metallic, material.base_roughness);
+    let look = |layer| Look {
+        base,
+        base_metallic,
+        base_roughness,
+        layer,
+    };
     let sheen_layer = |s: SheenValues| Layer::Sheen {
         color: s.color,
         roughness: s.roughness,
@@ -845,6 +895,8 @@ mod tests {
             name: None,
             kind: Kind::FuzzFallback,
             base: [0.5; 3],
+            base_metallic: 0.0,
+            base_roughness: 1.0,
             factors: Swatch {
                 label: "factors",
                 sheen: None,

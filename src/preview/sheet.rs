@@ -204,14 +204,110 @@ pub fn background_code() -> u8 {
     encode(BACKGROUND) / 2
 }
 
-/// 8-bit sRGB codes of a sphere composited over the background.
-pub fn sphere_codes(sphere: &Sphere) -> Vec<[u8; 3]> {
+/// The two colours of the hatch that marks a sphere pixel above 1 (sRGB codes): diagonal
+/// stripes two pixels wide, magenta and black, so that the mark shows on any colour. A pixel
+/// whose linear value exceeds 1 (a sheen whose E exceeds 1 at grazing views, a metal's
+/// highlight) cannot be shown; it is drawn hatched instead of clipping silently, and a note
+/// under the sheet gives their number per column and light. The difference image and the
+/// verdict read the clamped values.
+pub const MARK: [[u8; 3]; 2] = [[255, 0, 255], [0, 0, 0]];
+
+/// Whether a pixel's linear value exceeds 1 in any channel (it cannot be shown: clamped, it
+/// would clip silently).
+pub fn above_one(radiance: [f64; 3]) -> bool {
+    radiance.iter().any(|&v| v > 1.0)
+}
+
+/// The hatch colour at pixel `i` of a sphere of `size` pixels a side.
+fn mark_at(size: usize, i: usize) -> [u8; 3] {
+    let (x, y) = (i % size, i / size);
+    MARK[((x + y) / 2) % 2]
+}
+
+/// 8-bit sRGB codes of a sphere composited over the background, clamped into [0, 1] (what the
+/// difference image and the verdict read).
+pub fn sphere_codes_clamped(sphere: &Sphere) -> Vec<[u8; 3]> {
     sphere
         .radiance
         .iter()
         .zip(&sphere.coverage)
         .map(|(rad, &c)| rad.map(|v| encode(c * clamp01(v) + (1.0 - c) * BACKGROUND)))
         .collect()
+}
+
+/// 8-bit sRGB codes of a sphere as drawn: composited over the background, and each pixel the
+/// sphere covers whose linear value exceeds 1 in any channel marked with the [`MARK`] hatch.
+pub fn sphere_codes(sphere: &Sphere) -> Vec<[u8; 3]> {
+    marked(sphere, sphere_codes_clamped(sphere))
+}
+
+/// `codes` (the sphere's clamped codes) with the pixels above 1 marked.
+fn marked(sphere: &Sphere, mut codes: Vec<[u8; 3]>) -> Vec<[u8; 3]> {
+    for (i, (rad, &c)) in sphere.radiance.iter().zip(&sphere.coverage).enumerate() {
+        if c > 0.0 && above_one(*rad) {
+            codes[i] = mark_at(sphere.size, i);
+        }
+    }
+    codes
+}
+
+/// How many pixels the sphere covers whose linear value exceeds 1, and the largest value.
+pub fn pixels_above_one(sphere: &Sphere) -> (usize, f64) {
+    sphere
+        .radiance
+        .iter()
+        .zip(&sphere.coverage)
+        .filter(|(rad, &c)| c > 0.0 && above_one(**rad))
+        .fold((0, 1.0), |(n, top), (rad, _)| {
+            (n + 1, rad.iter().fold(top, |t, &v| t.max(v)))
+        })
+}
+
+/// The notes on the pixels above 1, one per column and light that has any: how many (over the
+/// swatches' rows), the largest value, and that they are marked.
+fn above_one_notes(
+    rows: &[(usize, Light)],
+    rendered: &[Vec<Sphere>],
+    headed: &[Column],
+    labels: &[&str],
+) -> Vec<String> {
+    let mut notes = Vec::new();
+    for light in [Light::Furnace, Light::Directional] {
+        for (j, column) in headed.iter().enumerate() {
+            let mut total = 0;
+            let mut top: f64 = 1.0;
+            let mut per_row = Vec::new();
+            for (r, &(s, l)) in rows.iter().enumerate() {
+                if l != light {
+                    continue;
+                }
+                let (n, t) = rendered[r].get(j).map_or((0, 1.0), pixels_above_one);
+                total += n;
+                top = top.max(t);
+                per_row.push(format!("{} {n}", labels[s]));
+            }
+            if total == 0 {
+                continue;
+            }
+            let light_words = match light {
+                Light::Furnace => "in the furnace",
+                Light::Directional => "under the light",
+            };
+            let rows_words = if per_row.len() > 1 {
+                format!(" (rows {})", per_row.join(", "))
+            } else {
+                String::new()
+            };
+            notes.push(format!(
+                "column {} ({} {}) {light_words}: {total} pixel(s) above 1 in linear light{rows_words}, \
+                 up to {top:.3}; they are drawn with a magenta and black hatch, not clipped",
+                j + 1,
+                column.title,
+                column.detail
+            ));
+        }
+    }
+    notes
 }
 
 fn clamp01(x: f64) -> f64 {
@@ -312,14 +408,20 @@ pub fn render(title: &str, material: &Material) -> Sheet {
     let rows: Vec<(usize, Light)> = (0..material.swatches.len())
         .flat_map(|s| [(s, Light::Furnace), (s, Light::Directional)])
         .collect();
-    let spheres: Vec<Vec<Vec<[u8; 3]>>> = rows
+    let rendered: Vec<Vec<Sphere>> = rows
         .par_iter()
         .map(|&(s, light)| {
             per_swatch[s]
                 .par_iter()
-                .map(|c| sphere_codes(&render_sphere(&shaded[find(&c.look)], light, SPHERE)))
+                .map(|c| render_sphere(&shaded[find(&c.look)], light, SPHERE))
                 .collect()
         })
+        .collect();
+    // The difference image and the verdict read the values clamped; the spheres are drawn
+    // with the pixels above 1 marked.
+    let spheres: Vec<Vec<Vec<[u8; 3]>>> = rendered
+        .iter()
+        .map(|row| row.iter().map(sphere_codes_clamped).collect())
         .collect();
     let mut max_codes = [0u8; 2];
     let diffs: Vec<Vec<[u8; 3]>> = rows
@@ -356,6 +458,11 @@ pub fn render(title: &str, material: &Material) -> Sheet {
         let slot = usize::from(light == Light::Directional);
         flip[slot] = flip[slot].max(*f);
     }
+    let spheres: Vec<Vec<Vec<[u8; 3]>>> = rendered
+        .iter()
+        .zip(spheres)
+        .map(|(row, codes)| row.iter().zip(codes).map(|(s, c)| marked(s, c)).collect())
+        .collect();
 
     let ncols = per_swatch[0].len();
     // The headings name the values at the factors; textured rows scale them per swatch.
@@ -369,6 +476,8 @@ pub fn render(title: &str, material: &Material) -> Sheet {
                 .to_string(),
         );
     }
+    let labels: Vec<&str> = material.swatches.iter().map(|s| s.label).collect();
+    notes.extend(above_one_notes(&rows, &rendered, &headed, &labels));
     let title = title.to_string();
     let summary = Summary {
         title,
