@@ -210,6 +210,20 @@ struct ValidateArgs {
     schema_dir: Option<PathBuf>,
     #[command(flatten)]
     load: LoadArgs,
+    /// Repair the findings a safe fix can repair, in place, and report what remains (the exit
+    /// status follows the findings left).
+    #[arg(long)]
+    fix: bool,
+    /// With --fix or --diff: apply unsafe fixes too (they change the asset's meaning as their
+    /// findings imply; each is named in the output).
+    #[arg(long)]
+    unsafe_fixes: bool,
+    /// Print the fixes as a unified diff; write nothing (exit status 1 when there is one).
+    #[arg(long, conflicts_with = "fix")]
+    diff: bool,
+    /// With --fix: exit with status 1 when a file was changed (for pre-commit hooks).
+    #[arg(long, requires = "fix")]
+    exit_non_zero_on_fix: bool,
 }
 
 #[derive(clap::Args)]
@@ -447,28 +461,7 @@ fn man(dir: Option<PathBuf>) -> ExitCode {
 }
 
 fn codes_table(format: CodesFormat) -> String {
-    let codes = velvet::rules::all_codes();
-    match format {
-        CodesFormat::Text => {
-            let width = codes.iter().map(|c| c.name.len()).max().unwrap_or(0);
-            codes
-                .iter()
-                .map(|c| format!("{:width$}  {:7}  {}\n", c.name, c.severity.as_str(), c.doc))
-                .collect()
-        }
-        CodesFormat::Markdown => {
-            let mut out = String::from("| code | severity | meaning |\n|---|---|---|\n");
-            for c in codes {
-                out += &format!(
-                    "| `{}` | {} | {} |\n",
-                    c.name,
-                    c.severity,
-                    c.doc.replace('|', "\\|")
-                );
-            }
-            out
-        }
-    }
+    report::codes_table(matches!(format, CodesFormat::Markdown))
 }
 
 fn resolver(args: &SettingsArgs) -> Result<Resolver, config::ConfigError> {
@@ -541,16 +534,26 @@ fn validate(args: ValidateArgs, color: ColorChoice, quiet: bool) -> ExitCode {
         color: args.format == Format::Text && color.for_stdout(),
         quiet,
         no_fold: args.no_fold,
+        diff: args.diff,
     };
+    let fixing = velvet::fix::Fixing::new(
+        &validator,
+        velvet::fix::Mode {
+            apply: args.fix,
+            diff: args.diff,
+            unsafe_fixes: args.unsafe_fixes,
+        },
+    );
     // Each file's report is written as soon as it is done (see report::Stream).
     let stdout = std::io::BufWriter::new(std::io::stdout().lock());
     let mut stream = report::Stream::new(args.format, options, stdout).json_array(!one_file);
-    let outcome = match velvet::run::validate_shard_each(
+    let outcome = match velvet::run::check_shard_each(
         &validator,
         &paths,
         args.input.shard,
         &mut resolver,
         progress.as_ref(),
+        &|path, settings| fixing.check(path, settings),
         &mut |r| match &progress {
             // The bar is cleared while the report is written, so the two do not mix.
             Some(bar) => bar.suspend(|| {
@@ -569,7 +572,10 @@ fn validate(args: ValidateArgs, color: ColorChoice, quiet: bool) -> ExitCode {
         }
     };
     stream.finish();
-    if outcome.failed {
+    // Fixed findings do not fail the run; those left do. A change fails it where it is asked to
+    // be reviewed (--diff, --exit-non-zero-on-fix).
+    let changed = fixing.files_changed() > 0 && (args.diff || args.exit_non_zero_on_fix);
+    if outcome.failed || changed {
         ExitCode::from(1)
     } else {
         ExitCode::SUCCESS

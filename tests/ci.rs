@@ -764,13 +764,15 @@ fn help_documents_the_exit_status() {
     let top = stdout(&velvet(&["--help"]));
     assert!(
         top.contains(
-            "Exit status:\n  0  validate: no file has an issue at or above --fail-on; migrate, bake: "
+            "Exit status:\n  0  validate: no file has an issue at or above --fail-on (with --fix: none is left after fixing); migrate, bake: "
         ),
         "{top}"
     );
     let validate = stdout(&velvet(&["validate", "--help"]));
     assert!(
-        validate.contains("Exit status:\n  0  no file has an issue at or above --fail-on\n"),
+        validate.contains(
+            "Exit status:\n  0  no file has an issue at or above --fail-on (with --fix: none is left after fixing)\n"
+        ),
         "{validate}"
     );
     for text in [&top, &validate] {
@@ -1218,7 +1220,8 @@ fn fail_on_hint_fails_a_file_whose_only_findings_are_hints() {
     .unwrap();
     let status = |args: &[&str]| velvet_in(dir.path(), args).status.code();
     let o = velvet_in(dir.path(), &["validate", "fuzz.gltf"]);
-    assert!(stdout(&o).ends_with("1 file checked: 0 errors, 0 warnings, 0 info, 2 hints\n"));
+    assert!(stdout(&o)
+        .ends_with("1 file checked: 0 errors, 0 warnings, 0 info, 2 hints; 1 fixable with --fix\n"));
     assert_eq!(o.status.code(), Some(0));
     assert_eq!(
         status(&["validate", "--fail-on", "info", "fuzz.gltf"]),
@@ -1317,12 +1320,12 @@ fn text_output_folds_a_repeated_finding_and_lists_findings_in_file_order() {
     assert_eq!(
         stdout(&o),
         format!(
-            "many.gltf:5:25: error VALUE_NOT_IN_RANGE: 3 is greater than the maximum of 1.0\n    at {p}/sheenRoughnessFactor\n\
+            "many.gltf:5:25: error VALUE_NOT_IN_RANGE: 3 is greater than the maximum of 1.0\n    at {p}/sheenRoughnessFactor\n    fix (unsafe, --fix --unsafe-fixes): clamp sheenRoughnessFactor to 1\n\
              many.gltf:6:16: warning KHR_MATERIALS_SHEEN_LEGACY_DRAFT: sheenFactor belongs to the pre-ratification KHR_materials_sheen draft and is ignored by ratified loaders; `velvet migrate` upgrades it\n    at {p}/sheenFactor\n\
              many.gltf:7:8: warning UNEXPECTED_PROPERTY: unexpected property 'odd'\n    at {p}/odd\n\
              \x20   and 7 more at 10:48, 11:48, 12:48, 13:48, 14:48, … (8 in all; --no-fold prints each)\n\
              many.gltf:8:12: warning UNEXPECTED_PROPERTY: unexpected property 'strange'\n    at {p}/strange\n\
-             1 file checked: 1 error, 10 warnings, 0 info, 0 hints\n"
+             1 file checked: 1 error, 10 warnings, 0 info, 0 hints; 1 fixable with --fix --unsafe-fixes\n"
         )
     );
     let o = velvet_in(
@@ -1341,7 +1344,10 @@ fn text_output_folds_a_repeated_finding_and_lists_findings_in_file_order() {
         "many.gltf:8:12: warning UNEXPECTED_PROPERTY".to_string(),
     ];
     expected.extend((10..17).map(|l| format!("many.gltf:{l}:48: warning UNEXPECTED_PROPERTY")));
-    expected.push("1 file checked: 1 error, 10 warnings, 0 info, 0 hints".to_string());
+    expected.push(
+        "1 file checked: 1 error, 10 warnings, 0 info, 0 hints; 1 fixable with --fix --unsafe-fixes"
+            .to_string(),
+    );
     assert_eq!(lines, expected);
 }
 
@@ -1436,7 +1442,9 @@ fn readme_pre_commit_snippet_runs_as_pre_commit_runs_it_with_mixed_case_names() 
         "{out}"
     );
     assert!(
-        out.ends_with("2 files checked: 2 errors, 2 warnings, 0 info, 2 hints\n"),
+        out.ends_with(
+            "2 files checked: 2 errors, 2 warnings, 0 info, 2 hints; 2 fixable with --fix (1 more with --unsafe-fixes)\n"
+        ),
         "{out}"
     );
     std::fs::remove_file(dir.path().join("models/UPPER.GLTF")).unwrap();

@@ -250,6 +250,7 @@ mod tests {
                 fuzz_material_count: 0,
             }),
             missing: Default::default(),
+            fixes: Default::default(),
         }
     }
 
