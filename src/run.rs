@@ -10,9 +10,9 @@
 
 use crate::asset::discover::{self, Shard};
 use crate::config::{ConfigError, Resolver};
+use crate::diagnostics::Settings;
 use crate::validate::{FileReport, Validator};
 use rayon::prelude::*;
-use crate::diagnostics::Settings;
 use std::path::{Path, PathBuf};
 
 /// What a run produced.

@@ -1220,8 +1220,9 @@ fn fail_on_hint_fails_a_file_whose_only_findings_are_hints() {
     .unwrap();
     let status = |args: &[&str]| velvet_in(dir.path(), args).status.code();
     let o = velvet_in(dir.path(), &["validate", "fuzz.gltf"]);
-    assert!(stdout(&o)
-        .ends_with("1 file checked: 0 errors, 0 warnings, 0 info, 2 hints; 1 fixable with --fix\n"));
+    assert!(stdout(&o).ends_with(
+        "1 file checked: 0 errors, 0 warnings, 0 info, 2 hints; 1 fixable with --fix\n"
+    ));
     assert_eq!(o.status.code(), Some(0));
     assert_eq!(
         status(&["validate", "--fail-on", "info", "fuzz.gltf"]),

@@ -43,7 +43,10 @@ pub const OUT_OF_RANGE: Fixer = Fixer {
 mod tests {
     #[test]
     fn the_bound_is_read_from_inclusive_messages_only() {
-        assert_eq!(super::bound("1.5 is greater than the maximum of 1.0"), Some(1.0));
+        assert_eq!(
+            super::bound("1.5 is greater than the maximum of 1.0"),
+            Some(1.0)
+        );
         assert_eq!(super::bound("-2 is less than the minimum of 0"), Some(0.0));
         assert_eq!(
             super::bound("0 is less than or equal to the minimum of 0"),

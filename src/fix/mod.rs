@@ -117,9 +117,9 @@ pub fn combined(root: Node, fixes: &[&Fix]) -> Vec<Edit> {
             .map_or(0, |a| a.len());
         let added_to = out.iter().any(|e| match e {
             Edit::DeclareUsed { .. } => parent == "/extensionsUsed",
-            Edit::Set { pointer, .. } | Edit::Replace { pointer, .. } | Edit::Remove { pointer } => {
-                pointer.starts_with(&format!("{parent}/"))
-            }
+            Edit::Set { pointer, .. }
+            | Edit::Replace { pointer, .. }
+            | Edit::Remove { pointer } => pointer.starts_with(&format!("{parent}/")),
         });
         if count == len && !added_to && !parent.is_empty() {
             out.push(Edit::remove(parent.clone()));
@@ -219,7 +219,8 @@ impl<'v> Fixing<'v> {
         let wanted: Vec<usize> = (0..fixes.len())
             .filter(|&i| !self.mode.changes() || self.mode.applies(fixes[i].safety))
             .collect();
-        let (accepted, refused, fixed) = self.choose(path, &source, &before, &fixes, &wanted, &unlimited);
+        let (accepted, refused, fixed) =
+            self.choose(path, &source, &before, &fixes, &wanted, &unlimited);
         let edits = if source.container == Container::Gltf {
             fixes
                 .par_iter()
@@ -230,7 +231,9 @@ impl<'v> Fixing<'v> {
         };
         let changed = fixed
             .as_ref()
-            .filter(|f| self.mode.changes() && !accepted.is_empty() && f.bytes != file_bytes(&source))
+            .filter(|f| {
+                self.mode.changes() && !accepted.is_empty() && f.bytes != file_bytes(&source)
+            })
             .is_some();
         let status = |i: usize| -> FixStatus {
             if let Some((_, reason)) = refused.iter().find(|(r, _)| *r == i) {
@@ -444,7 +447,10 @@ fn fix_text_edits(source: &Asset, fix: &Fix) -> Vec<TextEdit> {
 /// `report` (of every finding) with `settings`' cap on the listing, as a validation under
 /// `settings` lists it: the most severe findings kept.
 fn capped(mut report: FileReport, settings: &Settings) -> FileReport {
-    if let Some(max) = settings.max_issues.filter(|max| report.findings.len() > *max) {
+    if let Some(max) = settings
+        .max_issues
+        .filter(|max| report.findings.len() > *max)
+    {
         report.findings.sort_by_key(|f| f.diagnostic.severity);
         report.omitted = report.findings.len() - max;
         report.findings.truncate(max);

@@ -138,7 +138,10 @@ mod tests {
     #[test]
     fn the_diff_names_the_file_and_shows_the_changed_lines() {
         let diff = unified_diff("m.gltf", "{\n  \"a\": 1\n}\n", "{\n  \"a\": 2\n}\n");
-        assert!(diff.starts_with("--- a/m.gltf\n+++ b/m.gltf\n@@ -1,3 +1,3 @@\n"), "{diff}");
+        assert!(
+            diff.starts_with("--- a/m.gltf\n+++ b/m.gltf\n@@ -1,3 +1,3 @@\n"),
+            "{diff}"
+        );
         assert!(diff.contains("-  \"a\": 1\n+  \"a\": 2\n"), "{diff}");
     }
 }

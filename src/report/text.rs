@@ -174,7 +174,12 @@ fn fixes_done(file: &str, fixes: &FileFixes) -> String {
                 let _ = writeln!(out, "{file}: fixed: {}", terminal(&what));
             }
             FixStatus::Refused(reason) => {
-                let _ = writeln!(out, "{file}: not fixed: {}: {}", terminal(&what), terminal(reason));
+                let _ = writeln!(
+                    out,
+                    "{file}: not fixed: {}: {}",
+                    terminal(&what),
+                    terminal(reason)
+                );
             }
             FixStatus::Available => {}
         }
