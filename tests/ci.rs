@@ -617,12 +617,16 @@ fn run_hook(hook: &Hook, dir: &Path, batch: usize) -> (bool, String) {
 }
 
 #[test]
-fn hooks_file_declares_both_hooks_for_gltf_and_glb() {
+fn hooks_file_declares_every_hook_for_gltf_and_glb() {
     let hooks = hooks();
     let ids: Vec<&str> = hooks.iter().map(|h| h.id.as_str()).collect();
-    assert_eq!(ids, ["velvet-validate", "velvet-migrate-check"]);
+    assert_eq!(
+        ids,
+        ["velvet-validate", "velvet-migrate-check", "velvet-validate-fix"]
+    );
     assert_eq!(hooks[0].entry, "velvet validate");
     assert_eq!(hooks[1].entry, "velvet migrate --check");
+    assert_eq!(hooks[2].entry, "velvet validate --fix --exit-non-zero-on-fix");
     for h in &hooks {
         assert_eq!(h.language, "rust");
         let p = regex::Regex::new(&h.files).unwrap();
@@ -2225,4 +2229,74 @@ fn a_validate_command_line_clap_refuses_still_writes_the_report_its_format_asks_
     let o = velvet_in(dir.path(), &["migrate", "--format", "json", "--bogus"]);
     assert_eq!(o.status.code(), Some(2));
     assert!(o.stdout.is_empty(), "only validate writes reports");
+}
+
+#[test]
+fn readme_fix_diff_example_is_what_velvet_prints() {
+    let readme = readme();
+    let start = readme
+        .find("```text\n$ velvet validate --diff assets/mixed.gltf\n")
+        .expect("the README shows a --diff example");
+    let body = &readme[start + "```text\n".len()..];
+    let body = &body[..body.find("```\n").unwrap()];
+    let (command, shown) = body.split_once('\n').unwrap();
+    let args: Vec<&str> = command.split_whitespace().skip(2).collect();
+    let o = velvet(&args);
+    assert_eq!(o.status.code(), Some(1));
+    assert_eq!(stdout(&o), shown);
+}
+
+#[test]
+fn readme_fixing_pre_commit_hook_fixes_fails_once_and_then_passes() {
+    let text = block_after(&readme(), "### pre-commit", "yaml");
+    let config: Value = serde_yaml_ng::from_str(&text).expect("the snippet is YAML");
+    let hook = &config["repos"][0]["hooks"][1];
+    let hook = Hook {
+        id: hook["id"].as_str().unwrap().to_string(),
+        entry: hook["entry"].as_str().unwrap().to_string(),
+        language: hook["language"].as_str().unwrap().to_string(),
+        files: hook["files"].as_str().unwrap().to_string(),
+    };
+    assert_eq!(hook.id, "velvet-validate-fix");
+    // The hook velvet's repository ships runs the same command.
+    let shipped = hooks();
+    let ours = shipped.iter().find(|h| h.id == hook.id).expect("shipped");
+    assert_eq!((&ours.entry, &ours.files), (&hook.entry, &hook.files));
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join("models")).unwrap();
+    let undeclared = r#"{"asset":{"version":"2.0"},"materials":[{"extensions":{"KHR_materials_sheen":{"sheenColorFactor":[1,1,1]}}}]}"#;
+    std::fs::write(dir.path().join("models/Cloth.GLTF"), undeclared).unwrap();
+    std::fs::copy(
+        project().join("assets/clean.gltf"),
+        dir.path().join("models/chair.gltf"),
+    )
+    .unwrap();
+    let clean_before = std::fs::read(dir.path().join("models/chair.gltf")).unwrap();
+    let (ok, out) = run_hook(&hook, dir.path(), 100);
+    assert!(!ok, "a changed file fails the hook: {out}");
+    assert!(
+        out.contains("models/Cloth.GLTF: fixed: declare KHR_materials_sheen in extensionsUsed"),
+        "{out}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(dir.path().join("models/Cloth.GLTF")).unwrap(),
+        r#"{"asset":{"version":"2.0"},"extensionsUsed":["KHR_materials_sheen"],"materials":[{"extensions":{"KHR_materials_sheen":{"sheenColorFactor":[1,1,1]}}}]}"#
+    );
+    assert_eq!(
+        std::fs::read(dir.path().join("models/chair.gltf")).unwrap(),
+        clean_before
+    );
+    let (ok, out) = run_hook(&hook, dir.path(), 100);
+    assert!(ok, "nothing left to fix: {out}");
+    // An error no fix repairs fails the hook every time.
+    std::fs::copy(
+        project().join("assets/mixed.gltf"),
+        dir.path().join("models/mixed.gltf"),
+    )
+    .unwrap();
+    for _ in 0..2 {
+        let (ok, out) = run_hook(&hook, dir.path(), 100);
+        assert!(!ok, "{out}");
+        assert!(out.contains("error UNRESOLVED_REFERENCE"), "{out}");
+    }
 }
