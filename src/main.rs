@@ -542,6 +542,7 @@ fn validate(args: ValidateArgs, color: ColorChoice, quiet: bool) -> ExitCode {
             apply: args.fix,
             diff: args.diff,
             unsafe_fixes: args.unsafe_fixes,
+            edits: matches!(args.format, Format::Json | Format::Jsonl | Format::Sarif),
         },
     );
     // Each file's report is written as soon as it is done (see report::Stream).

@@ -622,11 +622,18 @@ fn hooks_file_declares_every_hook_for_gltf_and_glb() {
     let ids: Vec<&str> = hooks.iter().map(|h| h.id.as_str()).collect();
     assert_eq!(
         ids,
-        ["velvet-validate", "velvet-migrate-check", "velvet-validate-fix"]
+        [
+            "velvet-validate",
+            "velvet-migrate-check",
+            "velvet-validate-fix"
+        ]
     );
     assert_eq!(hooks[0].entry, "velvet validate");
     assert_eq!(hooks[1].entry, "velvet migrate --check");
-    assert_eq!(hooks[2].entry, "velvet validate --fix --exit-non-zero-on-fix");
+    assert_eq!(
+        hooks[2].entry,
+        "velvet validate --fix --exit-non-zero-on-fix"
+    );
     for h in &hooks {
         assert_eq!(h.language, "rust");
         let p = regex::Regex::new(&h.files).unwrap();

@@ -627,7 +627,7 @@ fn several_fixes_of_one_file_are_applied_in_one_pass() {
 /// A GLB of `json` (padded with spaces) and `bin`.
 fn glb(json: &[u8], bin: &[u8]) -> Vec<u8> {
     let mut json = json.to_vec();
-    while json.len() % 4 != 0 {
+    while !json.len().is_multiple_of(4) {
         json.push(b' ');
     }
     let total = 12 + 8 + json.len() + 8 + bin.len();
@@ -703,4 +703,44 @@ fn the_fixers_table_in_the_docs_names_every_fixable_code_with_its_safety() {
         .collect();
     registry.sort();
     assert_eq!(named, registry);
+}
+
+#[test]
+fn the_json_fixes_of_many_materials_applied_together_are_what_fix_writes() {
+    // A fix per material (found and spliced together), one shared by several findings, and a
+    // declaration: applied apart from velvet they give the bytes --fix writes.
+    let dir = tempfile::tempdir().unwrap();
+    let materials: Vec<String> = (0..40)
+        .map(|i| {
+            format!(
+                "    {{\n      \"name\": \"m{i}\",\n      \"extensions\": {{\n        \"KHR_materials_fuzz\": {{\n          \"fuzzFactor\": 1\n        }},\n        \"EXT_made_up\": {{}}\n      }}\n    }}"
+            )
+        })
+        .collect();
+    let text = format!(
+        "{{\n  \"asset\": {{\n    \"version\": \"2.0\"\n  }},\n  \"extensionsUsed\": [\n    \"KHR_materials_fuzz\"\n  ],\n  \"materials\": [\n{}\n  ]\n}}\n",
+        materials.join(",\n")
+    );
+    std::fs::write(dir.path().join("m.gltf"), &text).unwrap();
+    let o = velvet_in(dir.path(), &["validate", "--format", "json", "m.gltf"]);
+    let report: Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(report["fixes"]["fixable"], 41);
+    let mut replacements = Vec::new();
+    for message in report["issues"]["messages"].as_array().unwrap() {
+        for edit in message["fix"]["edits"].as_array().into_iter().flatten() {
+            replacements.push(Replacement {
+                start: edit["location"]["offset"].as_u64().unwrap() as usize,
+                end: edit["endLocation"]["offset"].as_u64().unwrap() as usize,
+                text: edit["content"].as_str().unwrap().to_string(),
+            });
+        }
+    }
+    let applied = apply_replacements(text.as_bytes(), replacements);
+    let o = velvet_in(dir.path(), &["validate", "--fix", "m.gltf"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stdout(&o));
+    let fixed = std::fs::read(dir.path().join("m.gltf")).unwrap();
+    assert_eq!(
+        String::from_utf8(applied).unwrap(),
+        String::from_utf8(fixed).unwrap()
+    );
 }

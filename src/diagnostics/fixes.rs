@@ -81,7 +81,11 @@ impl FixView {
 /// would be) changed, with the unified diff when one was asked for.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct FileFixes {
-    pub fixes: Vec<FixView>,
+    /// The fixes; set with [`FileFixes::new`], which indexes them by the findings they repair.
+    fixes: Vec<FixView>,
+    /// The available fix of each finding (`code`, NUL, `pointer`): a report looks each finding
+    /// up, and a document may have a fix per material.
+    available: std::collections::HashMap<String, usize>,
     /// True when the fixes changed the file's bytes (written, or shown by `--diff`).
     pub changed: bool,
     /// With `--diff`: the change as a unified diff.
@@ -90,7 +94,44 @@ pub struct FileFixes {
     pub write_error: Option<String>,
 }
 
+fn finding_key(code: &str, pointer: &str) -> String {
+    format!("{code}\0{pointer}")
+}
+
 impl FileFixes {
+    pub fn new(fixes: Vec<FixView>) -> FileFixes {
+        let mut available = std::collections::HashMap::new();
+        for (i, fix) in fixes.iter().enumerate() {
+            if fix.status == FixStatus::Available {
+                for r in &fix.repairs {
+                    available
+                        .entry(finding_key(r.code, &r.pointer))
+                        .or_insert(i);
+                }
+            }
+        }
+        FileFixes {
+            fixes,
+            available,
+            ..Default::default()
+        }
+    }
+
+    /// Every fix planned for the file.
+    pub fn fixes(&self) -> &[FixView] {
+        &self.fixes
+    }
+
+    /// Marks every applied fix refused for `reason` (the fixed file could not be written).
+    pub fn refuse_applied(&mut self, reason: &str) {
+        for fix in &mut self.fixes {
+            if fix.status == FixStatus::Applied {
+                fix.status = FixStatus::Refused(reason.to_string());
+            }
+        }
+        self.changed = false;
+    }
+
     /// Findings that an available fix of `safety` repairs (each finding once).
     pub fn available(&self, safety: Safety) -> usize {
         self.fixes
@@ -102,9 +143,12 @@ impl FileFixes {
 
     /// The available fix that repairs the finding with `code` at `pointer`, if any.
     pub fn for_finding(&self, code: &str, pointer: &str) -> Option<&FixView> {
-        self.fixes
-            .iter()
-            .find(|f| f.status == FixStatus::Available && f.repairs(code, pointer))
+        if self.available.is_empty() {
+            return None;
+        }
+        self.available
+            .get(&finding_key(code, pointer))
+            .map(|&i| &self.fixes[i])
     }
 
     /// Findings repaired by applied fixes.

@@ -45,6 +45,8 @@ pub struct Fix {
 /// that make the same edits are one fix repairing each of their findings.
 pub fn plan(asset: &Asset, findings: &[Finding]) -> Vec<Fix> {
     let mut fixes: Vec<Fix> = Vec::new();
+    // Each fix by its safety and edits, as text: a document may have a fix per material.
+    let mut by_edits: HashMap<String, usize> = HashMap::new();
     for finding in findings {
         let d: &Diagnostic = &finding.diagnostic;
         let Some(fixer) = fixers::fixer_for(d.code) else {
@@ -58,17 +60,18 @@ pub fn plan(asset: &Asset, findings: &[Finding]) -> Vec<Fix> {
             pointer: d.pointer.clone(),
             message: d.message.clone(),
         };
-        match fixes
-            .iter_mut()
-            .find(|f| f.edits == proposal.edits && f.safety == fixer.safety)
-        {
-            Some(fix) => fix.repairs.push(repair),
-            None => fixes.push(Fix {
-                repairs: vec![repair],
-                safety: fixer.safety,
-                title: proposal.title,
-                edits: proposal.edits,
-            }),
+        let key = format!("{:?} {:?}", fixer.safety, proposal.edits);
+        match by_edits.get(&key) {
+            Some(&i) => fixes[i].repairs.push(repair),
+            None => {
+                by_edits.insert(key, fixes.len());
+                fixes.push(Fix {
+                    repairs: vec![repair],
+                    safety: fixer.safety,
+                    title: proposal.title,
+                    edits: proposal.edits,
+                });
+            }
         }
     }
     fixes
@@ -80,8 +83,9 @@ pub fn plan(asset: &Asset, findings: &[Finding]) -> Vec<Fix> {
 /// removed whole, unless another edit adds to it.
 pub fn combined(root: Node, fixes: &[&Fix]) -> Vec<Edit> {
     let mut edits: Vec<Edit> = Vec::new();
+    let mut seen: std::collections::HashSet<String> = std::collections::HashSet::new();
     for edit in fixes.iter().flat_map(|f| &f.edits) {
-        if !edits.contains(edit) {
+        if seen.insert(format!("{edit:?}")) {
             edits.push(edit.clone());
         }
     }
@@ -144,6 +148,9 @@ pub struct Mode {
     pub diff: bool,
     /// `--unsafe-fixes`: apply unsafe fixes too.
     pub unsafe_fixes: bool,
+    /// Give each fix its edits of the text (the JSON and SARIF reports show them; a text
+    /// report does not, and a document with thousands of fixes is spared working them out).
+    pub edits: bool,
 }
 
 impl Mode {
@@ -221,11 +228,8 @@ impl<'v> Fixing<'v> {
             .collect();
         let (accepted, refused, fixed) =
             self.choose(path, &source, &before, &fixes, &wanted, &unlimited);
-        let edits = if source.container == Container::Gltf {
-            fixes
-                .par_iter()
-                .map(|fix| fix_text_edits(&source, fix))
-                .collect()
+        let edits = if self.mode.edits && source.container == Container::Gltf {
+            all_text_edits(&source, &fixes)
         } else {
             vec![Vec::new(); fixes.len()]
         };
@@ -235,33 +239,29 @@ impl<'v> Fixing<'v> {
                 self.mode.changes() && !accepted.is_empty() && f.bytes != file_bytes(&source)
             })
             .is_some();
-        let status = |i: usize| -> FixStatus {
-            if let Some((_, reason)) = refused.iter().find(|(r, _)| *r == i) {
-                FixStatus::Refused(reason.clone())
-            } else if changed && accepted.contains(&i) {
-                FixStatus::Applied
-            } else {
-                FixStatus::Available
+        let mut statuses = vec![FixStatus::Available; fixes.len()];
+        if changed {
+            for &i in &accepted {
+                statuses[i] = FixStatus::Applied;
             }
-        };
+        }
+        for (i, reason) in refused {
+            statuses[i] = FixStatus::Refused(reason);
+        }
         let views: Vec<FixView> = fixes
             .into_iter()
             .zip(edits)
-            .enumerate()
-            .map(|(i, (fix, edits))| FixView {
+            .zip(statuses)
+            .map(|((fix, edits), status)| FixView {
                 repairs: fix.repairs,
                 safety: fix.safety,
                 title: fix.title,
                 edits,
-                status: status(i),
+                status,
             })
             .collect();
-        let mut file_fixes = FileFixes {
-            fixes: views,
-            changed,
-            diff: None,
-            write_error: None,
-        };
+        let mut file_fixes = FileFixes::new(views);
+        file_fixes.changed = changed;
         let Some(fixed) = fixed.filter(|_| changed) else {
             let mut report = capped(before, settings);
             report.fixes = file_fixes;
@@ -284,12 +284,7 @@ impl<'v> Fixing<'v> {
             if let Err(e) = written {
                 // Nothing was written: the file's findings stand, and the run fails.
                 let mut report = capped(before, settings);
-                for fix in &mut file_fixes.fixes {
-                    if fix.status == FixStatus::Applied {
-                        fix.status = FixStatus::Refused(format!("not written: {e}"));
-                    }
-                }
-                file_fixes.changed = false;
+                file_fixes.refuse_applied(&format!("not written: {e}"));
                 file_fixes.write_error = Some(e.clone());
                 report.findings.push(Finding {
                     diagnostic: Diagnostic::new(&IO_ERROR, "", e),
@@ -432,6 +427,100 @@ fn verdict(before: &[Finding], after: &[Finding], fixes: &[&Fix]) -> Result<(), 
         }
     }
     Ok(())
+}
+
+/// The edits of the JSON text each of `fixes` makes alone. A fix that edits within one element
+/// of a top-level array that no other fix edits (a material's fix, of which a document may
+/// have thousands) is spliced together with the others of its kind, in one pass, and each
+/// replacement goes to the fix whose element holds it; the others are spliced one by one.
+fn all_text_edits(source: &Asset, fixes: &[Fix]) -> Vec<Vec<TextEdit>> {
+    let root = source.root();
+    let text = source.json_text.as_str();
+    let units: Vec<Option<(String, std::ops::Range<usize>)>> =
+        fixes.iter().map(|fix| element_of(root, fix)).collect();
+    let mut count: HashMap<&str, usize> = HashMap::new();
+    for (pointer, _) in units.iter().flatten() {
+        *count.entry(pointer.as_str()).or_default() += 1;
+    }
+    let (mut batched, mut alone): (Vec<usize>, Vec<usize>) = (0..fixes.len()).partition(|&i| {
+        units[i]
+            .as_ref()
+            .is_some_and(|(p, _)| count[p.as_str()] == 1)
+    });
+    let mut out = vec![Vec::new(); fixes.len()];
+    if !batched.is_empty() {
+        let together: Vec<&Fix> = batched.iter().map(|&i| &fixes[i]).collect();
+        let edits = combined(root, &together);
+        let placed = match crate::edit::splice::splice_edits(text, root, &edits) {
+            Ok(Some((spliced, _))) => {
+                let replacements = text::replacements(text, &spliced);
+                let edits = text::text_edits(text, &replacements);
+                batched.sort_by_key(|&i| units[i].as_ref().map_or(0, |(_, s)| s.start));
+                let spans: Vec<&std::ops::Range<usize>> = batched
+                    .iter()
+                    .filter_map(|&i| units[i].as_ref().map(|(_, s)| s))
+                    .collect();
+                let mut placed = vec![Vec::new(); fixes.len()];
+                let all_placed = replacements.iter().zip(edits).all(|(r, edit)| {
+                    let k = spans.partition_point(|s| s.start <= r.start);
+                    match k.checked_sub(1) {
+                        Some(k) if r.end <= spans[k].end => {
+                            placed[batched[k]].push(edit);
+                            true
+                        }
+                        _ => false,
+                    }
+                });
+                all_placed.then_some(placed)
+            }
+            _ => None,
+        };
+        match placed {
+            Some(placed) => {
+                for (slot, edits) in out.iter_mut().zip(placed) {
+                    if !edits.is_empty() {
+                        *slot = edits;
+                    }
+                }
+            }
+            None => alone.append(&mut batched),
+        }
+    }
+    let done: Vec<(usize, Vec<TextEdit>)> = alone
+        .par_iter()
+        .map(|&i| (i, fix_text_edits(source, &fixes[i])))
+        .collect();
+    for (i, edits) in done {
+        out[i] = edits;
+    }
+    out
+}
+
+/// The element of a top-level array (`/materials/3`) within which every edit of `fix` lies,
+/// with its span, if there is one.
+fn element_of(root: Node, fix: &Fix) -> Option<(String, std::ops::Range<usize>)> {
+    let mut unit: Option<(String, std::ops::Range<usize>)> = None;
+    for edit in &fix.edits {
+        let pointer = match edit {
+            Edit::Set { pointer, .. }
+            | Edit::Replace { pointer, .. }
+            | Edit::Remove { pointer } => pointer,
+            Edit::DeclareUsed { .. } => return None,
+        };
+        let mut tokens = pointer.splitn(4, '/');
+        tokens.next();
+        let (member, index) = (tokens.next()?, tokens.next()?);
+        // Within the element, not the element itself.
+        tokens.next()?;
+        crate::asset::pointer::array_index(index)?;
+        let at = format!("/{member}/{index}");
+        if unit.as_ref().is_some_and(|(u, _)| *u != at) {
+            return None;
+        }
+        let span = root.pointer(&at)?.span();
+        unit = Some((at, span));
+    }
+    unit
 }
 
 /// The edits of the JSON text that `fix` makes alone.

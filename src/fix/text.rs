@@ -1,7 +1,7 @@
 //! A fix seen as text: the edits of the JSON text that a plan's splices make (what the JSON
 //! and SARIF reports carry), and the unified diff `--diff` prints.
 
-use crate::asset::position::position_of;
+use crate::asset::position::{position_of, Position};
 use crate::diagnostics::fixes::TextEdit;
 use crate::edit::splice::Spliced;
 
@@ -101,14 +101,47 @@ pub fn apply(source: &str, replacements: &[Replacement]) -> String {
 
 /// The replacements as the reports give them, placed at lines and columns of `source`.
 pub fn text_edits(source: &str, replacements: &[Replacement]) -> Vec<TextEdit> {
+    let offsets: Vec<usize> = replacements.iter().flat_map(|r| [r.start, r.end]).collect();
+    let positions = positions_of(source, &offsets);
     replacements
         .iter()
-        .map(|r| TextEdit {
-            start: position_of(source, r.start),
-            end: position_of(source, r.end),
+        .zip(positions.chunks(2))
+        .map(|(r, p)| TextEdit {
+            start: p[0],
+            end: p[1],
             content: r.text.clone(),
         })
         .collect()
+}
+
+/// The positions of `offsets` (on character boundaries, in increasing order as replacements
+/// give them) in `source`, read front to back once rather than from the start for each.
+fn positions_of(source: &str, offsets: &[usize]) -> Vec<Position> {
+    let mut out = Vec::with_capacity(offsets.len());
+    let (mut at, mut line, mut line_start) = (0, 1, 0);
+    for &offset in offsets {
+        if offset < at {
+            out.push(position_of(source, offset));
+            continue;
+        }
+        for (i, b) in source.as_bytes()[at..offset.min(source.len())]
+            .iter()
+            .enumerate()
+        {
+            if *b == b'\n' {
+                line += 1;
+                line_start = at + i + 1;
+            }
+        }
+        at = offset.min(source.len());
+        let column = source[line_start..at].chars().count() + 1;
+        out.push(Position {
+            line,
+            column,
+            offset: at,
+        });
+    }
+    out
 }
 
 /// The unified diff from `before` to `after` of the file shown as `name` (three lines of
@@ -143,5 +176,17 @@ mod tests {
             "{diff}"
         );
         assert!(diff.contains("-  \"a\": 1\n+  \"a\": 2\n"), "{diff}");
+    }
+
+    #[test]
+    fn positions_read_in_one_pass_are_those_read_one_by_one() {
+        let text = "{\n  \"é\": [1,\n 2]\n}";
+        let offsets: Vec<usize> = (0..=text.len())
+            .filter(|&i| text.is_char_boundary(i))
+            .collect();
+        let one_pass = positions_of(text, &offsets);
+        for (offset, p) in offsets.iter().zip(one_pass) {
+            assert_eq!(p, position_of(text, *offset), "{offset}");
+        }
     }
 }

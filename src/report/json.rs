@@ -151,7 +151,7 @@ fn fix_shape<'a>(report: &FileReport, fix: &'a FixView) -> FixShape<'a> {
 }
 
 fn fixes_shape(fixes: &FileFixes) -> Option<FixesShape<'_>> {
-    if fixes.fixes.is_empty() {
+    if fixes.fixes().is_empty() {
         return None;
     }
     Some(FixesShape {
@@ -159,13 +159,13 @@ fn fixes_shape(fixes: &FileFixes) -> Option<FixesShape<'_>> {
         fixable_unsafe: fixes.available(Safety::Unsafe),
         changed: fixes.changed,
         applied: fixes
-            .fixes
+            .fixes()
             .iter()
             .filter(|f| f.status == FixStatus::Applied)
             .map(done_shape)
             .collect(),
         refused: fixes
-            .fixes
+            .fixes()
             .iter()
             .filter(|f| matches!(f.status, FixStatus::Refused(_)))
             .map(done_shape)
@@ -429,24 +429,21 @@ mod tests {
             column: offset + 1,
             offset,
         };
-        report.fixes = FileFixes {
-            fixes: vec![FixView {
-                repairs: vec![Repair {
-                    code: first.code,
-                    pointer: first.pointer.clone(),
-                    message: first.message.clone(),
-                }],
-                safety: Safety::Safe,
-                title: "declare \"X\" in extensionsUsed".into(),
-                edits: vec![TextEdit {
-                    start: at(4),
-                    end: at(4),
-                    content: ",\n    \"X\"".into(),
-                }],
-                status: FixStatus::Available,
+        report.fixes = FileFixes::new(vec![FixView {
+            repairs: vec![Repair {
+                code: first.code,
+                pointer: first.pointer.clone(),
+                message: first.message.clone(),
             }],
-            ..Default::default()
-        };
+            safety: Safety::Safe,
+            title: "declare \"X\" in extensionsUsed".into(),
+            edits: vec![TextEdit {
+                start: at(4),
+                end: at(4),
+                content: ",\n    \"X\"".into(),
+            }],
+            status: FixStatus::Available,
+        }]);
         let mut written = Vec::new();
         write_pretty(&mut written, &report).unwrap();
         let expected = report_pretty(&report) + "\n";

@@ -153,7 +153,7 @@ fn fix_line(fix: &FixView) -> String {
 /// findings it repaired (an unsafe one said so), each refused one with the reason.
 fn fixes_done(file: &str, fixes: &FileFixes) -> String {
     let mut out = String::new();
-    for fix in &fixes.fixes {
+    for fix in fixes.fixes() {
         let codes: Vec<&str> = fix.repairs.iter().map(|r| r.code).collect();
         let mut codes_list: Vec<&str> = Vec::new();
         for c in codes {
