@@ -34,6 +34,8 @@ pub const FIXERS: &[Fixer] = &[
     super::texture::SHEEN_WITHOUT_EFFECT,
     super::texture::FUZZ_WITHOUT_EFFECT,
     super::clamp::OUT_OF_RANGE,
+    super::legacy::UPGRADE,
+    super::texcoord::TEXCOORD,
 ];
 
 /// The fixer of `code`, if it has one.

@@ -18,6 +18,8 @@ pub mod clamp;
 pub mod declare;
 pub mod fixers;
 pub mod fuzz_roughness;
+pub mod legacy;
+pub mod texcoord;
 pub mod text;
 pub mod texture;
 
