@@ -582,7 +582,7 @@ fn a_fix_that_would_bring_another_finding_is_refused_with_the_reason_and_not_wri
     );
     assert!(out.contains("error VALUE_NOT_IN_RANGE"), "{out}");
     assert!(
-        out.contains("m.gltf: not fixed: clamp sheenRoughnessFactor to 0 (unsafe, 1 finding of VALUE_NOT_IN_RANGE): the fixed file would have KHR_MATERIALS_SHEEN_TEXTURE_WITHOUT_EFFECT"),
+        out.contains("    at /materials/0/extensions/KHR_materials_sheen/sheenRoughnessFactor\n    fix (unsafe) not applied: clamp sheenRoughnessFactor to 0: the fixed file would have KHR_MATERIALS_SHEEN_TEXTURE_WITHOUT_EFFECT"),
         "{out}"
     );
     let o = velvet_in(
@@ -743,4 +743,46 @@ fn the_json_fixes_of_many_materials_applied_together_are_what_fix_writes() {
         String::from_utf8(applied).unwrap(),
         String::from_utf8(fixed).unwrap()
     );
+}
+
+#[test]
+fn after_fix_the_fixes_left_are_given_against_the_text_written() {
+    // A safe fix (applied) and an unsafe one (left): the JSON report of the --fix run gives the
+    // unsafe fix's edits in the file as written, where applying them does what
+    // --unsafe-fixes does.
+    let dir = tempfile::tempdir().unwrap();
+    let text = "{\n  \"asset\": {\n    \"version\": \"2.0\"\n  },\n  \"materials\": [\n    {\n      \"extensions\": {\n        \"KHR_materials_sheen\": {\n          \"sheenColorFactor\": [1, 1, 1],\n          \"sheenRoughnessFactor\": 1.5\n        }\n      }\n    }\n  ]\n}\n";
+    std::fs::write(dir.path().join("m.gltf"), text).unwrap();
+    let o = velvet_in(
+        dir.path(),
+        &["validate", "--fix", "--format", "json", "m.gltf"],
+    );
+    assert_eq!(o.status.code(), Some(1));
+    let report: Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(
+        report["fixes"]["applied"][0]["repairs"][0]["code"],
+        "UNDECLARED_EXTENSION"
+    );
+    assert_eq!(report["fixes"]["changed"], true);
+    assert_eq!(report["fixes"]["fixableUnsafe"], 1);
+    let written = std::fs::read(dir.path().join("m.gltf")).unwrap();
+    let messages = report["issues"]["messages"].as_array().unwrap();
+    assert_eq!(messages.len(), 1, "{messages:?}");
+    let replacements: Vec<Replacement> = messages[0]["fix"]["edits"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| Replacement {
+            start: e["location"]["offset"].as_u64().unwrap() as usize,
+            end: e["endLocation"]["offset"].as_u64().unwrap() as usize,
+            text: e["content"].as_str().unwrap().to_string(),
+        })
+        .collect();
+    let applied = apply_replacements(&written, replacements);
+    let o = velvet_in(
+        dir.path(),
+        &["validate", "--fix", "--unsafe-fixes", "m.gltf"],
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", stdout(&o));
+    assert_eq!(applied, std::fs::read(dir.path().join("m.gltf")).unwrap());
 }

@@ -83,9 +83,9 @@ impl FixView {
 pub struct FileFixes {
     /// The fixes; set with [`FileFixes::new`], which indexes them by the findings they repair.
     fixes: Vec<FixView>,
-    /// The available fix of each finding (`code`, NUL, `pointer`): a report looks each finding
-    /// up, and a document may have a fix per material.
-    available: std::collections::HashMap<String, usize>,
+    /// The fix of each finding (`code`, NUL, `pointer`): a report looks each finding up, and a
+    /// document may have a fix per material.
+    by_finding: std::collections::HashMap<String, usize>,
     /// True when the fixes changed the file's bytes (written, or shown by `--diff`).
     pub changed: bool,
     /// With `--diff`: the change as a unified diff.
@@ -100,19 +100,17 @@ fn finding_key(code: &str, pointer: &str) -> String {
 
 impl FileFixes {
     pub fn new(fixes: Vec<FixView>) -> FileFixes {
-        let mut available = std::collections::HashMap::new();
+        let mut by_finding = std::collections::HashMap::new();
         for (i, fix) in fixes.iter().enumerate() {
-            if fix.status == FixStatus::Available {
-                for r in &fix.repairs {
-                    available
-                        .entry(finding_key(r.code, &r.pointer))
-                        .or_insert(i);
-                }
+            for r in &fix.repairs {
+                by_finding
+                    .entry(finding_key(r.code, &r.pointer))
+                    .or_insert(i);
             }
         }
         FileFixes {
             fixes,
-            available,
+            by_finding,
             ..Default::default()
         }
     }
@@ -143,10 +141,16 @@ impl FileFixes {
 
     /// The available fix that repairs the finding with `code` at `pointer`, if any.
     pub fn for_finding(&self, code: &str, pointer: &str) -> Option<&FixView> {
-        if self.available.is_empty() {
+        self.fix_of(code, pointer)
+            .filter(|f| f.status == FixStatus::Available)
+    }
+
+    /// The fix planned for the finding with `code` at `pointer`, whatever became of it.
+    pub fn fix_of(&self, code: &str, pointer: &str) -> Option<&FixView> {
+        if self.by_finding.is_empty() {
             return None;
         }
-        self.available
+        self.by_finding
             .get(&finding_key(code, pointer))
             .map(|&i| &self.fixes[i])
     }

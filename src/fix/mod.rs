@@ -209,6 +209,19 @@ impl<'v> Fixing<'v> {
         } else {
             (asset::load_with(path, load), None)
         };
+        self.check_loaded(path, loaded, snapshot, settings, self.mode)
+    }
+
+    /// [`Fixing::check`] of a file loaded (`snapshot`: what it was when read, for writing it),
+    /// in `mode`.
+    fn check_loaded(
+        &self,
+        path: &Path,
+        loaded: asset::Loaded,
+        snapshot: Option<asset::Snapshot>,
+        settings: &Settings,
+        mode: Mode,
+    ) -> FileReport {
         let Some(source) = loaded.asset else {
             return self.validator.validate_loaded_with(path, loaded, settings);
         };
@@ -226,20 +239,18 @@ impl<'v> Fixing<'v> {
             return capped(before, settings);
         }
         let wanted: Vec<usize> = (0..fixes.len())
-            .filter(|&i| !self.mode.changes() || self.mode.applies(fixes[i].safety))
+            .filter(|&i| !mode.changes() || mode.applies(fixes[i].safety))
             .collect();
         let (accepted, refused, fixed) =
             self.choose(path, &source, &before, &fixes, &wanted, &unlimited);
-        let edits = if self.mode.edits && source.container == Container::Gltf {
+        let edits = if mode.edits && source.container == Container::Gltf {
             all_text_edits(&source, &fixes)
         } else {
             vec![Vec::new(); fixes.len()]
         };
         let changed = fixed
             .as_ref()
-            .filter(|f| {
-                self.mode.changes() && !accepted.is_empty() && f.bytes != file_bytes(&source)
-            })
+            .filter(|f| mode.changes() && !accepted.is_empty() && f.bytes != file_bytes(&source))
             .is_some();
         let mut statuses = vec![FixStatus::Available; fixes.len()];
         if changed {
@@ -269,7 +280,7 @@ impl<'v> Fixing<'v> {
             report.fixes = file_fixes;
             return report;
         };
-        if self.mode.diff {
+        if mode.diff {
             let name = crate::asset::discover::display_path(path);
             let before_text = source.json_text.trim_end_matches(['\0', ' ']);
             let after_text = fixed.json_text.trim_end_matches(['\0', ' ']);
@@ -298,8 +309,30 @@ impl<'v> Fixing<'v> {
             }
         }
         self.changed.fetch_add(1, Ordering::Relaxed);
-        let mut report = capped(fixed.report, settings);
-        report.fixes = file_fixes;
+        if mode.diff {
+            // The file is as it was: the fixes left are given against its text.
+            let mut report = capped(fixed.report, settings);
+            report.fixes = file_fixes;
+            return report;
+        }
+        // The report of the file as written: its findings, and the fixes left for them planned
+        // against its new text (an unsafe fix not asked for, a refused one), with this run's.
+        let loaded = asset::load_bytes_with(path, &fixed.bytes, &self.validator.load);
+        let review = Mode {
+            apply: false,
+            diff: false,
+            ..mode
+        };
+        let mut report = self.check_loaded(path, loaded, None, settings, review);
+        let mut all: Vec<FixView> = file_fixes
+            .fixes()
+            .iter()
+            .filter(|f| f.status == FixStatus::Applied)
+            .cloned()
+            .collect();
+        all.extend(report.fixes.fixes().iter().cloned());
+        report.fixes = FileFixes::new(all);
+        report.fixes.changed = true;
         report
     }
 

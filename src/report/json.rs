@@ -7,8 +7,9 @@
 //! (rows and columns 1-based, columns in characters, offsets in bytes of the file), each fix
 //! apart from the others (an edit that several findings share is given with each; apply it
 //! once). A report with fixes ends with `fixes {fixable, fixableUnsafe, changed, applied[],
-//! refused[]}`: the findings a fix repairs (with `--fix`, those it did) and the fixes refused
-//! with the reason.
+//! refused[], diff}`: the findings a fix repairs (with `--fix`, those it did), the fixes refused
+//! with the reason, and with `--diff` the change as a unified diff. After `--fix` wrote a file,
+//! the fixes left are given against its new text.
 //!
 //! The shape is a set of borrowing structs serialised straight to text: a report with tens of
 //! thousands of findings is written without first being copied into a JSON tree.
@@ -41,6 +42,9 @@ struct FixesShape<'a> {
     changed: bool,
     applied: Vec<DoneShape<'a>>,
     refused: Vec<DoneShape<'a>>,
+    /// With `--diff`: the change as a unified diff.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    diff: Option<&'a str>,
 }
 
 #[derive(Serialize)]
@@ -158,6 +162,7 @@ fn fixes_shape(fixes: &FileFixes) -> Option<FixesShape<'_>> {
         fixable: fixes.available(Safety::Safe),
         fixable_unsafe: fixes.available(Safety::Unsafe),
         changed: fixes.changed,
+        diff: fixes.diff.as_deref(),
         applied: fixes
             .fixes()
             .iter()

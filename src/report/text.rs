@@ -100,12 +100,14 @@ pub fn render_with(reports: &[FileReport], options: &Options) -> String {
                     )
                 );
             }
-            if let Some(fix) = report.fixes.for_finding(d.code, &d.pointer) {
-                let _ = writeln!(
-                    out,
-                    "    {}",
-                    paint(Style::new().dimmed(), &terminal(&fix_line(fix)))
-                );
+            if let Some(fix) = report.fixes.fix_of(d.code, &d.pointer) {
+                if fix.status != FixStatus::Applied {
+                    let _ = writeln!(
+                        out,
+                        "    {}",
+                        paint(Style::new().dimmed(), &terminal(&fix_line(fix)))
+                    );
+                }
             }
             if !group.rest.is_empty() {
                 let line = folded_line(&group.rest, report.container, report.json_offset);
@@ -141,16 +143,22 @@ pub fn summary_with(files: usize, totals: [usize; 4], fixes: &FixTotals) -> Stri
     format!("{}{}\n", line.trim_end_matches('\n'), fixes.summary())
 }
 
-/// The line under a finding that a fix repairs: how safe the fix is and what it does.
+/// The line under a finding that a fix repairs: how safe the fix is and what it does, or why
+/// it was not applied.
 fn fix_line(fix: &FixView) -> String {
-    match fix.safety {
-        Safety::Safe => format!("fix (safe, --fix): {}", fix.title),
-        Safety::Unsafe => format!("fix (unsafe, --fix --unsafe-fixes): {}", fix.title),
+    match (&fix.status, fix.safety) {
+        (FixStatus::Refused(reason), safety) => format!(
+            "fix ({}) not applied: {}: {reason}",
+            safety.as_str(),
+            fix.title
+        ),
+        (_, Safety::Safe) => format!("fix (safe, --fix): {}", fix.title),
+        (_, Safety::Unsafe) => format!("fix (unsafe, --fix --unsafe-fixes): {}", fix.title),
     }
 }
 
-/// A file's lines about its fixes that were applied or refused: each applied fix with the
-/// findings it repaired (an unsafe one said so), each refused one with the reason.
+/// A file's lines about the fixes applied: each with the findings it repaired (an unsafe one
+/// said so).
 fn fixes_done(file: &str, fixes: &FileFixes) -> String {
     let mut out = String::new();
     for fix in fixes.fixes() {
@@ -173,15 +181,8 @@ fn fixes_done(file: &str, fixes: &FileFixes) -> String {
             FixStatus::Applied => {
                 let _ = writeln!(out, "{file}: fixed: {}", terminal(&what));
             }
-            FixStatus::Refused(reason) => {
-                let _ = writeln!(
-                    out,
-                    "{file}: not fixed: {}: {}",
-                    terminal(&what),
-                    terminal(reason)
-                );
-            }
-            FixStatus::Available => {}
+            // A refused fix is said under its finding, which stays.
+            FixStatus::Refused(_) | FixStatus::Available => {}
         }
     }
     out
