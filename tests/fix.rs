@@ -786,3 +786,23 @@ fn after_fix_the_fixes_left_are_given_against_the_text_written() {
     assert_eq!(o.status.code(), Some(0), "{}", stdout(&o));
     assert_eq!(applied, std::fs::read(dir.path().join("m.gltf")).unwrap());
 }
+
+#[test]
+fn the_codes_command_says_how_each_code_is_fixed() {
+    let o = velvet_in(Path::new("."), &["codes"]);
+    let out = stdout(&o);
+    for code in all_codes() {
+        let line = out
+            .lines()
+            .find(|l| l.split_whitespace().next() == Some(code.name))
+            .unwrap();
+        assert_eq!(
+            line.split_whitespace().nth(2),
+            Some(code.fix_label()),
+            "{line}"
+        );
+    }
+    let fixable = fixable_codes();
+    assert!(fixable.iter().any(|c| c.fix == Some(Safety::Safe)));
+    assert!(fixable.iter().any(|c| c.fix == Some(Safety::Unsafe)));
+}
