@@ -178,6 +178,8 @@ pub struct Fixing<'v> {
 
 /// A file with fixes applied, validated again.
 struct Fixed {
+    /// Whether the edits changed the document (a GLB's bytes are repacked either way).
+    changed: bool,
     bytes: Vec<u8>,
     json_text: String,
     report: FileReport,
@@ -250,7 +252,12 @@ impl<'v> Fixing<'v> {
         };
         let changed = fixed
             .as_ref()
-            .filter(|f| mode.changes() && !accepted.is_empty() && f.bytes != file_bytes(&source))
+            .filter(|f| {
+                mode.changes()
+                    && !accepted.is_empty()
+                    && f.changed
+                    && f.bytes != file_bytes(&source)
+            })
             .is_some();
         let mut statuses = vec![FixStatus::Available; fixes.len()];
         if changed {
@@ -394,8 +401,8 @@ impl<'v> Fixing<'v> {
         settings: &Settings,
     ) -> Result<Fixed, String> {
         let edits = combined(source.root(), fixes);
-        let output = match crate::edit::write::spliced_bytes(source, &edits) {
-            Ok(Some((output, _))) => output,
+        let (output, changed) = match crate::edit::write::spliced_bytes(source, &edits) {
+            Ok(Some(spliced)) => spliced,
             Ok(None) => return Err("its edits could not be spliced into the file's text".into()),
             Err(e) => return Err(format!("its edits do not apply: {e}")),
         };
@@ -412,6 +419,7 @@ impl<'v> Fixing<'v> {
             .validate_asset(path, &after, loaded.diagnostics, settings);
         verdict(&before.findings, &report.findings, fixes)?;
         Ok(Fixed {
+            changed,
             json_text: after.json_text.to_string(),
             bytes,
             report,
