@@ -595,6 +595,114 @@ mod tests {
     use super::*;
     use crate::rules::all_codes;
 
+    fn load(text: &str) -> Asset {
+        asset::load_bytes(Path::new("m.gltf"), text.as_bytes())
+            .asset
+            .expect("the document loads")
+    }
+
+    fn fix(edits: Vec<Edit>) -> Fix {
+        Fix {
+            repairs: Vec::new(),
+            safety: Safety::Safe,
+            title: String::new(),
+            edits,
+        }
+    }
+
+    fn finding(code: &'static crate::diagnostics::Code, pointer: &str, message: &str) -> Finding {
+        Finding {
+            diagnostic: Diagnostic::new(code, pointer, message),
+            position: None,
+        }
+    }
+
+    #[test]
+    fn removals_from_one_array_go_last_highest_index_first_and_an_emptied_array_goes_whole() {
+        let asset = load(r#"{"asset":{"version":"2.0"},"extensionsUsed":["A","B","C"]}"#);
+        let (a, b) = (
+            fix(vec![Edit::remove("/extensionsUsed/0")]),
+            fix(vec![Edit::remove("/extensionsUsed/1")]),
+        );
+        assert_eq!(
+            combined(asset.root(), &[&a, &b]),
+            [
+                Edit::remove("/extensionsUsed/1"),
+                Edit::remove("/extensionsUsed/0")
+            ]
+        );
+        let c = fix(vec![Edit::remove("/extensionsUsed/2")]);
+        assert_eq!(
+            combined(asset.root(), &[&a, &b, &c]),
+            [Edit::remove("/extensionsUsed")]
+        );
+        // Kept when another fix declares an extension in it; each distinct edit once.
+        let d = fix(vec![Edit::declare_used("D")]);
+        assert_eq!(
+            combined(asset.root(), &[&a, &b, &c, &d, &d]),
+            [
+                Edit::declare_used("D"),
+                Edit::remove("/extensionsUsed/2"),
+                Edit::remove("/extensionsUsed/1"),
+                Edit::remove("/extensionsUsed/0"),
+            ]
+        );
+    }
+
+    #[test]
+    fn findings_one_edit_repairs_are_one_fix() {
+        use crate::rules::declaration::{UNDECLARED_EXTENSION, UNUSED_EXTENSION_REQUIRED};
+        let asset = load(
+            r#"{"asset":{"version":"2.0"},"extensionsRequired":["KHR_materials_sheen"],"materials":[{"extensions":{"KHR_materials_sheen":{}}}]}"#,
+        );
+        let findings = [
+            finding(
+                &UNDECLARED_EXTENSION,
+                "/materials/0/extensions/KHR_materials_sheen",
+                "u",
+            ),
+            finding(&UNUSED_EXTENSION_REQUIRED, "/extensionsRequired/0", "r"),
+        ];
+        let fixes = plan(&asset, &findings);
+        assert_eq!(fixes.len(), 1, "{fixes:?}");
+        assert_eq!(fixes[0].edits, [Edit::declare_used("KHR_materials_sheen")]);
+        let codes: Vec<&str> = fixes[0].repairs.iter().map(|r| r.code).collect();
+        assert_eq!(
+            codes,
+            [UNDECLARED_EXTENSION.name, UNUSED_EXTENSION_REQUIRED.name]
+        );
+    }
+
+    #[test]
+    fn the_verdict_names_a_finding_left_or_one_brought() {
+        use crate::diagnostics::codes::VALUE_NOT_IN_RANGE;
+        use crate::rules::disabled_layer::SHEEN_TEXTURE_WITHOUT_EFFECT;
+        let before = [finding(&VALUE_NOT_IN_RANGE, "/a", "too big")];
+        let mut f = fix(Vec::new());
+        f.repairs.push(Repair {
+            code: VALUE_NOT_IN_RANGE.name,
+            pointer: "/a".into(),
+            message: "too big".into(),
+        });
+        assert_eq!(verdict(&before, &[], &[&f]), Ok(()));
+        assert_eq!(
+            verdict(&before, &before, &[&f]),
+            Err("the fixed file would still have VALUE_NOT_IN_RANGE".into())
+        );
+        let brought = [finding(&SHEEN_TEXTURE_WITHOUT_EFFECT, "/b", "no effect")];
+        assert_eq!(
+            verdict(&before, &brought, &[&f]),
+            Err(
+                "the fixed file would have KHR_MATERIALS_SHEEN_TEXTURE_WITHOUT_EFFECT (no effect)"
+                    .into()
+            )
+        );
+        // A finding that moved (an array element before it removed) is the same finding.
+        let moved = [finding(&SHEEN_TEXTURE_WITHOUT_EFFECT, "/c/0", "no effect")];
+        let was = [finding(&SHEEN_TEXTURE_WITHOUT_EFFECT, "/c/1", "no effect")];
+        assert_eq!(verdict(&was, &moved, &[]), Ok(()));
+    }
+
     #[test]
     fn the_registry_says_which_codes_are_fixable_as_the_fixers_table_does() {
         for code in all_codes() {
