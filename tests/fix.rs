@@ -806,3 +806,38 @@ fn the_codes_command_says_how_each_code_is_fixed() {
     assert!(fixable.iter().any(|c| c.fix == Some(Safety::Safe)));
     assert!(fixable.iter().any(|c| c.fix == Some(Safety::Unsafe)));
 }
+
+#[test]
+fn a_byte_order_mark_stays_with_its_finding_and_the_fix_edits_count_it() {
+    let dir = case_copy("UNDECLARED_EXTENSION");
+    let mut bytes = b"\xEF\xBB\xBF".to_vec();
+    bytes.extend(std::fs::read(dir.path().join("triggers.gltf")).unwrap());
+    std::fs::write(dir.path().join("bom.gltf"), &bytes).unwrap();
+    let o = velvet_in(dir.path(), &["validate", "--format", "json", "bom.gltf"]);
+    let report: Value = serde_json::from_slice(&o.stdout).unwrap();
+    let mut replacements = Vec::new();
+    for message in report["issues"]["messages"].as_array().unwrap() {
+        for edit in message["fix"]["edits"].as_array().into_iter().flatten() {
+            replacements.push(Replacement {
+                start: edit["location"]["offset"].as_u64().unwrap() as usize,
+                end: edit["endLocation"]["offset"].as_u64().unwrap() as usize,
+                text: edit["content"].as_str().unwrap().to_string(),
+            });
+        }
+    }
+    let mut expected = b"\xEF\xBB\xBF".to_vec();
+    expected.extend(expected_fixed("UNDECLARED_EXTENSION"));
+    assert_eq!(apply_replacements(&bytes, replacements), expected);
+    let o = velvet_in(dir.path(), &["validate", "--fix", "bom.gltf"]);
+    assert_eq!(
+        o.status.code(),
+        Some(1),
+        "BOM_PRESENT is left: {}",
+        stdout(&o)
+    );
+    assert_eq!(
+        std::fs::read(dir.path().join("bom.gltf")).unwrap(),
+        expected
+    );
+    assert!(stdout(&o).contains("error BOM_PRESENT"));
+}

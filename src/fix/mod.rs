@@ -166,6 +166,9 @@ impl Mode {
     }
 }
 
+/// The UTF-8 byte-order mark, the only thing a .gltf's JSON text may follow in its file.
+const BYTE_ORDER_MARK: [u8; 3] = [0xEF, 0xBB, 0xBF];
+
 /// The most fixes of one file tried one by one when they fail together.
 const TRIED_ONE_BY_ONE: usize = 32;
 
@@ -406,10 +409,17 @@ impl<'v> Fixing<'v> {
             Ok(None) => return Err("its edits could not be spliced into the file's text".into()),
             Err(e) => return Err(format!("its edits do not apply: {e}")),
         };
-        let bytes: Vec<u8> = match output {
+        let mut bytes: Vec<u8> = match output {
             crate::edit::write::Output::Bytes(bytes) => bytes.into_owned(),
             crate::edit::write::Output::Spliced(spliced) => spliced.to_text().into_bytes(),
         };
+        if source.container == Container::Gltf && source.json_offset > 0 {
+            // What came before the text (a byte-order mark, which has its own finding) stays:
+            // a fix changes only what it says.
+            let mut file = BYTE_ORDER_MARK[..source.json_offset.min(3)].to_vec();
+            file.append(&mut bytes);
+            bytes = file;
+        }
         let loaded = asset::load_bytes_with(path, &bytes, &self.validator.load);
         let Some(after) = loaded.asset else {
             return Err("the fixed file would not load".into());
