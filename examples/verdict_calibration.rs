@@ -7,23 +7,24 @@
 
 use velvet::preview::material::columns;
 use velvet::preview::shade::{render_sphere, Light, Shaded};
-use velvet::preview::sheet::{sphere_codes, SPHERE};
+use velvet::preview::sheet::{sphere_codes_clamped, SPHERE};
 
 fn sweep_document() -> String {
     let mut materials = Vec::new();
     for i in 0..=10 {
         let r = 0.03 + 0.97 * f64::from(i) / 10.0;
-        for base in [0.1, 0.5, 1.0] {
+        // Dielectric bases of three colours (fabric-like roughness 0.8), and a metal.
+        for (base, metallic) in [(0.1, 0.0), (0.5, 0.0), (1.0, 0.0), (0.5, 1.0)] {
             for c in [[1.0, 1.0, 1.0], [0.9, 0.3, 0.5], [0.2, 0.2, 0.2]] {
                 let pbr = format!(
-                    r#""pbrMetallicRoughness": {{"baseColorFactor": [{base}, {base}, {base}, 1]}}"#
+                    r#""pbrMetallicRoughness": {{"baseColorFactor": [{base}, {base}, {base}, 1], "metallicFactor": {metallic}, "roughnessFactor": 0.8}}"#
                 );
                 materials.push(format!(
-                    r#"{{"name": "sheen r {r:.3} c {:.1} base {base}", {pbr}, "extensions": {{"KHR_materials_sheen": {{"sheenColorFactor": [{}, {}, {}], "sheenRoughnessFactor": {r}}}}}}}"#,
+                    r#"{{"name": "sheen r {r:.3} c {:.1} base {base} metal {metallic}", {pbr}, "extensions": {{"KHR_materials_sheen": {{"sheenColorFactor": [{}, {}, {}], "sheenRoughnessFactor": {r}}}}}}}"#,
                     c[1], c[0], c[1], c[2]
                 ));
                 materials.push(format!(
-                    r#"{{"name": "fuzz a {r:.3} c {:.1} base {base}", {pbr}, "extensions": {{"KHR_materials_fuzz": {{"fuzzFactor": 1, "fuzzColorFactor": [{}, {}, {}], "fuzzRoughnessFactor": {r}}}}}}}"#,
+                    r#"{{"name": "fuzz a {r:.3} c {:.1} base {base} metal {metallic}", {pbr}, "extensions": {{"KHR_materials_fuzz": {{"fuzzFactor": 1, "fuzzColorFactor": [{}, {}, {}], "fuzzRoughnessFactor": {r}}}}}}}"#,
                     c[1], c[0], c[1], c[2]
                 ));
             }
@@ -54,7 +55,9 @@ fn main() {
             for light in [Light::Furnace, Light::Directional] {
                 let codes: Vec<Vec<[u8; 3]>> = cols[..2]
                     .iter()
-                    .map(|c| sphere_codes(&render_sphere(&Shaded::new(c.look), light, SPHERE)))
+                    .map(|c| {
+                        sphere_codes_clamped(&render_sphere(&Shaded::new(c.look), light, SPHERE))
+                    })
                     .collect();
                 let flat = |c: &Vec<[u8; 3]>| c.iter().flatten().copied().collect::<Vec<u8>>();
                 let a = nv_flip::FlipImageRgb8::with_data(

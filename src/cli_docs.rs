@@ -9,16 +9,16 @@ use std::path::Path;
 /// The exit statuses of `velvet validate`, as `--help` prints them: one `  N  meaning` line each.
 pub const EXIT_STATUS: &str = "\
 Exit status:
-  0  no file has an issue at or above --fail-on
-  1  a file has an issue at or above --fail-on (a file that cannot be read or parsed has an error)
+  0  no file has an issue at or above --fail-on (with --fix: none is left after fixing)
+  1  a file has an issue at or above --fail-on (with --fix: after fixing; a file that cannot be read, parsed or written has an error), or --diff shows a change, or --exit-non-zero-on-fix and --fix changed a file
   2  usage or configuration error (bad flag, unknown code, invalid velvet.toml, a path that does not exist or is not a regular file or folder, a folder without .gltf/.glb files, every file found excluded)";
 
 /// The exit statuses of every command that works on files, for `velvet --help`: what each
 /// status means for each command (each command's `--help` gives its own).
 pub const EXIT_STATUS_ALL: &str = "\
 Exit status:
-  0  validate: no file has an issue at or above --fail-on; migrate, bake: every file done, or nothing to do; preview: every sheet written
-  1  validate: a file has an issue at or above --fail-on (a file that cannot be read or parsed has an error); migrate: a file failed (the others are still written) or, with --check, a file would change; bake: a file failed (the others are still written); preview: a file could not be previewed or a sheet not written
+  0  validate: no file has an issue at or above --fail-on (with --fix: none is left after fixing); migrate, bake: every file done, or nothing to do; preview: every sheet written
+  1  validate: a file has an issue at or above --fail-on (a file that cannot be read or parsed has an error), --diff shows a change, or --fix --exit-non-zero-on-fix changed a file; migrate: a file failed (the others are still written) or, with --check, a file would change; bake: a file failed (the others are still written); preview: a file could not be previewed or a sheet not written
   2  usage or configuration error in validate, migrate, bake or preview (bad flag, unknown code, invalid velvet.toml, a path that does not exist or is not a regular file or folder, a folder without .gltf/.glb files, every file found excluded, a refused output); migrate, bake and preview then write nothing
   130  migrate, bake: stopped by SIGINT (143: by SIGTERM); the files finished before are complete, nothing is left of the others; preview: the sheets written are complete, no index is written";
 
@@ -93,7 +93,7 @@ mod tests {
         let page = String::from_utf8(man_page(command).unwrap()).unwrap();
         assert!(!page.contains(".SH EXTRA"), "{page}");
         let section = &page[page.find(".SH \"EXIT STATUS\"").expect("section present")..];
-        assert!(section.starts_with(".SH \"EXIT STATUS\"\n.TP\n\\fB0\\fR\nno file has an issue at or above \\-\\-fail\\-on\n.TP\n\\fB1\\fR\n"), "{section}");
+        assert!(section.starts_with(".SH \"EXIT STATUS\"\n.TP\n\\fB0\\fR\nno file has an issue at or above \\-\\-fail\\-on (with \\-\\-fix: none is left after fixing)\n.TP\n\\fB1\\fR\n"), "{section}");
         assert_eq!(section.matches(".TP").count(), 3);
     }
 

@@ -2,7 +2,7 @@
 //! KHR_materials_fuzz.
 //!
 //! The flow is one way: load ([`asset`]) → validate ([`validate`], [`rules`]) → report
-//! ([`report`]); [`migrate`] and [`bake`] plan and apply edits, and share [`output`] for
+//! ([`report`]), and [`fix`] repairs what it can of the findings; [`migrate`] and [`bake`] plan and apply edits, and share [`output`] for
 //! where their outputs go; [`preview`] draws contact sheets of what a migration does to each
 //! material. The binary in `main.rs` only parses arguments and maps outcomes to exit codes.
 
@@ -14,6 +14,7 @@ pub mod config;
 pub mod diagnostics;
 pub mod document;
 pub mod edit;
+pub mod fix;
 pub mod layers;
 pub mod migrate;
 pub mod output;

@@ -227,6 +227,20 @@ struct ValidateArgs {
     schema_dir: Option<PathBuf>,
     #[command(flatten)]
     load: LoadArgs,
+    /// Repair the findings a safe fix can repair, in place, and report what remains (the exit
+    /// status follows the findings left).
+    #[arg(long)]
+    fix: bool,
+    /// With --fix or --diff: apply unsafe fixes too (they change the asset's meaning as their
+    /// findings imply; each is named in the output).
+    #[arg(long)]
+    unsafe_fixes: bool,
+    /// Print the fixes as a unified diff; write nothing (exit status 1 when there is one).
+    #[arg(long, conflicts_with = "fix")]
+    diff: bool,
+    /// With --fix: exit with status 1 when a file was changed (for pre-commit hooks).
+    #[arg(long, requires = "fix")]
+    exit_non_zero_on_fix: bool,
 }
 
 #[derive(clap::Args)]
@@ -439,28 +453,7 @@ fn man(dir: Option<PathBuf>) -> Status {
 }
 
 fn codes_table(format: CodesFormat) -> String {
-    let codes = velvet::rules::all_codes();
-    match format {
-        CodesFormat::Text => {
-            let width = codes.iter().map(|c| c.name.len()).max().unwrap_or(0);
-            codes
-                .iter()
-                .map(|c| format!("{:width$}  {:7}  {}\n", c.name, c.severity.as_str(), c.doc))
-                .collect()
-        }
-        CodesFormat::Markdown => {
-            let mut out = String::from("| code | severity | meaning |\n|---|---|---|\n");
-            for c in codes {
-                out += &format!(
-                    "| `{}` | {} | {} |\n",
-                    c.name,
-                    c.severity,
-                    c.doc.replace('|', "\\|")
-                );
-            }
-            out
-        }
-    }
+    report::codes_table(matches!(format, CodesFormat::Markdown))
 }
 
 #[derive(clap::Args)]
@@ -574,6 +567,12 @@ fn validate(args: ValidateArgs, color: ColorChoice, quiet: bool) -> Status {
         color,
         quiet,
         no_fold: args.no_fold,
+        fix: command::validate::FixFlags {
+            fix: args.fix,
+            unsafe_fixes: args.unsafe_fixes,
+            diff: args.diff,
+            exit_non_zero_on_fix: args.exit_non_zero_on_fix,
+        },
     })
 }
 

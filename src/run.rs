@@ -10,9 +10,10 @@
 
 use crate::asset::discover::{self, Shard};
 use crate::config::{ConfigError, Resolver};
+use crate::diagnostics::Settings;
 use crate::validate::{FileReport, Validator};
 use rayon::prelude::*;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// What a run produced.
 #[derive(Debug)]
@@ -79,6 +80,22 @@ pub fn validate_shard_each(
     progress: Option<&indicatif::ProgressBar>,
     sink: &mut dyn FnMut(FileReport),
 ) -> Result<Totals, ConfigError> {
+    let check = |file: &Path, settings: &Settings| validator.validate_file_with(file, settings);
+    check_shard_each(validator, inputs, shard, resolver, progress, &check, sink)
+}
+
+/// Runs like [`validate_shard_each`], each file's report made by `check` (given the file and
+/// its configuration's settings) instead of a plain validation: `velvet validate --fix`
+/// checks, fixes and validates again (see `crate::fix`).
+pub fn check_shard_each(
+    validator: &Validator,
+    inputs: &[PathBuf],
+    shard: Option<Shard>,
+    resolver: &mut Resolver,
+    progress: Option<&indicatif::ProgressBar>,
+    check: &(dyn Fn(&Path, &Settings) -> FileReport + Sync),
+    sink: &mut dyn FnMut(FileReport),
+) -> Result<Totals, ConfigError> {
     let (found, walk_errors) = discover::find(inputs, shard);
     let mut planned = Vec::with_capacity(found.len());
     let mut excluded = Vec::new();
@@ -128,7 +145,7 @@ pub fn validate_shard_each(
         let checked: Vec<(FileReport, bool)> = batch
             .par_iter()
             .map(|(file, config)| {
-                let report = validator.validate_file_with(file, config.settings());
+                let report = check(file, config.settings());
                 let fails = report.fails(config.settings());
                 if let Some(bar) = progress {
                     bar.inc(1);

@@ -81,6 +81,8 @@ pub struct FileReport {
     pub omitted: usize,
     pub info: Option<AssetInfo>,
     pub missing: MissingResources,
+    /// The fixes planned for the file (see `crate::fix`); empty when none were planned.
+    pub fixes: crate::diagnostics::fixes::FileFixes,
 }
 
 impl FileReport {
@@ -212,7 +214,7 @@ impl Validator {
         self.validate_loaded_with(path, loaded, &self.settings)
     }
 
-    fn validate_loaded_with(
+    pub fn validate_loaded_with(
         &self,
         path: &Path,
         loaded: asset::Loaded,
@@ -229,7 +231,19 @@ impl Validator {
                 None,
             );
         };
-        let cx = Context::new(&asset, self.schemas.get_or_init(Schemas::builtin));
+        self.validate_asset(path, &asset, diagnostics, settings)
+    }
+
+    /// Validates a loaded document under `settings`; `diagnostics` are the loader's findings
+    /// about it. The document is only read: a caller that goes on to edit it (`--fix`) keeps it.
+    pub fn validate_asset(
+        &self,
+        path: &Path,
+        asset: &asset::Asset,
+        diagnostics: Vec<Diagnostic>,
+        settings: &Settings,
+    ) -> FileReport {
+        let cx = Context::new(asset, self.schemas.get_or_init(Schemas::builtin));
         let parallel = asset.json_text.len() >= PARALLEL_RULES_FROM;
         let (found, info) = if parallel {
             rayon::join(|| run_rules(&cx, true), || asset_info(asset.root()))
@@ -314,6 +328,7 @@ impl Validator {
             omitted,
             info,
             missing: MissingResources::default(),
+            fixes: Default::default(),
         }
     }
 }

@@ -617,12 +617,23 @@ fn run_hook(hook: &Hook, dir: &Path, batch: usize) -> (bool, String) {
 }
 
 #[test]
-fn hooks_file_declares_both_hooks_for_gltf_and_glb() {
+fn hooks_file_declares_every_hook_for_gltf_and_glb() {
     let hooks = hooks();
     let ids: Vec<&str> = hooks.iter().map(|h| h.id.as_str()).collect();
-    assert_eq!(ids, ["velvet-validate", "velvet-migrate-check"]);
+    assert_eq!(
+        ids,
+        [
+            "velvet-validate",
+            "velvet-migrate-check",
+            "velvet-validate-fix"
+        ]
+    );
     assert_eq!(hooks[0].entry, "velvet validate");
     assert_eq!(hooks[1].entry, "velvet migrate --check");
+    assert_eq!(
+        hooks[2].entry,
+        "velvet validate --fix --exit-non-zero-on-fix"
+    );
     for h in &hooks {
         assert_eq!(h.language, "rust");
         let p = regex::Regex::new(&h.files).unwrap();
@@ -764,13 +775,15 @@ fn help_documents_the_exit_status() {
     let top = stdout(&velvet(&["--help"]));
     assert!(
         top.contains(
-            "Exit status:\n  0  validate: no file has an issue at or above --fail-on; migrate, bake: "
+            "Exit status:\n  0  validate: no file has an issue at or above --fail-on (with --fix: none is left after fixing); migrate, bake: "
         ),
         "{top}"
     );
     let validate = stdout(&velvet(&["validate", "--help"]));
     assert!(
-        validate.contains("Exit status:\n  0  no file has an issue at or above --fail-on\n"),
+        validate.contains(
+            "Exit status:\n  0  no file has an issue at or above --fail-on (with --fix: none is left after fixing)\n"
+        ),
         "{validate}"
     );
     for text in [&top, &validate] {
@@ -1218,7 +1231,9 @@ fn fail_on_hint_fails_a_file_whose_only_findings_are_hints() {
     .unwrap();
     let status = |args: &[&str]| velvet_in(dir.path(), args).status.code();
     let o = velvet_in(dir.path(), &["validate", "fuzz.gltf"]);
-    assert!(stdout(&o).ends_with("1 file checked: 0 errors, 0 warnings, 0 info, 2 hints\n"));
+    assert!(stdout(&o).ends_with(
+        "1 file checked: 0 errors, 0 warnings, 0 info, 2 hints; 1 fixable with --fix\n"
+    ));
     assert_eq!(o.status.code(), Some(0));
     assert_eq!(
         status(&["validate", "--fail-on", "info", "fuzz.gltf"]),
@@ -1317,12 +1332,12 @@ fn text_output_folds_a_repeated_finding_and_lists_findings_in_file_order() {
     assert_eq!(
         stdout(&o),
         format!(
-            "many.gltf:5:25: error VALUE_NOT_IN_RANGE: 3 is greater than the maximum of 1.0\n    at {p}/sheenRoughnessFactor\n\
+            "many.gltf:5:25: error VALUE_NOT_IN_RANGE: 3 is greater than the maximum of 1.0\n    at {p}/sheenRoughnessFactor\n    fix (unsafe, --fix --unsafe-fixes): clamp sheenRoughnessFactor to 1\n\
              many.gltf:6:16: warning KHR_MATERIALS_SHEEN_LEGACY_DRAFT: sheenFactor belongs to the pre-ratification KHR_materials_sheen draft and is ignored by ratified loaders; `velvet migrate` upgrades it\n    at {p}/sheenFactor\n\
              many.gltf:7:8: warning UNEXPECTED_PROPERTY: unexpected property 'odd'\n    at {p}/odd\n\
              \x20   and 7 more at 10:48, 11:48, 12:48, 13:48, 14:48, … (8 in all; --no-fold prints each)\n\
              many.gltf:8:12: warning UNEXPECTED_PROPERTY: unexpected property 'strange'\n    at {p}/strange\n\
-             1 file checked: 1 error, 10 warnings, 0 info, 0 hints\n"
+             1 file checked: 1 error, 10 warnings, 0 info, 0 hints; 1 fixable with --fix --unsafe-fixes\n"
         )
     );
     let o = velvet_in(
@@ -1341,7 +1356,10 @@ fn text_output_folds_a_repeated_finding_and_lists_findings_in_file_order() {
         "many.gltf:8:12: warning UNEXPECTED_PROPERTY".to_string(),
     ];
     expected.extend((10..17).map(|l| format!("many.gltf:{l}:48: warning UNEXPECTED_PROPERTY")));
-    expected.push("1 file checked: 1 error, 10 warnings, 0 info, 0 hints".to_string());
+    expected.push(
+        "1 file checked: 1 error, 10 warnings, 0 info, 0 hints; 1 fixable with --fix --unsafe-fixes"
+            .to_string(),
+    );
     assert_eq!(lines, expected);
 }
 
@@ -1436,7 +1454,9 @@ fn readme_pre_commit_snippet_runs_as_pre_commit_runs_it_with_mixed_case_names() 
         "{out}"
     );
     assert!(
-        out.ends_with("2 files checked: 2 errors, 2 warnings, 0 info, 2 hints\n"),
+        out.ends_with(
+            "2 files checked: 2 errors, 2 warnings, 0 info, 2 hints; 2 fixable with --fix (1 more with --unsafe-fixes)\n"
+        ),
         "{out}"
     );
     std::fs::remove_file(dir.path().join("models/UPPER.GLTF")).unwrap();
@@ -2221,7 +2241,10 @@ fn a_validate_command_line_clap_refuses_still_writes_the_report_its_format_asks_
 #[test]
 fn the_document_limit_takes_the_byte_suffixes_the_memory_budget_takes() {
     // velvet-chair.gltf is 3,547 bytes: over 3K (3,072), within 4K.
-    let chair = concat!(env!("CARGO_MANIFEST_DIR"), "/fixtures/sample/velvet-chair.gltf");
+    let chair = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/fixtures/sample/velvet-chair.gltf"
+    );
     let refused = velvet(&["validate", "--max-document-bytes", "3K", chair]);
     assert_eq!(refused.status.code(), Some(1));
     assert!(
@@ -2235,4 +2258,74 @@ fn the_document_limit_takes_the_byte_suffixes_the_memory_budget_takes() {
     assert_eq!(taken.status.code(), Some(0), "{}", stdout(&taken));
     let bad = velvet(&["validate", "--max-document-bytes", "4Q", chair]);
     assert_eq!(bad.status.code(), Some(2));
+}
+
+#[test]
+fn readme_fix_diff_example_is_what_velvet_prints() {
+    let readme = readme();
+    let start = readme
+        .find("```text\n$ velvet validate --diff assets/mixed.gltf\n")
+        .expect("the README shows a --diff example");
+    let body = &readme[start + "```text\n".len()..];
+    let body = &body[..body.find("```\n").unwrap()];
+    let (command, shown) = body.split_once('\n').unwrap();
+    let args: Vec<&str> = command.split_whitespace().skip(2).collect();
+    let o = velvet(&args);
+    assert_eq!(o.status.code(), Some(1));
+    assert_eq!(stdout(&o), shown);
+}
+
+#[test]
+fn readme_fixing_pre_commit_hook_fixes_fails_once_and_then_passes() {
+    let text = block_after(&readme(), "### pre-commit", "yaml");
+    let config: Value = serde_yaml_ng::from_str(&text).expect("the snippet is YAML");
+    let hook = &config["repos"][0]["hooks"][1];
+    let hook = Hook {
+        id: hook["id"].as_str().unwrap().to_string(),
+        entry: hook["entry"].as_str().unwrap().to_string(),
+        language: hook["language"].as_str().unwrap().to_string(),
+        files: hook["files"].as_str().unwrap().to_string(),
+    };
+    assert_eq!(hook.id, "velvet-validate-fix");
+    // The hook velvet's repository ships runs the same command.
+    let shipped = hooks();
+    let ours = shipped.iter().find(|h| h.id == hook.id).expect("shipped");
+    assert_eq!((&ours.entry, &ours.files), (&hook.entry, &hook.files));
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join("models")).unwrap();
+    let undeclared = r#"{"asset":{"version":"2.0"},"materials":[{"extensions":{"KHR_materials_sheen":{"sheenColorFactor":[1,1,1]}}}]}"#;
+    std::fs::write(dir.path().join("models/Cloth.GLTF"), undeclared).unwrap();
+    std::fs::copy(
+        project().join("assets/clean.gltf"),
+        dir.path().join("models/chair.gltf"),
+    )
+    .unwrap();
+    let clean_before = std::fs::read(dir.path().join("models/chair.gltf")).unwrap();
+    let (ok, out) = run_hook(&hook, dir.path(), 100);
+    assert!(!ok, "a changed file fails the hook: {out}");
+    assert!(
+        out.contains("models/Cloth.GLTF: fixed: declare KHR_materials_sheen in extensionsUsed"),
+        "{out}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(dir.path().join("models/Cloth.GLTF")).unwrap(),
+        r#"{"asset":{"version":"2.0"},"extensionsUsed":["KHR_materials_sheen"],"materials":[{"extensions":{"KHR_materials_sheen":{"sheenColorFactor":[1,1,1]}}}]}"#
+    );
+    assert_eq!(
+        std::fs::read(dir.path().join("models/chair.gltf")).unwrap(),
+        clean_before
+    );
+    let (ok, out) = run_hook(&hook, dir.path(), 100);
+    assert!(ok, "nothing left to fix: {out}");
+    // An error no fix repairs fails the hook every time.
+    std::fs::copy(
+        project().join("assets/mixed.gltf"),
+        dir.path().join("models/mixed.gltf"),
+    )
+    .unwrap();
+    for _ in 0..2 {
+        let (ok, out) = run_hook(&hook, dir.path(), 100);
+        assert!(!ok, "{out}");
+        assert!(out.contains("error UNRESOLVED_REFERENCE"), "{out}");
+    }
 }

@@ -240,7 +240,7 @@ fn text_output_places_findings_at_line_and_column() {
         "fixtures/validate/VALUE_NOT_IN_RANGE/triggers.gltf",
     ]);
     assert_eq!(status, 1);
-    let expected = "fixtures/validate/VALUE_NOT_IN_RANGE/triggers.gltf:15:13: error VALUE_NOT_IN_RANGE: 1.5 is greater than the maximum of 1.0\n    at /materials/0/extensions/KHR_materials_sheen/sheenColorFactor/0\n1 file checked: 1 error, 0 warnings, 0 info, 0 hints\n";
+    let expected = "fixtures/validate/VALUE_NOT_IN_RANGE/triggers.gltf:15:13: error VALUE_NOT_IN_RANGE: 1.5 is greater than the maximum of 1.0\n    at /materials/0/extensions/KHR_materials_sheen/sheenColorFactor/0\n    fix (unsafe, --fix --unsafe-fixes): clamp sheenColorFactor to 1\n1 file checked: 1 error, 0 warnings, 0 info, 0 hints; 1 fixable with --fix --unsafe-fixes\n";
     assert_eq!(out, expected);
 }
 
@@ -602,7 +602,9 @@ fn a_capped_run_fails_on_errors_it_does_not_list_and_lists_errors_first() {
         "{out}"
     );
     assert!(
-        out.ends_with("1 file checked: 2 errors, 1 warning, 1 info, 2 hints\n"),
+        out.ends_with(
+            "1 file checked: 2 errors, 1 warning, 1 info, 2 hints; 2 fixable with --fix (1 more with --unsafe-fixes)\n"
+        ),
         "{out}"
     );
     let (_, out, _) = velvet(&["validate", "--format", "json", "--max-issues", "2", mixed]);
@@ -686,7 +688,8 @@ fn a_large_file_reports_its_last_material_at_its_line_and_column() {
         out,
         format!(
             "{}:{line}:{column}: error VALUE_NOT_IN_RANGE: 1.5 is greater than the maximum of \
-             1.0\n    at /materials/{}/extensions/KHR_materials_sheen/sheenRoughnessFactor\n",
+             1.0\n    at /materials/{}/extensions/KHR_materials_sheen/sheenRoughnessFactor\n    \
+             fix (unsafe, --fix --unsafe-fixes): clamp sheenRoughnessFactor to 1\n",
             path.display(),
             materials - 1
         )

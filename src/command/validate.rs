@@ -1,6 +1,6 @@
 //! `velvet validate` as the command line runs it: the files found, each checked under its own
-//! configuration, each report written as soon as it is done, the exit status from every
-//! finding. A run that cannot start (a missing path, a bad velvet.toml or schema folder)
+//! configuration (and, with `--fix` or `--diff`, fixed through [`crate::fix`]), each report
+//! written as soon as it is done, the exit status from every finding left. A run that cannot start (a missing path, a bad velvet.toml or schema folder)
 //! still writes a report in the format asked for, recording why.
 
 use super::Status;
@@ -29,6 +29,20 @@ pub struct Request {
     pub quiet: bool,
     /// Text: every finding, none folded.
     pub no_fold: bool,
+    pub fix: FixFlags,
+}
+
+/// What `validate` does with the fixes of its findings.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct FixFlags {
+    /// `--fix`: write the fixes to the files.
+    pub fix: bool,
+    /// `--unsafe-fixes`: fixes that change the asset's meaning too.
+    pub unsafe_fixes: bool,
+    /// `--diff`: print the fixes as a unified diff, write nothing.
+    pub diff: bool,
+    /// `--exit-non-zero-on-fix`: with `--fix`, a changed file fails the run (pre-commit).
+    pub exit_non_zero_on_fix: bool,
 }
 
 /// Runs `velvet validate`, its reports on standard output.
@@ -67,16 +81,27 @@ pub fn command(request: &Request) -> Status {
         color: request.format == Format::Text && request.color.for_stdout(),
         quiet: request.quiet,
         no_fold: request.no_fold,
+        diff: request.fix.diff,
     };
+    let fixing = crate::fix::Fixing::new(
+        &validator,
+        crate::fix::Mode {
+            apply: request.fix.fix,
+            diff: request.fix.diff,
+            unsafe_fixes: request.fix.unsafe_fixes,
+            edits: matches!(request.format, Format::Json | Format::Jsonl | Format::Sarif),
+        },
+    );
     // Each file's report is written as soon as it is done (see report::Stream).
     let stdout = std::io::BufWriter::new(std::io::stdout().lock());
     let mut stream = report::Stream::new(request.format, options, stdout).json_array(!one_file);
-    let outcome = match crate::run::validate_shard_each(
+    let outcome = match crate::run::check_shard_each(
         &validator,
         &paths,
         request.shard,
         &mut resolver,
         progress.as_ref(),
+        &|path, settings| fixing.check(path, settings),
         &mut |r| match &progress {
             // The bar is cleared while the report is written, so the two do not mix.
             Some(bar) => bar.suspend(|| {
@@ -95,5 +120,9 @@ pub fn command(request: &Request) -> Status {
         }
     };
     stream.finish();
-    Status::failed_if(outcome.failed)
+    // Fixed findings do not fail the run; those left do. A change fails it where it is asked to
+    // be reviewed (--diff, --exit-non-zero-on-fix).
+    let changed =
+        fixing.files_changed() > 0 && (request.fix.diff || request.fix.exit_non_zero_on_fix);
+    Status::failed_if(outcome.failed || changed)
 }

@@ -184,7 +184,8 @@ pub const VALUE_NOT_IN_RANGE: Code = Code::new(
     "VALUE_NOT_IN_RANGE",
     Error,
     "A number lies outside the range the schema allows.",
-);
+)
+.fixable(super::Safety::Unsafe);
 pub const ARRAY_LENGTH_NOT_IN_LIST: Code = Code::new(
     "ARRAY_LENGTH_NOT_IN_LIST",
     Error,

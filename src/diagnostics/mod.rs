@@ -6,11 +6,13 @@
 //! codes table in docs/codes.md and the SARIF rule list are generated from.
 
 pub mod codes;
+pub mod fixes;
 pub mod settings;
 
 use serde::Serialize;
 use std::fmt;
 
+pub use fixes::Safety;
 pub use settings::{FailOn, Settings};
 
 /// Severity, numbered as in the Khronos glTF-Validator report (0 error … 3 hint).
@@ -55,12 +57,16 @@ impl Serialize for Severity {
     }
 }
 
-/// A code velvet can emit: its name, default severity and one line of documentation.
+/// A code velvet can emit: its name, default severity, one line of documentation, and whether
+/// `velvet validate --fix` repairs its findings (and how safely).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Code {
     pub name: &'static str,
     pub severity: Severity,
     pub doc: &'static str,
+    /// `Some` when a fixer repairs the code's findings (see `crate::fix`, whose table of
+    /// fixers a test holds to this).
+    pub fix: Option<Safety>,
 }
 
 impl Code {
@@ -69,7 +75,22 @@ impl Code {
             name,
             severity,
             doc,
+            fix: None,
         }
+    }
+
+    /// The same code, repaired by a fix of `safety`.
+    pub const fn fixable(self, safety: Safety) -> Code {
+        Code {
+            fix: Some(safety),
+            ..self
+        }
+    }
+
+    /// How the code is fixed, as `velvet codes` and docs/codes.md say it: `safe`, `unsafe`
+    /// or `-`.
+    pub fn fix_label(&self) -> &'static str {
+        self.fix.map_or("-", Safety::as_str)
     }
 }
 

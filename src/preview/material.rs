@@ -705,8 +705,11 @@ fn carried(roughness: f64, direction: Direction, mapping: RoughnessMapping) -> f
 /// KHR_materials_fuzz sees. Column 1 is the one the difference image and the verdict compare
 /// with column 0.
 pub fn columns(material: &Material, swatch: &Swatch) -> Vec<Column> {
-    let (base, base_metallic, base_roughness) =
-        (material.base, material.base_metallic, material.base_roughness);
+    let (base, base_metallic, base_roughness) = (
+        material.base,
+        material.base_metallic,
+        material.base_roughness,
+    );
     let look = |layer| Look {
         base,
         base_metallic,

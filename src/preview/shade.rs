@@ -60,8 +60,8 @@ use crate::shading::{fuzz_reflectance, sheen_albedo, AlbedoMethod};
 use rayon::prelude::*;
 use std::cmp::Ordering;
 use std::collections::HashMap;
-use std::sync::{Arc, Mutex, OnceLock};
 use std::f64::consts::PI;
+use std::sync::{Arc, Mutex, OnceLock};
 
 /// View cosines sampled per look: μ_i = (i / (CURVE_NODES − 1))².
 pub const CURVE_NODES: usize = 65;
@@ -493,9 +493,8 @@ pub fn base_furnace_terms(
                 * d_phi
                 / PI;
             sum_a += metallic * (1.0 - w) * g;
-            sum_b += ((1.0 - metallic) * (DIELECTRIC_F0 + (1.0 - DIELECTRIC_F0) * w)
-                + metallic * w)
-                * g;
+            sum_b +=
+                ((1.0 - metallic) * (DIELECTRIC_F0 + (1.0 - DIELECTRIC_F0) * w) + metallic * w) * g;
         }
     }
     [sum_a, sum_b]
@@ -742,7 +741,13 @@ mod tests {
             },
         ));
         let mut worst: f64 = 0.0;
-        for (metallic, roughness) in [(0.0, 1.0f64), (0.0, 0.05), (1.0, 0.3), (1.0, 0.05), (0.5, 0.6)] {
+        for (metallic, roughness) in [
+            (0.0, 1.0f64),
+            (0.0, 0.05),
+            (1.0, 0.3),
+            (1.0, 0.05),
+            (0.5, 0.6),
+        ] {
             let alpha = (roughness * roughness).max(MIN_ALPHA);
             for mu in [0.016, 0.1, 0.4, 1.0] {
                 let av = sheen.attenuation_at(mu);

@@ -21,12 +21,12 @@
 //! the Charlie sheen lobe and the fuzz lobe differ in shape for every pair, so its ꟻLIP is
 //! printed beside the verdict but does not decide it. The thresholds were calibrated on the
 //! public sample assets with `examples/verdict_calibration.rs` (docs/preview.md has the
-//! figures): conversions the mapping matches well stay at or below 0.22 (0.10–0.14 over a
-//! dark base, up to 0.216 for a white sheen over a white base, where the layers' different
-//! base attenuation moves 30 % of the sphere by 10–15 codes), while materials whose layer
+//! figures): conversions the mapping matches well stay at or below 0.22 (0.04–0.13 over a
+//! dark base, up to 0.214 for a white layer over a white base, where the layers' different
+//! base attenuation moves a third of the sphere by 10–16 codes), while materials whose layer
 //! really changes (the fallback sheen held at migrate's roughness floor over a dark base, a
 //! dark fuzz colour whose fallback cannot darken the base alike, a broad change of energy)
-//! reach 0.25–0.73. Over a bright base the furnace hides a sharp rim (everything is near
+//! reach 0.22–0.72. Over a bright base the furnace hides a sharp rim (everything is near
 //! white there), which the light row shows. A sheen roughness below 0.1 (no fuzz roughness
 //! matches it) is flagged beside it.
 

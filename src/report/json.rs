@@ -2,11 +2,22 @@
 //! `issues {numErrors, numWarnings, numInfos, numHints, messages[{code, message, severity,
 //! pointer}], truncated}` and `info`. Severities are numbers (0 error … 3 hint).
 //!
+//! A finding that a fix repairs carries it as `fix {applicability, message, edits[{content,
+//! location {row, column, offset}, endLocation}]}`: the replacements of the JSON text as read
+//! (rows and columns 1-based, columns in characters, offsets in bytes of the file), each fix
+//! apart from the others (an edit that several findings share is given with each; apply it
+//! once). A report with fixes ends with `fixes {fixable, fixableUnsafe, changed, applied[],
+//! refused[], diff}`: the findings a fix repairs (with `--fix`, those it did), the fixes refused
+//! with the reason, and with `--diff` the change as a unified diff. After `--fix` wrote a file,
+//! the fixes left are given against its new text.
+//!
 //! The shape is a set of borrowing structs serialised straight to text: a report with tens of
 //! thousands of findings is written without first being copied into a JSON tree.
 
 use super::display_path;
 use crate::asset::json_text::push_quoted;
+use crate::diagnostics::fixes::{FileFixes, FixStatus, FixView};
+use crate::diagnostics::Safety;
 use crate::validate::{AssetInfo, FileReport};
 use serde::Serialize;
 
@@ -19,6 +30,58 @@ struct ReportShape<'a> {
     issues: IssuesShape<'a>,
     #[serde(skip_serializing_if = "Option::is_none")]
     info: Option<InfoShape<'a>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    fixes: Option<FixesShape<'a>>,
+}
+
+#[derive(Serialize)]
+#[serde(rename_all = "camelCase")]
+struct FixesShape<'a> {
+    fixable: usize,
+    fixable_unsafe: usize,
+    changed: bool,
+    applied: Vec<DoneShape<'a>>,
+    refused: Vec<DoneShape<'a>>,
+    /// With `--diff`: the change as a unified diff.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    diff: Option<&'a str>,
+}
+
+#[derive(Serialize)]
+struct DoneShape<'a> {
+    message: &'a str,
+    applicability: &'static str,
+    repairs: Vec<RepairShape<'a>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    reason: Option<&'a str>,
+}
+
+#[derive(Serialize)]
+struct RepairShape<'a> {
+    code: &'a str,
+    pointer: &'a str,
+}
+
+#[derive(Serialize)]
+struct FixShape<'a> {
+    applicability: &'static str,
+    message: &'a str,
+    edits: Vec<EditShape<'a>>,
+}
+
+#[derive(Serialize)]
+#[serde(rename_all = "camelCase")]
+struct EditShape<'a> {
+    content: &'a str,
+    location: LocationShape,
+    end_location: LocationShape,
+}
+
+#[derive(Serialize)]
+struct LocationShape {
+    row: usize,
+    column: usize,
+    offset: usize,
 }
 
 #[derive(Serialize)]
@@ -38,6 +101,8 @@ struct MessageShape<'a> {
     message: &'a str,
     severity: u8,
     pointer: &'a str,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    fix: Option<FixShape<'a>>,
 }
 
 #[derive(Serialize)]
@@ -54,18 +119,91 @@ struct InfoShape<'a> {
 
 const VALIDATOR_VERSION: &str = concat!("velvet ", env!("CARGO_PKG_VERSION"));
 
-fn message_shape(f: &crate::validate::Finding) -> MessageShape<'_> {
+fn message_shape<'a>(report: &'a FileReport, f: &'a crate::validate::Finding) -> MessageShape<'a> {
+    let fix = report
+        .fixes
+        .for_finding(f.diagnostic.code, &f.diagnostic.pointer)
+        .map(|fix| fix_shape(report, fix));
     MessageShape {
         code: f.diagnostic.code,
         message: &f.diagnostic.message,
         severity: f.diagnostic.severity as u8,
         pointer: &f.diagnostic.pointer,
+        fix,
+    }
+}
+
+fn fix_shape<'a>(report: &FileReport, fix: &'a FixView) -> FixShape<'a> {
+    let at = |p: &crate::diagnostics::Position| LocationShape {
+        row: p.line,
+        column: p.column,
+        offset: report.json_offset + p.offset,
+    };
+    FixShape {
+        applicability: fix.safety.as_str(),
+        message: &fix.title,
+        edits: fix
+            .edits
+            .iter()
+            .map(|e| EditShape {
+                content: &e.content,
+                location: at(&e.start),
+                end_location: at(&e.end),
+            })
+            .collect(),
+    }
+}
+
+fn fixes_shape(fixes: &FileFixes) -> Option<FixesShape<'_>> {
+    if fixes.fixes().is_empty() {
+        return None;
+    }
+    Some(FixesShape {
+        fixable: fixes.available(Safety::Safe),
+        fixable_unsafe: fixes.available(Safety::Unsafe),
+        changed: fixes.changed,
+        diff: fixes.diff.as_deref(),
+        applied: fixes
+            .fixes()
+            .iter()
+            .filter(|f| f.status == FixStatus::Applied)
+            .map(done_shape)
+            .collect(),
+        refused: fixes
+            .fixes()
+            .iter()
+            .filter(|f| matches!(f.status, FixStatus::Refused(_)))
+            .map(done_shape)
+            .collect(),
+    })
+}
+
+fn done_shape(fix: &FixView) -> DoneShape<'_> {
+    DoneShape {
+        message: &fix.title,
+        applicability: fix.safety.as_str(),
+        repairs: fix
+            .repairs
+            .iter()
+            .map(|r| RepairShape {
+                code: r.code,
+                pointer: &r.pointer,
+            })
+            .collect(),
+        reason: match &fix.status {
+            FixStatus::Refused(reason) => Some(reason),
+            _ => None,
+        },
     }
 }
 
 fn shape(report: &FileReport) -> ReportShape<'_> {
     let mut shape = outline(report);
-    shape.issues.messages = report.findings.iter().map(message_shape).collect();
+    shape.issues.messages = report
+        .findings
+        .iter()
+        .map(|f| message_shape(report, f))
+        .collect();
     shape
 }
 
@@ -93,6 +231,7 @@ fn outline(report: &FileReport) -> ReportShape<'_> {
             sheen_material_count: info.sheen_material_count,
             fuzz_material_count: info.fuzz_material_count,
         }),
+        fixes: fixes_shape(&report.fixes),
     }
 }
 
@@ -129,7 +268,7 @@ pub fn write_pretty(out: &mut impl std::io::Write, report: &FileReport) -> std::
             if i > 0 {
                 text.push_str(",\n      ");
             }
-            push_message(text, &message_shape(finding));
+            push_message(text, &message_shape(report, finding));
         }
     };
     // Up to the list's opening bracket, the messages, then from the comma after the list on.
@@ -181,6 +320,17 @@ fn push_message(out: &mut String, m: &MessageShape) {
     }
     out.push_str(",\n        \"pointer\": ");
     push_quoted(out, m.pointer);
+    if let Some(fix) = &m.fix {
+        // As the printer writes it at this depth: its lines after the first indented by 8.
+        let text = serde_json::to_string_pretty(fix).expect("a fix serialises");
+        out.push_str(",\n        \"fix\": ");
+        for (i, line) in text.lines().enumerate() {
+            if i > 0 {
+                out.push_str("\n        ");
+            }
+            out.push_str(line);
+        }
+    }
     out.push_str("\n      }");
 }
 
@@ -250,6 +400,7 @@ mod tests {
                 fuzz_material_count: 0,
             }),
             missing: Default::default(),
+            fixes: Default::default(),
         }
     }
 
@@ -270,5 +421,38 @@ mod tests {
                 "{messages} messages: written differs from serde's"
             );
         }
+    }
+
+    #[test]
+    fn a_report_with_fixes_is_written_as_serde_writes_it() {
+        use crate::diagnostics::fixes::{FileFixes, FixStatus, FixView, Repair, TextEdit};
+        use crate::diagnostics::{Position, Safety};
+        let mut report = report(3, true);
+        let first = &report.findings[0].diagnostic;
+        let at = |offset| Position {
+            line: 2,
+            column: offset + 1,
+            offset,
+        };
+        report.fixes = FileFixes::new(vec![FixView {
+            repairs: vec![Repair {
+                code: first.code,
+                pointer: first.pointer.clone(),
+                message: first.message.clone(),
+            }],
+            safety: Safety::Safe,
+            title: "declare \"X\" in extensionsUsed".into(),
+            edits: vec![TextEdit {
+                start: at(4),
+                end: at(4),
+                content: ",\n    \"X\"".into(),
+            }],
+            status: FixStatus::Available,
+        }]);
+        let mut written = Vec::new();
+        write_pretty(&mut written, &report).unwrap();
+        let expected = report_pretty(&report) + "\n";
+        assert_eq!(String::from_utf8(written).unwrap(), expected);
+        assert!(expected.contains("\"fixable\": 1"), "{expected}");
     }
 }

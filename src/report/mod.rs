@@ -149,6 +149,41 @@ pub struct Options {
     pub quiet: bool,
     /// Text output: every finding on its own, instead of one entry per code, message and file.
     pub no_fold: bool,
+    /// Text output: each file's fixes as a unified diff, instead of its findings (`--diff`).
+    pub diff: bool,
+}
+
+/// The table of every code that `velvet codes` prints: name, default severity, how it is
+/// fixed (`safe`, `unsafe` or `-`) and its one line of documentation; as Markdown, the table
+/// of docs/codes.md.
+pub fn codes_table(markdown: bool) -> String {
+    let codes = crate::rules::all_codes();
+    if markdown {
+        let mut out = String::from("| code | severity | fix | meaning |\n|---|---|---|---|\n");
+        for c in codes {
+            out += &format!(
+                "| `{}` | {} | {} | {} |\n",
+                c.name,
+                c.severity,
+                c.fix_label(),
+                c.doc.replace('|', "\\|")
+            );
+        }
+        return out;
+    }
+    let width = codes.iter().map(|c| c.name.len()).max().unwrap_or(0);
+    codes
+        .iter()
+        .map(|c| {
+            format!(
+                "{:width$}  {:7}  {:6}  {}\n",
+                c.name,
+                c.severity.as_str(),
+                c.fix_label(),
+                c.doc
+            )
+        })
+        .collect()
 }
 
 /// Renders `reports` in `format`.
@@ -189,6 +224,7 @@ pub fn failed_run(format: Format, message: &str, json_array: bool) -> String {
         omitted: 0,
         info: None,
         missing: MissingResources::default(),
+        fixes: Default::default(),
     };
     match format {
         Format::Text => String::new(),
@@ -220,6 +256,8 @@ pub struct Stream<W: std::io::Write> {
     json_array: bool,
     /// GitHub output: the missing-resource annotations, written after every other one.
     deferred: String,
+    /// The run's fixes, counted for the text summary.
+    fixes: text::FixTotals,
 }
 
 /// A JSON report as an element of the pretty-printed array of several: every line indented.
@@ -247,6 +285,7 @@ impl<W: std::io::Write> Stream<W> {
             totals: [0; 4],
             json_array: true,
             deferred: String::new(),
+            fixes: Default::default(),
         }
     }
 
@@ -267,8 +306,11 @@ impl<W: std::io::Write> Stream<W> {
         {
             *t += n;
         }
+        self.fixes.add(&report.fixes);
         let one = std::slice::from_ref(&report);
         let text = match self.format {
+            // --diff: the file's change, and nothing else, so that the output applies as a patch.
+            Format::Text if self.options.diff => report.fixes.diff.clone().unwrap_or_default(),
             Format::Text => text::render_with(
                 one,
                 &Options {
@@ -317,7 +359,10 @@ impl<W: std::io::Write> Stream<W> {
             return;
         }
         let text = match self.format {
-            Format::Text if !self.options.quiet => text::summary(self.files, self.totals),
+            Format::Text if self.options.diff => String::new(),
+            Format::Text if !self.options.quiet => {
+                text::summary_with(self.files, self.totals, &self.fixes)
+            }
             Format::Json if self.json_array && self.files == 0 => "[]\n".to_string(),
             Format::Json if self.json_array => "\n]\n".to_string(),
             Format::Json => render(self.format, &self.kept, &self.options),
@@ -393,6 +438,7 @@ mod tests {
                     color: false,
                     quiet,
                     no_fold: false,
+                    diff: false,
                 };
                 for n in 0..4 {
                     let all = reports(n);

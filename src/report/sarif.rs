@@ -10,6 +10,12 @@
 //! `startLine` 1 because GitHub code scanning requires a line on every result. The JSON pointer
 //! goes in each result's `properties.pointer`.
 //!
+//! A finding that a fix repairs carries it in `fixes` (SARIF 2.1.0 §3.55): its description and
+//! one artifactChange whose replacements give each `deletedRegion` both as lines and columns
+//! (`startLine`, `startColumn`, `endLine`, `endColumn`: an empty region is an insertion point)
+//! and as bytes (`byteOffset`, `byteLength`), with the `insertedContent` text. A .glb's fixes
+//! are not given (its JSON chunk cannot be edited as text; `velvet validate --fix` repacks it).
+//!
 //! Each file's missing resources are one result (see [`super::Listing`]), at the place of the
 //! first, and these results follow every other result of the run.
 
@@ -155,6 +161,41 @@ struct SarifResult<'a> {
     message: Text<'a>,
     locations: [Location<'a>; 1],
     properties: Properties<'a>,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    fixes: Vec<SarifFix<'a>>,
+}
+
+#[derive(Serialize)]
+#[serde(rename_all = "camelCase")]
+struct SarifFix<'a> {
+    description: Text<'a>,
+    artifact_changes: [ArtifactChange<'a>; 1],
+}
+
+#[derive(Serialize)]
+#[serde(rename_all = "camelCase")]
+struct ArtifactChange<'a> {
+    artifact_location: &'a ArtifactLocation,
+    replacements: Vec<Replacement<'a>>,
+}
+
+#[derive(Serialize)]
+#[serde(rename_all = "camelCase")]
+struct Replacement<'a> {
+    deleted_region: DeletedRegion,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    inserted_content: Option<Text<'a>>,
+}
+
+#[derive(Serialize)]
+#[serde(rename_all = "camelCase")]
+struct DeletedRegion {
+    start_line: usize,
+    start_column: usize,
+    end_line: usize,
+    end_column: usize,
+    byte_offset: usize,
+    byte_length: usize,
 }
 
 #[derive(Serialize)]
@@ -211,7 +252,7 @@ fn artifact_location(path: &Path) -> ArtifactLocation {
 
 /// The result of one finding of `report`.
 fn result<'a>(
-    report: &FileReport,
+    report: &'a FileReport,
     artifact: &'a ArtifactLocation,
     f: &'a Finding,
     index: &HashMap<&str, usize>,
@@ -242,6 +283,35 @@ fn result<'a>(
         properties: Properties {
             pointer: &d.pointer,
         },
+        fixes: report
+            .fixes
+            .for_finding(d.code, &d.pointer)
+            .filter(|fix| !fix.edits.is_empty())
+            .map(|fix| {
+                vec![SarifFix {
+                    description: Text { text: &fix.title },
+                    artifact_changes: [ArtifactChange {
+                        artifact_location: artifact,
+                        replacements: fix
+                            .edits
+                            .iter()
+                            .map(|e| Replacement {
+                                deleted_region: DeletedRegion {
+                                    start_line: e.start.line,
+                                    start_column: e.start.column,
+                                    end_line: e.end.line,
+                                    end_column: e.end.column,
+                                    byte_offset: report.json_offset + e.start.offset,
+                                    byte_length: e.end.offset - e.start.offset,
+                                },
+                                inserted_content: (!e.content.is_empty())
+                                    .then_some(Text { text: &e.content }),
+                            })
+                            .collect(),
+                    }],
+                }]
+            })
+            .unwrap_or_default(),
     }
 }
 

@@ -11,7 +11,8 @@
 use super::escape::terminal;
 use super::{display_path, fold, Options};
 use crate::asset::Container;
-use crate::diagnostics::Severity;
+use crate::diagnostics::fixes::{FileFixes, FixStatus, FixView};
+use crate::diagnostics::{Safety, Severity};
 use crate::validate::{FileReport, Finding};
 use anstyle::{AnsiColor, Style};
 use std::fmt::Write;
@@ -42,7 +43,9 @@ pub fn render_with(reports: &[FileReport], options: &Options) -> String {
     };
     let mut out = String::new();
     let mut totals = [0usize; 4];
+    let mut fix_totals = FixTotals::default();
     for report in reports {
+        fix_totals.add(&report.fixes);
         let file = terminal(&display_path(&report.path)).into_owned();
         let place = |f: &Finding| match (f.position, report.container) {
             (Some(p), Some(Container::Glb)) => {
@@ -97,6 +100,15 @@ pub fn render_with(reports: &[FileReport], options: &Options) -> String {
                     )
                 );
             }
+            if let Some(fix) = report.fixes.fix_of(d.code, &d.pointer) {
+                if fix.status != FixStatus::Applied {
+                    let _ = writeln!(
+                        out,
+                        "    {}",
+                        paint(Style::new().dimmed(), &terminal(&fix_line(fix)))
+                    );
+                }
+            }
             if !group.rest.is_empty() {
                 let line = folded_line(&group.rest, report.container, report.json_offset);
                 let _ = writeln!(
@@ -109,6 +121,7 @@ pub fn render_with(reports: &[FileReport], options: &Options) -> String {
         if report.truncated() {
             let _ = writeln!(out, "{file}: {}", super::omitted_note(report.omitted));
         }
+        out += &fixes_done(&file, &report.fixes);
         let c = report.counts;
         for (t, n) in totals
             .iter_mut()
@@ -120,8 +133,91 @@ pub fn render_with(reports: &[FileReport], options: &Options) -> String {
     if options.quiet {
         return out;
     }
-    out += &summary(reports.len(), totals);
+    out += &summary_with(reports.len(), totals, &fix_totals);
     out
+}
+
+/// The closing line with the run's fixes at its end (see [`FixTotals::summary`]).
+pub fn summary_with(files: usize, totals: [usize; 4], fixes: &FixTotals) -> String {
+    let line = summary(files, totals);
+    format!("{}{}\n", line.trim_end_matches('\n'), fixes.summary())
+}
+
+/// The line under a finding that a fix repairs: how safe the fix is and what it does, or why
+/// it was not applied.
+fn fix_line(fix: &FixView) -> String {
+    match (&fix.status, fix.safety) {
+        (FixStatus::Refused(reason), safety) => format!(
+            "fix ({}) not applied: {}: {reason}",
+            safety.as_str(),
+            fix.title
+        ),
+        (_, Safety::Safe) => format!("fix (safe, --fix): {}", fix.title),
+        (_, Safety::Unsafe) => format!("fix (unsafe, --fix --unsafe-fixes): {}", fix.title),
+    }
+}
+
+/// A file's lines about the fixes applied: each with the findings it repaired (an unsafe one
+/// said so).
+fn fixes_done(file: &str, fixes: &FileFixes) -> String {
+    let mut out = String::new();
+    for fix in fixes.fixes() {
+        let codes: Vec<&str> = fix.repairs.iter().map(|r| r.code).collect();
+        let mut codes_list: Vec<&str> = Vec::new();
+        for c in codes {
+            if !codes_list.contains(&c) {
+                codes_list.push(c);
+            }
+        }
+        let what = format!(
+            "{} ({}, {} finding{} of {})",
+            fix.title,
+            fix.safety.as_str(),
+            fix.repairs.len(),
+            if fix.repairs.len() == 1 { "" } else { "s" },
+            codes_list.join(", ")
+        );
+        match &fix.status {
+            FixStatus::Applied => {
+                let _ = writeln!(out, "{file}: fixed: {}", terminal(&what));
+            }
+            // A refused fix is said under its finding, which stays.
+            FixStatus::Refused(_) | FixStatus::Available => {}
+        }
+    }
+    out
+}
+
+/// A run's fixes counted by finding: available safe and unsafe, and applied.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct FixTotals {
+    pub safe: usize,
+    pub unsafe_: usize,
+    pub applied: usize,
+}
+
+impl FixTotals {
+    pub fn add(&mut self, fixes: &FileFixes) {
+        self.safe += fixes.available(Safety::Safe);
+        self.unsafe_ += fixes.available(Safety::Unsafe);
+        self.applied += fixes.applied();
+    }
+
+    /// What ends the summary line when there are fixes: how many findings were fixed, and how
+    /// many more a fix repairs ("; N fixable with --fix"); nothing when there are none.
+    pub fn summary(&self) -> String {
+        let mut out = String::new();
+        if self.applied > 0 {
+            out += &format!("; {} fixed", self.applied);
+        }
+        match (self.safe, self.unsafe_) {
+            (0, 0) => {}
+            (s, 0) => out += &format!("; {s} fixable with --fix"),
+            (0, u) => out += &format!("; {u} fixable with --fix --unsafe-fixes"),
+            (s, u) => out += &format!("; {s} fixable with --fix ({u} more with --unsafe-fixes)"),
+        }
+        out
+    }
 }
 
 /// Positions listed on a folded entry's line before it ends in `…`.
@@ -205,6 +301,7 @@ mod tests {
             omitted: 0,
             info: None,
             missing: Default::default(),
+            fixes: Default::default(),
         }
     }
 

@@ -15,22 +15,26 @@ pub const UNDECLARED_EXTENSION: Code = Code::new(
     "UNDECLARED_EXTENSION",
     Severity::Error,
     "An extension object is used but its extension is not in extensionsUsed.",
-);
+)
+.fixable(crate::diagnostics::Safety::Safe);
 pub const UNUSED_EXTENSION_REQUIRED: Code = Code::new(
     "UNUSED_EXTENSION_REQUIRED",
     Severity::Error,
     "An extension in extensionsRequired is missing from extensionsUsed.",
-);
+)
+.fixable(crate::diagnostics::Safety::Safe);
 pub const SHEEN_DECLARED_UNUSED: Code = Code::new(
     "KHR_MATERIALS_SHEEN_DECLARED_UNUSED",
     Severity::Warning,
     "KHR_materials_sheen is in extensionsUsed but no material uses it.",
-);
+)
+.fixable(crate::diagnostics::Safety::Safe);
 pub const FUZZ_DECLARED_UNUSED: Code = Code::new(
     "KHR_MATERIALS_FUZZ_DECLARED_UNUSED",
     Severity::Warning,
     "KHR_materials_fuzz is in extensionsUsed but no material uses it.",
-);
+)
+.fixable(crate::diagnostics::Safety::Safe);
 
 pub struct Declaration;
 

@@ -12,12 +12,14 @@ pub const SHEEN_TEXTURE_WITHOUT_EFFECT: Code = Code::new(
     "KHR_MATERIALS_SHEEN_TEXTURE_WITHOUT_EFFECT",
     Severity::Warning,
     "A sheen texture without effect: on a layer switched off by sheenColorFactor [0,0,0] (the default), or a sheenRoughnessTexture scaled by sheenRoughnessFactor 0 (the default).",
-);
+)
+.fixable(crate::diagnostics::Safety::Unsafe);
 pub const FUZZ_TEXTURE_WITHOUT_EFFECT: Code = Code::new(
     "KHR_MATERIALS_FUZZ_TEXTURE_WITHOUT_EFFECT",
     Severity::Warning,
     "A fuzz texture on a layer switched off by fuzzFactor 0 (the default).",
-);
+)
+.fixable(crate::diagnostics::Safety::Unsafe);
 
 const ROUGHNESS_TEXTURE: &str = "sheenRoughnessTexture";
 

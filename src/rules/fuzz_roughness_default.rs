@@ -10,7 +10,8 @@ pub const FUZZ_ROUGHNESS_DEFAULT_AMBIGUOUS: Code = Code::new(
     "KHR_MATERIALS_FUZZ_ROUGHNESS_DEFAULT_AMBIGUOUS",
     Severity::Hint,
     "fuzzRoughnessFactor omitted on an active fuzz layer: the draft's table says 0.5, its schema 0.0; write it explicitly.",
-);
+)
+.fixable(crate::diagnostics::Safety::Safe);
 
 pub struct FuzzRoughnessDefault;
 

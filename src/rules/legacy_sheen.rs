@@ -11,7 +11,8 @@ pub const SHEEN_LEGACY_DRAFT: Code = Code::new(
     "KHR_MATERIALS_SHEEN_LEGACY_DRAFT",
     Severity::Warning,
     "A property of the pre-ratification sheen draft (sheenFactor, sheenColor, sheenTexture); ratified loaders ignore it.",
-);
+)
+.fixable(crate::diagnostics::Safety::Unsafe);
 
 pub use crate::layers::LEGACY_PROPERTIES;
 

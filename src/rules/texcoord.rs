@@ -12,7 +12,8 @@ pub const MESH_PRIMITIVE_TOO_FEW_TEXCOORDS: Code = Code::new(
     "MESH_PRIMITIVE_TOO_FEW_TEXCOORDS",
     Severity::Error,
     "A primitive uses a material with a texture (of the core or of an extension) that reads TEXCOORD_N, which the primitive lacks.",
-);
+)
+.fixable(crate::diagnostics::Safety::Unsafe);
 
 pub struct TexCoords;
 

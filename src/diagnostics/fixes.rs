@@ -1,0 +1,166 @@
+//! What a report says about fixes: how safe a fix is, the text edits it makes and whether it
+//! was applied. The fixes themselves are planned by `crate::fix`; these are the plain values
+//! every report format reads (the planner's one plan, seen from the report).
+
+use super::Position;
+
+/// How much a fix may change an asset.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Safety {
+    /// Cannot change how a conforming loader renders the asset: applied by `--fix`.
+    Safe,
+    /// Changes the asset's meaning in the way its finding implies: applied only with
+    /// `--unsafe-fixes`.
+    Unsafe,
+}
+
+impl Safety {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Safety::Safe => "safe",
+            Safety::Unsafe => "unsafe",
+        }
+    }
+}
+
+/// One replacement in the JSON text as it was read: the bytes from `start` to `end` are
+/// replaced by `content` (an insertion when they are equal, a deletion when `content` is
+/// empty). Positions are 1-based lines and character columns, with byte offsets.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct TextEdit {
+    pub start: Position,
+    pub end: Position,
+    pub content: String,
+}
+
+/// What became of a fix in this run.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum FixStatus {
+    /// Planned and checked, not applied (a run without `--fix`, or an unsafe fix without
+    /// `--unsafe-fixes`).
+    Available,
+    /// Written into the file (or, with `--diff`, shown).
+    Applied,
+    /// Not applied, and why (the fixed file would still have the finding, or another one).
+    Refused(String),
+}
+
+/// A finding a fix repairs: its code and pointer in the document as read.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Repair {
+    pub code: &'static str,
+    pub pointer: String,
+    pub message: String,
+}
+
+/// One fix as a report shows it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FixView {
+    /// The findings it repairs (one fix may repair several: declaring an extension repairs its
+    /// UNDECLARED_EXTENSION and its UNUSED_EXTENSION_REQUIRED).
+    pub repairs: Vec<Repair>,
+    pub safety: Safety,
+    /// What it does, in a few words ("declare KHR_materials_sheen in extensionsUsed").
+    pub title: String,
+    /// Its edits of the JSON text as read, apart from every other fix; none for a .glb, whose
+    /// JSON chunk cannot be edited as text (`--fix` repacks it).
+    pub edits: Vec<TextEdit>,
+    pub status: FixStatus,
+}
+
+impl FixView {
+    /// Whether this fix repairs the finding with `code` at `pointer`.
+    pub fn repairs(&self, code: &str, pointer: &str) -> bool {
+        self.repairs
+            .iter()
+            .any(|r| r.code == code && r.pointer == pointer)
+    }
+}
+
+/// A file's fixes: every fix planned for it, and whether the file was (or, with `--diff`,
+/// would be) changed, with the unified diff when one was asked for.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct FileFixes {
+    /// The fixes; set with [`FileFixes::new`], which indexes them by the findings they repair.
+    fixes: Vec<FixView>,
+    /// The fix of each finding (`code`, NUL, `pointer`): a report looks each finding up, and a
+    /// document may have a fix per material.
+    by_finding: std::collections::HashMap<String, usize>,
+    /// True when the fixes changed the file's bytes (written, or shown by `--diff`).
+    pub changed: bool,
+    /// With `--diff`: the change as a unified diff.
+    pub diff: Option<String>,
+    /// Why the fixed file could not be written, when it could not.
+    pub write_error: Option<String>,
+}
+
+fn finding_key(code: &str, pointer: &str) -> String {
+    format!("{code}\0{pointer}")
+}
+
+impl FileFixes {
+    pub fn new(fixes: Vec<FixView>) -> FileFixes {
+        let mut by_finding = std::collections::HashMap::new();
+        for (i, fix) in fixes.iter().enumerate() {
+            for r in &fix.repairs {
+                by_finding
+                    .entry(finding_key(r.code, &r.pointer))
+                    .or_insert(i);
+            }
+        }
+        FileFixes {
+            fixes,
+            by_finding,
+            ..Default::default()
+        }
+    }
+
+    /// Every fix planned for the file.
+    pub fn fixes(&self) -> &[FixView] {
+        &self.fixes
+    }
+
+    /// Marks every applied fix refused for `reason` (the fixed file could not be written).
+    pub fn refuse_applied(&mut self, reason: &str) {
+        for fix in &mut self.fixes {
+            if fix.status == FixStatus::Applied {
+                fix.status = FixStatus::Refused(reason.to_string());
+            }
+        }
+        self.changed = false;
+    }
+
+    /// Findings that an available fix of `safety` repairs (each finding once).
+    pub fn available(&self, safety: Safety) -> usize {
+        self.fixes
+            .iter()
+            .filter(|f| f.safety == safety && f.status == FixStatus::Available)
+            .map(|f| f.repairs.len())
+            .sum()
+    }
+
+    /// The available fix that repairs the finding with `code` at `pointer`, if any.
+    pub fn for_finding(&self, code: &str, pointer: &str) -> Option<&FixView> {
+        self.fix_of(code, pointer)
+            .filter(|f| f.status == FixStatus::Available)
+    }
+
+    /// The fix planned for the finding with `code` at `pointer`, whatever became of it.
+    pub fn fix_of(&self, code: &str, pointer: &str) -> Option<&FixView> {
+        if self.by_finding.is_empty() {
+            return None;
+        }
+        self.by_finding
+            .get(&finding_key(code, pointer))
+            .map(|&i| &self.fixes[i])
+    }
+
+    /// Findings repaired by applied fixes.
+    pub fn applied(&self) -> usize {
+        self.fixes
+            .iter()
+            .filter(|f| f.status == FixStatus::Applied)
+            .map(|f| f.repairs.len())
+            .sum()
+    }
+}

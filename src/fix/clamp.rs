@@ -1,0 +1,56 @@
+//! Values out of range, clamped: a material's number above the schema's maximum or below its
+//! minimum is set to that bound (the finding names it). Unsafe: the value changes, though to
+//! the one nearest what the file says that a loader may read. Only materials' numbers are
+//! clamped (their factors); an index out of range names another object, and an exclusive bound
+//! has no nearest value, so neither is fixed.
+
+use super::fixers::{last_token, Fixer, Proposal};
+use crate::asset::Asset;
+use crate::diagnostics::{codes::VALUE_NOT_IN_RANGE, Diagnostic, Safety};
+use crate::edit::Edit;
+
+/// The bound a VALUE_NOT_IN_RANGE message names, for an inclusive bound.
+fn bound(message: &str) -> Option<f64> {
+    let (_, bound) = message
+        .split_once(" is greater than the maximum of ")
+        .or_else(|| message.split_once(" is less than the minimum of "))?;
+    bound.trim().parse::<f64>().ok().filter(|b| b.is_finite())
+}
+
+pub const OUT_OF_RANGE: Fixer = Fixer {
+    code: &VALUE_NOT_IN_RANGE,
+    safety: Safety::Unsafe,
+    about: "clamps a material's number into its range",
+    propose: |asset: &Asset, d: &Diagnostic| {
+        if !d.pointer.starts_with("/materials/") || last_token(&d.pointer)? == "index" {
+            return None;
+        }
+        asset.root().pointer(&d.pointer)?.as_f64()?;
+        let to = bound(&d.message)?;
+        let key = d
+            .pointer
+            .rsplit('/')
+            .find(|t| crate::asset::pointer::array_index(t).is_none())
+            .unwrap_or_default();
+        Some(Proposal {
+            title: format!("clamp {key} to {to}"),
+            edits: vec![Edit::set(d.pointer.clone(), serde_json::json!(to))],
+        })
+    },
+};
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn the_bound_is_read_from_inclusive_messages_only() {
+        assert_eq!(
+            super::bound("1.5 is greater than the maximum of 1.0"),
+            Some(1.0)
+        );
+        assert_eq!(super::bound("-2 is less than the minimum of 0"), Some(0.0));
+        assert_eq!(
+            super::bound("0 is less than or equal to the minimum of 0"),
+            None
+        );
+    }
+}

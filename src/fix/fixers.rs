@@ -1,0 +1,60 @@
+//! The fixers, one small unit each, and the one table that registers them by code. A fixer
+//! reads one finding and the document, and proposes the edits that repair it (or nothing,
+//! when this finding cannot be repaired safely in this document). Fixers never call each
+//! other or the planner; the planner merges what they propose.
+
+use crate::asset::tape::Node;
+use crate::asset::Asset;
+use crate::diagnostics::{Code, Diagnostic, Safety};
+use crate::edit::Edit;
+
+/// What a fixer proposes: a title saying what it does, and the edits.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Proposal {
+    pub title: String,
+    pub edits: Vec<Edit>,
+}
+
+/// A fixer: the code it repairs, how safe its fix is, and the function that plans it.
+pub struct Fixer {
+    pub code: &'static Code,
+    pub safety: Safety,
+    /// What its fix does, for the codes table and the docs.
+    pub about: &'static str,
+    pub propose: fn(&Asset, &Diagnostic) -> Option<Proposal>,
+}
+
+/// Every fixer, by code (each code once).
+pub const FIXERS: &[Fixer] = &[
+    super::declare::UNDECLARED,
+    super::declare::REQUIRED_NOT_USED,
+    super::declare::SHEEN_UNUSED,
+    super::declare::FUZZ_UNUSED,
+    super::fuzz_roughness::EXPLICIT_DEFAULT,
+    super::texture::SHEEN_WITHOUT_EFFECT,
+    super::texture::FUZZ_WITHOUT_EFFECT,
+    super::clamp::OUT_OF_RANGE,
+    super::legacy::UPGRADE,
+    super::texcoord::TEXCOORD,
+];
+
+/// The fixer of `code`, if it has one.
+pub fn fixer_for(code: &str) -> Option<&'static Fixer> {
+    FIXERS.iter().find(|f| f.code.name == code)
+}
+
+/// The last reference token of `pointer`, unescaped.
+pub(super) fn last_token(pointer: &str) -> Option<std::borrow::Cow<'_, str>> {
+    let (_, last) = pointer.rsplit_once('/')?;
+    Some(crate::asset::pointer::unescape(last))
+}
+
+/// The pointer of the value that holds the one `pointer` names.
+pub(super) fn parent(pointer: &str) -> &str {
+    pointer.rsplit_once('/').map_or("", |(p, _)| p)
+}
+
+/// The string at `pointer` in `root`.
+pub(super) fn string_at(root: Node, pointer: &str) -> Option<String> {
+    root.pointer(pointer)?.as_str().map(|s| s.into_owned())
+}

@@ -1,0 +1,735 @@
+//! `velvet validate --fix`: findings repaired in place, as splices into the file's text.
+//!
+//! A [`Fix`] is a plain value: the edits that repair one or more findings (their codes and
+//! pointers) and how safe they are. Each fixer ([`fixers::FIXERS`], one table from code to
+//! fixer, one small unit per fixer) proposes the edits for one finding; [`plan`] merges the
+//! proposals that make the same edits into one fix. A file is then checked once
+//! ([`Fixing::check`]): its fixes are applied together through the same splice editor as
+//! migrate, in one pass, and the fixed text is validated again; a fix that would leave its
+//! finding, or bring another, is refused with the reason and the others are tried without it.
+//! That one plan is every view of the run: the fixes written by `--fix`, the diff `--diff`
+//! prints, the text edits of the JSON and SARIF reports and the "fixable" counts.
+//!
+//! Which codes are fixable, and how safely, is said by the code registry itself
+//! ([`crate::diagnostics::Code::fix`]), from which `velvet codes` and docs/codes.md are
+//! written; a test holds the registry and this table to each other.
+
+pub mod clamp;
+pub mod declare;
+pub mod fixers;
+pub mod fuzz_roughness;
+pub mod legacy;
+pub mod texcoord;
+pub mod text;
+pub mod texture;
+
+use crate::asset::tape::Node;
+use crate::asset::{self, Asset, Container};
+use crate::diagnostics::fixes::{FileFixes, FixStatus, FixView, Repair, TextEdit};
+use crate::diagnostics::{codes::IO_ERROR, Diagnostic, Safety, Settings};
+use crate::edit::Edit;
+use crate::validate::{FileReport, Finding, Validator};
+use rayon::prelude::*;
+use std::collections::HashMap;
+use std::path::Path;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// One fix: the findings it repairs, how safe it is, what it does and its edits.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Fix {
+    pub repairs: Vec<Repair>,
+    pub safety: Safety,
+    pub title: String,
+    pub edits: Vec<Edit>,
+}
+
+/// The fixes for `findings` of `asset`, in the order of the findings they first repair. Fixes
+/// that make the same edits are one fix repairing each of their findings.
+pub fn plan(asset: &Asset, findings: &[Finding]) -> Vec<Fix> {
+    let mut fixes: Vec<Fix> = Vec::new();
+    // Each fix by its safety and edits, as text: a document may have a fix per material.
+    let mut by_edits: HashMap<String, usize> = HashMap::new();
+    for finding in findings {
+        let d: &Diagnostic = &finding.diagnostic;
+        let Some(fixer) = fixers::fixer_for(d.code) else {
+            continue;
+        };
+        let Some(proposal) = (fixer.propose)(asset, d) else {
+            continue;
+        };
+        let repair = Repair {
+            code: fixer.code.name,
+            pointer: d.pointer.clone(),
+            message: d.message.clone(),
+        };
+        let key = format!("{:?} {:?}", fixer.safety, proposal.edits);
+        match by_edits.get(&key) {
+            Some(&i) => fixes[i].repairs.push(repair),
+            None => {
+                by_edits.insert(key, fixes.len());
+                fixes.push(Fix {
+                    repairs: vec![repair],
+                    safety: fixer.safety,
+                    title: proposal.title,
+                    edits: proposal.edits,
+                });
+            }
+        }
+    }
+    fixes
+}
+
+/// The edits of `fixes` as one plan for the splice editor: each distinct edit once; removals of
+/// array elements last, the highest index of each array first, so that each names the element
+/// it meant; and an array all of whose elements are removed (which glTF does not allow empty)
+/// removed whole, unless another edit adds to it.
+pub fn combined(root: Node, fixes: &[&Fix]) -> Vec<Edit> {
+    let mut edits: Vec<Edit> = Vec::new();
+    let mut seen: std::collections::HashSet<String> = std::collections::HashSet::new();
+    for edit in fixes.iter().flat_map(|f| &f.edits) {
+        if seen.insert(format!("{edit:?}")) {
+            edits.push(edit.clone());
+        }
+    }
+    let element_removal = |edit: &Edit| -> Option<(String, usize)> {
+        let Edit::Remove { pointer } = edit else {
+            return None;
+        };
+        let index = crate::asset::pointer::array_index(&fixers::last_token(pointer)?)?;
+        let parent = fixers::parent(pointer);
+        root.pointer(parent)?.as_array()?;
+        Some((parent.to_string(), index))
+    };
+    let (mut removals, rest): (Vec<(String, usize)>, Vec<Edit>) = {
+        let mut removals = Vec::new();
+        let mut rest = Vec::new();
+        for edit in edits {
+            match element_removal(&edit) {
+                Some(r) => removals.push(r),
+                None => rest.push(edit),
+            }
+        }
+        (removals, rest)
+    };
+    removals.sort_by(|a, b| a.0.cmp(&b.0).then(b.1.cmp(&a.1)));
+    let mut out = rest;
+    let mut i = 0;
+    while i < removals.len() {
+        let parent = removals[i].0.clone();
+        let count = removals[i..].iter().take_while(|r| r.0 == parent).count();
+        let len = root
+            .pointer(&parent)
+            .and_then(|a| a.as_array())
+            .map_or(0, |a| a.len());
+        let added_to = out.iter().any(|e| match e {
+            Edit::DeclareUsed { .. } => parent == "/extensionsUsed",
+            Edit::Set { pointer, .. }
+            | Edit::Replace { pointer, .. }
+            | Edit::Remove { pointer } => pointer.starts_with(&format!("{parent}/")),
+        });
+        if count == len && !added_to && !parent.is_empty() {
+            out.push(Edit::remove(parent.clone()));
+        } else {
+            out.extend(
+                removals[i..i + count]
+                    .iter()
+                    .map(|(p, k)| Edit::remove(format!("{p}/{k}"))),
+            );
+        }
+        i += count;
+    }
+    out
+}
+
+/// What a validate run does with fixes.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Mode {
+    /// `--fix`: write the fixes into the files.
+    pub apply: bool,
+    /// `--diff`: show the fixes as a unified diff; write nothing.
+    pub diff: bool,
+    /// `--unsafe-fixes`: apply unsafe fixes too.
+    pub unsafe_fixes: bool,
+    /// Give each fix its edits of the text (the JSON and SARIF reports show them; a text
+    /// report does not, and a document with thousands of fixes is spared working them out).
+    pub edits: bool,
+}
+
+impl Mode {
+    fn changes(self) -> bool {
+        self.apply || self.diff
+    }
+
+    /// Whether a fix of `safety` is applied in this mode (when it changes anything).
+    pub fn applies(self, safety: Safety) -> bool {
+        safety == Safety::Safe || self.unsafe_fixes
+    }
+}
+
+/// The UTF-8 byte-order mark, the only thing a .gltf's JSON text may follow in its file.
+const BYTE_ORDER_MARK: [u8; 3] = [0xEF, 0xBB, 0xBF];
+
+/// The most fixes of one file tried one by one when they fail together.
+const TRIED_ONE_BY_ONE: usize = 32;
+
+/// A validate run's files checked, fixed or shown with their fixes (see the module comment).
+pub struct Fixing<'v> {
+    validator: &'v Validator,
+    mode: Mode,
+    changed: AtomicUsize,
+}
+
+/// A file with fixes applied, validated again.
+struct Fixed {
+    /// Whether the edits changed the document (a GLB's bytes are repacked either way).
+    changed: bool,
+    bytes: Vec<u8>,
+    json_text: String,
+    report: FileReport,
+}
+
+impl<'v> Fixing<'v> {
+    pub fn new(validator: &'v Validator, mode: Mode) -> Fixing<'v> {
+        Fixing {
+            validator,
+            mode,
+            changed: AtomicUsize::new(0),
+        }
+    }
+
+    /// How many files the run changed (or, with `--diff`, would change).
+    pub fn files_changed(&self) -> usize {
+        self.changed.load(Ordering::Relaxed)
+    }
+
+    /// The file at `path` validated under `settings`, its fixes planned and, as the mode says,
+    /// applied: the report of the file as it is after the run, with its fixes.
+    pub fn check(&self, path: &Path, settings: &Settings) -> FileReport {
+        let load = &self.validator.load;
+        let (loaded, snapshot) = if self.mode.apply {
+            match asset::read_for_writing(path, load) {
+                Ok((bytes, snapshot)) => (asset::load_read(path, bytes, load).0, Some(snapshot)),
+                Err(_) => (asset::load_with(path, load), None),
+            }
+        } else {
+            (asset::load_with(path, load), None)
+        };
+        self.check_loaded(path, loaded, snapshot, settings, self.mode)
+    }
+
+    /// [`Fixing::check`] of a file loaded (`snapshot`: what it was when read, for writing it),
+    /// in `mode`.
+    fn check_loaded(
+        &self,
+        path: &Path,
+        loaded: asset::Loaded,
+        snapshot: Option<asset::Snapshot>,
+        settings: &Settings,
+        mode: Mode,
+    ) -> FileReport {
+        let Some(source) = loaded.asset else {
+            return self.validator.validate_loaded_with(path, loaded, settings);
+        };
+        // Every finding is planned for and compared, also those a --max-issues cap leaves out
+        // of the listing.
+        let unlimited = Settings {
+            max_issues: None,
+            ..settings.clone()
+        };
+        let before = self
+            .validator
+            .validate_asset(path, &source, loaded.diagnostics, &unlimited);
+        let fixes = plan(&source, &before.findings);
+        if fixes.is_empty() {
+            return capped(before, settings);
+        }
+        let wanted: Vec<usize> = (0..fixes.len())
+            .filter(|&i| !mode.changes() || mode.applies(fixes[i].safety))
+            .collect();
+        let (accepted, refused, fixed) =
+            self.choose(path, &source, &before, &fixes, &wanted, &unlimited);
+        let edits = if mode.edits && source.container == Container::Gltf {
+            all_text_edits(&source, &fixes)
+        } else {
+            vec![Vec::new(); fixes.len()]
+        };
+        let changed = fixed
+            .as_ref()
+            .filter(|f| {
+                mode.changes()
+                    && !accepted.is_empty()
+                    && f.changed
+                    && f.bytes != file_bytes(&source)
+            })
+            .is_some();
+        let mut statuses = vec![FixStatus::Available; fixes.len()];
+        if changed {
+            for &i in &accepted {
+                statuses[i] = FixStatus::Applied;
+            }
+        }
+        for (i, reason) in refused {
+            statuses[i] = FixStatus::Refused(reason);
+        }
+        let views: Vec<FixView> = fixes
+            .into_iter()
+            .zip(edits)
+            .zip(statuses)
+            .map(|((fix, edits), status)| FixView {
+                repairs: fix.repairs,
+                safety: fix.safety,
+                title: fix.title,
+                edits,
+                status,
+            })
+            .collect();
+        let mut file_fixes = FileFixes::new(views);
+        file_fixes.changed = changed;
+        let Some(fixed) = fixed.filter(|_| changed) else {
+            let mut report = capped(before, settings);
+            report.fixes = file_fixes;
+            return report;
+        };
+        if mode.diff {
+            let name = crate::asset::discover::display_path(path);
+            let before_text = source.json_text.trim_end_matches(['\0', ' ']);
+            let after_text = fixed.json_text.trim_end_matches(['\0', ' ']);
+            file_fixes.diff = Some(text::unified_diff(&name, before_text, after_text));
+        } else {
+            let written = match &snapshot {
+                Some(snapshot) => snapshot.unchanged(path),
+                None => Err(format!("{} could not be read for writing", path.display())),
+            }
+            .and_then(|()| {
+                crate::edit::write::write_atomic(path, &fixed.bytes)
+                    .map_err(|e| format!("cannot write {}: {e}", path.display()))
+            });
+            if let Err(e) = written {
+                // Nothing was written: the file's findings stand, and the run fails.
+                let mut report = capped(before, settings);
+                file_fixes.refuse_applied(&format!("not written: {e}"));
+                file_fixes.write_error = Some(e.clone());
+                report.findings.push(Finding {
+                    diagnostic: Diagnostic::new(&IO_ERROR, "", e),
+                    position: None,
+                });
+                report.counts.errors += 1;
+                report.fixes = file_fixes;
+                return report;
+            }
+        }
+        self.changed.fetch_add(1, Ordering::Relaxed);
+        if mode.diff {
+            // The file is as it was: the fixes left are given against its text.
+            let mut report = capped(fixed.report, settings);
+            report.fixes = file_fixes;
+            return report;
+        }
+        // The report of the file as written: its findings, and the fixes left for them planned
+        // against its new text (an unsafe fix not asked for, a refused one), with this run's.
+        let loaded = asset::load_bytes_with(path, &fixed.bytes, &self.validator.load);
+        let review = Mode {
+            apply: false,
+            diff: false,
+            ..mode
+        };
+        let mut report = self.check_loaded(path, loaded, None, settings, review);
+        let mut all: Vec<FixView> = file_fixes
+            .fixes()
+            .iter()
+            .filter(|f| f.status == FixStatus::Applied)
+            .cloned()
+            .collect();
+        all.extend(report.fixes.fixes().iter().cloned());
+        report.fixes = FileFixes::new(all);
+        report.fixes.changed = true;
+        report
+    }
+
+    /// The fixes of `wanted` that can be applied together, the refused ones with the reason,
+    /// and the file with the accepted ones applied. All are tried at once first; when that
+    /// fails, one by one (the first [`TRIED_ONE_BY_ONE`]), each kept if the file with it and
+    /// those kept before is still as meant.
+    #[allow(clippy::type_complexity)]
+    fn choose(
+        &self,
+        path: &Path,
+        source: &Asset,
+        before: &FileReport,
+        fixes: &[Fix],
+        wanted: &[usize],
+        settings: &Settings,
+    ) -> (Vec<usize>, Vec<(usize, String)>, Option<Fixed>) {
+        if wanted.is_empty() {
+            return (Vec::new(), Vec::new(), None);
+        }
+        let all: Vec<&Fix> = wanted.iter().map(|&i| &fixes[i]).collect();
+        if let Ok(fixed) = self.attempt(path, source, before, &all, settings) {
+            return (wanted.to_vec(), Vec::new(), Some(fixed));
+        }
+        let mut accepted = Vec::new();
+        let mut refused = Vec::new();
+        let mut fixed = None;
+        for (n, &i) in wanted.iter().enumerate() {
+            if n >= TRIED_ONE_BY_ONE {
+                refused.push((
+                    i,
+                    "not tried: too many fixes of this file fail together; run --fix again"
+                        .to_string(),
+                ));
+                continue;
+            }
+            let mut trial: Vec<&Fix> = accepted.iter().map(|&a| &fixes[a]).collect();
+            trial.push(&fixes[i]);
+            match self.attempt(path, source, before, &trial, settings) {
+                Ok(f) => {
+                    accepted.push(i);
+                    fixed = Some(f);
+                }
+                Err(reason) => refused.push((i, reason)),
+            }
+        }
+        (accepted, refused, fixed)
+    }
+
+    /// `fixes` applied to `source` in one pass, and the result validated: `Err` with the
+    /// reason when it does not load, still has a finding a fix repairs, or has one `before`
+    /// did not.
+    fn attempt(
+        &self,
+        path: &Path,
+        source: &Asset,
+        before: &FileReport,
+        fixes: &[&Fix],
+        settings: &Settings,
+    ) -> Result<Fixed, String> {
+        let edits = combined(source.root(), fixes);
+        let (output, changed) = match crate::edit::write::spliced_bytes(source, &edits) {
+            Ok(Some(spliced)) => spliced,
+            Ok(None) => return Err("its edits could not be spliced into the file's text".into()),
+            Err(e) => return Err(format!("its edits do not apply: {e}")),
+        };
+        let mut bytes: Vec<u8> = match output {
+            crate::edit::write::Output::Bytes(bytes) => bytes.into_owned(),
+            crate::edit::write::Output::Spliced(spliced) => spliced.to_text().into_bytes(),
+        };
+        if source.container == Container::Gltf && source.json_offset > 0 {
+            // What came before the text (a byte-order mark, which has its own finding) stays:
+            // a fix changes only what it says.
+            let mut file = BYTE_ORDER_MARK[..source.json_offset.min(3)].to_vec();
+            file.append(&mut bytes);
+            bytes = file;
+        }
+        let loaded = asset::load_bytes_with(path, &bytes, &self.validator.load);
+        let Some(after) = loaded.asset else {
+            return Err("the fixed file would not load".into());
+        };
+        let report = self
+            .validator
+            .validate_asset(path, &after, loaded.diagnostics, settings);
+        verdict(&before.findings, &report.findings, fixes)?;
+        Ok(Fixed {
+            changed,
+            json_text: after.json_text.to_string(),
+            bytes,
+            report,
+        })
+    }
+}
+
+/// The file's bytes as read, when the asset kept them (a .gltf); otherwise the JSON text (for
+/// comparing a fixed .gltf; a .glb's fixed bytes never equal its JSON).
+fn file_bytes(asset: &Asset) -> &[u8] {
+    asset
+        .file_bytes()
+        .unwrap_or_else(|| asset.json_text.as_bytes())
+}
+
+/// Whether the findings `after` fixing are those `before` without the ones `fixes` repair
+/// (counted by code and message: a pointer into an array moves when an element before it is
+/// removed). More are fine (a fix may repair more than it says); another, or one left, is not.
+fn verdict(before: &[Finding], after: &[Finding], fixes: &[&Fix]) -> Result<(), String> {
+    let mut excess: HashMap<(&str, &str), i64> = HashMap::new();
+    for f in after {
+        *excess
+            .entry((f.diagnostic.code, f.diagnostic.message.as_str()))
+            .or_default() += 1;
+    }
+    for f in before {
+        *excess
+            .entry((f.diagnostic.code, f.diagnostic.message.as_str()))
+            .or_default() -= 1;
+    }
+    let repairs: Vec<&Repair> = fixes.iter().flat_map(|f| &f.repairs).collect();
+    for r in &repairs {
+        *excess.entry((r.code, r.message.as_str())).or_default() += 1;
+    }
+    // The first finding of `after` in excess, in report order.
+    for f in after {
+        let key = (f.diagnostic.code, f.diagnostic.message.as_str());
+        if excess.get(&key).copied().unwrap_or(0) > 0 {
+            let left = repairs.iter().any(|r| (r.code, r.message.as_str()) == key);
+            return Err(if left {
+                format!("the fixed file would still have {}", f.diagnostic.code)
+            } else {
+                format!(
+                    "the fixed file would have {} ({})",
+                    f.diagnostic.code, f.diagnostic.message
+                )
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The edits of the JSON text each of `fixes` makes alone. A fix that edits within one element
+/// of a top-level array that no other fix edits (a material's fix, of which a document may
+/// have thousands) is spliced together with the others of its kind, in one pass, and each
+/// replacement goes to the fix whose element holds it; the others are spliced one by one.
+fn all_text_edits(source: &Asset, fixes: &[Fix]) -> Vec<Vec<TextEdit>> {
+    let root = source.root();
+    let text = source.json_text.as_str();
+    let units: Vec<Option<(String, std::ops::Range<usize>)>> =
+        fixes.iter().map(|fix| element_of(root, fix)).collect();
+    let mut count: HashMap<&str, usize> = HashMap::new();
+    for (pointer, _) in units.iter().flatten() {
+        *count.entry(pointer.as_str()).or_default() += 1;
+    }
+    let (mut batched, mut alone): (Vec<usize>, Vec<usize>) = (0..fixes.len()).partition(|&i| {
+        units[i]
+            .as_ref()
+            .is_some_and(|(p, _)| count[p.as_str()] == 1)
+    });
+    let mut out = vec![Vec::new(); fixes.len()];
+    if !batched.is_empty() {
+        let together: Vec<&Fix> = batched.iter().map(|&i| &fixes[i]).collect();
+        let edits = combined(root, &together);
+        let placed = match crate::edit::splice::splice_edits(text, root, &edits) {
+            Ok(Some((spliced, _))) => {
+                let replacements = text::replacements(text, &spliced);
+                let edits = text::text_edits(text, &replacements);
+                batched.sort_by_key(|&i| units[i].as_ref().map_or(0, |(_, s)| s.start));
+                let spans: Vec<&std::ops::Range<usize>> = batched
+                    .iter()
+                    .filter_map(|&i| units[i].as_ref().map(|(_, s)| s))
+                    .collect();
+                let mut placed = vec![Vec::new(); fixes.len()];
+                let all_placed = replacements.iter().zip(edits).all(|(r, edit)| {
+                    let k = spans.partition_point(|s| s.start <= r.start);
+                    match k.checked_sub(1) {
+                        Some(k) if r.end <= spans[k].end => {
+                            placed[batched[k]].push(edit);
+                            true
+                        }
+                        _ => false,
+                    }
+                });
+                all_placed.then_some(placed)
+            }
+            _ => None,
+        };
+        match placed {
+            Some(placed) => {
+                for (slot, edits) in out.iter_mut().zip(placed) {
+                    if !edits.is_empty() {
+                        *slot = edits;
+                    }
+                }
+            }
+            None => alone.append(&mut batched),
+        }
+    }
+    let done: Vec<(usize, Vec<TextEdit>)> = alone
+        .par_iter()
+        .map(|&i| (i, fix_text_edits(source, &fixes[i])))
+        .collect();
+    for (i, edits) in done {
+        out[i] = edits;
+    }
+    out
+}
+
+/// The element of a top-level array (`/materials/3`) within which every edit of `fix` lies,
+/// with its span, if there is one.
+fn element_of(root: Node, fix: &Fix) -> Option<(String, std::ops::Range<usize>)> {
+    let mut unit: Option<(String, std::ops::Range<usize>)> = None;
+    for edit in &fix.edits {
+        let pointer = match edit {
+            Edit::Set { pointer, .. }
+            | Edit::Replace { pointer, .. }
+            | Edit::Remove { pointer } => pointer,
+            Edit::DeclareUsed { .. } => return None,
+        };
+        let mut tokens = pointer.splitn(4, '/');
+        tokens.next();
+        let (member, index) = (tokens.next()?, tokens.next()?);
+        // Within the element, not the element itself.
+        tokens.next()?;
+        crate::asset::pointer::array_index(index)?;
+        let at = format!("/{member}/{index}");
+        if unit.as_ref().is_some_and(|(u, _)| *u != at) {
+            return None;
+        }
+        let span = root.pointer(&at)?.span();
+        unit = Some((at, span));
+    }
+    unit
+}
+
+/// The edits of the JSON text that `fix` makes alone.
+fn fix_text_edits(source: &Asset, fix: &Fix) -> Vec<TextEdit> {
+    let edits = combined(source.root(), &[fix]);
+    let text = source.json_text.as_str();
+    match crate::edit::splice::splice_edits(text, source.root(), &edits) {
+        Ok(Some((spliced, true))) => text::text_edits(text, &text::replacements(text, &spliced)),
+        _ => Vec::new(),
+    }
+}
+
+/// `report` (of every finding) with `settings`' cap on the listing, as a validation under
+/// `settings` lists it: the most severe findings kept.
+fn capped(mut report: FileReport, settings: &Settings) -> FileReport {
+    if let Some(max) = settings
+        .max_issues
+        .filter(|max| report.findings.len() > *max)
+    {
+        report.findings.sort_by_key(|f| f.diagnostic.severity);
+        report.omitted = report.findings.len() - max;
+        report.findings.truncate(max);
+    }
+    report
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rules::all_codes;
+
+    fn load(text: &str) -> Asset {
+        asset::load_bytes(Path::new("m.gltf"), text.as_bytes())
+            .asset
+            .expect("the document loads")
+    }
+
+    fn fix(edits: Vec<Edit>) -> Fix {
+        Fix {
+            repairs: Vec::new(),
+            safety: Safety::Safe,
+            title: String::new(),
+            edits,
+        }
+    }
+
+    fn finding(code: &'static crate::diagnostics::Code, pointer: &str, message: &str) -> Finding {
+        Finding {
+            diagnostic: Diagnostic::new(code, pointer, message),
+            position: None,
+        }
+    }
+
+    #[test]
+    fn removals_from_one_array_go_last_highest_index_first_and_an_emptied_array_goes_whole() {
+        let asset = load(r#"{"asset":{"version":"2.0"},"extensionsUsed":["A","B","C"]}"#);
+        let (a, b) = (
+            fix(vec![Edit::remove("/extensionsUsed/0")]),
+            fix(vec![Edit::remove("/extensionsUsed/1")]),
+        );
+        assert_eq!(
+            combined(asset.root(), &[&a, &b]),
+            [
+                Edit::remove("/extensionsUsed/1"),
+                Edit::remove("/extensionsUsed/0")
+            ]
+        );
+        let c = fix(vec![Edit::remove("/extensionsUsed/2")]);
+        assert_eq!(
+            combined(asset.root(), &[&a, &b, &c]),
+            [Edit::remove("/extensionsUsed")]
+        );
+        // Kept when another fix declares an extension in it; each distinct edit once.
+        let d = fix(vec![Edit::declare_used("D")]);
+        assert_eq!(
+            combined(asset.root(), &[&a, &b, &c, &d, &d]),
+            [
+                Edit::declare_used("D"),
+                Edit::remove("/extensionsUsed/2"),
+                Edit::remove("/extensionsUsed/1"),
+                Edit::remove("/extensionsUsed/0"),
+            ]
+        );
+    }
+
+    #[test]
+    fn findings_one_edit_repairs_are_one_fix() {
+        use crate::rules::declaration::{UNDECLARED_EXTENSION, UNUSED_EXTENSION_REQUIRED};
+        let asset = load(
+            r#"{"asset":{"version":"2.0"},"extensionsRequired":["KHR_materials_sheen"],"materials":[{"extensions":{"KHR_materials_sheen":{}}}]}"#,
+        );
+        let findings = [
+            finding(
+                &UNDECLARED_EXTENSION,
+                "/materials/0/extensions/KHR_materials_sheen",
+                "u",
+            ),
+            finding(&UNUSED_EXTENSION_REQUIRED, "/extensionsRequired/0", "r"),
+        ];
+        let fixes = plan(&asset, &findings);
+        assert_eq!(fixes.len(), 1, "{fixes:?}");
+        assert_eq!(fixes[0].edits, [Edit::declare_used("KHR_materials_sheen")]);
+        let codes: Vec<&str> = fixes[0].repairs.iter().map(|r| r.code).collect();
+        assert_eq!(
+            codes,
+            [UNDECLARED_EXTENSION.name, UNUSED_EXTENSION_REQUIRED.name]
+        );
+    }
+
+    #[test]
+    fn the_verdict_names_a_finding_left_or_one_brought() {
+        use crate::diagnostics::codes::VALUE_NOT_IN_RANGE;
+        use crate::rules::disabled_layer::SHEEN_TEXTURE_WITHOUT_EFFECT;
+        let before = [finding(&VALUE_NOT_IN_RANGE, "/a", "too big")];
+        let mut f = fix(Vec::new());
+        f.repairs.push(Repair {
+            code: VALUE_NOT_IN_RANGE.name,
+            pointer: "/a".into(),
+            message: "too big".into(),
+        });
+        assert_eq!(verdict(&before, &[], &[&f]), Ok(()));
+        assert_eq!(
+            verdict(&before, &before, &[&f]),
+            Err("the fixed file would still have VALUE_NOT_IN_RANGE".into())
+        );
+        let brought = [finding(&SHEEN_TEXTURE_WITHOUT_EFFECT, "/b", "no effect")];
+        assert_eq!(
+            verdict(&before, &brought, &[&f]),
+            Err(
+                "the fixed file would have KHR_MATERIALS_SHEEN_TEXTURE_WITHOUT_EFFECT (no effect)"
+                    .into()
+            )
+        );
+        // A finding that moved (an array element before it removed) is the same finding.
+        let moved = [finding(&SHEEN_TEXTURE_WITHOUT_EFFECT, "/c/0", "no effect")];
+        let was = [finding(&SHEEN_TEXTURE_WITHOUT_EFFECT, "/c/1", "no effect")];
+        assert_eq!(verdict(&was, &moved, &[]), Ok(()));
+    }
+
+    #[test]
+    fn the_registry_says_which_codes_are_fixable_as_the_fixers_table_does() {
+        for code in all_codes() {
+            let fixer = fixers::fixer_for(code.name);
+            assert_eq!(
+                code.fix,
+                fixer.map(|f| f.safety),
+                "{}: the registry and the fixers table disagree",
+                code.name
+            );
+        }
+        for fixer in fixers::FIXERS {
+            assert!(
+                all_codes().iter().any(|c| c.name == fixer.code.name),
+                "{} has a fixer but is not registered",
+                fixer.code.name
+            );
+        }
+    }
+}
