@@ -2,9 +2,11 @@
 //! KHR_materials_fuzz.
 //!
 //! The flow is one way: load ([`asset`]) → validate ([`validate`], [`rules`]) → report
-//! ([`report`]), and [`fix`] repairs what it can of the findings; [`migrate`] and [`bake`] plan and apply edits, and share [`output`] for
-//! where their outputs go; [`preview`] draws contact sheets of what a migration does to each
-//! material. The binary in `main.rs` only parses arguments and maps outcomes to exit codes.
+//! ([`report`]), and [`fix`] repairs what it can of the findings; [`migrate`] and [`bake`]
+//! plan and apply edits, and share [`output`] for where their outputs go; [`preview`] draws
+//! contact sheets of what a migration does to each material. [`command`] runs each of them as
+//! the command line does, on one spine; the binary in `main.rs` only parses arguments into its
+//! requests and maps the status a command returns to the exit code.
 
 pub mod asset;
 pub mod bake;
