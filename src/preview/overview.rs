@@ -67,13 +67,33 @@ impl WorstSheets {
     }
 }
 
-/// The overview picture's PNG bytes: the histogram of `flips` (one per sheet drawn) and `worst`.
-pub fn png(flips: &[f64], worst: &[Worst]) -> Vec<u8> {
+/// How many of `flips` fall in each bin of the histogram ([`BIN`] wide from 0, the last bin
+/// holding everything above).
+pub fn histogram(flips: &[f64]) -> [usize; BINS] {
     let mut counts = [0usize; BINS];
     for &f in flips {
         let bin = ((f / BIN).floor().max(0.0) as usize).min(BINS - 1);
         counts[bin] += 1;
     }
+    counts
+}
+
+/// How many of `flips` are same, close and visible.
+pub fn verdict_counts(flips: &[f64]) -> [usize; 3] {
+    let mut counts = [0; 3];
+    for &f in flips {
+        counts[match Verdict::from_flip(f) {
+            Verdict::Same => 0,
+            Verdict::Close => 1,
+            Verdict::Visible => 2,
+        }] += 1;
+    }
+    counts
+}
+
+/// The overview picture's PNG bytes: the histogram of `flips` (one per sheet drawn) and `worst`.
+pub fn png(flips: &[f64], worst: &[Worst]) -> Vec<u8> {
+    let counts = histogram(flips);
     let tallest = counts.iter().copied().max().unwrap_or(0).max(1);
     let plot_w = BINS * BAR_W;
     let left = MARGIN + font::width("100%") + 8;

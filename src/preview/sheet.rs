@@ -444,11 +444,8 @@ pub fn render(title: &str, material: &Material) -> Sheet {
         .collect();
 
     // ꟻLIP of column 1 against column 0, per row, over the sphere's pixels.
-    let on_sphere: Vec<bool> = render_sphere(&shaded[0], Light::Furnace, SPHERE)
-        .coverage
-        .iter()
-        .map(|&c| c > 0.5)
-        .collect();
+    // Coverage is the sphere's outline, the same for every look and light.
+    let on_sphere: Vec<bool> = rendered[0][0].coverage.iter().map(|&c| c > 0.5).collect();
     let flips: Vec<f64> = spheres
         .par_iter()
         .map(|row| flip_p99(&row[0], &row[1], &on_sphere))
@@ -647,10 +644,9 @@ impl Canvas {
         font::draw(text, x, y, |px, py, coverage| {
             if px < self.width && py < self.height {
                 let i = 3 * (py * self.width + px);
-                for k in 0..3 {
-                    let under = f32::from(self.rgb[i + k]);
-                    let over = f32::from(c[k]);
-                    self.rgb[i + k] = (under + (over - under) * coverage).round() as u8;
+                for (under, over) in self.rgb[i..i + 3].iter_mut().zip(c) {
+                    let (u, o) = (f32::from(*under), f32::from(over));
+                    *under = (u + (o - u) * coverage).round() as u8;
                 }
             }
         });
@@ -678,23 +674,12 @@ pub fn rgb_png(rgb: &[u8], width: usize, height: usize) -> Vec<u8> {
     out
 }
 
-/// `sheet` scaled down by `factor` (each output pixel the mean of a factor × factor block).
+/// `sheet` scaled down by `factor`, by `image`'s thumbnail filter (an area average).
 pub fn thumbnail(sheet: &Sheet, factor: usize) -> (Vec<u8>, usize, usize) {
     let (w, h) = (sheet.width / factor, sheet.height / factor);
-    let mut out = Vec::with_capacity(3 * w * h);
-    for y in 0..h {
-        for x in 0..w {
-            for k in 0..3 {
-                let mut sum = 0u32;
-                for dy in 0..factor {
-                    for dx in 0..factor {
-                        let i = 3 * ((y * factor + dy) * sheet.width + x * factor + dx) + k;
-                        sum += u32::from(sheet.rgb[i]);
-                    }
-                }
-                out.push(((sum + (factor * factor / 2) as u32) / (factor * factor) as u32) as u8);
-            }
-        }
-    }
-    (out, w, h)
+    let image =
+        image::RgbImage::from_raw(sheet.width as u32, sheet.height as u32, sheet.rgb.clone())
+            .expect("a sheet holds width × height RGB pixels");
+    let small = image::imageops::thumbnail(&image, w as u32, h as u32);
+    (small.into_raw(), w, h)
 }
