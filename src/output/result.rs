@@ -148,7 +148,7 @@ mod tests {
             Totals::of(&files),
             Totals {
                 files: 4,
-                changed: 2 - 1,
+                changed: 1,
                 unchanged: 2,
                 failed: 1,
                 would_change: 0,

@@ -77,8 +77,8 @@ pub fn command(request: &Request, shard: Option<Shard>, view: &View) -> Status {
     }
     let failed =
         report.failed() || preview_failed || (view.check && report.summary.totals.would_change > 0);
-    // The process ends next: a library's report (a plan for every material) is left to the
-    // exit rather than freed value by value.
+    // The command line exits after this: a library's report (a plan for every material) is
+    // left to the exit rather than freed value by value.
     std::mem::forget(report);
     Status::failed_if(failed)
 }
