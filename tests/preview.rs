@@ -1308,3 +1308,36 @@ fn a_sheen_above_one_at_grazing_views_is_marked_and_noted() {
         0
     );
 }
+
+#[test]
+fn migrate_preview_draws_the_plans_migrate_wrote_and_no_sheet_for_a_file_it_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = write(dir.path(), "good.gltf", &gltf(&sheen("cloth", 0.8, 0.5)));
+    // A sheen colour texture naming a texture the asset lacks: migrate refuses the file.
+    let refused = write(
+        dir.path(),
+        "dangling.gltf",
+        &gltf(
+            r#"{"extensions": {"KHR_materials_sheen": {"sheenColorFactor": [1, 1, 1], "sheenColorTexture": {"index": 4}}}}"#,
+        ),
+    );
+    let sheets = dir.path().join("sheets");
+    let o = run_velvet(&[
+        "migrate",
+        good.to_str().unwrap(),
+        refused.to_str().unwrap(),
+        "--out-dir",
+        dir.path().join("out").to_str().unwrap(),
+        "--preview",
+        sheets.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("velvet: preview: ")
+            && err.contains("dangling.gltf")
+            && err.contains("cannot be migrated"),
+        "{err}"
+    );
+    assert_eq!(pngs(&sheets), ["good-m0-cloth.png"]);
+}

@@ -146,27 +146,43 @@ fn sheet_name(entry: &Entry) -> String {
     name + ".png"
 }
 
+/// The folders a search for assets could not read, with why.
+pub type WalkErrors = Vec<(PathBuf, std::io::Error)>;
+
+/// One file's part of a preview: its path, its label and its materials as migrate's plan of it
+/// writes them, or why it has none.
+pub struct FileMaterials {
+    pub file: PathBuf,
+    pub label: String,
+    pub materials: Result<Vec<material::Material>, String>,
+}
+
+/// The labels of the files `velvet preview` or `migrate --preview` finds under `inputs` (the
+/// files of `shard`), by path, and the folders it could not read.
+pub fn labels(
+    inputs: &[PathBuf],
+    shard: Option<discover::Shard>,
+) -> (Vec<(PathBuf, String)>, WalkErrors) {
+    let (found, walk_errors) = discover::find(inputs, shard);
+    let labels = found
+        .iter()
+        .map(|f| (f.path.clone(), label(f, inputs)))
+        .collect();
+    (labels, walk_errors)
+}
+
 /// Reads every asset under `inputs` and plans its sheets; draws and writes nothing. Each
-/// asset's migration is planned with `options` (`velvet preview`: the defaults; `migrate
-/// --preview`: the run's), and the sheets show what that plan writes. Materials whose
-/// appearance is the same ([`material::Material::appearance`]) share one sheet, named and
-/// titled after the first of them.
+/// asset's migration is planned with `options` (`velvet preview`'s defaults), and the sheets
+/// show what that plan writes (`migrate --preview` hands [`assemble`] the materials of the
+/// plans it writes instead).
 pub fn plan(inputs: &[PathBuf], options: &crate::migrate::Options) -> Plan {
-    let (found, walk_errors) = discover::find(inputs, None);
-    let mut plan = Plan::default();
-    for (path, e) in walk_errors {
-        plan.failures.push(Failure {
-            file: path,
-            message: format!("cannot read this folder: {e}"),
-        });
-    }
+    let (labels, walk_errors) = labels(inputs, None);
     // Load and read the materials of each file (in parallel over files).
-    type Read = Result<Vec<material::Material>, String>;
-    let files: Vec<(PathBuf, String, Read)> = found
-        .par_iter()
-        .map(|f| {
-            let loaded = crate::asset::load_with(&f.path, &options.load);
-            let result = match loaded.asset {
+    let files: Vec<FileMaterials> = labels
+        .into_par_iter()
+        .map(|(file, label)| {
+            let loaded = crate::asset::load_with(&file, &options.load);
+            let materials = match loaded.asset {
                 Some(asset) => {
                     let plan = crate::migrate::plan_document(&asset, options);
                     Ok(material::materials(&asset, &plan, options.roughness))
@@ -178,11 +194,34 @@ pub fn plan(inputs: &[PathBuf], options: &crate::migrate::Options) -> Plan {
                     .collect::<Vec<_>>()
                     .join("; ")),
             };
-            (f.path.clone(), label(f, inputs), result)
+            FileMaterials {
+                file,
+                label,
+                materials,
+            }
         })
         .collect();
+    assemble(files, walk_errors)
+}
+
+/// The plan of a preview of `files` (in input order) and the folders that could not be read:
+/// materials whose appearance is the same ([`material::Material::appearance`]) share one
+/// sheet, named and titled after the first of them, and the sheets are ranked worst first.
+pub fn assemble(files: Vec<FileMaterials>, walk_errors: WalkErrors) -> Plan {
+    let mut plan = Plan::default();
+    for (path, e) in walk_errors {
+        plan.failures.push(Failure {
+            file: path,
+            message: format!("cannot read this folder: {e}"),
+        });
+    }
     let mut materials = Vec::new();
-    for (path, label, result) in files {
+    for FileMaterials {
+        file: path,
+        label,
+        materials: result,
+    } in files
+    {
         match result {
             Err(message) => plan.failures.push(Failure {
                 file: path,

@@ -45,6 +45,10 @@ pub struct MigrateDetail {
     pub textures_added: usize,
     /// Their encoded size in bytes (0 in a dry run: nothing is encoded).
     pub bytes_added: usize,
+    /// `--preview`: the materials as the sheets show them, read from this file's plan before
+    /// it was written (so `--in-place` shows them as they were).
+    #[serde(skip)]
+    pub sheets: Option<Vec<crate::preview::material::Material>>,
 }
 
 impl Account for MigrateDetail {
@@ -87,7 +91,13 @@ impl RunReport {
     }
 }
 
-fn migrate_one(job: &Job, options: &Options, dry_run: bool, claims: &Claims) -> FileResult {
+fn migrate_one(
+    job: &Job,
+    options: &Options,
+    dry_run: bool,
+    sheets: bool,
+    claims: &Claims,
+) -> FileResult {
     if let Err(stopped) = crate::output::interrupt::check() {
         return FileResult::failed(&job.input, job.output.as_deref(), stopped);
     }
@@ -95,6 +105,9 @@ fn migrate_one(job: &Job, options: &Options, dry_run: bool, claims: &Claims) -> 
         Ok(plan) => plan,
         Err(error) => return FileResult::failed(&job.input, job.output.as_deref(), error),
     };
+    let sheets = sheets.then(|| {
+        crate::preview::material::materials(&plan.asset, &plan.document, options.roughness)
+    });
     let outcome = if dry_run {
         FileOutcome::Planned {
             changes: plan.changes(),
@@ -159,6 +172,7 @@ fn migrate_one(job: &Job, options: &Options, dry_run: bool, claims: &Claims) -> 
             notes,
             textures_added,
             bytes_added,
+            sheets,
         },
     }
 }
@@ -170,6 +184,16 @@ pub fn run(request: &Request) -> Result<RunReport, UsageError> {
 
 /// Runs like [`run`] over the files of one shard only (see [`Shard`]).
 pub fn run_shard(request: &Request, shard: Option<Shard>) -> Result<RunReport, UsageError> {
+    run_shard_with_sheets(request, shard, false)
+}
+
+/// Runs like [`run_shard`]; with `sheets`, each file's result also holds its materials as
+/// `--preview` draws them, from the plan that was written.
+pub fn run_shard_with_sheets(
+    request: &Request,
+    shard: Option<Shard>,
+    sheets: bool,
+) -> Result<RunReport, UsageError> {
     let scope = Scope {
         inputs: &request.inputs,
         destination: &request.destination,
@@ -186,7 +210,7 @@ pub fn run_shard(request: &Request, shard: Option<Shard>) -> Result<RunReport, U
                 format!("cannot read folder {}: {e}", path.display()),
             )
         },
-        |job, claims| migrate_one(job, &request.options, request.dry_run, claims),
+        |job, claims| migrate_one(job, &request.options, request.dry_run, sheets, claims),
     )?;
     let summary = summarise(&files);
     Ok(RunReport {

@@ -6,11 +6,12 @@ pub mod batch;
 pub mod render;
 
 pub use batch::{
-    run, run_shard, FileOutcome, FileResult, MigrateDetail, Request, RunReport, Summary,
+    run, run_shard, run_shard_with_sheets, FileOutcome, FileResult, MigrateDetail, Request,
+    RunReport, Summary,
 };
 
 use super::{stopped, ReportFormat, Status};
-use crate::asset::discover::{self, Shard};
+use crate::asset::discover::Shard;
 use crate::output::summary::Detail;
 use std::path::PathBuf;
 
@@ -29,19 +30,6 @@ pub struct View {
 pub fn command(request: &Request, shard: Option<Shard>, view: &View) -> Status {
     // Before anything is read or written: a signal from here on stops the run cleanly.
     crate::output::interrupt::install();
-    // The sheets are planned from the inputs before they are migrated (--in-place overwrites
-    // them), and drawn after.
-    let previews = view.preview.as_ref().map(|_| {
-        let inputs: Vec<PathBuf> = match shard {
-            None => request.inputs.clone(),
-            Some(shard) => discover::find(&request.inputs, Some(shard))
-                .0
-                .into_iter()
-                .map(|f| f.path)
-                .collect(),
-        };
-        crate::preview::plan(&inputs, &request.options)
-    });
     // A list that names no asset (a change that touched none) is nothing to do, not an error.
     let report = if request.inputs.is_empty() {
         RunReport {
@@ -50,7 +38,7 @@ pub fn command(request: &Request, shard: Option<Shard>, view: &View) -> Status {
             summary: Summary::default(),
         }
     } else {
-        match run_shard(request, shard) {
+        match run_shard_with_sheets(request, shard, view.preview.is_some()) {
             Ok(report) => report,
             Err(e) => return super::usage_error(e),
         }
@@ -65,11 +53,12 @@ pub fn command(request: &Request, shard: Option<Shard>, view: &View) -> Status {
         }
         .as_bytes(),
     );
+    let mut report = report;
     let mut preview_failed = false;
-    if let (Some(dir), Some(previews)) = (&view.preview, &previews) {
-        preview_failed = super::preview::report_failures(previews, "preview: ");
-        // The sheets are drawn from the plans made before the inputs were migrated.
-        match super::preview::write(previews, dir, None, true) {
+    if let Some(dir) = &view.preview {
+        let previews = sheets_of(request, shard, &mut report);
+        preview_failed = super::preview::report_failures(&previews, "preview: ");
+        match super::preview::write(&previews, dir, None, true) {
             Some(Status::Stopped(signal)) => return Status::Stopped(signal),
             Some(_) => preview_failed = true,
             None => {}
@@ -81,4 +70,37 @@ pub fn command(request: &Request, shard: Option<Shard>, view: &View) -> Status {
     // left to the exit rather than freed value by value.
     std::mem::forget(report);
     Status::failed_if(failed)
+}
+
+/// The preview of a run: each file's materials as its plan (the one written) gave them, read
+/// before the file was written; a file migrate could not plan has no sheet, and says why.
+fn sheets_of(
+    request: &Request,
+    shard: Option<Shard>,
+    report: &mut RunReport,
+) -> crate::preview::Plan {
+    let (labels, walk_errors) = crate::preview::labels(&request.inputs, shard);
+    let mut by_path: std::collections::HashMap<PathBuf, Result<_, String>> = report
+        .files
+        .iter_mut()
+        .map(|f| {
+            let sheets = match (f.detail.sheets.take(), &f.outcome) {
+                (Some(sheets), _) => Ok(sheets),
+                (None, FileOutcome::Failed { error }) => Err(error.clone()),
+                (None, _) => Err("not planned".to_string()),
+            };
+            (f.input.clone(), sheets)
+        })
+        .collect();
+    let files = labels
+        .into_iter()
+        .map(|(file, label)| crate::preview::FileMaterials {
+            materials: by_path
+                .remove(&file)
+                .unwrap_or_else(|| Err("not planned".to_string())),
+            file,
+            label,
+        })
+        .collect();
+    crate::preview::assemble(files, walk_errors)
 }
