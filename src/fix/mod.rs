@@ -184,7 +184,8 @@ struct Fixed {
     /// Whether the edits changed the document (a GLB's bytes are repacked either way).
     changed: bool,
     bytes: Vec<u8>,
-    json_text: String,
+    /// The fixed document, loaded, and its report (of every finding).
+    asset: Asset,
     report: FileReport,
 }
 
@@ -239,6 +240,24 @@ impl<'v> Fixing<'v> {
         let before = self
             .validator
             .validate_asset(path, &source, loaded.diagnostics, &unlimited);
+        self.check_validated(path, source, before, snapshot, settings, mode)
+    }
+
+    /// [`Fixing::check_loaded`] of a document whose report (`before`, of every finding, under
+    /// `settings` uncapped) is known.
+    fn check_validated(
+        &self,
+        path: &Path,
+        source: Asset,
+        before: FileReport,
+        snapshot: Option<asset::Snapshot>,
+        settings: &Settings,
+        mode: Mode,
+    ) -> FileReport {
+        let unlimited = Settings {
+            max_issues: None,
+            ..settings.clone()
+        };
         let fixes = plan(&source, &before.findings);
         if fixes.is_empty() {
             return capped(before, settings);
@@ -300,7 +319,7 @@ impl<'v> Fixing<'v> {
         if mode.diff {
             let name = crate::asset::discover::display_path(path);
             let before_text = source.json_text.trim_end_matches(['\0', ' ']);
-            let after_text = fixed.json_text.trim_end_matches(['\0', ' ']);
+            let after_text = fixed.asset.json_text.trim_end_matches(['\0', ' ']);
             file_fixes.diff = Some(text::unified_diff(&name, before_text, after_text));
         } else {
             let written = match &snapshot {
@@ -334,13 +353,15 @@ impl<'v> Fixing<'v> {
         }
         // The report of the file as written: its findings, and the fixes left for them planned
         // against its new text (an unsafe fix not asked for, a refused one), with this run's.
-        let loaded = asset::load_bytes_with(path, &fixed.bytes, &self.validator.load);
+        // The fixed document was loaded and validated before it was written: its report
+        // stands for the file as written.
         let review = Mode {
             apply: false,
             diff: false,
             ..mode
         };
-        let mut report = self.check_loaded(path, loaded, None, settings, review);
+        let mut report =
+            self.check_validated(path, fixed.asset, fixed.report, None, settings, review);
         let mut all: Vec<FixView> = file_fixes
             .fixes()
             .iter()
@@ -437,8 +458,8 @@ impl<'v> Fixing<'v> {
         verdict(&before.findings, &report.findings, fixes)?;
         Ok(Fixed {
             changed,
-            json_text: after.json_text.to_string(),
             bytes,
+            asset: after,
             report,
         })
     }
