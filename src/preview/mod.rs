@@ -373,8 +373,17 @@ pub fn write(
     }
     let flips: Vec<f64> = written.drawn.iter().map(|d| d.summary.flip[0]).collect();
     let path = out_dir.join("overview.png");
-    write_atomic(&path, &overview::png(&flips, &worst.into_inner()))
-        .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    let chosen_sheets: Vec<(f64, bool)> = plan
+        .sheets
+        .iter()
+        .enumerate()
+        .map(|(s, sheet)| (sheet.metric, s < chosen))
+        .collect();
+    write_atomic(
+        &path,
+        &overview::png(&flips, &chosen_sheets, &worst.into_inner()),
+    )
+    .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
     written.overview = Some(path);
     for (page, html) in index::pages(plan, &written.drawn).into_iter().enumerate() {
         let path = out_dir.join(index::page_name(page));

@@ -1,7 +1,10 @@
 //! The overview of a preview run (`overview.png`): a histogram of the verdict's ꟻLIP over the
 //! sheets drawn, with the "same" and "close" thresholds marked and the bars coloured by
-//! verdict, and beside it the sheets with the largest ꟻLIP, scaled down, worst first. It is
-//! the one picture of a library: how many materials a migration moves, and which most.
+//! verdict; under it a histogram of the plan's measure over every sheet of the run, drawn or
+//! not (the measure `--worst` ranks by, known before anything is drawn), the sheets drawn in
+//! colour and the others in grey; and beside them the sheets with the largest ꟻLIP, scaled
+//! down, worst first. It is the one picture of a library: how many materials a migration
+//! moves, and which most.
 
 use super::font::{self, LINE_HEIGHT};
 use super::sheet::{self, Canvas, Verdict, CLOSE_FLIP, SAME_FLIP};
@@ -78,6 +81,28 @@ pub fn histogram(flips: &[f64]) -> [usize; BINS] {
     counts
 }
 
+/// The histogram of the plan's measure over every sheet: the bin width (the smallest of 1, 2
+/// and 5 × 10ᵏ for which [`BINS`] bins reach the largest measure) and, per bin, how many
+/// sheets were drawn and how many were not. `metrics` is one (measure, drawn) per sheet.
+pub fn metric_histogram(metrics: &[(f64, bool)]) -> (f64, [[usize; 2]; BINS]) {
+    let top = metrics
+        .iter()
+        .map(|m| m.0)
+        .filter(|m| m.is_finite())
+        .fold(0.0f64, f64::max);
+    let width = (-6..=1)
+        .flat_map(|k| [1.0, 2.0, 5.0].map(|m| m * 10f64.powi(k)))
+        .find(|w| w * BINS as f64 > top)
+        .unwrap_or(1.0);
+    let mut counts = [[0usize; 2]; BINS];
+    for &(m, drawn) in metrics {
+        let m = if m.is_finite() { m } else { 0.0 };
+        let bin = ((m / width).floor().max(0.0) as usize).min(BINS - 1);
+        counts[bin][usize::from(!drawn)] += 1;
+    }
+    (width, counts)
+}
+
 /// How many of `flips` are same, close and visible.
 pub fn verdict_counts(flips: &[f64]) -> [usize; 3] {
     let mut counts = [0; 3];
@@ -91,32 +116,38 @@ pub fn verdict_counts(flips: &[f64]) -> [usize; 3] {
     counts
 }
 
-/// The overview picture's PNG bytes: the histogram of `flips` (one per sheet drawn) and `worst`.
-pub fn png(flips: &[f64], worst: &[Worst]) -> Vec<u8> {
+/// The overview picture's PNG bytes: the histogram of `flips` (one per sheet drawn), the
+/// histogram of the plan's measure over every sheet (`metrics`: one (measure, drawn) per
+/// sheet), and `worst`.
+pub fn png(flips: &[f64], metrics: &[(f64, bool)], worst: &[Worst]) -> Vec<u8> {
     let counts = histogram(flips);
     let tallest = counts.iter().copied().max().unwrap_or(0).max(1);
+    let (metric_bin, metric_counts) = metric_histogram(metrics);
+    let metric_tallest = metric_counts
+        .iter()
+        .map(|[d, u]| d + u)
+        .max()
+        .unwrap_or(0)
+        .max(1);
     let plot_w = BINS * BAR_W;
-    let left = MARGIN + font::width("100%") + 8;
+    let left = MARGIN + font::width("100000") + 8;
     let thumbs_w = worst.iter().map(|w| w.width).max().unwrap_or(0);
     let thumbs_h: usize = worst.iter().map(|w| w.height + 2 * LINE_HEIGHT + 8).sum();
-    let width = left + plot_w + 2 * MARGIN + thumbs_w + MARGIN;
+    let width = left + plot_w + 3 * MARGIN + thumbs_w + MARGIN;
     let plot_top = MARGIN + 4 * LINE_HEIGHT;
-    let height = (plot_top + PLOT_H + 4 * LINE_HEIGHT + MARGIN).max(MARGIN + thumbs_h + MARGIN);
+    let axis = plot_top + PLOT_H;
+    let metric_top = axis + 6 * LINE_HEIGHT;
+    let metric_axis = metric_top + PLOT_H;
+    let height = (metric_axis + 3 * LINE_HEIGHT + MARGIN).max(MARGIN + thumbs_h + MARGIN);
     let background = sheet::background_code();
     let mut c = Canvas::new(width, height, [background; 3]);
-    let (same, close, visible) =
-        flips
-            .iter()
-            .fold((0, 0, 0), |(s, c, v), &f| match Verdict::from_flip(f) {
-                Verdict::Same => (s + 1, c, v),
-                Verdict::Close => (s, c + 1, v),
-                Verdict::Visible => (s, c, v + 1),
-            });
+    let [same, close, visible] = verdict_counts(flips);
+    let drawn = metrics.iter().filter(|m| m.1).count();
     c.text(
         MARGIN,
         MARGIN,
         &format!(
-            "{} sheets: {same} same to the eye, {close} close, {visible} visible difference",
+            "{} sheets drawn: {same} same to the eye, {close} close, {visible} visible difference",
             flips.len()
         ),
         TEXT,
@@ -132,7 +163,6 @@ pub fn png(flips: &[f64], worst: &[Worst]) -> Vec<u8> {
         Verdict::Close => [200, 170, 80],
         Verdict::Visible => [210, 80, 80],
     };
-    let axis = plot_top + PLOT_H;
     for (i, &n) in counts.iter().enumerate() {
         let h = (n * PLOT_H).div_ceil(tallest);
         let mid = (i as f64 + 0.5) * BIN;
@@ -144,8 +174,7 @@ pub fn png(flips: &[f64], worst: &[Worst]) -> Vec<u8> {
             colour(Verdict::from_flip(mid)),
         );
     }
-    c.fill(left, axis, plot_w, 1, DIM);
-    c.fill(left - 1, plot_top, 1, PLOT_H, DIM);
+    axes(&mut c, left, plot_top, tallest);
     // The thresholds, their labels on lines of their own so that they never overlap.
     for (k, (threshold, label)) in [(SAME_FLIP, "same"), (CLOSE_FLIP, "close")]
         .into_iter()
@@ -158,25 +187,38 @@ pub fn png(flips: &[f64], worst: &[Worst]) -> Vec<u8> {
         let y = plot_top - (2 - k) * LINE_HEIGHT;
         c.text(x + 3, y, &format!("{label} ≤ {threshold:.2}"), DIM);
     }
-    for tick in [0.0, 0.2, 0.4, 0.6, 0.8] {
-        let x = left + (tick / BIN * BAR_W as f64).round() as usize;
-        c.fill(x, axis, 1, 4, DIM);
-        let label = if tick >= 0.8 {
-            "≥ 0.78".to_string()
-        } else {
-            format!("{tick:.1}")
-        };
-        c.text(
-            x.saturating_sub(font::width(&label) / 2),
-            axis + 6,
-            &label,
-            DIM,
-        );
+    ticks(&mut c, left, axis, BIN);
+
+    // The plan's measure over every sheet.
+    c.text(
+        MARGIN,
+        metric_top - 3 * LINE_HEIGHT,
+        &format!(
+            "all {} sheets by the plan's measure: {drawn} drawn (colour), {} not drawn (grey)",
+            metrics.len(),
+            metrics.len() - drawn
+        ),
+        TEXT,
+    );
+    c.text(
+        MARGIN,
+        metric_top - 2 * LINE_HEIGHT,
+        "largest |max3·E − w·R| over views with μ ≥ 0.1, authored against migrated",
+        DIM,
+    );
+    for (i, &[d, u]) in metric_counts.iter().enumerate() {
+        let total = d + u;
+        let h = (total * PLOT_H).div_ceil(metric_tallest);
+        let hd = (d * PLOT_H).div_ceil(metric_tallest).min(h);
+        let x = left + i * BAR_W + 1;
+        c.fill(x, metric_axis - h, BAR_W - 2, h - hd, [110, 110, 110]);
+        c.fill(x, metric_axis - hd, BAR_W - 2, hd, [110, 160, 220]);
     }
-    c.text(MARGIN, plot_top, &tallest.to_string(), DIM);
-    c.text(MARGIN, axis - LINE_HEIGHT, "0", DIM);
+    axes(&mut c, left, metric_top, metric_tallest);
+    ticks(&mut c, left, metric_axis, metric_bin);
+
     // The worst sheets.
-    let x0 = left + plot_w + 2 * MARGIN;
+    let x0 = left + plot_w + 3 * MARGIN;
     let mut y = MARGIN;
     for (k, w) in worst.iter().enumerate() {
         let label = format!("{}. ꟻLIP {:.3}", k + 1, w.flip);
@@ -193,6 +235,43 @@ pub fn png(flips: &[f64], worst: &[Worst]) -> Vec<u8> {
         y += w.height + 4;
     }
     sheet::rgb_png(&c.rgb, c.width, c.height)
+}
+
+/// A plot's two axes and its count labels (the tallest bar's count at the top, 0 at the foot).
+fn axes(c: &mut Canvas, left: usize, top: usize, tallest: usize) {
+    let axis = top + PLOT_H;
+    c.fill(left, axis, BINS * BAR_W, 1, DIM);
+    c.fill(left - 1, top, 1, PLOT_H, DIM);
+    c.text(MARGIN, top, &tallest.to_string(), DIM);
+    c.text(MARGIN, axis - LINE_HEIGHT, "0", DIM);
+}
+
+/// Five ticks under a plot of bins `bin` wide, at every eighth bin; the last one, at the
+/// plot's right end, reads "≥" since the last bin holds everything above, and is drawn
+/// right-aligned so that it stays inside the plot's width.
+fn ticks(c: &mut Canvas, left: usize, axis: usize, bin: f64) {
+    let digits = if bin >= 0.05 {
+        1
+    } else if bin >= 0.005 {
+        2
+    } else {
+        3
+    };
+    for k in 0..=4 {
+        let bins = k * BINS / 4;
+        let x = left + bins * BAR_W;
+        c.fill(x.min(left + BINS * BAR_W - 1), axis, 1, 4, DIM);
+        let value = bins as f64 * bin;
+        let (label, lx) = if k == 4 {
+            let label = format!("≥ {:.*}", digits, value - bin);
+            let lx = (left + BINS * BAR_W).saturating_sub(font::width(&label));
+            (label, lx)
+        } else {
+            let label = format!("{value:.digits$}");
+            (label.clone(), x.saturating_sub(font::width(&label) / 2))
+        };
+        c.text(lx, axis + 6, &label, DIM);
+    }
 }
 
 #[cfg(test)]
@@ -238,8 +317,37 @@ mod tests {
     }
 
     #[test]
+    fn the_plan_measure_histogram_covers_every_sheet_and_splits_drawn_from_not() {
+        // Largest 0.093: 40 bins of 0.005 reach 0.2 (of 0.002 only 0.08).
+        let metrics = [
+            (0.093, true),
+            (0.0925, true),
+            (0.051, true),
+            (0.0499, false),
+            (0.0, false),
+            (0.0049, false),
+            (f64::NAN, false),
+        ];
+        let (width, counts) = metric_histogram(&metrics);
+        assert_eq!(width, 0.005);
+        assert_eq!(counts[18], [2, 0]);
+        assert_eq!(counts[10], [1, 0]);
+        assert_eq!(counts[9], [0, 1]);
+        assert_eq!(counts[0], [0, 3]);
+        let total: usize = counts.iter().map(|[d, u]| d + u).sum();
+        assert_eq!(total, metrics.len());
+        // Everything at 0 (no sheen–fuzz pair): the finest bins, all in the first.
+        let (width, counts) = metric_histogram(&[(0.0, true), (0.0, false)]);
+        assert_eq!((width, counts[0]), (1e-6, [1, 1]));
+    }
+
+    #[test]
     fn the_overview_counts_each_verdict() {
-        let png = png(&[0.05, 0.15, 0.3, 0.31], &[]);
+        let png = png(
+            &[0.05, 0.15, 0.3, 0.31],
+            &[(0.01, true), (0.002, false)],
+            &[],
+        );
         let image = image::load_from_memory(&png).unwrap();
         assert!(image.width() as usize >= BINS * BAR_W);
         assert_eq!(

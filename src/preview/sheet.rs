@@ -320,7 +320,7 @@ fn clamp01(x: f64) -> f64 {
 
 /// Linear light in [0, 1] to an 8-bit sRGB code.
 pub fn encode(linear: f64) -> u8 {
-    srgb::quantise(srgb::encode(clamp01(linear)), 255) as u8
+    srgb::encode_code_8(linear)
 }
 
 fn figure_lines(material: &Material) -> (Vec<String>, bool) {
