@@ -69,10 +69,11 @@ pub fn linear_table_16() -> &'static [f64] {
 
 /// The 8-bit sRGB code of linear light, `quantise(encode(l), 255)` with l clamped into [0, 1]
 /// (NaN as 0), found among the 255 linear values where the code steps up instead of by a
-/// power per value: a renderer encodes every pixel, and this is about 10× faster than `powf`.
-/// The steps are located by bisection over the f64 values of [0, 1] on `quantise(encode(·))`
-/// itself, so every value gives the code the direct formula gives (the test checks each step
-/// and the values next to it).
+/// power per value: a renderer encodes every pixel. The steps are located by bisection over
+/// the f64 values of [0, 1] on `quantise(encode(·))` itself, so every value gives the code the
+/// direct formula gives (the test checks each step and the values next to it). A value's
+/// bucket of [`CODE_BUCKETS`] gives the code at the bucket's start, and at most a step or two
+/// follow within a bucket (the toe's slope is 12.92 × 255 ≈ 3295 codes per unit).
 pub fn encode_code_8(l: f64) -> u8 {
     if l.is_nan() || l <= 0.0 {
         return direct_code_8(0.0);
@@ -80,7 +81,28 @@ pub fn encode_code_8(l: f64) -> u8 {
     if l >= 1.0 {
         return direct_code_8(1.0);
     }
-    code_steps_8().partition_point(|&t| t <= l) as u8
+    let steps = code_steps_8();
+    // l · 4096 is exact (a power of two), so the bucket starts at or below l.
+    let mut code = usize::from(bucket_codes_8()[(l * CODE_BUCKETS as f64) as usize]);
+    while code < steps.len() && steps[code] <= l {
+        code += 1;
+    }
+    code as u8
+}
+
+/// The buckets of [`encode_code_8`] over [0, 1).
+const CODE_BUCKETS: usize = 4096;
+
+/// The code at the start b / [`CODE_BUCKETS`] of each bucket.
+fn bucket_codes_8() -> &'static [u8; CODE_BUCKETS] {
+    static CODES: OnceLock<[u8; CODE_BUCKETS]> = OnceLock::new();
+    CODES.get_or_init(|| {
+        let steps = code_steps_8();
+        std::array::from_fn(|b| {
+            let start = b as f64 / CODE_BUCKETS as f64;
+            steps.partition_point(|&t| t <= start) as u8
+        })
+    })
 }
 
 fn direct_code_8(l: f64) -> u8 {
