@@ -669,20 +669,12 @@ fn coverage(size: usize, x: usize, y: usize) -> f64 {
     inside as f64 / (n * n) as f64
 }
 
-/// A sphere image: linear radiance and coverage per pixel, row by row.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Sphere {
-    pub size: usize,
-    pub radiance: Vec<[f64; 3]>,
-    pub coverage: Vec<f64>,
-}
-
-/// Renders `shaded` as a sphere of `size`×`size` pixels under `light`. Pixels whose centre lies
-/// off the sphere but which it partly covers are shaded at the nearest point of the sphere
-/// just inside the silhouette.
-pub fn render_sphere(shaded: &Shaded, light: Light, size: usize) -> Sphere {
-    let mut radiance = Vec::with_capacity(size * size);
-    let mut cov = Vec::with_capacity(size * size);
+/// Per pixel of a sphere of `size` pixels a side: the normal it is shaded with and the fraction
+/// of it the sphere covers (0: off the sphere). Pixels whose centre lies off the sphere but
+/// which it partly covers are shaded at the nearest point of the sphere just inside the
+/// silhouette.
+fn pixel_geometry(size: usize) -> Vec<([f64; 3], f64)> {
+    let mut out = Vec::with_capacity(size * size);
     for y in 0..size {
         for x in 0..size {
             let c = coverage(size, x, y);
@@ -695,18 +687,50 @@ pub fn render_sphere(shaded: &Shaded, light: Light, size: usize) -> Sphere {
                 let (px, py) = (px * k, py * k);
                 [px, py, (1.0 - px * px - py * py).max(0.0).sqrt()]
             });
-            radiance.push(if c > 0.0 {
-                shaded.radiance(n, light)
-            } else {
-                [0.0; 3]
-            });
-            cov.push(c);
+            out.push((n, c));
         }
     }
+    out
+}
+
+/// [`pixel_geometry`] of `size`, computed once per size: every sphere of a sheet has the same
+/// outline.
+fn geometry_of(size: usize) -> Arc<Vec<([f64; 3], f64)>> {
+    static KNOWN: OnceLock<Mutex<HashMap<usize, Arc<Vec<([f64; 3], f64)>>>>> = OnceLock::new();
+    let known = KNOWN.get_or_init(|| Mutex::new(HashMap::new()));
+    let mut known = known.lock().unwrap_or_else(|e| e.into_inner());
+    Arc::clone(
+        known
+            .entry(size)
+            .or_insert_with(|| Arc::new(pixel_geometry(size))),
+    )
+}
+
+/// A sphere image: linear radiance and coverage per pixel, row by row.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Sphere {
+    pub size: usize,
+    pub radiance: Vec<[f64; 3]>,
+    pub coverage: Vec<f64>,
+}
+
+/// Renders `shaded` as a sphere of `size`×`size` pixels under `light` (see [`pixel_geometry`]
+/// for the pixels on its outline).
+pub fn render_sphere(shaded: &Shaded, light: Light, size: usize) -> Sphere {
+    let geometry = geometry_of(size);
     Sphere {
         size,
-        radiance,
-        coverage: cov,
+        radiance: geometry
+            .iter()
+            .map(|&(n, c)| {
+                if c > 0.0 {
+                    shaded.radiance(n, light)
+                } else {
+                    [0.0; 3]
+                }
+            })
+            .collect(),
+        coverage: geometry.iter().map(|g| g.1).collect(),
     }
 }
 
