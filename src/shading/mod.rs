@@ -8,6 +8,7 @@
 #[cfg(feature = "bench")]
 pub mod accuracy;
 pub mod albedo;
+mod albedo_table32;
 #[cfg(feature = "bench")]
 pub mod bench;
 pub mod charlie;
