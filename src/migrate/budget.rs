@@ -133,10 +133,36 @@ fn texture_and_target(
 
 /// The largest |written · texture − target| over `pairs`.
 fn worst(pairs: &[(f64, f64)], written: f64) -> f64 {
-    pairs
-        .iter()
-        .map(|(t, a)| (written * t - a).abs())
-        .fold(0.0, f64::max)
+    largest(pairs.len(), |i| (written * pairs[i].0 - pairs[i].1).abs())
+}
+
+/// The largest of `term(0..n)` and 0, NaN terms skipped: the value `fold(0.0, f64::max)`
+/// gives. The minimax searches spend most of the planner's time here. `f64::max` is a
+/// five-instruction NaN-aware sequence in one chain of dependent steps; a plain comparison
+/// (false for NaN, so NaN is skipped alike) is one instruction, and four running maxima over
+/// interleaved terms break the chain. The value is the same: the largest of a set does not
+/// depend on the order it is taken in, and the terms are absolute values (no −0).
+#[inline]
+fn largest(n: usize, term: impl Fn(usize) -> f64) -> f64 {
+    let mut lanes = [0.0f64; 4];
+    let whole = n - n % 4;
+    for i in (0..whole).step_by(4) {
+        for (k, lane) in lanes.iter_mut().enumerate() {
+            let d = term(i + k);
+            if d > *lane {
+                *lane = d;
+            }
+        }
+    }
+    for i in whole..n {
+        let d = term(i);
+        if d > lanes[0] {
+            lanes[0] = d;
+        }
+    }
+    lanes
+        .into_iter()
+        .fold(0.0, |m, d| if d > m { d } else { m })
 }
 
 /// The factor, as velvet writes it (rounded, not below the floor, at most 1), that minimises
@@ -196,6 +222,10 @@ fn fit_shared(codes: &Codes, mapping: &Curve, factors: &[f64]) -> Curve {
         .iter()
         .map(|&f| codes.values().map(|x| mapping.eval(f * x)).collect())
         .collect();
+    // The targets by code (each code's across the factors) for the codes' own searches.
+    let by_code: Vec<Vec<f64>> = (0..codes.present.len())
+        .map(|k| targets.iter().map(|a| a[k]).collect())
+        .collect();
     for _ in 0..3 {
         let stored: Vec<f64> = codes
             .present
@@ -206,26 +236,15 @@ fn fit_shared(codes: &Codes, mapping: &Curve, factors: &[f64]) -> Curve {
             .iter()
             .map(|a| {
                 minimax(
-                    |w| {
-                        stored
-                            .iter()
-                            .zip(a)
-                            .map(|(t, a)| (w * t - a).abs())
-                            .fold(0.0, f64::max)
-                    },
+                    |w| largest(stored.len().min(a.len()), |i| (w * stored[i] - a[i]).abs()),
                     50,
                 )
             })
             .collect();
         for (k, &c) in codes.present.iter().enumerate() {
+            let column = &by_code[k];
             g[c as usize] = minimax(
-                |v| {
-                    scales
-                        .iter()
-                        .zip(&targets)
-                        .map(|(w, a)| (w * v - a[k]).abs())
-                        .fold(0.0, f64::max)
-                },
+                |v| largest(scales.len(), |f| (scales[f] * v - column[f]).abs()),
                 50,
             );
         }
