@@ -178,11 +178,16 @@ pub struct TextureStats {
 /// which migrate adds nothing), are left out.
 pub fn materials(asset: &Asset, plan: &DocumentPlan, mapping: RoughnessMapping) -> Vec<Material> {
     let mut images = ImageCache::default();
+    // Each material's plan by index (the first, as a search in order would find it).
+    let mut planned: std::collections::HashMap<usize, &MaterialPlan> = Default::default();
+    for p in &plan.materials {
+        planned.entry(p.index).or_insert(p);
+    }
     layers::materials(asset.json())
         .iter()
         .enumerate()
         .filter_map(|(index, m)| {
-            let planned = plan.materials.iter().find(|p| p.index == index);
+            let planned = planned.get(&index).copied();
             read(asset, index, m, planned, mapping, &mut images)
         })
         .collect()
