@@ -135,7 +135,8 @@ pub(crate) fn catmull_rom_weights(y: f64) -> [f64; 4] {
 pub(crate) fn catmull_rom(n: usize, sample: impl Fn(usize) -> f64, x: f64) -> f64 {
     debug_assert!(n >= 2);
     let p = clamp01(x) * (n - 1) as f64;
-    let i = (p.floor() as usize).min(n - 2);
+    // p ≥ 0, so truncation is the floor (without a call to libm's floor).
+    let i = (p as usize).min(n - 2);
     let w = catmull_rom_weights(p - i as f64);
     let before = if i == 0 {
         2.0 * sample(0) - sample(1)
