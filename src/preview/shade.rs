@@ -696,7 +696,8 @@ fn pixel_geometry(size: usize) -> Vec<([f64; 3], f64)> {
 /// [`pixel_geometry`] of `size`, computed once per size: every sphere of a sheet has the same
 /// outline.
 fn geometry_of(size: usize) -> Arc<Vec<([f64; 3], f64)>> {
-    static KNOWN: OnceLock<Mutex<HashMap<usize, Arc<Vec<([f64; 3], f64)>>>>> = OnceLock::new();
+    type Geometry = Arc<Vec<([f64; 3], f64)>>;
+    static KNOWN: OnceLock<Mutex<HashMap<usize, Geometry>>> = OnceLock::new();
     let known = KNOWN.get_or_init(|| Mutex::new(HashMap::new()));
     let mut known = known.lock().unwrap_or_else(|e| e.into_inner());
     Arc::clone(
