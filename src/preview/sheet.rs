@@ -41,15 +41,22 @@ use crate::shading::mapping::{layer_match_with, POOR_MATCH_BELOW};
 use crate::shading::{AlbedoMethod, ReflectanceMethod};
 use rayon::prelude::*;
 use std::collections::HashMap;
-use std::sync::Mutex;
+use std::sync::{Mutex, OnceLock};
 
 /// A layer reflectance that remembers its values: the report's comparisons of one sheet
-/// evaluate the same (μ, roughness) more than once. A value is a function of its inputs alone,
-/// so which task computes it first does not change it.
+/// evaluate the same (μ, roughness) more than once, and the sheets of a library share
+/// roughness values (a sweep, a family of fabrics). One memo per layer serves the whole
+/// process, emptied when it reaches [`MEMO_VALUES`] values. A value is a function of its
+/// inputs alone, so which task computes it first, and whether it was remembered, does not
+/// change it.
 struct Memo<R> {
     inner: R,
     values: Mutex<HashMap<(u64, u64), f64>>,
 }
+
+/// The most values a [`Memo`] holds (about 5 MB): 97 view cosines each for some 2,000
+/// roughness values.
+const MEMO_VALUES: usize = 200_000;
 
 impl<R: LayerReflectance> Memo<R> {
     fn new(inner: R) -> Self {
@@ -58,6 +65,17 @@ impl<R: LayerReflectance> Memo<R> {
             values: Mutex::new(HashMap::new()),
         }
     }
+}
+
+/// The process's memos of the report's E and R (quadrature at the report's tolerance).
+fn figure_memos() -> &'static (Memo<SheenAlbedo>, Memo<FuzzReflectance>) {
+    static MEMOS: OnceLock<(Memo<SheenAlbedo>, Memo<FuzzReflectance>)> = OnceLock::new();
+    MEMOS.get_or_init(|| {
+        (
+            Memo::new(SheenAlbedo(AlbedoMethod::Quadrature)),
+            Memo::new(FuzzReflectance(ReflectanceMethod::Quadrature)),
+        )
+    })
 }
 
 impl<R: LayerReflectance> LayerReflectance for Memo<R> {
@@ -75,10 +93,11 @@ impl<R: LayerReflectance> LayerReflectance for Memo<R> {
             .copied();
         known.unwrap_or_else(|| {
             let v = self.inner.reflectance(mu, roughness);
-            self.values
-                .lock()
-                .unwrap_or_else(|e| e.into_inner())
-                .insert(key, v);
+            let mut values = self.values.lock().unwrap_or_else(|e| e.into_inner());
+            if values.len() >= MEMO_VALUES {
+                values.clear();
+            }
+            values.insert(key, v);
             v
         })
     }
@@ -331,9 +350,9 @@ fn figure_lines(material: &Material) -> (Vec<String>, bool) {
         .skip(1)
         .filter_map(|(j, c)| layer_pair(&cols[0].look.layer, &c.look.layer).map(|p| (j, p)))
         .collect();
-    // The comparisons share the authored layer: its E or R is computed once per view cosine.
-    let sheen_memo = Memo::new(SheenAlbedo(AlbedoMethod::Quadrature));
-    let fuzz_memo = Memo::new(FuzzReflectance(ReflectanceMethod::Quadrature));
+    // The comparisons share the authored layer (its E or R is computed once per view cosine),
+    // and sheets share roughness values.
+    let (sheen_memo, fuzz_memo) = figure_memos();
     let results: Vec<_> = pairs
         .par_iter()
         .map(|&(j, (sheen, fuzz))| {
@@ -341,8 +360,8 @@ fn figure_lines(material: &Material) -> (Vec<String>, bool) {
                 j,
                 sheen,
                 fuzz,
-                layer_match_with(sheen, fuzz, &sheen_memo, &fuzz_memo),
-                compare_base_attenuation(sheen, fuzz, &sheen_memo, &fuzz_memo),
+                layer_match_with(sheen, fuzz, sheen_memo, fuzz_memo),
+                compare_base_attenuation(sheen, fuzz, sheen_memo, fuzz_memo),
             )
         })
         .collect();
