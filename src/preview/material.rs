@@ -32,7 +32,10 @@ use crate::migrate::roughness::{self, Direction, RoughnessMapping};
 use crate::migrate::textures::TextureBake;
 use crate::migrate::{Conversion, DocumentPlan, MaterialPlan};
 use crate::shading::layering::{max3, FuzzParams, SheenParams};
+use rayon::prelude::*;
 use serde_json::Value;
+use std::collections::HashMap;
+use std::sync::{Arc, OnceLock};
 
 use super::shade::{Layer, Look};
 
@@ -177,18 +180,18 @@ pub struct TextureStats {
 /// exclude both layers, so migrate leaves them), and a switched-off sheen or fuzz alone (to
 /// which migrate adds nothing), are left out.
 pub fn materials(asset: &Asset, plan: &DocumentPlan, mapping: RoughnessMapping) -> Vec<Material> {
-    let mut images = ImageCache::default();
+    let images = ImageCache::default();
     // Each material's plan by index (the first, as a search in order would find it).
     let mut planned: std::collections::HashMap<usize, &MaterialPlan> = Default::default();
     for p in &plan.materials {
         planned.entry(p.index).or_insert(p);
     }
     layers::materials(asset.json())
-        .iter()
+        .par_iter()
         .enumerate()
         .filter_map(|(index, m)| {
             let planned = planned.get(&index).copied();
-            read(asset, index, m, planned, mapping, &mut images)
+            read(asset, index, m, planned, mapping, &images)
         })
         .collect()
 }
@@ -216,10 +219,14 @@ fn migrated(material: &Value, index: usize, plan: &MaterialPlan) -> Result<Value
     Ok(out)
 }
 
+/// Each image's statistics per way of reading it, computed once however many materials (on
+/// however many threads) read it: the first to ask computes them, the others wait for them.
 #[derive(Default)]
 struct ImageCache {
-    stats: Vec<(usize, Read, Transfer, Result<TextureStats, String>)>,
+    stats: std::sync::Mutex<HashMap<(usize, Read, Transfer), Arc<OnceLock<ImageStats>>>>,
 }
+
+type ImageStats = Result<TextureStats, String>;
 
 fn read(
     asset: &Asset,
@@ -227,7 +234,7 @@ fn read(
     material: &Value,
     plan: Option<&MaterialPlan>,
     mapping: RoughnessMapping,
-    images: &mut ImageCache,
+    images: &ImageCache,
 ) -> Option<Material> {
     let mut notes = Vec::new();
     let written = match plan.map(|p| migrated(material, index, p)) {
@@ -307,7 +314,7 @@ fn read(
     let mut base_roughness = factor("roughnessFactor");
     if let Some(info) = pbr.and_then(|p| p.get("metallicRoughnessTexture")) {
         let channel_means = image_index(asset, info).and_then(|image| {
-            let mut mean = |channel| {
+            let mean = |channel| {
                 image_stats(asset, image, Read::One(channel), Transfer::Linear, images)
                     .map(|s| s.mean[0])
             };
@@ -428,7 +435,7 @@ fn baked_stats(
     asset: &Asset,
     bake: &TextureBake,
     slot: &Slot,
-    images: &mut ImageCache,
+    images: &ImageCache,
 ) -> Result<TextureStats, String> {
     let (_, base) = *bake
         .sources
@@ -573,7 +580,7 @@ fn texture_stats(
     info: &Value,
     channels: Channels,
     transfer: Transfer,
-    cache: &mut ImageCache,
+    cache: &ImageCache,
 ) -> Result<TextureStats, String> {
     let image = image_index(asset, info)?;
     let read = match channels {
@@ -586,7 +593,7 @@ fn texture_stats(
 
 /// Which values of an image a percentile ranks: its colour (by the largest channel), or one
 /// channel (0 red … 3 alpha).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 enum Read {
     Rgb,
     One(usize),
@@ -597,21 +604,23 @@ fn image_stats(
     image: usize,
     read: Read,
     transfer: Transfer,
-    cache: &mut ImageCache,
+    cache: &ImageCache,
 ) -> Result<TextureStats, String> {
-    if let Some((_, _, _, s)) = cache
-        .stats
-        .iter()
-        .find(|(i, r, t, _)| *i == image && *r == read && *t == transfer)
-    {
-        return s.clone();
-    }
-    let stats = asset
-        .decode_image(image)
-        .map_err(|d| d.message)
-        .map(|img| stats_by(&img.to_rgba8(), read, transfer));
-    cache.stats.push((image, read, transfer, stats.clone()));
-    stats
+    let cell = Arc::clone(
+        cache
+            .stats
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .entry((image, read, transfer))
+            .or_default(),
+    );
+    cell.get_or_init(|| {
+        asset
+            .decode_image(image)
+            .map_err(|d| d.message)
+            .map(|img| stats_by(&img.to_rgba8(), read, transfer))
+    })
+    .clone()
 }
 
 /// The mean, 5th and 95th percentiles of the values a slot reads from `img` (see the module
