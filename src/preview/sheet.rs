@@ -677,12 +677,15 @@ pub fn to_png(sheet: &Sheet) -> Vec<u8> {
     rgb_png(&sheet.rgb, sheet.width, sheet.height)
 }
 
-/// 8-bit RGB pixels as PNG bytes (deterministic: fixed filter and compression).
+/// 8-bit RGB pixels as PNG bytes (deterministic: fixed filter and compression). Deflate level
+/// 2: a library's sheets are many, and against the fastest setting it writes a three-swatch
+/// sheet in 324 instead of 585 KB for 12 ms more (24 ms and 305 KB at level 3, 59 ms and 293
+/// KB at the default level).
 pub fn rgb_png(rgb: &[u8], width: usize, height: usize) -> Vec<u8> {
     use image::codecs::png::{CompressionType, FilterType, PngEncoder};
     use image::ImageEncoder;
     let mut out = Vec::new();
-    PngEncoder::new_with_quality(&mut out, CompressionType::Fast, FilterType::Adaptive)
+    PngEncoder::new_with_quality(&mut out, CompressionType::Level(2), FilterType::Adaptive)
         .write_image(
             rgb,
             width as u32,
