@@ -82,15 +82,16 @@ pub fn histogram(flips: &[f64]) -> [usize; BINS] {
 }
 
 /// The histogram of the plan's measure over every sheet: the bin width (the smallest of 1, 2
-/// and 5 × 10ᵏ for which [`BINS`] bins reach the largest measure) and, per bin, how many
-/// sheets were drawn and how many were not. `metrics` is one (measure, drawn) per sheet.
+/// and 5 × 10ᵏ, at least 0.001, for which [`BINS`] bins reach the largest measure) and, per
+/// bin, how many sheets were drawn and how many were not. `metrics` is one (measure, drawn)
+/// per sheet.
 pub fn metric_histogram(metrics: &[(f64, bool)]) -> (f64, [[usize; 2]; BINS]) {
     let top = metrics
         .iter()
         .map(|m| m.0)
         .filter(|m| m.is_finite())
         .fold(0.0f64, f64::max);
-    let width = (-6..=1)
+    let width = (-3..=1)
         .flat_map(|k| [1.0, 2.0, 5.0].map(|m| m * 10f64.powi(k)))
         .find(|w| w * BINS as f64 > top)
         .unwrap_or(1.0);
@@ -336,9 +337,10 @@ mod tests {
         assert_eq!(counts[0], [0, 3]);
         let total: usize = counts.iter().map(|[d, u]| d + u).sum();
         assert_eq!(total, metrics.len());
-        // Everything at 0 (no sheen–fuzz pair): the finest bins, all in the first.
+        // Everything at 0 (no sheen–fuzz pair) or no sheet at all: the finest bins, 0.001.
         let (width, counts) = metric_histogram(&[(0.0, true), (0.0, false)]);
-        assert_eq!((width, counts[0]), (1e-6, [1, 1]));
+        assert_eq!((width, counts[0]), (0.001, [1, 1]));
+        assert_eq!(metric_histogram(&[]).0, 0.001);
     }
 
     #[test]
