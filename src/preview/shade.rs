@@ -58,7 +58,7 @@
 //! highlight) are left as they are: the sheet marks them.
 
 use crate::shading::albedo::albedo_quadrature;
-use crate::shading::charlie::{sheen_brdf_cos, Visibility};
+use crate::shading::charlie::{clamp01, sheen_brdf_cos, Visibility};
 use crate::shading::fuzz::{
     catmull_rom, multiple_scattering_cos, reflectance_quadrature, single_scattering_cos, Scattering,
 };
@@ -159,14 +159,6 @@ fn sheen_node(mu: f64, roughness: f64, tol: f64) -> f64 {
 /// R(μ, α) of the fuzz layer by quadrature to `tol`.
 fn fuzz_node(mu: f64, roughness: f64, tol: f64) -> f64 {
     reflectance_quadrature(mu, roughness, Scattering::Total, tol).value
-}
-
-fn clamp01(x: f64) -> f64 {
-    if x.is_nan() {
-        0.0
-    } else {
-        x.clamp(0.0, 1.0)
-    }
 }
 
 impl Shaded {
@@ -376,9 +368,10 @@ pub fn base_brdf(
     )
 }
 
-/// The base's directional albedo terms (no attenuation) at the curve nodes for (metallic, α).
-/// They are a function of those two numbers alone, so they are computed once per process and
-/// shared by every look with that base (which task computes them first does not change them).
+/// The base's directional albedo terms (no attenuation) at the curve nodes for (metallic, α):
+/// its [`base_rules`] integrated with no attenuation. They are a function of those two numbers
+/// alone, so they are computed once per process and shared by every look with that base
+/// (which task computes them first does not change them).
 fn base_albedo_curve(metallic: f64, alpha: f64) -> Arc<Vec<[f64; 2]>> {
     type Curves = HashMap<(u64, u64), Arc<Vec<[f64; 2]>>>;
     static KNOWN: OnceLock<Mutex<Curves>> = OnceLock::new();
@@ -388,9 +381,9 @@ fn base_albedo_curve(metallic: f64, alpha: f64) -> Arc<Vec<[f64; 2]>> {
         return Arc::clone(curve);
     }
     let curve: Arc<Vec<[f64; 2]>> = Arc::new(
-        (0..CURVE_NODES)
-            .into_par_iter()
-            .map(|i| base_furnace_terms(node_mu(i), metallic, alpha, &|_| 1.0, Steps::default()))
+        base_rules(metallic, alpha)
+            .par_iter()
+            .map(|rule| rule.integrate(&|_| 1.0))
             .collect(),
     );
     known

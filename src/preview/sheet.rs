@@ -34,6 +34,7 @@ use super::font::{self, LINE_HEIGHT};
 use super::material::{columns, layer_pair, Column, Kind, Material};
 use super::shade::{render_sphere, Light, Look, Shaded, Sphere};
 use crate::bake::srgb;
+use crate::shading::charlie::clamp01;
 use crate::shading::layering::{
     compare_base_attenuation, FuzzReflectance, LayerReflectance, SheenAlbedo,
 };
@@ -327,14 +328,6 @@ fn above_one_notes(
         }
     }
     notes
-}
-
-fn clamp01(x: f64) -> f64 {
-    if x.is_nan() {
-        0.0
-    } else {
-        x.clamp(0.0, 1.0)
-    }
 }
 
 /// Linear light in [0, 1] to an 8-bit sRGB code.
