@@ -385,24 +385,17 @@ pub fn generate_table() -> Vec<f64> {
 }
 
 /// The source text of `fuzz_table.rs` for the given values.
-pub fn table_source(values: &[f64]) -> String {
-    let mut out = String::from(
+#[cfg(test)]
+fn table_source(values: &[f64]) -> String {
+    super::square_table_source(
         "//! R(μ, α) at the nodes of velvet's fuzz reflectance table (see `fuzz.rs`), computed by\n\
          //! velvet's quadrature. Generated: `VELVET_UPDATE_GOLDEN=1 cargo test --lib\n\
          //! shading::fuzz` rewrites this file, and that test fails when the quadrature no longer\n\
-         //! gives these values. Do not edit by hand.\n\n\
-         /// Nodes per axis.\n\
-         pub const SIZE: usize = 33;\n\n\
-         /// R at μ_i = (i/32)², α_j = j/32, in VALUES[j·SIZE + i].\n\
-         #[rustfmt::skip]\n\
-         pub static VALUES: [f64; SIZE * SIZE] = [\n",
-    );
-    for row in values.chunks(TABLE_SIZE) {
-        let line: Vec<String> = row.iter().map(|v| format!("{v:?}")).collect();
-        out.push_str(&format!("    {},\n", line.join(", ")));
-    }
-    out.push_str("];\n");
-    out
+         //! gives these values. Do not edit by hand.\n",
+        TABLE_SIZE,
+        "R at μ_i = (i/32)², α_j = j/32, in VALUES[j·SIZE + i].",
+        values,
+    )
 }
 
 #[cfg(test)]

@@ -40,3 +40,25 @@ pub fn sheen_albedo(mu: f64, r: f64, method: AlbedoMethod) -> f64 {
         AlbedoMethod::Fit => fit::albedo_fit(mu, r),
     }
 }
+
+/// The source text of a generated n×n table file (`fuzz_table.rs`, `albedo_table32.rs`): the
+/// module comment `doc` (whole `//!` lines), `SIZE`, and `VALUES` row by row under the comment
+/// `values_doc`, each value written so that it reads back to the same f64.
+#[cfg(test)]
+pub(crate) fn square_table_source(
+    doc: &str,
+    size: usize,
+    values_doc: &str,
+    values: &[f64],
+) -> String {
+    let mut out = format!(
+        "{doc}\n/// Nodes per axis.\npub const SIZE: usize = {size};\n\n/// {values_doc}\n\
+         #[rustfmt::skip]\npub static VALUES: [f64; SIZE * SIZE] = [\n"
+    );
+    for row in values.chunks(size) {
+        let line: Vec<String> = row.iter().map(|v| format!("{v:?}")).collect();
+        out.push_str(&format!("    {},\n", line.join(", ")));
+    }
+    out.push_str("];\n");
+    out
+}

@@ -93,24 +93,17 @@ pub fn lut32() -> &'static AlbedoTable {
 }
 
 /// The source text of `albedo_table32.rs` for `table`.
-pub fn table32_source(table: &AlbedoTable) -> String {
-    let mut out = String::from(
+#[cfg(test)]
+fn table32_source(table: &AlbedoTable) -> String {
+    super::square_table_source(
         "//! E(μ, r) of the Charlie sheen at the nodes of velvet's 32×32 albedo table (see\n\
          //! `table.rs`), computed by velvet's quadrature. Generated: `VELVET_UPDATE_GOLDEN=1 cargo\n\
          //! test --lib shading::table` rewrites this file, and that test fails when the quadrature\n\
-         //! no longer gives these values. Do not edit by hand.\n\n\
-         /// Nodes per axis.\n\
-         pub const SIZE: usize = 32;\n\n\
-         /// E at μ_i = (i + ½)/32, r_j = (j + ½)/32, in VALUES[j·SIZE + i].\n\
-         #[rustfmt::skip]\n\
-         pub static VALUES: [f64; SIZE * SIZE] = [\n",
-    );
-    for row in table.values.chunks(table.n) {
-        let line: Vec<String> = row.iter().map(|v| format!("{v:?}")).collect();
-        out.push_str(&format!("    {},\n", line.join(", ")));
-    }
-    out.push_str("];\n");
-    out
+         //! no longer gives these values. Do not edit by hand.\n",
+        table.n,
+        "E at μ_i = (i + ½)/32, r_j = (j + ½)/32, in VALUES[j·SIZE + i].",
+        &table.values,
+    )
 }
 
 #[cfg(test)]
