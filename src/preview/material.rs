@@ -223,10 +223,11 @@ fn migrated(material: &Value, index: usize, plan: &MaterialPlan) -> Result<Value
 /// however many threads) read it: the first to ask computes them, the others wait for them.
 #[derive(Default)]
 struct ImageCache {
-    stats: std::sync::Mutex<HashMap<(usize, Read, Transfer), Arc<OnceLock<ImageStats>>>>,
+    stats: std::sync::Mutex<HashMap<(usize, Read, Transfer), StatsCell>>,
 }
 
-type ImageStats = Result<TextureStats, String>;
+/// One image's statistics for one way of reading it, once computed.
+type StatsCell = Arc<OnceLock<Result<TextureStats, String>>>;
 
 fn read(
     asset: &Asset,
