@@ -252,6 +252,28 @@ struct Replacement {
     text: String,
 }
 
+impl Replacement {
+    /// One text edit of a JSON report's fix.
+    fn of_json_edit(edit: &Value) -> Replacement {
+        Replacement {
+            start: edit["location"]["offset"].as_u64().unwrap() as usize,
+            end: edit["endLocation"]["offset"].as_u64().unwrap() as usize,
+            text: edit["content"].as_str().unwrap().to_string(),
+        }
+    }
+}
+
+/// Every text edit of every fix in a JSON report.
+fn json_report_replacements(report: &Value) -> Vec<Replacement> {
+    report["issues"]["messages"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|m| m["fix"]["edits"].as_array().into_iter().flatten())
+        .map(Replacement::of_json_edit)
+        .collect()
+}
+
 /// `source` with `replacements` made: each distinct one once, in order of place.
 fn apply_replacements(source: &[u8], mut replacements: Vec<Replacement>) -> Vec<u8> {
     replacements.sort();
@@ -308,11 +330,7 @@ fn json_and_sarif_fixes_applied_apart_from_velvet_give_the_fixed_bytes() {
             }
             for edit in fix["edits"].as_array().unwrap() {
                 let (start, end) = (&edit["location"], &edit["endLocation"]);
-                let r = Replacement {
-                    start: start["offset"].as_u64().unwrap() as usize,
-                    end: end["offset"].as_u64().unwrap() as usize,
-                    text: edit["content"].as_str().unwrap().to_string(),
-                };
+                let r = Replacement::of_json_edit(edit);
                 // Rows and columns name the same places as the offsets.
                 let place = |l: &Value| {
                     offset_of(
@@ -725,16 +743,7 @@ fn the_json_fixes_of_many_materials_applied_together_are_what_fix_writes() {
     let o = velvet_in(dir.path(), &["validate", "--format", "json", "m.gltf"]);
     let report: Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(report["fixes"]["fixable"], 41);
-    let mut replacements = Vec::new();
-    for message in report["issues"]["messages"].as_array().unwrap() {
-        for edit in message["fix"]["edits"].as_array().into_iter().flatten() {
-            replacements.push(Replacement {
-                start: edit["location"]["offset"].as_u64().unwrap() as usize,
-                end: edit["endLocation"]["offset"].as_u64().unwrap() as usize,
-                text: edit["content"].as_str().unwrap().to_string(),
-            });
-        }
-    }
+    let replacements = json_report_replacements(&report);
     let applied = apply_replacements(text.as_bytes(), replacements);
     let o = velvet_in(dir.path(), &["validate", "--fix", "m.gltf"]);
     assert_eq!(o.status.code(), Some(0), "{}", stdout(&o));
@@ -772,11 +781,7 @@ fn after_fix_the_fixes_left_are_given_against_the_text_written() {
         .as_array()
         .unwrap()
         .iter()
-        .map(|e| Replacement {
-            start: e["location"]["offset"].as_u64().unwrap() as usize,
-            end: e["endLocation"]["offset"].as_u64().unwrap() as usize,
-            text: e["content"].as_str().unwrap().to_string(),
-        })
+        .map(Replacement::of_json_edit)
         .collect();
     let applied = apply_replacements(&written, replacements);
     let o = velvet_in(
@@ -815,16 +820,7 @@ fn a_byte_order_mark_stays_with_its_finding_and_the_fix_edits_count_it() {
     std::fs::write(dir.path().join("bom.gltf"), &bytes).unwrap();
     let o = velvet_in(dir.path(), &["validate", "--format", "json", "bom.gltf"]);
     let report: Value = serde_json::from_slice(&o.stdout).unwrap();
-    let mut replacements = Vec::new();
-    for message in report["issues"]["messages"].as_array().unwrap() {
-        for edit in message["fix"]["edits"].as_array().into_iter().flatten() {
-            replacements.push(Replacement {
-                start: edit["location"]["offset"].as_u64().unwrap() as usize,
-                end: edit["endLocation"]["offset"].as_u64().unwrap() as usize,
-                text: edit["content"].as_str().unwrap().to_string(),
-            });
-        }
-    }
+    let replacements = json_report_replacements(&report);
     let mut expected = b"\xEF\xBB\xBF".to_vec();
     expected.extend(expected_fixed("UNDECLARED_EXTENSION"));
     assert_eq!(apply_replacements(&bytes, replacements), expected);
