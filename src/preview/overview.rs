@@ -344,21 +344,43 @@ mod tests {
     }
 
     #[test]
-    fn the_overview_counts_each_verdict() {
-        let png = png(
-            &[0.05, 0.15, 0.3, 0.31],
-            &[(0.01, true), (0.002, false)],
-            &[],
-        );
-        let image = image::load_from_memory(&png).unwrap();
-        assert!(image.width() as usize >= BINS * BAR_W);
+    fn the_overview_counts_each_verdict_and_draws_each_bar_in_its_colour() {
+        let flips = [0.05, 0.15, 0.3, 0.31];
+        assert_eq!(verdict_counts(&flips), [1, 1, 2]);
+        let counts = histogram(&flips);
+        // 0.3 and 0.31 share bin 15 ([0.30, 0.32)).
         assert_eq!(
             (
-                Verdict::from_flip(0.05),
-                Verdict::from_flip(0.15),
-                Verdict::from_flip(0.3)
+                counts[2],
+                counts[7],
+                counts[15],
+                counts.iter().sum::<usize>()
             ),
-            (Verdict::Same, Verdict::Close, Verdict::Visible)
+            (1, 1, 2, 4)
+        );
+        let metrics = [(0.01, true), (0.002, false)];
+        let image = image::load_from_memory(&png(&flips, &metrics, &[]))
+            .unwrap()
+            .to_rgb8();
+        // Each bar's foot, in the middle of its bin: the verdict's colour above, blue for a
+        // drawn sheet and grey for one not drawn below (bins of 0.001 there).
+        let left = MARGIN + font::width("100000") + 8;
+        let axis = MARGIN + 4 * LINE_HEIGHT + PLOT_H;
+        let metric_axis = axis + 6 * LINE_HEIGHT + PLOT_H;
+        let foot = |bin: usize, axis: usize| {
+            image
+                .get_pixel((left + bin * BAR_W + BAR_W / 2) as u32, (axis - 1) as u32)
+                .0
+        };
+        assert_eq!(foot(2, axis), [90, 170, 110]);
+        assert_eq!(foot(7, axis), [200, 170, 80]);
+        assert_eq!(foot(15, axis), [210, 80, 80]);
+        assert_eq!(foot(10, metric_axis), [110, 160, 220]);
+        assert_eq!(foot(2, metric_axis), [110, 110, 110]);
+        let background = [sheet::background_code(); 3];
+        assert_eq!(
+            (foot(14, axis), foot(5, metric_axis)),
+            (background, background)
         );
     }
 }
