@@ -203,7 +203,9 @@ pub const UNEXPECTED_PROPERTY: Code = Code::new(
 );
 pub const VALUE_NOT_IN_LIST: Code = Code::new(
     "VALUE_NOT_IN_LIST",
-    Error,
+    // A warning in the Khronos validator: an unknown enum value (a filter, an alphaMode) is
+    // one a newer loader may know.
+    Warning,
     "A value is not one of those the schema allows.",
 );
 pub const SCHEMA_MISMATCH: Code = Code::new(

@@ -1,7 +1,10 @@
 //! Attribute semantics: the spec names the semantics a primitive may use (POSITION, NORMAL,
 //! TANGENT, TEXCOORD_n, COLOR_n, JOINTS_n, WEIGHTS_n) and says that application-specific ones
 //! MUST start with an underscore. Any other name is an error: loaders do not know what to bind
-//! it to.
+//! it to. The same holds for a morph target's attributes, each of which displaces the base
+//! attribute of its name (MESH_PRIMITIVE_MORPH_TARGET_NO_BASE_ACCESSOR where there is none), and
+//! every primitive of a mesh has as many morph targets as the first
+//! (MESH_PRIMITIVES_UNEQUAL_TARGETS_COUNT), as the Khronos glTF-Validator checks.
 
 use super::{Context, Rule};
 use crate::asset::pointer;
@@ -28,32 +31,91 @@ pub fn is_valid_semantic(name: &str) -> bool {
         })
 }
 
+pub const MESH_PRIMITIVE_MORPH_TARGET_NO_BASE_ACCESSOR: Code = Code::new(
+    "MESH_PRIMITIVE_MORPH_TARGET_NO_BASE_ACCESSOR",
+    Severity::Error,
+    "A morph target displaces an attribute that its primitive does not define.",
+);
+pub const MESH_PRIMITIVES_UNEQUAL_TARGETS_COUNT: Code = Code::new(
+    "MESH_PRIMITIVES_UNEQUAL_TARGETS_COUNT",
+    Severity::Error,
+    "The primitives of one mesh have different numbers of morph targets.",
+);
+
+fn invalid(at: &str, name: &str, out: &mut Vec<Diagnostic>) {
+    out.push(Diagnostic::new(
+        &MESH_PRIMITIVE_INVALID_ATTRIBUTE,
+        format!("{at}/{}", pointer::escape(name)),
+        format!(
+            "'{name}' is not a glTF attribute semantic; application-specific ones start with '_'"
+        ),
+    ));
+}
+
 pub struct Attributes;
 
 impl Rule for Attributes {
     fn codes(&self) -> &'static [&'static Code] {
-        &[&MESH_PRIMITIVE_INVALID_ATTRIBUTE]
+        &[
+            &MESH_PRIMITIVE_INVALID_ATTRIBUTE,
+            &MESH_PRIMITIVE_MORPH_TARGET_NO_BASE_ACCESSOR,
+            &MESH_PRIMITIVES_UNEQUAL_TARGETS_COUNT,
+        ]
     }
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
         let meshes = cx.json().get("meshes").and_then(|m| m.as_array());
         for (m, mesh) in meshes.iter().flat_map(|a| a.iter()).enumerate() {
             let primitives = mesh.get("primitives").and_then(|p| p.as_array());
+            let mut first_count = None;
             for (p, primitive) in primitives.iter().flat_map(|a| a.iter()).enumerate() {
                 let attributes = primitive.get("attributes").and_then(|a| a.as_object());
-                for name in attributes.into_iter().flat_map(|a| a.keys()) {
-                    if !is_valid_semantic(&name) {
-                        out.push(Diagnostic::new(
-                            &MESH_PRIMITIVE_INVALID_ATTRIBUTE,
-                            format!(
-                                "/meshes/{m}/primitives/{p}/attributes/{}",
-                                pointer::escape(&name)
-                            ),
-                            format!(
-                                "'{name}' is not a glTF attribute semantic; application-specific ones start with '_'"
-                            ),
-                        ));
+                let at = format!("/meshes/{m}/primitives/{p}");
+                let base: Vec<_> = attributes.iter().flat_map(|a| a.keys()).collect();
+                for name in &base {
+                    if !is_valid_semantic(name) {
+                        invalid(&format!("{at}/attributes"), name, out);
                     }
+                }
+                // A morph target's attributes displace the base attributes of the same name.
+                let targets = primitive.get("targets").and_then(|t| t.as_array());
+                for (t, target) in targets.iter().flat_map(|a| a.iter()).enumerate() {
+                    for name in target.as_object().into_iter().flat_map(|o| o.keys()) {
+                        let target_at = format!("{at}/targets/{t}");
+                        if !is_valid_semantic(&name) {
+                            invalid(&target_at, &name, out);
+                        }
+                        if !base.contains(&name) {
+                            out.push(Diagnostic::new(
+                                &MESH_PRIMITIVE_MORPH_TARGET_NO_BASE_ACCESSOR,
+                                format!("{target_at}/{}", pointer::escape(&name)),
+                                format!("the morph target displaces '{name}', which the primitive's attributes do not define"),
+                            ));
+                        }
+                    }
+                }
+                // Targets that are not a list of morph targets are the schema's findings, and
+                // such a primitive is not compared (as the Khronos validator does).
+                let Some(count) = (match targets {
+                    None => Some(0),
+                    Some(list) => (!list.is_empty()
+                        && list.iter().all(|t| t.as_object().is_some_and(|o| !o.is_empty())))
+                    .then(|| list.len()),
+                }) else {
+                    continue;
+                };
+                match first_count {
+                    None => first_count = Some(count),
+                    Some(first) if first != count => out.push(Diagnostic::new(
+                        &MESH_PRIMITIVES_UNEQUAL_TARGETS_COUNT,
+                        if primitive.get("targets").is_some() {
+                            format!("{at}/targets")
+                        } else {
+                            at.clone()
+                        },
+                        format!("the primitive has {count} morph targets, the mesh's first primitive {first}"),
+                    )),
+                    Some(_) => {}
                 }
             }
         }

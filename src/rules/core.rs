@@ -91,6 +91,51 @@ pub const NODE_MATRIX_TRS: Code = Code::new(
     "A node has both a matrix and translation, rotation or scale.",
 );
 
+/// Makes the schemas' open enumerations judge their values, as the Khronos validator does.
+///
+/// The glTF schemas write an enumeration as `anyOf` of its values and a bare `{"type": T}`,
+/// so that a newer value still passes (`"type": "VEC5"`, a light of type "ambient"). The
+/// Khronos validator reports such a value as VALUE_NOT_IN_LIST, a warning: a loader that
+/// knows only the listed values cannot use it. Here the bare branch becomes `{"not": {"type":
+/// T}}` and `T` the property's type: a value of another type is TYPE_MISMATCH, one of type `T`
+/// outside the list fails the `anyOf` (VALUE_NOT_IN_LIST). Both are draft-4 keywords, so every
+/// file keeps its draft.
+pub(crate) fn close_open_enums(schema: &mut Value) {
+    match schema {
+        Value::Object(map) => {
+            let open = map.get("anyOf").and_then(Value::as_array).and_then(|branches| {
+                let listed = branches
+                    .iter()
+                    .filter(|b| b.get("const").is_some() || b.get("enum").is_some())
+                    .count();
+                let bare: Vec<&Value> = branches
+                    .iter()
+                    .filter_map(|b| {
+                        let b = b.as_object()?;
+                        let only_type = b.keys().all(|k| k == "type" || k == "description");
+                        only_type.then(|| b.get("type")).flatten()
+                    })
+                    .collect();
+                (listed > 0 && listed + 1 == branches.len() && bare.len() == 1)
+                    .then(|| bare[0].clone())
+            });
+            if let Some(kind) = open {
+                if let Some(Value::Array(branches)) = map.get_mut("anyOf") {
+                    for branch in branches.iter_mut() {
+                        if branch.get("const").is_none() && branch.get("enum").is_none() {
+                            *branch = serde_json::json!({"not": {"type": kind.clone()}});
+                        }
+                    }
+                }
+                map.entry("type").or_insert(kind);
+            }
+            map.values_mut().for_each(close_open_enums);
+        }
+        Value::Array(items) => items.iter_mut().for_each(close_open_enums),
+        _ => {}
+    }
+}
+
 /// The core schema compiled for one run.
 pub struct CoreSchema {
     validator: jsonschema::Validator<TapeJson>,
@@ -102,10 +147,9 @@ impl CoreSchema {
         let files: HashMap<String, Value> = CORE_SCHEMAS
             .iter()
             .map(|(name, text)| {
-                (
-                    name.to_string(),
-                    serde_json::from_str(text).expect("core schemas are valid JSON"),
-                )
+                let mut schema = serde_json::from_str(text).expect("core schemas are valid JSON");
+                close_open_enums(&mut schema);
+                (name.to_string(), schema)
             })
             .collect();
         let root = files["glTF.schema.json"].clone();
@@ -125,7 +169,14 @@ impl CoreSchema {
         if self.validator.is_valid(json) {
             return;
         }
+        let first = out.len();
         diagnostics(&self.validator, json, out);
+        // The Khronos validator names the document's root "/".
+        for found in &mut out[first..] {
+            if found.pointer.is_empty() {
+                found.pointer.push('/');
+            }
+        }
     }
 }
 
@@ -138,11 +189,35 @@ pub(crate) fn diagnostics(
 ) {
     // The (code, pointer) of each finding so far: a document with many faults has many
     // findings, and comparing each with all the others would take quadratic time.
-    let mut seen: std::collections::HashSet<(&'static str, String)> =
+    let mut seen: std::collections::HashSet<(&'static str, String, String)> =
         std::collections::HashSet::new();
     for error in validator.iter_errors(json) {
-        let at = error.instance_path().as_str().to_string();
+        let mut at = error.instance_path().as_str().to_string();
         let schema_path = error.schema_path().as_str().to_string();
+        let dependent = match error.kind() {
+            ValidationErrorKind::Required { property } if schema_path.ends_with("/dependencies") => {
+                json.pointer(&at).and_then(|object| {
+                    dependent_property(object, &property_name(property), |key| {
+                        !seen.contains(&(
+                            UNSATISFIED_DEPENDENCY.name,
+                            format!("{at}/{}", crate::asset::pointer::escape(key)),
+                            String::new(),
+                        ))
+                    })
+                })
+            }
+            _ => None,
+        };
+        if let Some(property) = &dependent {
+            // The Khronos validator judges these two elsewhere: a default scene that names no
+            // scene is UNRESOLVED_REFERENCE (the references rule), an alphaCutoff without
+            // alphaMode is MATERIAL_ALPHA_CUTOFF_INVALID_MODE (a warning, the alpha rule).
+            if (at.is_empty() && property == "scene")
+                || (at.starts_with("/materials/") && property == "alphaCutoff")
+            {
+                continue;
+            }
+        }
         let (instance, len) = match json.pointer(&at) {
             Some(node) => sample(node),
             None => {
@@ -153,14 +228,82 @@ pub(crate) fn diagnostics(
                 (value, len)
             }
         };
+        // A property's missing dependency is reported at the property that needs it, as the
+        // Khronos validator does (`/accessors/0/byteOffset` needs `bufferView`).
+        if let Some(property) = &dependent {
+            at.push('/');
+            crate::asset::pointer::push_escaped(&mut at, property);
+        }
+        // Each missing property is a finding of its own, as in the Khronos validator.
+        let missing = match error.kind() {
+            ValidationErrorKind::Required { property } if dependent.is_none() => {
+                property_name(property)
+            }
+            _ => String::new(),
+        };
         let found = diagnostic(error.kind(), &schema_path, &instance, len, at);
         // A fault is one finding, though the schema may say so twice: a number past f64's
         // range fails both its type and its maximum, a value its own `type` and its base's.
-        if !seen.insert((found.code, found.pointer.clone())) {
+        if !seen.insert((found.code, found.pointer.clone(), missing)) {
             continue;
         }
         out.push(found);
     }
+}
+
+/// Every `dependencies` entry of the core and extension schemas: (the property present, a
+/// property it needs). jsonschema places a failed dependency at the `dependencies` keyword,
+/// not at the entry, so the property that needs the missing one is found from this list.
+static DEPENDENCIES: std::sync::LazyLock<Vec<(String, String)>> = std::sync::LazyLock::new(|| {
+    fn collect(value: &Value, out: &mut Vec<(String, String)>) {
+        match value {
+            Value::Object(map) => {
+                if let Some(Value::Object(entries)) = map.get("dependencies") {
+                    for (present, needs) in entries {
+                        for need in needs.as_array().into_iter().flatten() {
+                            if let Some(need) = need.as_str() {
+                                out.push((present.clone(), need.to_string()));
+                            }
+                        }
+                    }
+                }
+                map.values().for_each(|v| collect(v, out));
+            }
+            Value::Array(items) => items.iter().for_each(|v| collect(v, out)),
+            _ => {}
+        }
+    }
+    let mut out = Vec::new();
+    let texts = CORE_SCHEMAS.iter().chain(
+        super::extensions::EXTENSION_FILES
+            .iter()
+            .flat_map(|(_, files)| files.iter()),
+    );
+    for (_, text) in texts {
+        let schema: Value = serde_json::from_str(text).expect("compiled-in schemas are valid JSON");
+        collect(&schema, &mut out);
+    }
+    out
+});
+
+/// The member of `object` whose dependency on `missing` failed: the first, in the object's
+/// order, that needs it and that `unreported` accepts (a node with both `weights` and `skin`
+/// and no `mesh` fails twice).
+fn dependent_property(
+    object: Node,
+    missing: &str,
+    unreported: impl Fn(&str) -> bool,
+) -> Option<String> {
+    object
+        .as_object()?
+        .iter()
+        .map(|(key, _)| key.into_owned())
+        .find(|key| {
+            DEPENDENCIES
+                .iter()
+                .any(|(present, need)| present == key && need == missing)
+                && unreported(key)
+        })
 }
 
 /// The first elements (or members) a message can show of the value `node` is, with how many
@@ -425,9 +568,48 @@ impl Rule for CoreStructure {
     }
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
-        cx.schemas.core.check(cx.json(), out);
+        let json = cx.json();
+        let first = out.len();
+        cx.schemas.core.check(json, out);
+        // Values an extension adds to a core enumeration are in the list once the extension
+        // is declared, as the Khronos validator reads them.
+        let declared = |name: &str| {
+            super::elements(json.get("extensionsUsed")).any(|e| e.is_str(name))
+        };
+        let mut kept = first;
+        for at in first..out.len() {
+            let d = &out[at];
+            let added = d.code == codes::VALUE_NOT_IN_LIST.name
+                && json.pointer(&d.pointer).is_some_and(|value| {
+                    EXTENDED_VALUES.iter().any(|(property, value_added, extension)| {
+                        d.pointer.ends_with(property) && value.is_str(value_added) && declared(extension)
+                    })
+                });
+            if !added {
+                out.swap(kept, at);
+                kept += 1;
+            }
+        }
+        out.truncate(kept);
+        // The Khronos validator reads extensionsRequired as depending on extensionsUsed,
+        // though the published schema does not say so.
+        if json.get("extensionsRequired").is_some() && json.get("extensionsUsed").is_none() {
+            out.push(Diagnostic::new(
+                &UNSATISFIED_DEPENDENCY,
+                "/extensionsRequired",
+                "'extensionsUsed' must be defined here (extensionsRequired depends on it)",
+            ));
+        }
     }
 }
+
+/// Values that extensions add to core enumerations: (the property's last pointer segment,
+/// the value, the extension that adds it).
+const EXTENDED_VALUES: &[(&str, &str, &str)] = &[
+    ("/target/path", "pointer", "KHR_animation_pointer"),
+    ("/mimeType", "image/webp", "EXT_texture_webp"),
+    ("/mimeType", "image/ktx2", "KHR_texture_basisu"),
+];
 
 #[cfg(test)]
 mod tests {

@@ -4,8 +4,8 @@
 //! (`schema/extensions/<EXTENSION>/`, compiled in) name the kind of object each extends:
 //! `material.KHR_materials_ior.schema.json` extends a material. [`PLACEMENTS`] is the one table
 //! of where every extension with a schema may stand and the file that judges it there. An
-//! extension object on any other kind of object is UNEXPECTED_EXTENSION_OBJECT (a warning, as
-//! in the Khronos validator: loaders ignore it there); one where it belongs is judged by its
+//! extension object on any other kind of object is UNEXPECTED_EXTENSION_OBJECT (an error, as
+//! in the Khronos validator, which lists it among its link errors); one where it belongs is judged by its
 //! schema, with the codes and pointers of the core schema check.
 //!
 //! The kinds of objects come from the schemas too: the walk starts at the root with
@@ -566,8 +566,8 @@ pub const PLACEMENTS: &[Placement] = &[
 
 pub const UNEXPECTED_EXTENSION_OBJECT: Code = Code::new(
     "UNEXPECTED_EXTENSION_OBJECT",
-    Severity::Warning,
-    "An extension object stands on a kind of object its extension does not extend (KHR_materials_ior on a node, KHR_texture_transform on a material); loaders ignore it there.",
+    Severity::Error,
+    "An extension object stands on a kind of object its extension does not extend (KHR_materials_ior on a node, KHR_texture_transform on a material).",
 );
 
 /// Whether velvet's layer schema check, not this rule, judges the extension's contents.
@@ -603,10 +603,13 @@ struct Shape {
     is: Vec<String>,
     /// Its properties that hold objects of a known kind: name, kind, whether an array of them.
     children: Vec<(String, usize, bool)>,
+    /// Every property its schemas define (its own and its bases'), sorted; `None` when the
+    /// schema admits any other (`additionalProperties` other than `false`).
+    known: Option<Vec<String>>,
 }
 
 /// The kinds of objects of a glTF document and of its extension objects, from the schemas.
-struct Shapes {
+pub(crate) struct Shapes {
     shapes: Vec<Shape>,
     /// Per kind: whether it is a textureInfo, and a normal texture's, read once here rather
     /// than by comparing file names at every object of every material.
@@ -634,6 +637,11 @@ fn is_leaf(name: &str) -> bool {
 
 /// The schema file a property refers to for its objects, and whether it holds an array of them.
 fn object_ref(property: &Value) -> Option<(&str, bool)> {
+    // An object described in place, with properties of its own beside the schema it extends
+    // (KHR_materials_variants' mappings), is not that schema's kind.
+    if property.get("properties").is_some() {
+        return None;
+    }
     if let Some(target) = property.get("$ref").and_then(Value::as_str) {
         return Some((target, false));
     }
@@ -678,10 +686,16 @@ impl ShapeBuilder {
         self.shapes.push(Shape {
             is: vec![name.to_string()],
             children: Vec::new(),
+            known: None,
         });
         self.known.insert(key, at);
         let mut is = vec![name.to_string()];
         let mut children = Vec::new();
+        let mut known: Option<Vec<String>> =
+            match schema.get("additionalProperties") {
+                None | Some(Value::Bool(false)) => Some(Vec::new()),
+                Some(_) => None,
+            };
         for base in schema
             .get("allOf")
             .and_then(Value::as_array)
@@ -692,6 +706,10 @@ impl ShapeBuilder {
             if let Some(base) = self.shape(folder, base) {
                 is.extend(self.shapes[base].is.iter().cloned());
                 children.extend(self.shapes[base].children.iter().cloned());
+                match (&mut known, &self.shapes[base].known) {
+                    (Some(own), Some(inherited)) => own.extend(inherited.iter().cloned()),
+                    _ => known = None,
+                }
             }
         }
         for (property, sub) in schema
@@ -700,6 +718,9 @@ impl ShapeBuilder {
             .into_iter()
             .flatten()
         {
+            if let Some(own) = &mut known {
+                own.push(property.clone());
+            }
             if let Some((target, array)) = object_ref(sub) {
                 if let Some(child) = self.shape(folder, target) {
                     children.retain(|(name, _, _)| name != property);
@@ -707,7 +728,15 @@ impl ShapeBuilder {
                 }
             }
         }
-        self.shapes[at] = Shape { is, children };
+        if let Some(own) = &mut known {
+            own.sort();
+            own.dedup();
+        }
+        self.shapes[at] = Shape {
+            is,
+            children,
+            known,
+        };
         Some(at)
     }
 }
@@ -775,7 +804,44 @@ pub fn prepare() {
     LazyLock::force(&SHAPES);
 }
 
+/// The kinds of objects, read from the schemas on first use.
+pub(crate) fn shapes() -> &'static Shapes {
+    &SHAPES
+}
+
 impl Shapes {
+    /// The kind of the document's root.
+    pub(crate) fn root(&self) -> usize {
+        self.root
+    }
+
+    /// The properties of kind `shape` that hold objects of a known kind: name, kind, whether
+    /// an array of them.
+    pub(crate) fn children(&self, shape: usize) -> &[(String, usize, bool)] {
+        &self.shapes[shape].children
+    }
+
+    /// Whether kind `shape`'s schemas define property `key`; true for every key of a kind
+    /// whose schema admits any.
+    pub(crate) fn defines(&self, shape: usize, key: &str) -> bool {
+        self.shapes[shape]
+            .known
+            .as_ref()
+            .is_none_or(|known| known.binary_search_by(|k| k.as_str().cmp(key)).is_ok())
+    }
+
+    /// The kind of extension `name`'s object where it stands on an object of kind `on`, for
+    /// an extension judged by a published schema there (not sheen and fuzz, which the layer
+    /// schema check judges, nor one misplaced or without a schema).
+    pub(crate) fn extension_object(&self, name: &str, on: usize) -> Option<usize> {
+        if judged_as_layer(name) {
+            return None;
+        }
+        let placements = self.by_extension.get(name)?;
+        let placement = placements.iter().find(|p| self.fits(**p, on))?;
+        Some(self.placed[*placement])
+    }
+
     /// Whether placement `placement` may stand on an object of kind `shape`.
     fn fits(&self, placement: usize, shape: usize) -> bool {
         self.fit[shape][placement]
@@ -793,10 +859,9 @@ static CORE_FILES: LazyLock<HashMap<String, Value>> = LazyLock::new(|| {
     super::core::CORE_SCHEMAS
         .iter()
         .map(|(name, text)| {
-            (
-                name.to_string(),
-                serde_json::from_str(text).expect("core schemas are valid JSON"),
-            )
+            let mut schema = serde_json::from_str(text).expect("core schemas are valid JSON");
+            super::core::close_open_enums(&mut schema);
+            (name.to_string(), schema)
         })
         .collect()
 });
@@ -824,10 +889,9 @@ impl ExtensionSchemas {
 fn compile(placement: &Placement) -> jsonschema::Validator<TapeJson> {
     let mut files = CORE_FILES.clone();
     for (name, text) in folder_of(placement.extension) {
-        files.insert(
-            name.to_string(),
-            serde_json::from_str(text).expect("compiled-in schemas are valid JSON"),
-        );
+        let mut schema = serde_json::from_str(text).expect("compiled-in schemas are valid JSON");
+        super::core::close_open_enums(&mut schema);
+        files.insert(name.to_string(), schema);
     }
     let root = files[placement.schema].clone();
     // Each file declares its draft (draft 4 or 2020-12), and is read as it declares.

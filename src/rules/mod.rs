@@ -5,7 +5,10 @@
 //!
 //! Rules read the asset and push diagnostics; they never change anything.
 
+pub mod accessors;
 pub mod asset_version;
+pub mod buffer_views;
+pub mod cameras;
 pub mod attributes;
 pub mod clearcoat;
 pub mod core;
@@ -19,6 +22,8 @@ pub mod fuzz_roughness_mapping;
 pub mod image_size;
 pub mod legacy_sheen;
 pub mod lights;
+pub mod materials;
+pub mod node_tree;
 pub mod references;
 pub mod resources;
 pub mod roughness_alpha;
@@ -26,6 +31,7 @@ pub mod schema;
 pub mod skins;
 pub mod tangent_space;
 pub mod texcoord;
+pub mod unexpected_property;
 
 use crate::asset::tape::Node;
 use crate::asset::Asset;
@@ -218,10 +224,16 @@ pub static REGISTRY: &[&dyn Rule] = &[
     &asset_version::AssetVersion,
     &declaration::Declaration,
     &extensions::ExtensionObjects,
+    &unexpected_property::UnexpectedProperty,
     &lights::Lights,
     &exclusions::Exclusions,
     &references::References,
     &attributes::Attributes,
+    &accessors::Accessors,
+    &buffer_views::BufferViews,
+    &node_tree::NodeTree,
+    &cameras::Cameras,
+    &materials::Materials,
     &resources::Resources,
     &texcoord::TexCoords,
     &tangent_space::TangentSpace,

@@ -1,0 +1,142 @@
+//! Properties no schema defines: UNEXPECTED_PROPERTY (a warning, as in the Khronos
+//! glTF-Validator) at each key of a core object or of an extension object with a published
+//! schema that its schemas, its bases' included, do not name.
+//!
+//! The glTF 2.0 schemas do not close their objects (`additionalProperties` is absent), so the
+//! schema check passes a misspelt `"nmae"`; the Khronos validator reports it, and so does this
+//! rule. The kinds of objects and the properties each defines come from the same schema walk
+//! as the extension placements (`rules/extensions.rs`); `extras`, extensions without a schema
+//! and schemas that admit any property are open and not judged. Sheen and fuzz objects are the
+//! layer schema check's (`rules/schema.rs`).
+//!
+//! Example: `{"nodes": [{"nmae": "a"}]}` → UNEXPECTED_PROPERTY at `/nodes/0/nmae`.
+
+use super::extensions::{shapes, Shapes};
+use super::{Context, Rule};
+use crate::asset::pointer;
+use crate::asset::tape::Node;
+use crate::diagnostics::{codes, Code, Diagnostic};
+
+pub struct UnexpectedProperty;
+
+/// Objects are never this deep in a real asset; a hostile one stops here.
+const MAX_DEPTH: usize = 64;
+
+impl Rule for UnexpectedProperty {
+    fn codes(&self) -> &'static [&'static Code] {
+        &[&codes::UNEXPECTED_PROPERTY]
+    }
+
+    fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
+        let shapes = shapes();
+        let mut path = String::new();
+        walk(shapes, cx.json(), shapes.root(), &mut path, 0, out);
+    }
+}
+
+fn walk(
+    shapes: &Shapes,
+    value: Node,
+    shape: usize,
+    path: &mut String,
+    depth: usize,
+    out: &mut Vec<Diagnostic>,
+) {
+    let Some(object) = value.as_object() else {
+        return;
+    };
+    if depth > MAX_DEPTH {
+        return;
+    }
+    for (key, member) in object.iter() {
+        let len = path.len();
+        path.push('/');
+        pointer::push_escaped(path, &key);
+        if !shapes.defines(shape, &key) {
+            out.push(Diagnostic::new(
+                &codes::UNEXPECTED_PROPERTY,
+                path.as_str(),
+                format!("unexpected property '{key}'"),
+            ));
+        } else if key == "extensions" {
+            for (name, extension) in member.as_object().into_iter().flat_map(|o| o.iter()) {
+                if let Some(kind) = shapes.extension_object(&name, shape) {
+                    let len = path.len();
+                    path.push('/');
+                    pointer::push_escaped(path, &name);
+                    walk(shapes, extension, kind, path, depth + 1, out);
+                    path.truncate(len);
+                }
+            }
+        } else if let Some((_, child, array)) =
+            shapes.children(shape).iter().find(|(name, _, _)| *name == key)
+        {
+            if *array {
+                for (i, element) in member.as_array().into_iter().flat_map(|a| a.iter()).enumerate() {
+                    let len = path.len();
+                    path.push('/');
+                    path.push_str(&i.to_string());
+                    walk(shapes, element, *child, path, depth + 1, out);
+                    path.truncate(len);
+                }
+            } else {
+                walk(shapes, member, *child, path, depth + 1, out);
+            }
+        }
+        path.truncate(len);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::asset::{load_bytes_with, LoadOptions};
+
+    fn found(text: &str) -> Vec<String> {
+        let loaded = load_bytes_with(
+            std::path::Path::new("t.gltf"),
+            text.as_bytes(),
+            &LoadOptions::default(),
+        );
+        let asset = loaded.asset.expect("the document parses");
+        let schemas = super::super::schema::Schemas::builtin();
+        let cx = Context::new(&asset, &schemas);
+        let mut out = Vec::new();
+        UnexpectedProperty.check(&cx, &mut out);
+        out.into_iter()
+            .map(|d| format!("{} {}", d.code, d.pointer))
+            .collect()
+    }
+
+    #[test]
+    fn keys_no_schema_defines_are_found_in_core_and_extension_objects() {
+        let text = r#"{"asset":{"version":"2.0","bogus":1},"nmae":"x",
+            "nodes":[{"name":"n","extras":{"free":1},"extensions":{"KHR_node_visibility":{"visible":false,"odd":2},"EXT_unknown":{"any":1}}}],
+            "materials":[{"pbrMetallicRoughness":{"baseColorTexture":{"index":0,"scale":2}},
+                "extensions":{"KHR_materials_sheen":{"whatever":1},
+                              "KHR_texture_transform":{"nope":1}}}],
+            "accessors":[{"componentType":5126,"count":1,"type":"SCALAR","sparse":{"count":1,"indices":{"bufferView":0,"componentType":5123,"x":0},"values":{"bufferView":0}}}],
+            "a/b":1}"#;
+        assert_eq!(
+            found(text),
+            [
+                "UNEXPECTED_PROPERTY /asset/bogus",
+                "UNEXPECTED_PROPERTY /nmae",
+                "UNEXPECTED_PROPERTY /nodes/0/extensions/KHR_node_visibility/odd",
+                "UNEXPECTED_PROPERTY /materials/0/pbrMetallicRoughness/baseColorTexture/scale",
+                "UNEXPECTED_PROPERTY /accessors/0/sparse/indices/x",
+                "UNEXPECTED_PROPERTY /a~1b",
+            ]
+        );
+    }
+
+    #[test]
+    fn a_document_of_defined_properties_has_none() {
+        let text = r#"{"asset":{"version":"2.0","generator":"g","copyright":"c","extras":{}},
+            "scene":0,"scenes":[{"nodes":[0],"name":"s"}],
+            "nodes":[{"mesh":0,"translation":[0,0,0],"extensions":{"KHR_lights_punctual":{"light":0}}}],
+            "extensions":{"KHR_lights_punctual":{"lights":[{"type":"spot","spot":{"innerConeAngle":0.1}}]}},
+            "materials":[{"normalTexture":{"index":0,"scale":1,"texCoord":0},"occlusionTexture":{"index":0,"strength":1}}]}"#;
+        assert_eq!(found(text), Vec::<String>::new());
+    }
+}
