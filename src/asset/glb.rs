@@ -32,17 +32,17 @@ fn u32_at(bytes: &[u8], at: usize) -> u32 {
     u32::from_le_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]])
 }
 
-/// Splits a GLB file, pushing a diagnostic for every fault. Returns `None` when no JSON chunk
-/// can be had.
+/// Splits a GLB file, pushing a diagnostic for every fault, with the Khronos glTF-Validator's
+/// codes: the header's length is the length of the GLB, chunks are read in order until it is
+/// reached or the file ends, and the first chunk must be JSON. Returns `None` when no JSON
+/// chunk can be had.
 pub fn split<'a>(bytes: &'a [u8], out: &mut Vec<Diagnostic>) -> Option<GlbParts<'a>> {
-    if bytes.len() < HEADER_LEN {
+    let size = bytes.len();
+    if size < HEADER_LEN {
         out.push(Diagnostic::new(
-            &codes::GLB_UNEXPECTED_END,
+            &codes::GLB_UNEXPECTED_END_OF_HEADER,
             "",
-            format!(
-                "the file is {} bytes long; a GLB header needs 12",
-                bytes.len()
-            ),
+            format!("the file is {size} bytes long; a GLB header needs 12"),
         ));
         return None;
     }
@@ -67,43 +67,29 @@ pub fn split<'a>(bytes: &'a [u8], out: &mut Vec<Diagnostic>) -> Option<GlbParts<
         return None;
     }
     let declared = u32_at(bytes, 8) as usize;
-    // Bytes after the declared length are not part of the GLB: loaders stop at the length.
-    let end = if declared > bytes.len() || declared < HEADER_LEN {
+    if declared <= HEADER_LEN {
         out.push(Diagnostic::new(
-            &codes::GLB_LENGTH_MISMATCH,
+            &codes::GLB_LENGTH_TOO_SMALL,
             "",
-            format!(
-                "the GLB header declares {declared} bytes but the file has {}",
-                bytes.len()
-            ),
+            format!("the GLB header declares {declared} bytes, leaving no room for a chunk"),
         ));
-        bytes.len()
-    } else {
-        if declared < bytes.len() {
-            out.push(Diagnostic::new(
-                &codes::GLB_TRAILING_DATA,
-                "",
-                format!(
-                    "the file has {} bytes after the {declared} its GLB header declares; they are ignored",
-                    bytes.len() - declared
-                ),
-            ));
-        }
-        declared
-    };
+    }
     let mut at = HEADER_LEN;
     let mut json: Option<(usize, usize)> = None;
     let mut bin: Option<(usize, usize)> = None;
     let mut index = 0usize;
     let mut after_unknown = false;
     let mut other = Vec::new();
-    while at < end {
-        if end - at < CHUNK_HEADER_LEN {
+    // Whether the file ended inside a chunk: its length is then not judged again.
+    let mut cut_short = false;
+    while at < declared && at < size {
+        if size - at < CHUNK_HEADER_LEN {
             out.push(Diagnostic::new(
-                &codes::GLB_UNEXPECTED_END,
+                &codes::GLB_UNEXPECTED_END_OF_CHUNK_HEADER,
                 "",
                 format!("the file ends inside the header of chunk {index} at byte {at}"),
             ));
+            cut_short = true;
             break;
         }
         let length = u32_at(bytes, at) as usize;
@@ -116,37 +102,62 @@ pub fn split<'a>(bytes: &'a [u8], out: &mut Vec<Diagnostic>) -> Option<GlbParts<
                 format!("chunk {index} at byte {at} has length {length}, not a multiple of 4"),
             ));
         }
-        let available = end - data;
+        if data.saturating_add(length) > declared {
+            out.push(Diagnostic::new(
+                &codes::GLB_CHUNK_TOO_BIG,
+                "",
+                format!(
+                    "chunk {index} at byte {at} declares {length} bytes, past the {declared} the GLB header declares"
+                ),
+            ));
+        }
+        let available = size - data;
         let (data_end, truncated) = if length > available {
             out.push(Diagnostic::new(
-                &codes::GLB_UNEXPECTED_END,
+                &codes::GLB_UNEXPECTED_END_OF_CHUNK_DATA,
                 "",
                 format!(
                     "chunk {index} at byte {at} declares {length} bytes but only {available} remain in the file"
                 ),
             ));
-            (end, true)
+            cut_short = true;
+            (size, true)
         } else {
             (data + length, false)
         };
+        if kind == CHUNK_JSON && length == 0 {
+            out.push(Diagnostic::new(
+                &codes::GLB_EMPTY_CHUNK,
+                "",
+                format!("chunk {index} at byte {at} is an empty JSON chunk"),
+            ));
+        }
+        if index == 0 && kind != CHUNK_JSON {
+            out.push(Diagnostic::new(
+                &codes::GLB_UNEXPECTED_FIRST_CHUNK,
+                "",
+                format!("the first chunk has type 0x{kind:08X}; it must be JSON (0x4E4F534A)"),
+            ));
+        }
         match kind {
-            CHUNK_JSON if index == 0 => json = Some((data, data_end)),
-            CHUNK_BIN if index == 1 && !after_unknown && bin.is_none() => {
-                bin = Some((data, data_end))
-            }
-            _ if index == 0 => {
-                out.push(Diagnostic::new(
-                    &codes::GLB_UNEXPECTED_FIRST_CHUNK,
-                    "",
-                    format!("the first chunk has type 0x{kind:08X}; it must be JSON (0x4E4F534A)"),
-                ));
-                return None;
+            CHUNK_JSON if json.is_none() && index == 0 => json = Some((data, data_end)),
+            CHUNK_BIN if bin.is_none() => {
+                // A BIN chunk after an unknown one is out of place, but it is still the BIN
+                // chunk: loaders that find it use it.
+                if after_unknown {
+                    out.push(Diagnostic::new(
+                        &codes::GLB_UNEXPECTED_BIN_CHUNK,
+                        "",
+                        format!("the BIN chunk at byte {at} follows a chunk of unknown type; it must come right after the JSON chunk"),
+                    ));
+                }
+                bin = Some((data, data_end));
             }
             CHUNK_JSON | CHUNK_BIN => out.push(Diagnostic::new(
-                &codes::GLB_UNEXPECTED_CHUNK,
+                &codes::GLB_DUPLICATE_CHUNK,
                 "",
                 format!(
-                    "chunk {index} at byte {at} is a {} chunk where none may stand; it is ignored",
+                    "chunk {index} at byte {at} is a second {} chunk; it is ignored",
                     if kind == CHUNK_JSON { "JSON" } else { "BIN" }
                 ),
             )),
@@ -170,16 +181,27 @@ pub fn split<'a>(bytes: &'a [u8], out: &mut Vec<Diagnostic>) -> Option<GlbParts<
         at = data_end;
         index += 1;
     }
-    let Some((json_start, json_end)) = json else {
-        if end == HEADER_LEN {
+    if !cut_short {
+        if at == declared && size > declared {
+            // Bytes after the declared length are not part of the GLB: loaders stop there.
             out.push(Diagnostic::new(
-                &codes::GLB_UNEXPECTED_END,
+                &codes::GLB_EXTRA_DATA,
                 "",
-                "the GLB ends after its header: it has no JSON chunk",
+                format!(
+                    "the file has {} bytes after the {declared} its GLB header declares; they are ignored",
+                    size - declared
+                ),
+            ));
+        } else if at != declared {
+            out.push(Diagnostic::new(
+                &codes::GLB_LENGTH_MISMATCH,
+                "",
+                format!("the GLB header declares {declared} bytes but the file has {size}"),
             ));
         }
-        return None;
-    };
+    }
+    // An empty JSON chunk is that finding alone: there is no document to read.
+    let (json_start, json_end) = json.filter(|(start, end)| end > start)?;
     let json_bytes = &bytes[json_start..json_end];
     // Padding must be spaces; NULs (a common exporter mistake) would also break JSON parsers.
     if json_bytes.ends_with(&[0]) {
@@ -255,10 +277,7 @@ mod tests {
         let cut = &bytes[..bytes.len() - 6];
         let mut out = Vec::new();
         let parts = split(cut, &mut out).unwrap();
-        assert_eq!(
-            codes_of(&out),
-            vec!["GLB_LENGTH_MISMATCH", "GLB_UNEXPECTED_END"]
-        );
+        assert_eq!(codes_of(&out), vec!["GLB_UNEXPECTED_END_OF_CHUNK_DATA"]);
         assert_eq!(parts.bin.map(<[u8]>::len), Some(10));
     }
 
@@ -271,7 +290,7 @@ mod tests {
         assert_eq!(
             codes_of(&out),
             vec![
-                "GLB_UNEXPECTED_END",
+                "GLB_UNEXPECTED_END_OF_HEADER",
                 "GLB_INVALID_MAGIC",
                 "GLB_INVALID_VERSION"
             ]
@@ -295,6 +314,74 @@ mod tests {
         );
         assert_eq!(parts.json, b"{\"a\":1}");
         assert!(parts.bin.is_none());
+    }
+
+    /// A GLB of the given chunks (type, data), its header's length `declared` or the real one.
+    fn glb_of(chunks: &[(&[u8; 4], &[u8])], declared: Option<u32>) -> Vec<u8> {
+        let mut bytes = b"glTF\x02\0\0\0\0\0\0\0".to_vec();
+        for (kind, data) in chunks {
+            bytes.extend_from_slice(&(data.len() as u32).to_le_bytes());
+            bytes.extend_from_slice(*kind);
+            bytes.extend_from_slice(data);
+        }
+        let len = declared.unwrap_or(bytes.len() as u32);
+        bytes[8..12].copy_from_slice(&len.to_le_bytes());
+        bytes
+    }
+
+    fn split_codes(bytes: &[u8]) -> Vec<&'static str> {
+        let mut out = Vec::new();
+        split(bytes, &mut out);
+        out.iter().map(|d| d.code).collect()
+    }
+
+    #[test]
+    fn container_faults_get_the_reference_validators_codes() {
+        let json: &[u8] = b"{\"asset\":{\"version\":\"2.0\"}}  ";
+        assert_eq!(split_codes(&glb_of(&[], Some(12))), ["GLB_LENGTH_TOO_SMALL"]);
+        assert_eq!(
+            split_codes(&glb_of(&[], Some(0))),
+            ["GLB_LENGTH_TOO_SMALL", "GLB_LENGTH_MISMATCH"]
+        );
+        assert_eq!(
+            split_codes(&glb_of(&[(b"JSON", json)], Some(13))),
+            ["GLB_CHUNK_TOO_BIG", "GLB_LENGTH_MISMATCH"]
+        );
+        let whole = glb_of(&[(b"JSON", json)], None);
+        let mut extra = whole.clone();
+        extra.push(0);
+        assert_eq!(split_codes(&extra), ["GLB_EXTRA_DATA"]);
+        let mut longer = whole.clone();
+        longer[8] += 1;
+        assert_eq!(split_codes(&longer), ["GLB_LENGTH_MISMATCH"]);
+        assert_eq!(
+            split_codes(&whole[..13]),
+            ["GLB_UNEXPECTED_END_OF_CHUNK_HEADER"]
+        );
+        assert_eq!(
+            split_codes(&glb_of(&[(b"JSON", b""), (b"JSON", b"")], None)),
+            ["GLB_EMPTY_CHUNK", "GLB_EMPTY_CHUNK", "GLB_DUPLICATE_CHUNK"]
+        );
+        assert_eq!(
+            split_codes(&glb_of(&[(b"JSON", json), (b"BIN\0", b"abcd"), (b"BIN\0", b"abcd")], None)),
+            ["GLB_DUPLICATE_CHUNK"]
+        );
+        let mut out = Vec::new();
+        let misplaced = glb_of(&[(b"JSON", json), (b"UNK\0", b"abcd"), (b"BIN\0", b"efgh")], None);
+        let parts = split(&misplaced, &mut out).expect("the JSON chunk is read");
+        assert_eq!(
+            codes_of(&out),
+            ["GLB_UNKNOWN_CHUNK_TYPE", "GLB_UNEXPECTED_BIN_CHUNK"]
+        );
+        assert_eq!(parts.bin, Some(&b"efgh"[..]));
+        assert_eq!(
+            split_codes(&glb_of(&[(b"UNK\0", b"abcd")], None)),
+            ["GLB_UNEXPECTED_FIRST_CHUNK", "GLB_UNKNOWN_CHUNK_TYPE"]
+        );
+        assert_eq!(
+            split_codes(&glb_of(&[(b"BIN\0", b"abcd"), (b"BIN\0", b"abcd")], None)),
+            ["GLB_UNEXPECTED_FIRST_CHUNK", "GLB_DUPLICATE_CHUNK"]
+        );
     }
 
     #[test]

@@ -362,7 +362,8 @@ fn load_text(
     };
     if !index.root(parse_text).is_object() {
         diagnostics.push(Diagnostic::new(
-            &codes::INVALID_JSON_ROOT_OBJECT,
+            // The Khronos validator's code for a root that is no object.
+            &codes::TYPE_MISMATCH,
             "",
             "the JSON root is not an object",
         ));

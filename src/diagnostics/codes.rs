@@ -13,11 +13,6 @@ pub const INVALID_JSON: Code = Code::new(
     Error,
     "The glTF JSON is not valid UTF-8 JSON (the message gives line and column).",
 );
-pub const INVALID_JSON_ROOT_OBJECT: Code = Code::new(
-    "INVALID_JSON_ROOT_OBJECT",
-    Error,
-    "The glTF JSON's root is not an object.",
-);
 pub const BOM_PRESENT: Code = Code::new(
     "BOM_PRESENT",
     Error,
@@ -38,10 +33,45 @@ pub const GLB_LENGTH_MISMATCH: Code = Code::new(
     Error,
     "The length in the GLB header differs from the file's length.",
 );
-pub const GLB_UNEXPECTED_END: Code = Code::new(
-    "GLB_UNEXPECTED_END",
+pub const GLB_UNEXPECTED_END_OF_HEADER: Code = Code::new(
+    "GLB_UNEXPECTED_END_OF_HEADER",
     Error,
-    "The GLB ends inside its header, a chunk header or a chunk's data (truncated file).",
+    "A .glb file ends inside its 12-byte header.",
+);
+pub const GLB_UNEXPECTED_END_OF_CHUNK_HEADER: Code = Code::new(
+    "GLB_UNEXPECTED_END_OF_CHUNK_HEADER",
+    Error,
+    "A .glb file ends inside a chunk's header.",
+);
+pub const GLB_UNEXPECTED_END_OF_CHUNK_DATA: Code = Code::new(
+    "GLB_UNEXPECTED_END_OF_CHUNK_DATA",
+    Error,
+    "A .glb file ends inside a chunk's data (a truncated file).",
+);
+pub const GLB_LENGTH_TOO_SMALL: Code = Code::new(
+    "GLB_LENGTH_TOO_SMALL",
+    Error,
+    "The length in the GLB header leaves no room for a chunk.",
+);
+pub const GLB_CHUNK_TOO_BIG: Code = Code::new(
+    "GLB_CHUNK_TOO_BIG",
+    Error,
+    "A GLB chunk runs past the length the GLB header declares.",
+);
+pub const GLB_EMPTY_CHUNK: Code = Code::new(
+    "GLB_EMPTY_CHUNK",
+    Error,
+    "A GLB JSON chunk is empty.",
+);
+pub const GLB_DUPLICATE_CHUNK: Code = Code::new(
+    "GLB_DUPLICATE_CHUNK",
+    Error,
+    "A second JSON or BIN chunk; loaders ignore it.",
+);
+pub const GLB_UNEXPECTED_BIN_CHUNK: Code = Code::new(
+    "GLB_UNEXPECTED_BIN_CHUNK",
+    Error,
+    "The BIN chunk follows a chunk of unknown type; it must come right after the JSON chunk.",
 );
 pub const GLB_CHUNK_LENGTH_UNALIGNED: Code = Code::new(
     "GLB_CHUNK_LENGTH_UNALIGNED",
@@ -52,11 +82,6 @@ pub const GLB_UNEXPECTED_FIRST_CHUNK: Code = Code::new(
     "GLB_UNEXPECTED_FIRST_CHUNK",
     Error,
     "The first GLB chunk is not the JSON chunk.",
-);
-pub const GLB_UNEXPECTED_CHUNK: Code = Code::new(
-    "GLB_UNEXPECTED_CHUNK",
-    Error,
-    "A second JSON chunk, a second BIN chunk, or a BIN chunk after an unknown chunk.",
 );
 pub const GLB_UNKNOWN_CHUNK_TYPE: Code = Code::new(
     "GLB_UNKNOWN_CHUNK_TYPE",
@@ -109,8 +134,8 @@ pub const BUFFER_MISSING_GLB_DATA: Code = Code::new(
     Error,
     "A GLB's first buffer has no uri, and the GLB has no BIN chunk to hold its data.",
 );
-pub const GLB_TRAILING_DATA: Code = Code::new(
-    "GLB_TRAILING_DATA",
+pub const GLB_EXTRA_DATA: Code = Code::new(
+    "GLB_EXTRA_DATA",
     Warning,
     "A .glb file has bytes after the length its header declares; loaders ignore them.",
 );
@@ -153,16 +178,21 @@ pub const LOADER: &[&Code] = &[
     &DOCUMENT_TOO_LARGE,
     &JSON_TOO_DEEP,
     &INVALID_JSON,
-    &INVALID_JSON_ROOT_OBJECT,
     &BOM_PRESENT,
     &GLB_INVALID_MAGIC,
     &GLB_INVALID_VERSION,
     &GLB_LENGTH_MISMATCH,
-    &GLB_TRAILING_DATA,
-    &GLB_UNEXPECTED_END,
+    &GLB_LENGTH_TOO_SMALL,
+    &GLB_EXTRA_DATA,
+    &GLB_UNEXPECTED_END_OF_HEADER,
+    &GLB_UNEXPECTED_END_OF_CHUNK_HEADER,
+    &GLB_UNEXPECTED_END_OF_CHUNK_DATA,
+    &GLB_CHUNK_TOO_BIG,
+    &GLB_EMPTY_CHUNK,
     &GLB_CHUNK_LENGTH_UNALIGNED,
     &GLB_UNEXPECTED_FIRST_CHUNK,
-    &GLB_UNEXPECTED_CHUNK,
+    &GLB_DUPLICATE_CHUNK,
+    &GLB_UNEXPECTED_BIN_CHUNK,
     &GLB_UNKNOWN_CHUNK_TYPE,
     &GLB_INVALID_PADDING,
     &URI_NOT_FOLLOWED,

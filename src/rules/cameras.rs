@@ -7,10 +7,13 @@
 //! - CAMERA_ZFAR_LEQUAL_ZNEAR (error): `zfar` not beyond `znear`; at the projection object.
 //! - CAMERA_YFOV_GEQUAL_PI (warning): a perspective `yfov` of π or more; at the projection object.
 //!
+//! - UNDEFINED_PROPERTY (error): a camera of type "perspective" or "orthographic" without
+//!   that object, which the schema cannot require of the type.
+//!
 //! Values of the wrong type or range are the schema's findings and are skipped here.
 
 use super::{elements, Context, Rule};
-use crate::diagnostics::{Code, Diagnostic, Severity};
+use crate::diagnostics::{codes, Code, Diagnostic, Severity};
 
 pub const CAMERA_XMAG_YMAG_ZERO: Code = Code::new(
     "CAMERA_XMAG_YMAG_ZERO",
@@ -38,6 +41,7 @@ pub struct Cameras;
 impl Rule for Cameras {
     fn codes(&self) -> &'static [&'static Code] {
         &[
+            &codes::UNDEFINED_PROPERTY,
             &CAMERA_XMAG_YMAG_ZERO,
             &CAMERA_XMAG_YMAG_NEGATIVE,
             &CAMERA_ZFAR_LEQUAL_ZNEAR,
@@ -47,6 +51,18 @@ impl Rule for Cameras {
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
         for (i, camera) in elements(cx.json().get("cameras")).enumerate() {
+            // The schema cannot tie the projection object to `type`; the spec requires it.
+            if let Some(kind) = camera.get("type").and_then(|t| t.as_str()) {
+                if matches!(kind.as_ref(), "perspective" | "orthographic")
+                    && camera.get(kind.as_ref()).is_none()
+                {
+                    out.push(Diagnostic::new(
+                        &codes::UNDEFINED_PROPERTY,
+                        format!("/cameras/{i}"),
+                        format!("property '{kind}' must be defined for a camera of type '{kind}'"),
+                    ));
+                }
+            }
             let number = |object: &crate::asset::tape::Node, key: &str| {
                 object.get(key).and_then(|v| v.as_f64())
             };
@@ -129,7 +145,8 @@ mod tests {
             {"type":"orthographic","orthographic":{"xmag":1,"ymag":0,"znear":0,"zfar":1}},
             {"type":"orthographic","orthographic":{"xmag":-1,"ymag":1,"znear":2,"zfar":2}},
             {"type":"perspective","perspective":{"yfov":3.2,"znear":1,"zfar":0.5}},
-            {"type":"perspective","perspective":{"yfov":1,"znear":0.1}}]}"#;
+            {"type":"perspective","perspective":{"yfov":1,"znear":0.1}},
+            {"type":"orthographic"}]}"#;
         assert_eq!(
             found(text),
             [
@@ -138,6 +155,7 @@ mod tests {
                 "CAMERA_ZFAR_LEQUAL_ZNEAR /cameras/1/orthographic",
                 "CAMERA_ZFAR_LEQUAL_ZNEAR /cameras/2/perspective",
                 "CAMERA_YFOV_GEQUAL_PI /cameras/2/perspective",
+                "UNDEFINED_PROPERTY /cameras/4",
             ]
         );
     }

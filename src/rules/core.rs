@@ -85,6 +85,16 @@ pub const DUPLICATE_ELEMENTS: Code = Code::new(
     Severity::Error,
     "An array whose elements must be unique holds one twice (extensionsUsed, a scene's or node's node list).",
 );
+pub const VALUE_MULTIPLE_OF: Code = Code::new(
+    "VALUE_MULTIPLE_OF",
+    Severity::Error,
+    "A number is not a multiple of the step its schema gives (a bufferView's byteStride of 4).",
+);
+pub const ARRAY_TYPE_MISMATCH: Code = Code::new(
+    "ARRAY_TYPE_MISMATCH",
+    Severity::Error,
+    "An element of a nested array has the wrong JSON type (a primitive that is no object).",
+);
 pub const NODE_MATRIX_TRS: Code = Code::new(
     "NODE_MATRIX_TRS",
     Severity::Error,
@@ -189,6 +199,7 @@ pub(crate) fn diagnostics(
 ) {
     // The (code, pointer) of each finding so far: a document with many faults has many
     // findings, and comparing each with all the others would take quadratic time.
+    let first = out.len();
     let mut seen: std::collections::HashSet<(&'static str, String, String)> =
         std::collections::HashSet::new();
     for error in validator.iter_errors(json) {
@@ -241,13 +252,64 @@ pub(crate) fn diagnostics(
             }
             _ => String::new(),
         };
-        let found = diagnostic(error.kind(), &schema_path, &instance, len, at);
+        let mut found = diagnostic(error.kind(), &schema_path, &instance, len, at);
+        if found.code == codes::SCHEMA_MISMATCH.name {
+            // jsonschema's own words, which name the value and the constraint plainly.
+            found.message = format!("{}: {error}", quote(&instance));
+        }
+        reshape(&mut found, json);
         // A fault is one finding, though the schema may say so twice: a number past f64's
         // range fails both its type and its maximum, a value its own `type` and its base's.
         if !seen.insert((found.code, found.pointer.clone(), missing)) {
             continue;
         }
         out.push(found);
+    }
+    // A value of the wrong type is that one finding: what else its schema says of it (no
+    // `oneOf` alternative matches an array) follows from the type.
+    let mistyped: std::collections::HashSet<String> = out[first..]
+        .iter()
+        .filter(|d| d.code == codes::TYPE_MISMATCH.name)
+        .map(|d| d.pointer.clone())
+        .collect();
+    if !mistyped.is_empty() {
+        let mut at = first;
+        for i in first..out.len() {
+            if out[i].code == codes::TYPE_MISMATCH.name || !mistyped.contains(&out[i].pointer) {
+                out.swap(at, i);
+                at += 1;
+            }
+        }
+        out.truncate(at);
+    }
+}
+
+/// Places a finding as the Khronos validator does, where its pointer or code differ from the
+/// schema error's:
+/// - a nested array's element of the wrong type is ARRAY_TYPE_MISMATCH at the array (the
+///   top-level arrays' elements, `/materials/0`, stay TYPE_MISMATCH at the element);
+/// - a duplicate is reported at its second occurrence, not at the array;
+/// - a node's matrix beside translation, rotation or scale is reported at the matrix.
+fn reshape(found: &mut Diagnostic, json: Node) {
+    if found.code == codes::TYPE_MISMATCH.name {
+        if let Some((array, last)) = found.pointer.rsplit_once('/') {
+            let nested = array.matches('/').count() >= 2;
+            if nested && last.parse::<usize>().is_ok() && json.pointer(array).is_some_and(|a| a.is_array()) {
+                found.code = ARRAY_TYPE_MISMATCH.name;
+                found.severity = ARRAY_TYPE_MISMATCH.severity;
+                found.message = format!("an element of the array is not of the type its items must have ({})", found.message);
+                found.pointer = array.to_string();
+            }
+        }
+    } else if found.code == DUPLICATE_ELEMENTS.name {
+        if let Some(array) = json.pointer(&found.pointer).and_then(|a| a.as_array()) {
+            let raw: Vec<&str> = array.iter().map(|e| e.raw()).collect();
+            if let Some(second) = (1..raw.len()).find(|i| raw[..*i].contains(&raw[*i])) {
+                found.pointer = format!("{}/{second}", found.pointer);
+            }
+        }
+    } else if found.code == NODE_MATRIX_TRS.name {
+        found.pointer.push_str("/matrix");
     }
 }
 
@@ -482,6 +544,10 @@ fn diagnostic(
             &ONE_OF_MISMATCH,
             format!("exactly one of {} must be defined", one_of_names(&at)),
         ),
+        K::MultipleOf { multiple_of } => (
+            &VALUE_MULTIPLE_OF,
+            format!("{} is not a multiple of {multiple_of}", quote(instance)),
+        ),
         K::Not { .. } if at.starts_with("/nodes/") => (
             &NODE_MATRIX_TRS,
             "a node has either a matrix or translation/rotation/scale, not both".to_string(),
@@ -494,12 +560,9 @@ fn diagnostic(
             &DUPLICATE_ELEMENTS,
             "the array holds an element twice".to_string(),
         ),
-        other => (
+        _ => (
             &codes::SCHEMA_MISMATCH,
-            format!(
-                "{} does not match the glTF 2.0 schema ({other:?})",
-                quote(instance)
-            ),
+            format!("{} does not match the glTF 2.0 schema", quote(instance)),
         ),
     };
     Diagnostic::new(code, at, message)
@@ -564,6 +627,8 @@ impl Rule for CoreStructure {
             &ONE_OF_MISMATCH,
             &DUPLICATE_ELEMENTS,
             &NODE_MATRIX_TRS,
+            &VALUE_MULTIPLE_OF,
+            &ARRAY_TYPE_MISMATCH,
         ]
     }
 

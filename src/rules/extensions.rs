@@ -564,6 +564,10 @@ pub const PLACEMENTS: &[Placement] = &[
     ),
 ];
 
+/// Published extensions that define no extension object at all (KHR_mesh_quantization only
+/// widens the accessor types attributes may use): an object under their name stands nowhere.
+const OBJECTLESS: &[&str] = &["KHR_mesh_quantization"];
+
 pub const UNEXPECTED_EXTENSION_OBJECT: Code = Code::new(
     "UNEXPECTED_EXTENSION_OBJECT",
     Severity::Error,
@@ -936,7 +940,9 @@ impl Rule for ExtensionObjects {
             for (name, _) in extensions.as_object().into_iter().flat_map(|o| o.iter()) {
                 if judged_as_layer(&name) {
                     layer_keys += 1;
-                } else if shapes.by_extension.contains_key(name.as_ref()) {
+                } else if shapes.by_extension.contains_key(name.as_ref())
+                    || OBJECTLESS.contains(&name.as_ref())
+                {
                     others = true;
                 }
             }
@@ -990,6 +996,13 @@ impl<'a> Walk<'_, 'a> {
         if let Some(extensions) = object.get("extensions").and_then(|e| e.as_object()) {
             for (name, extension) in extensions.iter() {
                 let Some(placements) = self.shapes.by_extension.get(name.as_ref()) else {
+                    if OBJECTLESS.contains(&name.as_ref()) {
+                        self.out.push(Diagnostic::new(
+                            &UNEXPECTED_EXTENSION_OBJECT,
+                            format!("{}/extensions/{}", self.path, pointer::escape(&name)),
+                            format!("{name} defines no extension object; it is only declared"),
+                        ));
+                    }
                     continue;
                 };
                 let len = self.path.len();
