@@ -6,6 +6,7 @@
 //! Rules read the asset and push diagnostics; they never change anything.
 
 pub mod accessors;
+pub mod animations;
 pub mod asset_version;
 pub mod buffer_views;
 pub mod cameras;
@@ -24,6 +25,8 @@ pub mod legacy_sheen;
 pub mod lights;
 pub mod materials;
 pub mod node_tree;
+pub mod nodes;
+pub mod primitives;
 pub mod references;
 pub mod resources;
 pub mod roughness_alpha;
@@ -232,6 +235,9 @@ pub static REGISTRY: &[&dyn Rule] = &[
     &accessors::Accessors,
     &buffer_views::BufferViews,
     &node_tree::NodeTree,
+    &nodes::Nodes,
+    &primitives::Primitives,
+    &animations::Animations,
     &cameras::Cameras,
     &materials::Materials,
     &resources::Resources,
