@@ -55,6 +55,18 @@ pub fn resolve_with(
             Some(media_type) => (media_type, true),
             None => (header, false),
         };
+        // RFC 2397: after the type, each parameter is `attribute=value`.
+        if media_type
+            .split(';')
+            .skip(1)
+            .any(|parameter| !parameter.split_once('=').is_some_and(|(a, _)| !a.is_empty()))
+        {
+            return Err(Diagnostic::new(
+                &codes::INVALID_URI,
+                pointer,
+                format!("the data: URI's media type '{media_type}' has a parameter that is not attribute=value"),
+            ));
+        }
         let bytes = if base64 {
             base64::engine::general_purpose::STANDARD
                 .decode(payload.trim_end())
@@ -81,6 +93,16 @@ pub fn resolve_with(
         });
     }
     let mut path_part = uri;
+    // A relative reference's first segment cannot hold ':' (RFC 3986, 4.2); before a ':' there,
+    // a URI has its scheme, which is not empty and starts with a letter.
+    let first_segment = uri.split(['/', '?', '#']).next().unwrap_or_default();
+    if first_segment.contains(':') && !has_scheme(uri) {
+        return Err(Diagnostic::new(
+            &codes::INVALID_URI,
+            pointer,
+            format!("'{uri}' is not a URI: the part before its ':' is no scheme"),
+        ));
+    }
     if has_scheme(uri) {
         match file_uri_path(uri) {
             Some(path) if allow_outside => path_part = path,

@@ -4,7 +4,9 @@
 //! it to. The same holds for a morph target's attributes, each of which displaces the base
 //! attribute of its name (MESH_PRIMITIVE_MORPH_TARGET_NO_BASE_ACCESSOR where there is none), and
 //! every primitive of a mesh has as many morph targets as the first
-//! (MESH_PRIMITIVES_UNEQUAL_TARGETS_COUNT), as the Khronos glTF-Validator checks.
+//! (MESH_PRIMITIVES_UNEQUAL_TARGETS_COUNT), and the sets of an indexed semantic are numbered
+//! from 0 without gaps (MESH_PRIMITIVE_INDEXED_SEMANTIC_CONTINUITY), as the Khronos
+//! glTF-Validator checks.
 
 use super::{Context, Rule};
 use crate::asset::pointer;
@@ -42,6 +44,27 @@ pub const MESH_PRIMITIVES_UNEQUAL_TARGETS_COUNT: Code = Code::new(
     "The primitives of one mesh have different numbers of morph targets.",
 );
 
+pub const MESH_PRIMITIVE_INDEXED_SEMANTIC_CONTINUITY: Code = Code::new(
+    "MESH_PRIMITIVE_INDEXED_SEMANTIC_CONTINUITY",
+    Severity::Error,
+    "A primitive's TEXCOORD_n, COLOR_n, JOINTS_n or WEIGHTS_n sets are not numbered from 0 without gaps.",
+);
+
+/// For a family of indexed semantics, the (highest set + 1, sets given) when the valid sets
+/// of `names` are not 0, 1, …, n−1.
+fn discontinuous<N: AsRef<str>>(family: &str, names: &[N]) -> Option<(usize, usize)> {
+    let mut sets: Vec<usize> = names
+        .iter()
+        .map(AsRef::as_ref)
+        .filter(|n| is_valid_semantic(n))
+        .filter_map(|n| n.strip_prefix(family)?.strip_prefix('_')?.parse().ok())
+        .collect();
+    sets.sort_unstable();
+    sets.dedup();
+    let expected = sets.last().map_or(0, |last| last + 1);
+    (expected != sets.len()).then_some((expected, sets.len()))
+}
+
 fn invalid(at: &str, name: &str, out: &mut Vec<Diagnostic>) {
     out.push(Diagnostic::new(
         &MESH_PRIMITIVE_INVALID_ATTRIBUTE,
@@ -60,6 +83,7 @@ impl Rule for Attributes {
             &MESH_PRIMITIVE_INVALID_ATTRIBUTE,
             &MESH_PRIMITIVE_MORPH_TARGET_NO_BASE_ACCESSOR,
             &MESH_PRIMITIVES_UNEQUAL_TARGETS_COUNT,
+            &MESH_PRIMITIVE_INDEXED_SEMANTIC_CONTINUITY,
         ]
     }
 
@@ -75,6 +99,15 @@ impl Rule for Attributes {
                 for name in &base {
                     if !is_valid_semantic(name) {
                         invalid(&format!("{at}/attributes"), name, out);
+                    }
+                }
+                for family in ["COLOR", "JOINTS", "TEXCOORD", "WEIGHTS"] {
+                    if let Some((expected, provided)) = discontinuous(family, &base) {
+                        out.push(Diagnostic::new(
+                            &MESH_PRIMITIVE_INDEXED_SEMANTIC_CONTINUITY,
+                            format!("{at}/attributes"),
+                            format!("the {family}_n sets must be numbered from 0 without gaps: {provided} given, so 0 to {} expected, {expected} in all", provided.saturating_sub(1)),
+                        ));
                     }
                 }
                 // A morph target's attributes displace the base attributes of the same name.
@@ -125,6 +158,14 @@ impl Rule for Attributes {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn indexed_sets_count_from_zero_without_gaps() {
+        assert_eq!(discontinuous("TEXCOORD", &["TEXCOORD_0", "TEXCOORD_1"]), None);
+        assert_eq!(discontinuous("TEXCOORD", &["TEXCOORD_1", "TEXCOORD_00"]), Some((2, 1)));
+        assert_eq!(discontinuous("COLOR", &["COLOR_0", "COLOR_2", "TEXCOORD_5"]), Some((3, 2)));
+        assert_eq!(discontinuous("JOINTS", &["POSITION"]), None);
+    }
 
     #[test]
     fn semantics_follow_the_spec_names() {

@@ -60,7 +60,8 @@ impl Rule for Lights {
                 if outer <= inner {
                     out.push(Diagnostic::new(
                         &KHR_LIGHTS_PUNCTUAL_LIGHT_SPOT_ANGLES,
-                        format!("{at}/spot"),
+                        // The Khronos validator places it at the outer angle, the one that must grow.
+                        format!("{at}/spot/outerConeAngle"),
                         format!(
                             "outerConeAngle ({outer}) is less than or equal to innerConeAngle ({inner}): the cone has no falloff"
                         ),
@@ -111,11 +112,11 @@ mod tests {
                 ),
                 (
                     "KHR_LIGHTS_PUNCTUAL_LIGHT_SPOT_ANGLES",
-                    "/extensions/KHR_lights_punctual/lights/1/spot".to_string()
+                    "/extensions/KHR_lights_punctual/lights/1/spot/outerConeAngle".to_string()
                 ),
                 (
                     "KHR_LIGHTS_PUNCTUAL_LIGHT_SPOT_ANGLES",
-                    "/extensions/KHR_lights_punctual/lights/2/spot".to_string()
+                    "/extensions/KHR_lights_punctual/lights/2/spot/outerConeAngle".to_string()
                 ),
             ]
         );

@@ -16,6 +16,7 @@ pub mod core;
 pub mod declaration;
 pub mod disabled_layer;
 pub mod exclusions;
+pub mod extension_names;
 pub mod extensions;
 pub mod fallback;
 pub mod fuzz_roughness_default;
@@ -34,6 +35,7 @@ pub mod schema;
 pub mod skins;
 pub mod tangent_space;
 pub mod texcoord;
+pub mod texture_sources;
 pub mod unexpected_property;
 
 use crate::asset::tape::Node;
@@ -228,6 +230,7 @@ pub static REGISTRY: &[&dyn Rule] = &[
     &declaration::Declaration,
     &extensions::ExtensionObjects,
     &unexpected_property::UnexpectedProperty,
+    &extension_names::ExtensionNames,
     &lights::Lights,
     &exclusions::Exclusions,
     &references::References,
@@ -241,6 +244,7 @@ pub static REGISTRY: &[&dyn Rule] = &[
     &cameras::Cameras,
     &materials::Materials,
     &resources::Resources,
+    &texture_sources::TextureSources,
     &texcoord::TexCoords,
     &tangent_space::TangentSpace,
     &skins::Skins,

@@ -129,8 +129,9 @@ fn check_buffer(cx: &Context, index: usize, buffer: Node, out: &mut Vec<Diagnost
     let pointer = format!("/buffers/{index}/uri");
     match locate(cx, &uri, &pointer, out) {
         Some(Located::Data { media_type, len }) => {
+            // Media types are case-insensitive (RFC 2045).
             if !matches!(
-                media_type.as_str(),
+                media_type.to_ascii_lowercase().as_str(),
                 "application/octet-stream" | "application/gltf-buffer"
             ) {
                 out.push(Diagnostic::new(
@@ -193,6 +194,12 @@ fn check_image(cx: &Context, index: usize, image: Node, out: &mut Vec<Diagnostic
             };
             let actual = mime_of(header.format);
             if mime != actual {
+                // The Khronos validator places the mismatch at the image's data: its uri.
+                let pointer = if image.get("uri").is_some() {
+                    format!("/images/{index}/uri")
+                } else {
+                    pointer
+                };
                 out.push(Diagnostic::new(
                     &IMAGE_MIME_TYPE_INVALID,
                     pointer,
