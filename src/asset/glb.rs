@@ -337,7 +337,7 @@ mod tests {
 
     #[test]
     fn container_faults_get_the_reference_validators_codes() {
-        let json: &[u8] = b"{\"asset\":{\"version\":\"2.0\"}}  ";
+        let json: &[u8] = b"{\"asset\":{\"version\":\"2.0\"}} ";
         assert_eq!(split_codes(&glb_of(&[], Some(12))), ["GLB_LENGTH_TOO_SMALL"]);
         assert_eq!(
             split_codes(&glb_of(&[], Some(0))),

@@ -416,7 +416,7 @@ fn check_bin_length(json: tape::Node, bin: Option<&[u8]>, out: &mut Vec<Diagnost
         )),
         Some(bin) if (bin.len() as u64) < declared => out.push(Diagnostic::new(
             &codes::BUFFER_BYTE_LENGTH_MISMATCH,
-            "/buffers/0/byteLength",
+            "/buffers/0",
             format!(
                 "buffer 0 declares {declared} bytes but the GLB's BIN chunk holds {}",
                 bin.len()
@@ -436,7 +436,7 @@ fn check_buffer_length(
     match buffer.get("byteLength").and_then(|v| v.as_u64()) {
         Some(declared) if (actual as u64) < declared => Err(Diagnostic::new(
             &codes::BUFFER_BYTE_LENGTH_MISMATCH,
-            format!("{pointer}/byteLength"),
+            pointer.to_string(),
             format!("buffer {index} declares {declared} bytes but its data holds {actual}"),
         )),
         _ => Ok(()),

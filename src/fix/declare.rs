@@ -41,13 +41,14 @@ pub const REQUIRED_NOT_USED: Fixer = Fixer {
 };
 
 /// Removes the unused declaration at `d.pointer` (`/extensionsUsed/K`), unless the extension
-/// is also required.
+/// is also required or used anywhere (the rule's own notion of used).
 fn remove_unused(asset: &Asset, d: &Diagnostic) -> Option<Proposal> {
     let root = asset.root();
     let name = string_at(root, &d.pointer)?;
     let required = crate::document::elements(root.get("extensionsRequired"))
         .any(|r| r.as_str().is_some_and(|r| r == name));
-    (!required && d.pointer.starts_with("/extensionsUsed/")).then(|| Proposal {
+    let used = declaration::is_used_anywhere(root, &name);
+    (!required && !used && d.pointer.starts_with("/extensionsUsed/")).then(|| Proposal {
         title: format!("remove {name} from extensionsUsed"),
         edits: vec![Edit::remove(d.pointer.clone())],
     })

@@ -106,7 +106,7 @@ impl Rule for Attributes {
                         out.push(Diagnostic::new(
                             &MESH_PRIMITIVE_INDEXED_SEMANTIC_CONTINUITY,
                             format!("{at}/attributes"),
-                            format!("the {family}_n sets must be numbered from 0 without gaps: {provided} given, so 0 to {} expected, {expected} in all", provided.saturating_sub(1)),
+                            format!("the {family}_n sets must be numbered from 0 without gaps: {family}_0 to {family}_{} make {expected} sets, {provided} given", expected - 1),
                         ));
                     }
                 }

@@ -303,8 +303,9 @@ fn reshape(found: &mut Diagnostic, json: Node) {
         }
     } else if found.code == DUPLICATE_ELEMENTS.name {
         if let Some(array) = json.pointer(&found.pointer).and_then(|a| a.as_array()) {
-            let raw: Vec<&str> = array.iter().map(|e| e.raw()).collect();
-            if let Some(second) = (1..raw.len()).find(|i| raw[..*i].contains(&raw[*i])) {
+            // Elements compared by their text, in one pass (a hostile array holds millions).
+            let mut seen = std::collections::HashSet::new();
+            if let Some(second) = array.iter().position(|e| !seen.insert(e.raw())) {
                 found.pointer = format!("{}/{second}", found.pointer);
             }
         }
@@ -674,6 +675,9 @@ const EXTENDED_VALUES: &[(&str, &str, &str)] = &[
     ("/target/path", "pointer", "KHR_animation_pointer"),
     ("/mimeType", "image/webp", "EXT_texture_webp"),
     ("/mimeType", "image/ktx2", "KHR_texture_basisu"),
+    ("/mimeType", "image/ktx2", "EXT_texture_astc"),
+    ("/mimeType", "image/vnd-ms.dds", "MSFT_texture_dds"),
+    ("/mimeType", "image/avif", "EXT_texture_avif"),
 ];
 
 #[cfg(test)]
@@ -719,13 +723,13 @@ mod tests {
         found.sort();
         let mut expected = vec![
             ("PATTERN_MISMATCH", "/asset/version".to_string()),
-            ("UNSATISFIED_DEPENDENCY", "".to_string()),
+            // `scene` without `scenes` is the references rule's UNRESOLVED_REFERENCE.
             ("EMPTY_ENTITY", "/nodes".to_string()),
             ("ONE_OF_MISMATCH", "/images/0".to_string()),
-            ("UNSATISFIED_DEPENDENCY", "/images/1".to_string()),
+            ("UNSATISFIED_DEPENDENCY", "/images/1/bufferView".to_string()),
             ("UNDEFINED_PROPERTY", "/accessors/0".to_string()),
             ("VALUE_NOT_IN_RANGE", "/accessors/0/count".to_string()),
-            ("DUPLICATE_ELEMENTS", "/extensionsUsed".to_string()),
+            ("DUPLICATE_ELEMENTS", "/extensionsUsed/1".to_string()),
             ("ONE_OF_MISMATCH", "/cameras/0".to_string()),
         ];
         expected.sort();
@@ -738,7 +742,7 @@ mod tests {
             "nodes": [{"matrix": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1], "scale": [1, 1, 1]}]});
         assert_eq!(
             codes_and_pointers(doc),
-            vec![("NODE_MATRIX_TRS", "/nodes/0".to_string())]
+            vec![("NODE_MATRIX_TRS", "/nodes/0/matrix".to_string())]
         );
     }
 }

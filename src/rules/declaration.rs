@@ -125,7 +125,9 @@ fn check_lists(
             layers::FUZZ => (used[1], &FUZZ_DECLARED_UNUSED),
             _ => continue,
         };
-        if !is_used {
+        // The layers found on materials answer at once; an object elsewhere (misplaced on
+        // pbrMetallicRoughness, say) is a use too, found by the walk the fixes share.
+        if !is_used && !is_used_anywhere(json, &name) {
             out.push(Diagnostic::new(
                 code,
                 format!("/extensionsUsed/{k}"),
@@ -133,6 +135,15 @@ fn check_lists(
             ));
         }
     }
+}
+
+/// Whether any extension object of the document is named `name`, wherever it stands: the one
+/// notion of "used" that the declaration rules and their fixes share (an extension object on
+/// the wrong kind of object is UNEXPECTED_EXTENSION_OBJECT, but still needs its declaration).
+pub fn is_used_anywhere(json: Node, name: &str) -> bool {
+    let mut used = false;
+    extension_objects(json, &mut Vec::new(), &mut |_, found| used |= found == name);
+    used
 }
 
 /// Calls `found` with the path and name of every extension object: every key of an

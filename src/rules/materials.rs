@@ -12,6 +12,9 @@
 //! - KHR_MATERIALS_DISPERSION_NO_VOLUME (warning): dispersion without a volume to act in.
 //! - MULTIPLE_EXTENSIONS (warning): KHR_materials_unlit or KHR_materials_pbrSpecularGlossiness,
 //!   which each define the whole material, beside another material extension; at each of them.
+//! - KHR_MATERIALS_CLEARCOAT_CLEARCOAT_NORMAL_TEXTURE_TEXCOORD and
+//!   KHR_MATERIALS_ANISOTROPY_ANISOTROPY_TEXTURE_TEXCOORD (warnings): a texture read in the
+//!   normal texture's tangent space through another texture coordinate set.
 
 use super::{materials, Context, Rule};
 use crate::asset::tape::Node;
@@ -42,6 +45,16 @@ pub const KHR_MATERIALS_DISPERSION_NO_VOLUME: Code = Code::new(
     Severity::Warning,
     "KHR_materials_dispersion without KHR_materials_volume: there is no volume to disperse light in.",
 );
+pub const KHR_MATERIALS_CLEARCOAT_CLEARCOAT_NORMAL_TEXTURE_TEXCOORD: Code = Code::new(
+    "KHR_MATERIALS_CLEARCOAT_CLEARCOAT_NORMAL_TEXTURE_TEXCOORD",
+    Severity::Warning,
+    "A clearcoat normal texture reads another texture coordinate set than the normal texture; the two share one tangent space.",
+);
+pub const KHR_MATERIALS_ANISOTROPY_ANISOTROPY_TEXTURE_TEXCOORD: Code = Code::new(
+    "KHR_MATERIALS_ANISOTROPY_ANISOTROPY_TEXTURE_TEXCOORD",
+    Severity::Warning,
+    "An anisotropy texture reads another texture coordinate set than the normal texture; the two share one tangent space.",
+);
 pub const MULTIPLE_EXTENSIONS: Code = Code::new(
     "MULTIPLE_EXTENSIONS",
     Severity::Warning,
@@ -62,10 +75,13 @@ impl Rule for Materials {
             &KHR_MATERIALS_VOLUME_DOUBLE_SIDED,
             &KHR_MATERIALS_DISPERSION_NO_VOLUME,
             &MULTIPLE_EXTENSIONS,
+            &KHR_MATERIALS_CLEARCOAT_CLEARCOAT_NORMAL_TEXTURE_TEXCOORD,
+            &KHR_MATERIALS_ANISOTROPY_ANISOTROPY_TEXTURE_TEXCOORD,
         ]
     }
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
+        tangent_space_sets(cx, out);
         for (i, material) in materials(cx.json()).enumerate() {
             if !material.is_object() {
                 continue;
@@ -149,6 +165,38 @@ impl Rule for Materials {
     }
 }
 
+/// The textures read in the normal texture's tangent space, each with its code.
+const TANGENT_SPACE_TEXTURES: [(&str, &Code); 2] = [
+    (
+        "/extensions/KHR_materials_clearcoat/clearcoatNormalTexture",
+        &KHR_MATERIALS_CLEARCOAT_CLEARCOAT_NORMAL_TEXTURE_TEXCOORD,
+    ),
+    (
+        "/extensions/KHR_materials_anisotropy/anisotropyTexture",
+        &KHR_MATERIALS_ANISOTROPY_ANISOTROPY_TEXTURE_TEXCOORD,
+    ),
+];
+
+/// Textures that share the normal texture's tangent space but read another texture
+/// coordinate set (KHR_texture_transform's `texCoord` counted).
+fn tangent_space_sets(cx: &Context, out: &mut Vec<Diagnostic>) {
+    for (m, textures) in cx.material_textures().iter().enumerate() {
+        let set_of = |pointer: &str| textures.iter().find(|t| t.pointer == pointer).map(|t| t.set);
+        let Some(normal) = set_of("/normalTexture") else {
+            continue;
+        };
+        for (pointer, code) in TANGENT_SPACE_TEXTURES {
+            if let Some(set) = set_of(pointer).filter(|set| *set != normal) {
+                out.push(Diagnostic::new(
+                    code,
+                    format!("/materials/{m}{pointer}"),
+                    format!("the texture reads TEXCOORD_{set}, the normal texture TEXCOORD_{normal}; they share one tangent space"),
+                ));
+            }
+        }
+    }
+}
+
 /// Whether an emissiveFactor is black: absent (its default) or all zeros.
 fn is_black(factor: Option<Node>) -> bool {
     match factor.and_then(|f| f.as_array()) {
@@ -176,6 +224,19 @@ mod tests {
         out.into_iter()
             .map(|d| format!("{} {}", d.code, d.pointer))
             .collect()
+    }
+
+    #[test]
+    fn textures_sharing_the_tangent_space_read_the_normal_textures_set() {
+        let text = r#"{"asset":{"version":"2.0"},"textures":[{}],"materials":[
+            {"normalTexture":{"index":0},"extensions":{
+                "KHR_materials_clearcoat":{"clearcoatNormalTexture":{"index":0,"texCoord":1}},
+                "KHR_materials_anisotropy":{"anisotropyTexture":{"index":0,"texCoord":1,
+                    "extensions":{"KHR_texture_transform":{"texCoord":0}}}}}}]}"#;
+        assert_eq!(
+            found(text),
+            ["KHR_MATERIALS_CLEARCOAT_CLEARCOAT_NORMAL_TEXTURE_TEXCOORD /materials/0/extensions/KHR_materials_clearcoat/clearcoatNormalTexture"]
+        );
     }
 
     #[test]

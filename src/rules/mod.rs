@@ -37,6 +37,7 @@ pub mod tangent_space;
 pub mod texcoord;
 pub mod texture_sources;
 pub mod unexpected_property;
+pub mod variants;
 
 use crate::asset::tape::Node;
 use crate::asset::Asset;
@@ -243,6 +244,7 @@ pub static REGISTRY: &[&dyn Rule] = &[
     &animations::Animations,
     &cameras::Cameras,
     &materials::Materials,
+    &variants::Variants,
     &resources::Resources,
     &texture_sources::TextureSources,
     &texcoord::TexCoords,

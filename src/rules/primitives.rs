@@ -434,7 +434,6 @@ mod tests {
                 "MESH_PRIMITIVE_NO_POSITION /meshes/0/primitives/0/attributes",
                 "MESH_PRIMITIVE_JOINTS_WEIGHTS_MISMATCH /meshes/0/primitives/0/attributes",
                 "MESH_PRIMITIVE_ATTRIBUTES_ACCESSOR_INVALID_FORMAT /meshes/0/primitives/0/attributes/JOINTS_0",
-                "MESH_PRIMITIVE_ATTRIBUTES_ACCESSOR_INVALID_FORMAT /meshes/1/primitives/0/attributes/POSITION",
                 "MESH_PRIMITIVE_POSITION_ACCESSOR_WITHOUT_BOUNDS /meshes/1/primitives/0/attributes/POSITION",
                 "MESH_PRIMITIVE_UNEQUAL_ACCESSOR_COUNT /meshes/1/primitives/0/attributes/_X",
                 "MESH_PRIMITIVE_ATTRIBUTES_ACCESSOR_UNSIGNED_INT /meshes/1/primitives/0/attributes/_X",

@@ -100,7 +100,7 @@ impl Rule for References {
     }
 
     fn codes(&self) -> &'static [&'static Code] {
-        &[&UNRESOLVED_REFERENCE]
+        &[&UNRESOLVED_REFERENCE, &super::core::UNSATISFIED_DEPENDENCY]
     }
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
@@ -161,7 +161,36 @@ impl Rule for References {
         walk(json, &steps.root, &ids, &mut Vec::new(), &mut found_at);
         // Reported link by link, in the table's order, each in document order.
         found.sort_by_key(|(link, _)| *link);
-        out.extend(found.into_iter().map(|(_, d)| d));
+        let mut dependent: Vec<String> = Vec::new();
+        for (link, d) in found {
+            // An index into a root extension's array where the document has no such root
+            // extension at all is a missing dependency, as the Khronos validator reports it: at
+            // the object that refers (the node's light, the mapping), once.
+            let target = LINKS[link].1;
+            if let Some(root) = target
+                .strip_prefix("/extensions/")
+                .and_then(|rest| rest.split('/').next())
+                .filter(|name| json.get("extensions").and_then(|e| e.get(*name)).is_none())
+            {
+                let mut holder = d.pointer.as_str();
+                while let Some((parent, _)) = holder.rsplit_once('/') {
+                    holder = parent;
+                    if json.pointer(holder).is_some_and(|n| n.is_object()) {
+                        break;
+                    }
+                }
+                if !dependent.iter().any(|h| h == holder) {
+                    dependent.push(holder.to_string());
+                    out.push(Diagnostic::new(
+                        &super::core::UNSATISFIED_DEPENDENCY,
+                        holder,
+                        format!("the document's root extensions must define {root}, which this refers to"),
+                    ));
+                }
+                continue;
+            }
+            out.push(d);
+        }
     }
 }
 

@@ -111,8 +111,9 @@ fn byte_length(buffer: Node) -> Option<u64> {
 
 fn short_buffer(index: usize, declared: u64, actual: u64, what: &str) -> Diagnostic {
     Diagnostic::new(
+        // At the buffer, as the Khronos validator places it.
         &codes::BUFFER_BYTE_LENGTH_MISMATCH,
-        format!("/buffers/{index}/byteLength"),
+        format!("/buffers/{index}"),
         format!("buffer {index} declares {declared} bytes but {what} holds {actual}"),
     )
 }

@@ -4,6 +4,8 @@
 //! loader generates one, and loaders generate different ones (a warning, as in the Khronos
 //! validator); sheen and fuzz assets are fabric and nearly always carry normal maps.
 //!
+//! KHR_materials_anisotropy's direction texture is read in the same tangent space.
+//!
 //! The clearcoat spec goes further: a primitive whose material has a clearcoat normal texture
 //! MUST have NORMAL and TANGENT, or its material MUST have a normal texture (from which loaders
 //! generate the tangents). Without either it is an error. Only the JSON is read.
@@ -19,7 +21,7 @@ pub const MESH_PRIMITIVE_GENERATED_TANGENT_SPACE: Code = Code::new(
 pub const MESH_PRIMITIVE_NO_TANGENT_SPACE: Code = Code::new(
     "MESH_PRIMITIVE_NO_TANGENT_SPACE",
     Severity::Error,
-    "A primitive without NORMAL and TANGENT uses a material whose extension needs a tangent space (clearcoatNormalTexture) and that has no normalTexture to generate it from.",
+    "A primitive without NORMAL and TANGENT uses a material whose extension needs a tangent space (clearcoatNormalTexture, anisotropyTexture) and that has no normalTexture to generate it from.",
 );
 
 pub struct TangentSpace;
@@ -38,11 +40,11 @@ impl Rule for TangentSpace {
             return;
         }
         let textures = cx.material_textures();
-        if !textures.iter().flatten().any(|t| t.normal) {
+        if !textures.iter().flatten().any(needs_tangents) {
             return;
         }
         for (m, p, primitive, material, reads) in cx.primitives_with_textures() {
-            let Some(first) = reads.iter().find(|t| t.normal).map(|t| &t.pointer) else {
+            let Some(first) = reads.iter().find(|t| needs_tangents(t)).map(|t| &t.pointer) else {
                 continue;
             };
             let attributes = primitive.get("attributes").and_then(|a| a.as_object());
@@ -72,6 +74,12 @@ impl Rule for TangentSpace {
             }
         }
     }
+}
+
+/// Whether a texture is read in tangent space: a normal texture, or KHR_materials_anisotropy's
+/// direction texture.
+fn needs_tangents(texture: &super::extensions::MaterialTexture) -> bool {
+    texture.normal || texture.pointer == "/extensions/KHR_materials_anisotropy/anisotropyTexture"
 }
 
 /// The attributes of a tangent space a primitive lacks, for messages.
