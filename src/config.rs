@@ -133,9 +133,15 @@ enum RawSeverity {
 fn known_code(code: &str, key: &str) -> Result<String, String> {
     match crate::rules::find_code(code) {
         Some(c) => Ok(c.name.to_string()),
-        None => Err(format!(
-            "{key}: no such code {code} (`velvet codes` lists them)"
-        )),
+        None => match crate::diagnostics::codes::renamed(code) {
+            Some(now) => Err(format!(
+                "{key}: {code} is no longer a code: it is now {}, as the Khronos glTF-Validator names it",
+                now.join(", ")
+            )),
+            None => Err(format!(
+                "{key}: no such code {code} (`velvet codes` lists them)"
+            )),
+        },
     }
 }
 
@@ -730,6 +736,10 @@ mod tests {
         assert_eq!(
             Layer::parse("ignore = [\"NOT_A_CODE\"]").unwrap_err(),
             "ignore: no such code NOT_A_CODE (`velvet codes` lists them)"
+        );
+        assert_eq!(
+            Layer::parse("ignore = [\"GLB_TRAILING_DATA\"]").unwrap_err(),
+            "ignore: GLB_TRAILING_DATA is no longer a code: it is now GLB_EXTRA_DATA, as the Khronos glTF-Validator names it"
         );
         assert_eq!(
             Layer::parse("ignore = []\nonly = []").unwrap_err(),

@@ -719,10 +719,10 @@ impl Asset {
                 image::ImageDecoder::color_type(&decoder).bytes_per_pixel(),
             ));
         let what = format!(
-            "decoding the {} × {} {:?} image",
+            "decoding the {} × {} image ({} bytes a pixel)",
             header.width,
             header.height,
-            image::ImageDecoder::color_type(&decoder)
+            image::ImageDecoder::color_type(&decoder).bytes_per_pixel()
         );
         let _reserved = limits::reserve(&what, needed, self.options.max_memory).map_err(|m| {
             Diagnostic::new(

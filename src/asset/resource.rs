@@ -328,6 +328,16 @@ pub enum ImageFormat {
 }
 
 impl ImageFormat {
+    /// The format's name as messages give it.
+    pub fn name(self) -> &'static str {
+        match self {
+            ImageFormat::Png => "PNG",
+            ImageFormat::Jpeg => "JPEG",
+            ImageFormat::Webp => "WebP",
+            ImageFormat::Ktx2 => "KTX2",
+        }
+    }
+
     pub fn sniff(bytes: &[u8]) -> Option<ImageFormat> {
         if bytes.starts_with(b"\x89PNG\r\n\x1a\n") {
             Some(ImageFormat::Png)

@@ -170,6 +170,30 @@ pub const USAGE_ERROR: Code = Code::new(
     "The run could not start (a path that does not exist, a bad flag value, an invalid velvet.toml); the JSON reports record it, and the exit status is 2.",
 );
 
+/// Codes velvet once emitted under its own names, with the Khronos glTF-Validator's codes that
+/// replace them: a velvet.toml or `--ignore` that still names one is told what to write.
+const RENAMED: &[(&str, &[&str])] = &[
+    (
+        "GLB_UNEXPECTED_END",
+        &[
+            "GLB_UNEXPECTED_END_OF_HEADER",
+            "GLB_UNEXPECTED_END_OF_CHUNK_HEADER",
+            "GLB_UNEXPECTED_END_OF_CHUNK_DATA",
+        ],
+    ),
+    (
+        "GLB_UNEXPECTED_CHUNK",
+        &["GLB_DUPLICATE_CHUNK", "GLB_UNEXPECTED_BIN_CHUNK"],
+    ),
+    ("GLB_TRAILING_DATA", &["GLB_EXTRA_DATA"]),
+    ("INVALID_JSON_ROOT_OBJECT", &["TYPE_MISMATCH"]),
+];
+
+/// The codes that replace a code velvet no longer emits.
+pub fn renamed(code: &str) -> Option<&'static [&'static str]> {
+    RENAMED.iter().find(|(old, _)| *old == code).map(|(_, now)| *now)
+}
+
 /// The codes about a run rather than a file (no asset triggers them).
 pub const RUN: &[&Code] = &[&USAGE_ERROR];
 

@@ -65,9 +65,9 @@ impl Rule for RoughnessAlpha {
                                 code,
                                 slot.pointer(),
                                 format!(
-                                    "{} reads alpha, but image {image} ({:?}, {} channel{}) has none: roughness will equal the factor everywhere",
+                                    "{} reads alpha, but image {image} ({}, {} channel{}) has none: roughness will equal the factor everywhere",
                                     slot.slot.texture,
-                                    header.format,
+                                    header.format.name(),
                                     header.channels.unwrap_or(0),
                                     if header.channels == Some(1) { "" } else { "s" }
                                 ),
