@@ -160,11 +160,15 @@ impl BufferViews {
                     .filter(|t| matches!(*t, ARRAY_BUFFER | ELEMENT_ARRAY_BUFFER))
             })
             .collect();
-        let mut used = |view: usize, target: u64, at: String, out: &mut Vec<Diagnostic>| match usage[view] {
+        // The pointer of a use is written only for a finding: a library has tens of thousands.
+        let mut used = |view: usize,
+                        target: u64,
+                        at: &dyn Fn() -> String,
+                        out: &mut Vec<Diagnostic>| match usage[view] {
             None => usage[view] = Some(target),
             Some(first) if first != target => out.push(Diagnostic::new(
                 &BUFFER_VIEW_TARGET_OVERRIDE,
-                at,
+                at(),
                 format!(
                     "buffer view {view} holds {}, and is used here for {}",
                     target_name(first),
@@ -175,7 +179,7 @@ impl BufferViews {
         };
         for (m, mesh) in elements(json.get("meshes")).enumerate() {
             for (p, primitive) in elements(mesh.get("primitives")).enumerate() {
-                let at = format!("/meshes/{m}/primitives/{p}");
+                let at = || format!("/meshes/{m}/primitives/{p}");
                 for (name, accessor) in primitive
                     .get("attributes")
                     .and_then(|a| a.as_object())
@@ -183,28 +187,27 @@ impl BufferViews {
                     .flat_map(|a| a.iter())
                 {
                     if let Some(view) = view_index(Some(accessor)) {
-                        used(view, ARRAY_BUFFER, format!("{at}/attributes/{}", pointer::escape(&name)), out);
+                        let pointer = || format!("{}/attributes/{}", at(), pointer::escape(&name));
+                        used(view, ARRAY_BUFFER, &pointer, out);
                     }
                 }
                 if let Some(view) = view_index(primitive.get("indices")) {
+                    let pointer = || format!("{}/indices", at());
                     if strided(view) {
                         out.push(Diagnostic::new(
                             &MESH_PRIMITIVE_INDICES_ACCESSOR_WITH_BYTESTRIDE,
-                            format!("{at}/indices"),
+                            pointer(),
                             "the indices' buffer view has a byteStride; indices must be tightly packed",
                         ));
                     }
-                    used(view, ELEMENT_ARRAY_BUFFER, format!("{at}/indices"), out);
+                    used(view, ELEMENT_ARRAY_BUFFER, &pointer, out);
                 }
                 for (t, target) in elements(primitive.get("targets")).enumerate() {
                     for (name, accessor) in target.as_object().into_iter().flat_map(|a| a.iter()) {
                         if let Some(view) = view_index(Some(accessor)) {
-                            used(
-                                view,
-                                ARRAY_BUFFER,
-                                format!("{at}/targets/{t}/{}", pointer::escape(&name)),
-                                out,
-                            );
+                            let pointer =
+                                || format!("{}/targets/{t}/{}", at(), pointer::escape(&name));
+                            used(view, ARRAY_BUFFER, &pointer, out);
                         }
                     }
                 }

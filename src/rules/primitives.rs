@@ -96,9 +96,9 @@ pub const MESH_INVALID_WEIGHTS_COUNT: Code = Code::new(
 );
 
 /// What this rule reads of an accessor.
-struct AccessorView {
+struct AccessorView<'a> {
     component_type: Option<u64>,
-    kind: Option<String>,
+    kind: Option<std::borrow::Cow<'a, str>>,
     count: Option<u64>,
     normalized: bool,
     byte_offset: u64,
@@ -106,14 +106,11 @@ struct AccessorView {
     bounded: bool,
 }
 
-impl AccessorView {
-    fn read(accessor: Node) -> AccessorView {
+impl<'a> AccessorView<'a> {
+    fn read(accessor: Node<'a>) -> AccessorView<'a> {
         AccessorView {
             component_type: accessor.get("componentType").and_then(|c| c.as_u64()),
-            kind: accessor
-                .get("type")
-                .and_then(|t| t.as_str())
-                .map(|t| t.into_owned()),
+            kind: accessor.get("type").and_then(|t| t.as_str()),
             count: accessor.get("count").and_then(|c| c.as_u64()),
             normalized: accessor.get("normalized").and_then(|n| n.as_bool()) == Some(true),
             byte_offset: accessor
@@ -133,7 +130,7 @@ impl AccessorView {
         let (Some(kind), Some(component)) = (&self.kind, self.component_type) else {
             return true;
         };
-        kinds.contains(&kind.as_str())
+        kinds.contains(&kind.as_ref())
             && formats
                 .iter()
                 .any(|(c, n)| *c == component && (*n == self.normalized || *c == FLOAT))
@@ -219,12 +216,13 @@ impl Rule for Primitives {
             elements(json.get("extensionsUsed")).any(|e| e.is_str("KHR_mesh_quantization"));
         // The first accessor found holding vertex attributes in each buffer view.
         let mut first_in_view: Vec<Option<usize>> = vec![None; strided.len()];
+        // Pointers are written only for findings: a library has tens of thousands of attributes.
         let mut vertex_attribute =
-            |at: &str, index: usize, view: &AccessorView, out: &mut Vec<Diagnostic>| {
+            |at: &dyn Fn() -> String, index: usize, view: &AccessorView, out: &mut Vec<Diagnostic>| {
                 if view.component_type == Some(5125) {
                     out.push(Diagnostic::new(
                         &MESH_PRIMITIVE_ATTRIBUTES_ACCESSOR_UNSIGNED_INT,
-                        at,
+                        at(),
                         "a vertex attribute cannot hold unsigned ints",
                     ));
                 }
@@ -234,7 +232,7 @@ impl Rule for Primitives {
                 if view.byte_offset % 4 != 0 {
                     out.push(Diagnostic::new(
                         &MESH_PRIMITIVE_ACCESSOR_UNALIGNED,
-                        at,
+                        at(),
                         format!(
                             "the accessor's byteOffset {} is not a multiple of 4",
                             view.byte_offset
@@ -245,7 +243,7 @@ impl Rule for Primitives {
                     None => first_in_view[bv] = Some(index),
                     Some(first) if first != index && !strided[bv] => out.push(Diagnostic::new(
                         &MESH_PRIMITIVE_ACCESSOR_WITHOUT_BYTESTRIDE,
-                        at,
+                        at(),
                         format!("buffer view {bv} holds the vertex attributes of accessors {first} and {index} but has no byteStride"),
                     )),
                     Some(_) => {}
@@ -254,7 +252,7 @@ impl Rule for Primitives {
         for (m, mesh) in elements(Some(meshes)).enumerate() {
             let mut targets_count = None;
             for (p, primitive) in elements(mesh.get("primitives")).enumerate() {
-                let at = format!("/meshes/{m}/primitives/{p}");
+                let at = || format!("/meshes/{m}/primitives/{p}");
                 let Some(attributes) = primitive.get("attributes").and_then(|a| a.as_object())
                 else {
                     continue;
@@ -268,14 +266,14 @@ impl Rule for Primitives {
                 if !attributes.contains_key("POSITION") {
                     out.push(Diagnostic::new(
                         &MESH_PRIMITIVE_NO_POSITION,
-                        format!("{at}/attributes"),
+                        format!("{}/attributes", at()),
                         "the primitive has no POSITION attribute",
                     ));
                 }
                 if attributes.contains_key("TANGENT") && !attributes.contains_key("NORMAL") {
                     out.push(Diagnostic::new(
                         &MESH_PRIMITIVE_TANGENT_WITHOUT_NORMAL,
-                        format!("{at}/attributes/TANGENT"),
+                        format!("{}/attributes/TANGENT", at()),
                         "TANGENT without NORMAL: the tangents are not used",
                     ));
                 }
@@ -284,7 +282,7 @@ impl Rule for Primitives {
                 if joints != weights {
                     out.push(Diagnostic::new(
                         &MESH_PRIMITIVE_JOINTS_WEIGHTS_MISMATCH,
-                        format!("{at}/attributes"),
+                        format!("{}/attributes", at()),
                         format!("{joints} JOINTS_n and {weights} WEIGHTS_n attributes; they come in pairs"),
                     ));
                 }
@@ -293,13 +291,13 @@ impl Rule for Primitives {
                     let Some((i, view)) = accessor(index) else {
                         continue;
                     };
-                    let attribute_at = format!("{at}/attributes/{}", pointer::escape(&name));
+                    let attribute_at = || format!("{}/attributes/{}", at(), pointer::escape(&name));
                     if let Some(count) = view.count {
                         match vertices {
                             None => vertices = Some(count),
                             Some(first) if first != count => out.push(Diagnostic::new(
                                 &MESH_PRIMITIVE_UNEQUAL_ACCESSOR_COUNT,
-                                attribute_at.clone(),
+                                attribute_at(),
                                 format!("the accessor holds {count} elements, the primitive's first attribute {first}"),
                             )),
                             Some(_) => {}
@@ -308,14 +306,14 @@ impl Rule for Primitives {
                     if !quantized && view.component_type != Some(5125) && !format_allowed(&name, view) {
                         out.push(Diagnostic::new(
                             &MESH_PRIMITIVE_ATTRIBUTES_ACCESSOR_INVALID_FORMAT,
-                            attribute_at.clone(),
+                            attribute_at(),
                             format!("{name} cannot be held as {} of component type {}", view.kind.as_deref().unwrap_or("?"), view.component_type.unwrap_or(0)),
                         ));
                     }
                     if name == "POSITION" && !view.bounded {
                         out.push(Diagnostic::new(
                             &MESH_PRIMITIVE_POSITION_ACCESSOR_WITHOUT_BOUNDS,
-                            attribute_at.clone(),
+                            attribute_at(),
                             "a POSITION accessor must have min and max",
                         ));
                     }
@@ -330,7 +328,7 @@ impl Rule for Primitives {
                         if !scalar_uint {
                             out.push(Diagnostic::new(
                                 &MESH_PRIMITIVE_INDICES_ACCESSOR_INVALID_FORMAT,
-                                format!("{at}/indices"),
+                                format!("{}/indices", at()),
                                 "indices must be unsigned byte, short or int scalars",
                             ));
                         }
@@ -344,7 +342,7 @@ impl Rule for Primitives {
                     if !fits_mode(mode, count) {
                         out.push(Diagnostic::new(
                             &MESH_PRIMITIVE_INCOMPATIBLE_MODE,
-                            at.clone(),
+                            at(),
                             format!("{count} vertices or indices cannot be drawn whole in mode {mode}"),
                         ));
                     }
@@ -354,12 +352,12 @@ impl Rule for Primitives {
                         let Some((i, view)) = accessor(index) else {
                             continue;
                         };
-                        let target_at = format!("{at}/targets/{t}/{}", pointer::escape(&name));
+                        let target_at = || format!("{}/targets/{t}/{}", at(), pointer::escape(&name));
                         if let (Some(count), Some(vertices)) = (view.count, vertices) {
                             if count != vertices {
                                 out.push(Diagnostic::new(
                                     &MESH_PRIMITIVE_MORPH_TARGET_INVALID_ATTRIBUTE_COUNT,
-                                    target_at.clone(),
+                                    target_at(),
                                     format!("the morph target's accessor holds {count} elements; the primitive has {vertices} vertices"),
                                 ));
                             }
@@ -367,7 +365,7 @@ impl Rule for Primitives {
                         if name == "POSITION" && !view.bounded {
                             out.push(Diagnostic::new(
                                 &MESH_PRIMITIVE_POSITION_ACCESSOR_WITHOUT_BOUNDS,
-                                target_at.clone(),
+                                target_at(),
                                 "a POSITION accessor must have min and max",
                             ));
                         }

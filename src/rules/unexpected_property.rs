@@ -19,71 +19,94 @@ use crate::diagnostics::{codes, Code, Diagnostic};
 
 pub struct UnexpectedProperty;
 
-/// Objects are never this deep in a real asset; a hostile one stops here.
-const MAX_DEPTH: usize = 64;
+/// Objects are never this deep in a real asset (a step is a key or an index); a hostile one
+/// stops here.
+const MAX_DEPTH: usize = 128;
 
 impl Rule for UnexpectedProperty {
     fn codes(&self) -> &'static [&'static Code] {
         &[&codes::UNEXPECTED_PROPERTY]
     }
 
+    /// A walk of every object of the document, as the core schema check's.
+    fn cost(&self) -> u32 {
+        2
+    }
+
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
         let shapes = shapes();
-        let mut path = String::new();
-        walk(shapes, cx.json(), shapes.root(), &mut path, 0, out);
+        let mut path = Vec::new();
+        walk(shapes, cx.json(), shapes.root(), &mut path, out);
     }
 }
 
-fn walk(
+/// One step of the path to a value: a key or an array index. The pointer is written only for
+/// a finding, not for each of the document's keys.
+enum Step<'a> {
+    Key(std::borrow::Cow<'a, str>),
+    Index(usize),
+}
+
+fn pointer_of(path: &[Step]) -> String {
+    let mut at = String::new();
+    for step in path {
+        at.push('/');
+        match step {
+            Step::Key(key) => pointer::push_escaped(&mut at, key),
+            Step::Index(i) => at.push_str(&i.to_string()),
+        }
+    }
+    at
+}
+
+fn walk<'a>(
     shapes: &Shapes,
-    value: Node,
+    value: Node<'a>,
     shape: usize,
-    path: &mut String,
-    depth: usize,
+    path: &mut Vec<Step<'a>>,
     out: &mut Vec<Diagnostic>,
 ) {
     let Some(object) = value.as_object() else {
         return;
     };
-    if depth > MAX_DEPTH {
+    if path.len() > MAX_DEPTH {
         return;
     }
     for (key, member) in object.iter() {
-        let len = path.len();
-        path.push('/');
-        pointer::push_escaped(path, &key);
         if !shapes.defines(shape, &key) {
+            let mut at = pointer_of(path);
+            at.push('/');
+            pointer::push_escaped(&mut at, &key);
             out.push(Diagnostic::new(
                 &codes::UNEXPECTED_PROPERTY,
-                path.as_str(),
+                at,
                 format!("unexpected property '{key}'"),
             ));
         } else if key == "extensions" {
+            path.push(Step::Key(key));
             for (name, extension) in member.as_object().into_iter().flat_map(|o| o.iter()) {
                 if let Some(kind) = shapes.extension_object(&name, shape) {
-                    let len = path.len();
-                    path.push('/');
-                    pointer::push_escaped(path, &name);
-                    walk(shapes, extension, kind, path, depth + 1, out);
-                    path.truncate(len);
+                    path.push(Step::Key(name));
+                    walk(shapes, extension, kind, path, out);
+                    path.pop();
                 }
             }
+            path.pop();
         } else if let Some((_, child, array)) =
             shapes.children(shape).iter().find(|(name, _, _)| *name == key)
         {
+            path.push(Step::Key(key));
             if *array {
                 for (i, element) in member.as_array().into_iter().flat_map(|a| a.iter()).enumerate() {
-                    let len = path.len();
-                    path.push('/');
-                    path.push_str(&i.to_string());
-                    walk(shapes, element, *child, path, depth + 1, out);
-                    path.truncate(len);
+                    path.push(Step::Index(i));
+                    walk(shapes, element, *child, path, out);
+                    path.pop();
                 }
             } else {
-                walk(shapes, member, *child, path, depth + 1, out);
+                walk(shapes, member, *child, path, out);
             }
+            path.pop();
         }
-        path.truncate(len);
     }
 }
 
