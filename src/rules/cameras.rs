@@ -121,22 +121,9 @@ fn zfar_beyond_znear(znear: f64, zfar: f64, at: &str, out: &mut Vec<Diagnostic>)
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::asset::{load_bytes_with, LoadOptions};
 
     fn found(text: &str) -> Vec<String> {
-        let loaded = load_bytes_with(
-            std::path::Path::new("t.gltf"),
-            text.as_bytes(),
-            &LoadOptions::default(),
-        );
-        let asset = loaded.asset.expect("the document parses");
-        let schemas = super::super::schema::Schemas::builtin();
-        let cx = Context::new(&asset, &schemas);
-        let mut out = Vec::new();
-        Cameras.check(&cx, &mut out);
-        out.into_iter()
-            .map(|d| format!("{} {}", d.code, d.pointer))
-            .collect()
+        crate::rules::findings_of(&Cameras, text)
     }
 
     #[test]

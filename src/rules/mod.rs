@@ -286,6 +286,25 @@ pub fn find_code(name: &str) -> Option<&'static Code> {
 pub use crate::document::{effective_tex_coord, elements, materials, texture_sources};
 pub use crate::layers::{as_index, layer_objects, slot_pointer, slot_uses, LayerObject, SlotUse};
 
+/// The findings of `rule` alone on the document `text`, as "CODE pointer" lines: the rules'
+/// unit tests read them.
+#[cfg(test)]
+pub(crate) fn findings_of(rule: &dyn Rule, text: &str) -> Vec<String> {
+    let loaded = crate::asset::load_bytes_with(
+        std::path::Path::new("t.gltf"),
+        text.as_bytes(),
+        &crate::asset::LoadOptions::default(),
+    );
+    let asset = loaded.asset.expect("the document parses");
+    let schemas = schema::Schemas::builtin();
+    let cx = Context::new(&asset, &schemas);
+    let mut out = Vec::new();
+    rule.check(&cx, &mut out);
+    out.into_iter()
+        .map(|d| format!("{} {}", d.code, d.pointer))
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -183,22 +183,9 @@ impl Rule for Nodes {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::asset::{load_bytes_with, LoadOptions};
 
     fn found(text: &str) -> Vec<String> {
-        let loaded = load_bytes_with(
-            std::path::Path::new("t.gltf"),
-            text.as_bytes(),
-            &LoadOptions::default(),
-        );
-        let asset = loaded.asset.expect("the document parses");
-        let schemas = super::super::schema::Schemas::builtin();
-        let cx = Context::new(&asset, &schemas);
-        let mut out = Vec::new();
-        Nodes.check(&cx, &mut out);
-        out.into_iter()
-            .map(|d| format!("{} {}", d.code, d.pointer))
-            .collect()
+        crate::rules::findings_of(&Nodes, text)
     }
 
     #[test]

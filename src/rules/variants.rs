@@ -56,7 +56,6 @@ impl Rule for Variants {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::asset::{load_bytes_with, LoadOptions};
 
     #[test]
     fn a_variant_mapped_twice_in_one_primitive_is_found_at_its_second_listing() {
@@ -66,13 +65,7 @@ mod tests {
                 {"mappings":[{"material":0,"variants":[1,0]},{"material":1,"variants":[0]}]}}},
                 {"attributes":{"POSITION":0},"extensions":{"KHR_materials_variants":
                 {"mappings":[{"material":0,"variants":[0]},{"material":1,"variants":[1]}]}}}]}]}"#;
-        let loaded = load_bytes_with(std::path::Path::new("t.gltf"), text.as_bytes(), &LoadOptions::default());
-        let asset = loaded.asset.expect("the document parses");
-        let schemas = super::super::schema::Schemas::builtin();
-        let cx = Context::new(&asset, &schemas);
-        let mut out = Vec::new();
-        Variants.check(&cx, &mut out);
-        let found: Vec<String> = out.iter().map(|d| format!("{} {}", d.code, d.pointer)).collect();
+        let found = crate::rules::findings_of(&Variants, text);
         assert_eq!(
             found,
             ["KHR_MATERIALS_VARIANTS_NON_UNIQUE_VARIANT /meshes/0/primitives/0/extensions/KHR_materials_variants/mappings/1/variants/0"]
