@@ -422,6 +422,16 @@ fn check_bin_length(json: tape::Node, bin: Option<&[u8]>, out: &mut Vec<Diagnost
                 bin.len()
             ),
         )),
+        // The chunk pads the buffer to 4 bytes; more than that is bytes no buffer holds.
+        Some(bin) if (bin.len() as u64) > declared.next_multiple_of(4) => out.push(Diagnostic::new(
+            &codes::BUFFER_GLB_CHUNK_TOO_BIG,
+            "/buffers/0",
+            format!(
+                "the GLB's BIN chunk holds {} bytes, {} more than buffer 0's byteLength of {declared} padded to 4",
+                bin.len(),
+                bin.len() as u64 - declared.next_multiple_of(4)
+            ),
+        )),
         Some(_) => {}
     }
 }
@@ -756,7 +766,12 @@ impl Asset {
         }
         // Decoded outside the lock: other images are checked meanwhile.
         let found = match self.decode_image(index) {
-            Err(d) if d.code == codes::IMAGE_DATA_INVALID.name => Err(d.message),
+            Err(d)
+                if d.code == codes::IMAGE_DATA_INVALID.name
+                    || d.code == codes::IMAGE_UNEXPECTED_EOS.name =>
+            {
+                Err(d.message)
+            }
             _ => Ok(()),
         };
         self.image_decodes

@@ -399,7 +399,11 @@ pub fn read_header<R: std::io::BufRead + std::io::Seek>(
         let mut head = [0u8; 28];
         let n = read_up_to(&mut reader, &mut head).map_err(|e| unrecognized(e.to_string()))?;
         if n < 28 {
-            return Err(unrecognized("the KTX2 header is truncated".to_string()));
+            return Err(Diagnostic::new(
+                &codes::IMAGE_UNEXPECTED_EOS,
+                pointer,
+                format!("{what}: the image ends inside its KTX2 header"),
+            ));
         }
         let width = u32::from_le_bytes([head[20], head[21], head[22], head[23]]);
         let height = u32::from_le_bytes([head[24], head[25], head[26], head[27]]);
@@ -412,18 +416,22 @@ pub fn read_header<R: std::io::BufRead + std::io::Seek>(
             bits: None,
         });
     }
+    // A header cut short is IMAGE_UNEXPECTED_EOS, as the Khronos validator names it; any other
+    // damage IMAGE_DATA_INVALID.
+    let damaged = |e: image::ImageError| match &e {
+        image::ImageError::IoError(io) if io.kind() == std::io::ErrorKind::UnexpectedEof => {
+            Diagnostic::new(
+                &codes::IMAGE_UNEXPECTED_EOS,
+                pointer,
+                format!("{what}: the image ends inside its header"),
+            )
+        }
+        _ => unrecognized(e.to_string()),
+    };
     let decoder: Box<dyn ImageDecoder> = match format {
-        ImageFormat::Png => Box::new(
-            image::codecs::png::PngDecoder::new(reader).map_err(|e| unrecognized(e.to_string()))?,
-        ),
-        ImageFormat::Jpeg => Box::new(
-            image::codecs::jpeg::JpegDecoder::new(reader)
-                .map_err(|e| unrecognized(e.to_string()))?,
-        ),
-        ImageFormat::Webp => Box::new(
-            image::codecs::webp::WebPDecoder::new(reader)
-                .map_err(|e| unrecognized(e.to_string()))?,
-        ),
+        ImageFormat::Png => Box::new(image::codecs::png::PngDecoder::new(reader).map_err(damaged)?),
+        ImageFormat::Jpeg => Box::new(image::codecs::jpeg::JpegDecoder::new(reader).map_err(damaged)?),
+        ImageFormat::Webp => Box::new(image::codecs::webp::WebPDecoder::new(reader).map_err(damaged)?),
         ImageFormat::Ktx2 => unreachable!("handled above"),
     };
     let (width, height) = decoder.dimensions();

@@ -116,6 +116,11 @@ pub const IMAGE_UNRECOGNIZED_FORMAT: Code = Code::new(
     Warning,
     "An image's bytes are not PNG, JPEG, WebP or KTX2; loaders that know only those cannot read it.",
 );
+pub const IMAGE_UNEXPECTED_EOS: Code = Code::new(
+    "IMAGE_UNEXPECTED_EOS",
+    Error,
+    "An image of a known format ends inside its header (a truncated file).",
+);
 pub const IMAGE_DATA_INVALID: Code = Code::new(
     "IMAGE_DATA_INVALID",
     Error,
@@ -133,6 +138,11 @@ pub const BUFFER_MISSING_GLB_DATA: Code = Code::new(
     "BUFFER_MISSING_GLB_DATA",
     Error,
     "A GLB's first buffer has no uri, and the GLB has no BIN chunk to hold its data.",
+);
+pub const BUFFER_GLB_CHUNK_TOO_BIG: Code = Code::new(
+    "BUFFER_GLB_CHUNK_TOO_BIG",
+    Warning,
+    "A GLB's BIN chunk is longer than its buffer's byteLength padded to 4 bytes.",
 );
 pub const GLB_EXTRA_DATA: Code = Code::new(
     "GLB_EXTRA_DATA",
@@ -223,8 +233,10 @@ pub const LOADER: &[&Code] = &[
     &INVALID_URI,
     &BUFFER_VIEW_OUT_OF_RANGE,
     &BUFFER_BYTE_LENGTH_MISMATCH,
+    &BUFFER_GLB_CHUNK_TOO_BIG,
     &IMAGE_UNRECOGNIZED_FORMAT,
     &IMAGE_DATA_INVALID,
+    &IMAGE_UNEXPECTED_EOS,
     &UNRESOLVED_REFERENCE,
     &BUFFER_MISSING_GLB_DATA,
 ];

@@ -5,11 +5,14 @@
 //!
 //! Rules read the asset and push diagnostics; they never change anything.
 
+pub mod accessor_bounds;
 pub mod accessors;
+pub mod animation_data;
 pub mod animations;
 pub mod asset_version;
 pub mod buffer_views;
 pub mod cameras;
+pub mod data;
 pub mod attributes;
 pub mod clearcoat;
 pub mod core;
@@ -32,12 +35,14 @@ pub mod references;
 pub mod resources;
 pub mod roughness_alpha;
 pub mod schema;
+pub mod skin_data;
 pub mod skins;
 pub mod tangent_space;
 pub mod texcoord;
 pub mod texture_sources;
 pub mod unexpected_property;
 pub mod variants;
+pub mod vertex_data;
 
 use crate::asset::tape::Node;
 use crate::asset::Asset;
@@ -52,6 +57,10 @@ pub struct Context<'a> {
     layers: std::sync::OnceLock<Vec<Layer<'a>>>,
     /// The textures each material reads, found once for every rule.
     material_textures: std::sync::OnceLock<Vec<Vec<extensions::MaterialTexture>>>,
+    /// The buffers, each read on the first rule that needs its data.
+    buffers: std::sync::OnceLock<data::Buffers<'a>>,
+    /// Whether the rules that read accessor data run (`--no-data` turns them off).
+    read_data: bool,
 }
 
 impl<'a> Context<'a> {
@@ -61,7 +70,28 @@ impl<'a> Context<'a> {
             schemas,
             layers: std::sync::OnceLock::new(),
             material_textures: std::sync::OnceLock::new(),
+            buffers: std::sync::OnceLock::new(),
+            read_data: true,
         }
+    }
+
+    /// The same context, with the rules that read accessor data on or off.
+    pub fn reading_data(mut self, on: bool) -> Context<'a> {
+        self.read_data = on;
+        self
+    }
+
+    /// Whether the rules that read accessor data run.
+    pub fn reads_data(&self) -> bool {
+        self.read_data
+    }
+
+    /// Buffer `index`'s bytes, read on first use and kept for every rule that reads data;
+    /// `None` when it cannot be read whole (the resource rules report why).
+    pub fn buffer(&self, index: usize) -> Option<&[u8]> {
+        self.buffers
+            .get_or_init(|| data::Buffers::new(elements(self.json().get("buffers")).count()))
+            .get(self.asset, index)
     }
 
     /// The textures each material reads (core and extensions, see
@@ -237,6 +267,10 @@ pub static REGISTRY: &[&dyn Rule] = &[
     &references::References,
     &attributes::Attributes,
     &accessors::Accessors,
+    &accessor_bounds::AccessorBounds,
+    &vertex_data::VertexData,
+    &animation_data::AnimationData,
+    &skin_data::SkinData,
     &buffer_views::BufferViews,
     &node_tree::NodeTree,
     &nodes::Nodes,

@@ -1,7 +1,8 @@
 //! A node's own properties, beyond their schema (the Khronos glTF-Validator's node checks, with
 //! its codes and pointers; the spec's "Transformations" and "Skins" sections):
 //!
-//! - ROTATION_NON_UNIT (error): a rotation quaternion whose length is not 1 (within 5·10⁻⁵).
+//! - ROTATION_NON_UNIT (error): a rotation quaternion whose length is not 1 (within 0.00769,
+//!   the Khronos validator's tolerance: a little more than signed 8-bit quantization loses).
 //! - NODE_MATRIX_NON_TRS (error): a matrix that no translation, rotation and scale make (its last
 //!   row not 0, 0, 0, 1, its 3×3 part singular or sheared), which the spec requires.
 //! - NODE_WEIGHTS_INVALID (error): `weights` not one per morph target of the node's mesh.
@@ -46,7 +47,7 @@ pub const NODE_SKINNED_MESH_LOCAL_TRANSFORMS: Code = Code::new(
 );
 
 /// How far from 1 a unit quaternion's length may be.
-const UNIT_TOLERANCE: f64 = 5e-5;
+const UNIT_TOLERANCE: f64 = super::data::UNIT_LENGTH_VEC4;
 /// How far from orthogonal (relative to their lengths) a matrix's scaled axes may be.
 const SHEAR_TOLERANCE: f64 = 1e-4;
 

@@ -33,6 +33,16 @@ pub const IMAGE_MIME_TYPE_INVALID: Code = Code::new(
     Severity::Error,
     "An image's data is in another format than its mimeType (or data: media type) declares.",
 );
+pub const IMAGE_NON_ENABLED_MIME_TYPE: Code = Code::new(
+    "IMAGE_NON_ENABLED_MIME_TYPE",
+    Severity::Error,
+    "An image is WebP or KTX2 but the extension that lets textures use it is not in extensionsUsed.",
+);
+pub const DATA_URI_GLB: Code = Code::new(
+    "DATA_URI_GLB",
+    Severity::Warning,
+    "A .glb's buffer or image uses a data: URI; the BIN chunk holds binary data without base64's third more bytes.",
+);
 pub const BUFFER_DATA_URI_MIME_TYPE_INVALID: Code = Code::new(
     "BUFFER_DATA_URI_MIME_TYPE_INVALID",
     Severity::Error,
@@ -72,17 +82,35 @@ impl Rule for Resources {
             &codes::IO_ERROR,
             &codes::IMAGE_UNRECOGNIZED_FORMAT,
             &codes::IMAGE_DATA_INVALID,
+            &codes::IMAGE_UNEXPECTED_EOS,
             &codes::BUFFER_BYTE_LENGTH_MISMATCH,
+            &IMAGE_NON_ENABLED_MIME_TYPE,
+            &DATA_URI_GLB,
         ]
     }
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
         let json = cx.json();
-        for (index, buffer) in array(json, "buffers") {
-            check_buffer(cx, index, buffer, out);
-        }
-        for (index, image) in array(json, "images") {
-            check_image(cx, index, image, out);
+        let glb = cx.asset.container == crate::asset::Container::Glb;
+        for (key, check) in [
+            ("buffers", check_buffer as fn(&Context, usize, Node, &mut Vec<Diagnostic>)),
+            ("images", check_image),
+        ] {
+            for (index, object) in array(json, key) {
+                // A data: URI without its payload is INVALID_URI alone.
+                let data_uri = object
+                    .get("uri")
+                    .and_then(|u| u.as_str())
+                    .is_some_and(|u| u.starts_with("data:") && u.contains(','));
+                if glb && data_uri {
+                    out.push(Diagnostic::new(
+                        &DATA_URI_GLB,
+                        format!("/{key}/{index}/uri"),
+                        "a data: URI in a .glb: the BIN chunk holds the same bytes without base64",
+                    ));
+                }
+                check(cx, index, object, out);
+            }
         }
     }
 }
@@ -190,6 +218,26 @@ fn check_image(cx: &Context, index: usize, image: Node, out: &mut Vec<Diagnostic
     }
     match cx.asset.image_header(index) {
         Ok(header) => {
+            // WebP and KTX2 are formats only an extension lets a texture use.
+            let enabling: &[&str] = match header.format {
+                ImageFormat::Webp => &["EXT_texture_webp"],
+                ImageFormat::Ktx2 => &["KHR_texture_basisu", "EXT_texture_astc"],
+                _ => &[],
+            };
+            let declared_extension = |name: &&str| {
+                super::elements(cx.json().get("extensionsUsed")).any(|e| e.is_str(name))
+            };
+            if !enabling.is_empty() && !enabling.iter().any(declared_extension) {
+                out.push(Diagnostic::new(
+                    &IMAGE_NON_ENABLED_MIME_TYPE,
+                    format!("/images/{index}"),
+                    format!(
+                        "image {index} is {}, which needs {} in extensionsUsed",
+                        mime_of(header.format),
+                        enabling.join(" or ")
+                    ),
+                ));
+            }
             let Some((mime, pointer)) = declared else {
                 return;
             };

@@ -1,0 +1,225 @@
+//! An accessor's values against its `min` and `max` (the spec: they "MUST match actual minimum
+//! and maximum binary values stored in buffers"), read from the data, with the Khronos
+//! glTF-Validator's codes and pointers:
+//!
+//! - ACCESSOR_MIN_MISMATCH, ACCESSOR_MAX_MISMATCH (errors): a component's declared bound is not
+//!   its actual minimum or maximum; at `min/c` or `max/c`.
+//! - ACCESSOR_ELEMENT_OUT_OF_MIN_BOUND, _OUT_OF_MAX_BOUND (errors): how many values of a
+//!   component lie beyond its declared bound; at the same place.
+//! - ACCESSOR_INVALID_FLOAT (error): a float component that is NaN or infinite; at the
+//!   accessor, one finding a value, at most [`MAX_REPORTED`] an accessor.
+//!
+//! Float accessors are compared in single precision, as their values are stored: a declared
+//! 0.1 matches a stored 0.1f. Non-finite values take no part in the bounds.
+
+use super::data::{accessor_count, Elements, MAX_COMPONENTS};
+use super::{Context, Rule};
+use crate::diagnostics::{Code, Diagnostic, Severity};
+
+pub const ACCESSOR_MIN_MISMATCH: Code = Code::new(
+    "ACCESSOR_MIN_MISMATCH",
+    Severity::Error,
+    "An accessor's declared min is not the actual minimum of its data.",
+);
+pub const ACCESSOR_MAX_MISMATCH: Code = Code::new(
+    "ACCESSOR_MAX_MISMATCH",
+    Severity::Error,
+    "An accessor's declared max is not the actual maximum of its data.",
+);
+pub const ACCESSOR_ELEMENT_OUT_OF_MIN_BOUND: Code = Code::new(
+    "ACCESSOR_ELEMENT_OUT_OF_MIN_BOUND",
+    Severity::Error,
+    "An accessor holds values below its declared min.",
+);
+pub const ACCESSOR_ELEMENT_OUT_OF_MAX_BOUND: Code = Code::new(
+    "ACCESSOR_ELEMENT_OUT_OF_MAX_BOUND",
+    Severity::Error,
+    "An accessor holds values above its declared max.",
+);
+pub const ACCESSOR_INVALID_FLOAT: Code = Code::new(
+    "ACCESSOR_INVALID_FLOAT",
+    Severity::Error,
+    "A float accessor holds NaN or an infinity.",
+);
+
+/// Findings of one kind an accessor gives at most: a hostile buffer of a billion NaNs is a
+/// thousand findings, not a billion.
+pub const MAX_REPORTED: usize = 1000;
+
+pub struct AccessorBounds;
+
+/// What the walk of one accessor's values found, component by component.
+struct Tally {
+    low: [f64; MAX_COMPONENTS],
+    high: [f64; MAX_COMPONENTS],
+    below: [usize; MAX_COMPONENTS],
+    above: [usize; MAX_COMPONENTS],
+}
+
+impl Rule for AccessorBounds {
+    fn codes(&self) -> &'static [&'static Code] {
+        &[
+            &ACCESSOR_MIN_MISMATCH,
+            &ACCESSOR_MAX_MISMATCH,
+            &ACCESSOR_ELEMENT_OUT_OF_MIN_BOUND,
+            &ACCESSOR_ELEMENT_OUT_OF_MAX_BOUND,
+            &ACCESSOR_INVALID_FLOAT,
+        ]
+    }
+
+    /// It reads every accessor's data.
+    fn cost(&self) -> u32 {
+        4
+    }
+
+    fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
+        if !cx.reads_data() {
+            return;
+        }
+        let accessors = cx.json().get("accessors");
+        for i in 0..accessor_count(cx) {
+            let Some(accessor) = accessors.and_then(|a| a.get(i)) else {
+                continue;
+            };
+            let bound = |key: &str| -> Option<Vec<f64>> {
+                let values = accessor.get(key)?.as_array()?;
+                values.iter().map(|v| v.as_f64()).collect()
+            };
+            let (min, max) = (bound("min"), bound("max"));
+            let float = accessor.get("componentType").and_then(|c| c.as_u64()) == Some(5126);
+            if min.is_none() && max.is_none() && !float {
+                continue;
+            }
+            let Some(elements) = Elements::of(cx, i) else {
+                continue;
+            };
+            let n = elements.components;
+            // Declared bounds as the data holds them: single precision for floats.
+            let stored = |v: f64| if float { f64::from(v as f32) } else { v };
+            let min = min.filter(|m| m.len() == n).map(|m| m.into_iter().map(stored).collect::<Vec<_>>());
+            let max = max.filter(|m| m.len() == n).map(|m| m.into_iter().map(stored).collect::<Vec<_>>());
+            let mut tally = Tally {
+                low: [f64::INFINITY; MAX_COMPONENTS],
+                high: [f64::NEG_INFINITY; MAX_COMPONENTS],
+                below: [0; MAX_COMPONENTS],
+                above: [0; MAX_COMPONENTS],
+            };
+            let mut invalid = 0;
+            elements.for_each(|e, values| {
+                for (c, &v) in values.iter().enumerate() {
+                    if !v.is_finite() {
+                        if invalid < MAX_REPORTED {
+                            out.push(Diagnostic::new(
+                                &ACCESSOR_INVALID_FLOAT,
+                                format!("/accessors/{i}"),
+                                format!("the value at index {} is {}", e * n + c, name_of(v)),
+                            ));
+                        }
+                        invalid += 1;
+                        continue;
+                    }
+                    tally.low[c] = tally.low[c].min(v);
+                    tally.high[c] = tally.high[c].max(v);
+                    if min.as_ref().is_some_and(|m| v < m[c]) {
+                        tally.below[c] += 1;
+                    }
+                    if max.as_ref().is_some_and(|m| v > m[c]) {
+                        tally.above[c] += 1;
+                    }
+                }
+            });
+            for (key, declared, actual, beyond, mismatch, outside, word) in [
+                ("min", &min, &tally.low, &tally.below, &ACCESSOR_MIN_MISMATCH, &ACCESSOR_ELEMENT_OUT_OF_MIN_BOUND, "less"),
+                ("max", &max, &tally.high, &tally.above, &ACCESSOR_MAX_MISMATCH, &ACCESSOR_ELEMENT_OUT_OF_MAX_BOUND, "greater"),
+            ] {
+                let Some(declared) = declared else {
+                    continue;
+                };
+                for c in 0..n {
+                    let at = format!("/accessors/{i}/{key}/{c}");
+                    if actual[c].is_finite() && declared[c] != actual[c] {
+                        out.push(Diagnostic::new(
+                            mismatch,
+                            at.clone(),
+                            format!(
+                                "the declared {key} of this component, {}, is not the actual {key}, {}",
+                                declared[c], actual[c]
+                            ),
+                        ));
+                    }
+                    if beyond[c] > 0 {
+                        out.push(Diagnostic::new(
+                            outside,
+                            at,
+                            format!(
+                                "{} value(s) of this component are {word} than the declared {key}, {}",
+                                beyond[c], declared[c]
+                            ),
+                        ));
+                    }
+                }
+            }
+        }
+    }
+}
+
+fn name_of(v: f64) -> &'static str {
+    if v.is_nan() {
+        "NaN"
+    } else if v > 0.0 {
+        "infinity"
+    } else {
+        "-infinity"
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use base64::Engine;
+
+    fn found(accessors: &str, bytes: &[u8]) -> Vec<String> {
+        let data = base64::engine::general_purpose::STANDARD.encode(bytes);
+        let text = format!(
+            r#"{{"asset":{{"version":"2.0"}},"buffers":[{{"byteLength":{},"uri":"data:application/octet-stream;base64,{data}"}}],
+            "bufferViews":[{{"buffer":0,"byteLength":{}}}],"accessors":{accessors}}}"#,
+            bytes.len(),
+            bytes.len()
+        );
+        crate::rules::findings_of(&AccessorBounds, &text)
+    }
+
+    #[test]
+    fn bounds_that_do_not_match_the_data_are_found_per_component() {
+        let mut bytes = Vec::new();
+        for v in [-1.0f32, 0.5, 0.1, 0.1, f32::NAN, 0.3] {
+            bytes.extend_from_slice(&v.to_le_bytes());
+        }
+        // Floats compared as stored: the declared 0.1 is the stored 0.1f.
+        let accessors = r#"[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC2","min":[0,0.1],"max":[1,0.5]}]"#;
+        assert_eq!(
+            found(accessors, &bytes),
+            [
+                "ACCESSOR_INVALID_FLOAT /accessors/0",
+                "ACCESSOR_MIN_MISMATCH /accessors/0/min/0",
+                "ACCESSOR_ELEMENT_OUT_OF_MIN_BOUND /accessors/0/min/0",
+                "ACCESSOR_MAX_MISMATCH /accessors/0/max/0",
+            ]
+        );
+    }
+
+    #[test]
+    fn integer_bounds_are_exact_and_matching_bounds_are_clean() {
+        let bytes = [0u8, 255, 7, 9];
+        let exact = r#"[{"bufferView":0,"componentType":5121,"count":2,"type":"VEC2","min":[0,9],"max":[7,255]}]"#;
+        assert_eq!(found(exact, &bytes), Vec::<String>::new());
+        let off = r#"[{"bufferView":0,"componentType":5121,"count":2,"type":"VEC2","min":[0,9],"max":[7,254]}]"#;
+        assert_eq!(
+            found(off, &bytes),
+            [
+                "ACCESSOR_MAX_MISMATCH /accessors/0/max/1",
+                "ACCESSOR_ELEMENT_OUT_OF_MAX_BOUND /accessors/0/max/1"
+            ]
+        );
+    }
+}

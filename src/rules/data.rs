@@ -1,0 +1,376 @@
+//! Accessor data, read for the rules that judge values rather than JSON (the Khronos
+//! glTF-Validator's DataError codes): each buffer is read once per document, on the first rule
+//! that asks for it ([`Buffers`]), and an accessor's elements are decoded from it where they lie,
+//! without a copy ([`Elements`]).
+//!
+//! An accessor is decoded only when everything it names holds together: a valid component
+//! type and type, a buffer view inside its buffer, the elements inside the view, sparse indices
+//! and values inside theirs. Anything else is the JSON-level rules' finding (UNRESOLVED_REFERENCE,
+//! ACCESSOR_TOO_LONG, BUFFER_VIEW_TOO_LONG, …) and its data is not judged.
+//!
+//! Values are read as they are stored (`normalized` has no effect on `min` and `max`, as the
+//! spec says); [`Elements::normalize`] gives the value a loader sees where a check needs it.
+
+use super::accessors::{component_size, components, element_layout};
+use super::{elements, Context};
+use crate::asset::tape::Node;
+use std::borrow::Cow;
+use std::sync::OnceLock;
+
+/// The document's buffers, each read on first use and kept for the other rules.
+pub struct Buffers<'a> {
+    slots: Vec<OnceLock<Option<Cow<'a, [u8]>>>>,
+}
+
+impl<'a> Buffers<'a> {
+    pub fn new(count: usize) -> Buffers<'a> {
+        Buffers {
+            slots: (0..count).map(|_| OnceLock::new()).collect(),
+        }
+    }
+
+    /// Buffer `index`'s bytes; `None` when it cannot be read or is shorter than its
+    /// byteLength (the resource rules' findings).
+    pub fn get(&self, asset: &'a crate::asset::Asset, index: usize) -> Option<&[u8]> {
+        self.slots
+            .get(index)?
+            .get_or_init(|| asset.buffer_bytes(index).ok())
+            .as_deref()
+    }
+}
+
+/// How far from 1 a unit vector's length may be (a little more than signed 8-bit quantization
+/// loses), as the Khronos validator allows: three components, and four.
+pub const UNIT_LENGTH_VEC3: f64 = 0.00674;
+pub const UNIT_LENGTH_VEC4: f64 = 0.00769;
+/// How far from 1 a sum of weights may be, per two components beyond the second (a little
+/// more than unsigned 8-bit quantization loses), as the Khronos validator allows.
+pub const UNIT_SUM_STEP: f64 = 0.0039216;
+
+/// The largest number of components an element has (MAT4).
+pub const MAX_COMPONENTS: usize = 16;
+
+/// Where an accessor's stored elements lie.
+struct Strided<'a> {
+    /// From the first element's first byte to the end of the buffer view.
+    bytes: &'a [u8],
+    stride: usize,
+    /// For matrices whose columns are padded to 4 bytes: (rows, bytes from column to column).
+    columns: Option<(usize, usize)>,
+}
+
+/// A sparse accessor's substitutions: (element index, its values' place in `values`), sorted by
+/// element index.
+struct Sparse<'a> {
+    substitutions: Vec<(usize, usize)>,
+    values: &'a [u8],
+}
+
+/// An accessor's elements, ready to be read.
+pub struct Elements<'a> {
+    pub component_type: u64,
+    pub components: usize,
+    pub count: usize,
+    pub normalized: bool,
+    size: usize,
+    base: Option<Strided<'a>>,
+    sparse: Option<Sparse<'a>>,
+}
+
+/// The unsigned integer at `at` of `index`, when it is one that fits a `usize`.
+fn index_of(node: Option<Node>) -> Option<usize> {
+    usize::try_from(node?.as_u64()?).ok()
+}
+
+/// A buffer view's bytes, when the view lies inside its buffer.
+fn view_bytes<'c>(cx: &'c Context, view: usize) -> Option<&'c [u8]> {
+    let json = cx.json();
+    let view = json.get("bufferViews")?.get(view)?;
+    let buffer = index_of(view.get("buffer"))?;
+    let offset = match view.get("byteOffset") {
+        None => 0,
+        Some(o) => usize::try_from(o.as_u64()?).ok()?,
+    };
+    let length = index_of(view.get("byteLength"))?;
+    let bytes = cx.buffer(buffer)?;
+    bytes.get(offset..offset.checked_add(length)?)
+}
+
+impl<'a> Elements<'a> {
+    /// Accessor `index`'s elements, or `None` when they cannot be read as the JSON says.
+    pub fn of(cx: &'a Context, index: usize) -> Option<Elements<'a>> {
+        let accessor = cx.json().get("accessors")?.get(index)?;
+        let component_type = accessor.get("componentType")?.as_u64()?;
+        let size = usize::try_from(component_size(component_type)?).ok()?;
+        let kind = accessor.get("type")?.as_str()?;
+        let components = usize::try_from(components(&kind)?).ok()?;
+        let count = index_of(accessor.get("count")).filter(|c| *c >= 1)?;
+        let normalized = accessor.get("normalized").and_then(|n| n.as_bool()) == Some(true);
+        let base = match accessor.get("bufferView") {
+            None => None,
+            Some(view) => {
+                let view = index_of(Some(view))?;
+                let bytes = view_bytes(cx, view)?;
+                let offset = match accessor.get("byteOffset") {
+                    None => 0,
+                    Some(o) => usize::try_from(o.as_u64()?).ok()?,
+                };
+                let (element, packed) = element_layout(size as u64, &kind)?;
+                let (element, packed) = (usize::try_from(element).ok()?, usize::try_from(packed).ok()?);
+                let stride = match cx
+                    .json()
+                    .get("bufferViews")
+                    .and_then(|v| v.get(view))
+                    .and_then(|v| v.get("byteStride"))
+                {
+                    None => packed,
+                    Some(s) => index_of(Some(s)).filter(|s| *s >= element)?,
+                };
+                let needed = stride.checked_mul(count - 1)?.checked_add(element)?;
+                let bytes = bytes.get(offset..)?.get(..needed)?;
+                let columns = (element != size * components).then(|| {
+                    let rows = match components {
+                        4 => 2,
+                        9 => 3,
+                        _ => 4,
+                    };
+                    (rows, (rows * size).next_multiple_of(4))
+                });
+                Some(Strided {
+                    bytes,
+                    stride,
+                    columns,
+                })
+            }
+        };
+        let sparse = match accessor.get("sparse") {
+            None => None,
+            Some(sparse) => Some(Self::sparse(cx, sparse, size * components, count)?),
+        };
+        if base.is_none() && sparse.is_none() {
+            // No data at all: the values come from elsewhere (an extension), not from the file.
+            return None;
+        }
+        Some(Elements {
+            component_type,
+            components,
+            count,
+            normalized,
+            size,
+            base,
+            sparse,
+        })
+    }
+
+    fn sparse(
+        cx: &'a Context,
+        sparse: Node,
+        element: usize,
+        count: usize,
+    ) -> Option<Sparse<'a>> {
+        let n = index_of(sparse.get("count")).filter(|n| *n >= 1 && *n <= count)?;
+        let indices = sparse.get("indices")?;
+        let values = sparse.get("values")?;
+        let index_type = indices.get("componentType")?.as_u64()?;
+        let index_size = match index_type {
+            5121 => 1,
+            5123 => 2,
+            5125 => 4,
+            _ => return None,
+        };
+        let part = |holder: Node, length: usize| -> Option<&'a [u8]> {
+            let view = index_of(holder.get("bufferView"))?;
+            let bytes = view_bytes(cx, view)?;
+            let offset = match holder.get("byteOffset") {
+                None => 0,
+                Some(o) => usize::try_from(o.as_u64()?).ok()?,
+            };
+            bytes.get(offset..offset.checked_add(length)?)
+        };
+        let index_bytes = part(indices, n.checked_mul(index_size)?)?;
+        let values = part(values, n.checked_mul(element)?)?;
+        let mut substitutions = Vec::with_capacity(n);
+        for k in 0..n {
+            let at = &index_bytes[k * index_size..(k + 1) * index_size];
+            let index = match index_size {
+                1 => usize::from(at[0]),
+                2 => usize::from(u16::from_le_bytes([at[0], at[1]])),
+                _ => usize::try_from(u32::from_le_bytes([at[0], at[1], at[2], at[3]])).ok()?,
+            };
+            if index >= count {
+                return None;
+            }
+            substitutions.push((index, k * element));
+        }
+        // A later substitution of one element wins, as a loader applying them in order does:
+        // the sort is stable, and readers take the last of an element's substitutions.
+        substitutions.sort_by_key(|(index, _)| *index);
+        Some(Sparse {
+            substitutions,
+            values,
+        })
+    }
+
+    /// One stored component as a number.
+    fn read(&self, bytes: &[u8]) -> f64 {
+        match (self.component_type, bytes) {
+            (5120, [b, ..]) => f64::from(*b as i8),
+            (5121, [b, ..]) => f64::from(*b),
+            (5122, [a, b, ..]) => f64::from(i16::from_le_bytes([*a, *b])),
+            (5123, [a, b, ..]) => f64::from(u16::from_le_bytes([*a, *b])),
+            (5125, [a, b, c, d, ..]) => f64::from(u32::from_le_bytes([*a, *b, *c, *d])),
+            (5126, [a, b, c, d, ..]) => f64::from(f32::from_le_bytes([*a, *b, *c, *d])),
+            _ => 0.0,
+        }
+    }
+
+    /// The value a loader sees for stored value `value`: for a normalized integer accessor,
+    /// the spec's conversion to [0, 1] or [-1, 1]; otherwise the value itself.
+    pub fn normalize(&self, value: f64) -> f64 {
+        if !self.normalized {
+            return value;
+        }
+        match self.component_type {
+            5120 => (value / 127.0).max(-1.0),
+            5121 => value / 255.0,
+            5122 => (value / 32767.0).max(-1.0),
+            5123 => value / 65535.0,
+            _ => value,
+        }
+    }
+
+    /// Element `i`'s stored components (sparse substitutions applied) into `values`, which
+    /// holds [`Elements::components`] of them; for reading several accessors side by side.
+    pub fn element(&self, i: usize, values: &mut [f64]) {
+        if let Some(sparse) = &self.sparse {
+            // The last substitution of an element wins.
+            let end = sparse.substitutions.partition_point(|(index, _)| *index <= i);
+            if let Some(&(index, at)) = end.checked_sub(1).and_then(|k| sparse.substitutions.get(k)) {
+                if index == i {
+                    for (c, slot) in values.iter_mut().enumerate() {
+                        *slot = self.read(&sparse.values[at + c * self.size..]);
+                    }
+                    return;
+                }
+            }
+        }
+        match &self.base {
+            Some(base) => self.read_stored(base, i, values),
+            None => values.fill(0.0),
+        }
+    }
+
+    fn read_stored(&self, base: &Strided, i: usize, values: &mut [f64]) {
+        let start = i * base.stride;
+        for (c, slot) in values.iter_mut().enumerate() {
+            let offset = match base.columns {
+                Some((rows, column)) => (c / rows) * column + (c % rows) * self.size,
+                None => c * self.size,
+            };
+            *slot = self.read(&base.bytes[start + offset..]);
+        }
+    }
+
+    /// Calls `visit` with each element's index and its stored components, in order, with the
+    /// sparse substitutions applied.
+    pub fn for_each(&self, mut visit: impl FnMut(usize, &[f64])) {
+        let mut element = [0.0; MAX_COMPONENTS];
+        let values = &mut element[..self.components];
+        let mut next = 0;
+        for i in 0..self.count {
+            let mut substituted = None;
+            if let Some(sparse) = &self.sparse {
+                while let Some(&(index, at)) = sparse.substitutions.get(next) {
+                    if index > i {
+                        break;
+                    }
+                    if index == i {
+                        substituted = Some(at);
+                    }
+                    next += 1;
+                }
+                if let Some(at) = substituted {
+                    for (c, slot) in values.iter_mut().enumerate() {
+                        *slot = self.read(&sparse.values[at + c * self.size..]);
+                    }
+                    visit(i, values);
+                    continue;
+                }
+            }
+            match &self.base {
+                Some(base) => self.read_stored(base, i, values),
+                None => values.fill(0.0),
+            }
+            visit(i, values);
+        }
+    }
+}
+
+/// Every accessor index `node` names, for the rules that read the accessors of a use (a
+/// primitive's attributes, a sampler's input).
+pub fn accessor_index(node: Option<Node>) -> Option<usize> {
+    index_of(node)
+}
+
+/// The number of accessors of the document.
+pub fn accessor_count(cx: &Context) -> usize {
+    elements(cx.json().get("accessors")).count()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::asset::{load_bytes_with, LoadOptions};
+    use base64::Engine;
+
+    fn decoded(accessors: &str, views: &str, bytes: &[u8]) -> Vec<Vec<Vec<f64>>> {
+        let data = base64::engine::general_purpose::STANDARD.encode(bytes);
+        let text = format!(
+            r#"{{"asset":{{"version":"2.0"}},"buffers":[{{"byteLength":{},"uri":"data:application/octet-stream;base64,{data}"}}],
+            "bufferViews":{views},"accessors":{accessors}}}"#,
+            bytes.len()
+        );
+        let loaded = load_bytes_with(std::path::Path::new("t.gltf"), text.as_bytes(), &LoadOptions::default());
+        let asset = loaded.asset.expect("the document parses");
+        let schemas = super::super::schema::Schemas::builtin();
+        let cx = Context::new(&asset, &schemas);
+        (0..accessor_count(&cx))
+            .map(|i| {
+                let mut out = Vec::new();
+                if let Some(e) = Elements::of(&cx, i) {
+                    e.for_each(|_, v| out.push(v.to_vec()));
+                }
+                out
+            })
+            .collect()
+    }
+
+    #[test]
+    fn elements_are_read_with_strides_padding_signs_and_sparse_substitutions() {
+        let mut bytes = Vec::new();
+        // View 0, stride 8: two float pairs (1, 2) and (3, 4), 4 bytes between them.
+        for v in [1.0f32, 2.0, 9.0, 3.0, 4.0, 9.0] {
+            bytes.extend_from_slice(&v.to_le_bytes());
+        }
+        // View 1 (offset 24): a byte MAT2, columns padded to 4 bytes: [1, -2 | 3, -4].
+        bytes.extend_from_slice(&[1, 0xFE, 0, 0, 3, 0xFC, 0, 0]);
+        // View 2 (offset 32): sparse indices (u16) 2 then 0, values (u16) 70, 80.
+        for v in [2u16, 0, 70, 80] {
+            bytes.extend_from_slice(&v.to_le_bytes());
+        }
+        let views = r#"[{"buffer":0,"byteLength":24,"byteStride":12},{"buffer":0,"byteOffset":24,"byteLength":8},
+            {"buffer":0,"byteOffset":32,"byteLength":4},{"buffer":0,"byteOffset":36,"byteLength":4}]"#;
+        let accessors = r#"[
+            {"bufferView":0,"componentType":5126,"count":2,"type":"VEC2"},
+            {"bufferView":1,"componentType":5120,"count":1,"type":"MAT2"},
+            {"componentType":5123,"count":3,"type":"SCALAR","sparse":{"count":2,
+                "indices":{"bufferView":2,"componentType":5123},"values":{"bufferView":3}}},
+            {"bufferView":0,"componentType":5126,"count":3,"type":"VEC2"}]"#;
+        let found = decoded(accessors, views, &bytes);
+        assert_eq!(found[0], [vec![1.0, 2.0], vec![3.0, 4.0]]);
+        assert_eq!(found[1], [vec![1.0, -2.0, 3.0, -4.0]]);
+        assert_eq!(found[2], [vec![80.0], vec![0.0], vec![70.0]]);
+        // Three elements of stride 12 need 32 bytes; the view holds 24: not read.
+        assert!(found[3].is_empty());
+    }
+}

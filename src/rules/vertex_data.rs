@@ -1,0 +1,455 @@
+//! Mesh data, read from the accessors a primitive draws (the spec's "Meshes" and "Skins"),
+//! with the Khronos glTF-Validator's codes and pointers, each at the attribute or `indices`:
+//!
+//! - ACCESSOR_INDEX_OOB (error): an index past the primitive's vertices.
+//! - ACCESSOR_INDEX_PRIMITIVE_RESTART (error): an index equal to its type's largest value, which
+//!   some APIs take as a primitive restart.
+//! - ACCESSOR_VECTOR3_NON_UNIT (error): a NORMAL, or a TANGENT's xyz, not of unit length.
+//! - ACCESSOR_INVALID_SIGN (error): a TANGENT's w other than 1 or -1.
+//! - ACCESSOR_NON_CLAMPED (error): a float COLOR_n component outside 0..1.
+//! - ACCESSOR_WEIGHTS_NEGATIVE (error), ACCESSOR_WEIGHTS_NON_NORMALIZED (error): a negative
+//!   weight; a vertex whose weights, over every WEIGHTS_n, do not sum to 1.
+//! - ACCESSOR_JOINTS_INDEX_OOB (error): a weighted joint past the joints of a skin that draws
+//!   the mesh; ACCESSOR_JOINTS_INDEX_DUPLICATE (error): a joint weighted twice for one vertex;
+//!   ACCESSOR_JOINTS_USED_ZERO_WEIGHT (warning): a non-zero joint with zero weight.
+//!
+//! Tolerances are the reference's (see `rules/data.rs`). Each kind is reported at most
+//! [`MAX_REPORTED`] times an accessor use.
+
+use super::accessor_bounds::MAX_REPORTED;
+use super::data::{accessor_index, Elements, UNIT_LENGTH_VEC3, UNIT_SUM_STEP};
+use super::{elements, Context, Rule};
+use crate::asset::pointer;
+use crate::diagnostics::{Code, Diagnostic, Severity};
+
+pub const ACCESSOR_INDEX_OOB: Code = Code::new(
+    "ACCESSOR_INDEX_OOB",
+    Severity::Error,
+    "A primitive's index names a vertex the primitive does not have.",
+);
+pub const ACCESSOR_INDEX_PRIMITIVE_RESTART: Code = Code::new(
+    "ACCESSOR_INDEX_PRIMITIVE_RESTART",
+    Severity::Error,
+    "A primitive's index is its type's largest value, which some graphics APIs read as a primitive restart.",
+);
+pub const ACCESSOR_VECTOR3_NON_UNIT: Code = Code::new(
+    "ACCESSOR_VECTOR3_NON_UNIT",
+    Severity::Error,
+    "A normal, or a tangent's xyz, is not of unit length.",
+);
+pub const ACCESSOR_INVALID_SIGN: Code = Code::new(
+    "ACCESSOR_INVALID_SIGN",
+    Severity::Error,
+    "A tangent's w is neither 1 nor -1.",
+);
+pub const ACCESSOR_NON_CLAMPED: Code = Code::new(
+    "ACCESSOR_NON_CLAMPED",
+    Severity::Error,
+    "A vertex colour component lies outside 0..1.",
+);
+pub const ACCESSOR_WEIGHTS_NEGATIVE: Code = Code::new(
+    "ACCESSOR_WEIGHTS_NEGATIVE",
+    Severity::Error,
+    "A joint weight is negative.",
+);
+pub const ACCESSOR_WEIGHTS_NON_NORMALIZED: Code = Code::new(
+    "ACCESSOR_WEIGHTS_NON_NORMALIZED",
+    Severity::Error,
+    "A vertex's joint weights do not sum to 1.",
+);
+pub const ACCESSOR_JOINTS_INDEX_OOB: Code = Code::new(
+    "ACCESSOR_JOINTS_INDEX_OOB",
+    Severity::Error,
+    "A weighted joint index is past the joints of a skin that draws the mesh.",
+);
+pub const ACCESSOR_JOINTS_INDEX_DUPLICATE: Code = Code::new(
+    "ACCESSOR_JOINTS_INDEX_DUPLICATE",
+    Severity::Error,
+    "A vertex weights one joint twice.",
+);
+pub const ACCESSOR_JOINTS_USED_ZERO_WEIGHT: Code = Code::new(
+    "ACCESSOR_JOINTS_USED_ZERO_WEIGHT",
+    Severity::Warning,
+    "A vertex names a non-zero joint with zero weight.",
+);
+
+pub struct VertexData;
+
+/// Findings of one kind at one place, counted so that each stops at [`MAX_REPORTED`].
+struct Capped<'o> {
+    out: &'o mut Vec<Diagnostic>,
+    counts: Vec<(&'static str, String, usize)>,
+}
+
+impl Capped<'_> {
+    fn push(&mut self, code: &'static Code, at: &str, message: impl FnOnce() -> String) {
+        let slot = match self
+            .counts
+            .iter()
+            .position(|(c, a, _)| *c == code.name && a == at)
+        {
+            Some(slot) => slot,
+            None => {
+                self.counts.push((code.name, at.to_string(), 0));
+                self.counts.len() - 1
+            }
+        };
+        if self.counts[slot].2 < MAX_REPORTED {
+            self.counts[slot].2 += 1;
+            self.out.push(Diagnostic::new(code, at, message()));
+        }
+    }
+}
+
+impl Rule for VertexData {
+    fn codes(&self) -> &'static [&'static Code] {
+        &[
+            &ACCESSOR_INDEX_OOB,
+            &ACCESSOR_INDEX_PRIMITIVE_RESTART,
+            &ACCESSOR_VECTOR3_NON_UNIT,
+            &ACCESSOR_INVALID_SIGN,
+            &ACCESSOR_NON_CLAMPED,
+            &ACCESSOR_WEIGHTS_NEGATIVE,
+            &ACCESSOR_WEIGHTS_NON_NORMALIZED,
+            &ACCESSOR_JOINTS_INDEX_OOB,
+            &ACCESSOR_JOINTS_INDEX_DUPLICATE,
+            &ACCESSOR_JOINTS_USED_ZERO_WEIGHT,
+        ]
+    }
+
+    /// It reads every primitive's data.
+    fn cost(&self) -> u32 {
+        3
+    }
+
+    fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
+        if !cx.reads_data() {
+            return;
+        }
+        let json = cx.json();
+        let Some(meshes) = json.get("meshes") else {
+            return;
+        };
+        let joint_limits = joint_limits(cx);
+        let mut capped = Capped {
+            out,
+            counts: Vec::new(),
+        };
+        // An accessor's values are judged once for each kind of use, at its first use, as the
+        // Khronos validator does: a colour accessor shared by COLOR_0 and COLOR_1 is one finding.
+        let mut judged: std::collections::HashSet<(&str, usize)> = std::collections::HashSet::new();
+        for (m, mesh) in elements(Some(meshes)).enumerate() {
+            for (p, primitive) in elements(mesh.get("primitives")).enumerate() {
+                let Some(attributes) = primitive.get("attributes").and_then(|a| a.as_object()) else {
+                    continue;
+                };
+                let at = format!("/meshes/{m}/primitives/{p}");
+                let mut read = |kind: &'static str, name: &str| {
+                    let index = accessor_index(attributes.get(name))?;
+                    judged.insert((kind, index)).then(|| Elements::of(cx, index)).flatten()
+                };
+                let vertices = accessor_index(attributes.get("POSITION"))
+                    .and_then(|i| cx.json().get("accessors")?.get(i)?.get("count")?.as_u64());
+                if let (Some(indices), Some(vertices)) = (
+                    accessor_index(primitive.get("indices")).and_then(|i| Elements::of(cx, i)),
+                    vertices,
+                ) {
+                    check_indices(&indices, vertices, &format!("{at}/indices"), &mut capped);
+                }
+                if let Some(normals) = read("normal", "NORMAL").filter(|e| e.components == 3) {
+                    let at = format!("{at}/attributes/NORMAL");
+                    normals.for_each(|i, v| unit_length(&normals, i, v, 3, &at, &mut capped));
+                }
+                if let Some(tangents) = read("tangent", "TANGENT").filter(|e| e.components == 4) {
+                    let at = format!("{at}/attributes/TANGENT");
+                    tangents.for_each(|i, v| {
+                        let w = tangents.normalize(v[3]);
+                        if w != 1.0 && w != -1.0 {
+                            capped.push(&ACCESSOR_INVALID_SIGN, &at, || {
+                                format!("the tangent at indices {}..{} has w {w}; it must be 1 or -1", i * 4, i * 4 + 3)
+                            });
+                        }
+                        unit_length(&tangents, i, &v[..3], 4, &at, &mut capped);
+                    });
+                }
+                for (name, _) in attributes.iter().filter(|(n, _)| n.starts_with("COLOR_")) {
+                    let Some(colors) = read("color", &name).filter(|e| e.component_type == 5126) else {
+                        continue;
+                    };
+                    let at = format!("{at}/attributes/{}", pointer::escape(&name));
+                    let n = colors.components;
+                    colors.for_each(|i, v| {
+                        for (c, &value) in v.iter().enumerate() {
+                            if !(0.0..=1.0).contains(&value) {
+                                capped.push(&ACCESSOR_NON_CLAMPED, &at, || {
+                                    format!("the value at index {} is not within 0..1: {value}", i * n + c)
+                                });
+                            }
+                        }
+                    });
+                }
+                let limit = primitive_joint_limit(&joint_limits, m);
+                check_skinning(cx, attributes, &at, limit, &mut capped);
+            }
+        }
+    }
+}
+
+/// Indices against the primitive's vertices and the restart value of their type.
+fn check_indices(indices: &Elements, vertices: u64, at: &str, capped: &mut Capped) {
+    if indices.components != 1 {
+        return;
+    }
+    let restart = match indices.component_type {
+        5121 => f64::from(u8::MAX),
+        5123 => f64::from(u16::MAX),
+        5125 => f64::from(u32::MAX),
+        _ => return,
+    };
+    let vertices = vertices as f64;
+    indices.for_each(|i, v| {
+        let index = v[0];
+        if index == restart {
+            capped.push(&ACCESSOR_INDEX_PRIMITIVE_RESTART, at, || {
+                format!("the index at {i} is {index}, the primitive restart value of its type")
+            });
+        } else if index >= vertices {
+            capped.push(&ACCESSOR_INDEX_OOB, at, || {
+                format!("the index at {i} is {index}, past the primitive's last vertex ({})", vertices - 1.0)
+            });
+        }
+    });
+}
+
+/// A vector's length (its first three components, as a loader reads them) against 1.
+fn unit_length(elements: &Elements, i: usize, v: &[f64], stride: usize, at: &str, capped: &mut Capped) {
+    let length = v[..3]
+        .iter()
+        .map(|c| elements.normalize(*c).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    if (length - 1.0).abs() > UNIT_LENGTH_VEC3 {
+        capped.push(&ACCESSOR_VECTOR3_NON_UNIT, at, || {
+            format!(
+                "the vector at indices {}..{} is not of unit length: {length}",
+                i * stride,
+                i * stride + 2
+            )
+        });
+    }
+}
+
+/// For each mesh, the smallest number of joints of the skins that draw it, with that skin.
+fn joint_limits(cx: &Context) -> Vec<(usize, usize, usize)> {
+    let json = cx.json();
+    let skins: Vec<_> = elements(json.get("skins")).collect();
+    let mut limits = Vec::new();
+    for node in elements(json.get("nodes")) {
+        let (Some(mesh), Some(skin)) = (accessor_index(node.get("mesh")), accessor_index(node.get("skin"))) else {
+            continue;
+        };
+        let Some(joints) = skins.get(skin).and_then(|s| s.get("joints")).and_then(|j| j.as_array()) else {
+            continue;
+        };
+        limits.push((mesh, joints.len(), skin));
+    }
+    limits
+}
+
+/// The smallest joint count (and its skin) of the skins drawing mesh `mesh`.
+fn primitive_joint_limit(limits: &[(usize, usize, usize)], mesh: usize) -> Option<(usize, usize)> {
+    limits
+        .iter()
+        .filter(|(m, _, _)| *m == mesh)
+        .map(|(_, joints, skin)| (*joints, *skin))
+        .min()
+}
+
+/// Weights and joints, set by set and vertex by vertex.
+fn check_skinning(
+    cx: &Context,
+    attributes: crate::asset::tape::Object,
+    at: &str,
+    limit: Option<(usize, usize)>,
+    capped: &mut Capped,
+) {
+    let mut sets = Vec::new();
+    for set in 0.. {
+        let weights = attributes.get(&format!("WEIGHTS_{set}"));
+        let joints = attributes.get(&format!("JOINTS_{set}"));
+        if weights.is_none() && joints.is_none() {
+            break;
+        }
+        let weights = accessor_index(weights).and_then(|i| Elements::of(cx, i)).filter(|e| e.components == 4);
+        let joints = accessor_index(joints).and_then(|i| Elements::of(cx, i)).filter(|e| e.components == 4);
+        sets.push((set, weights, joints));
+    }
+    if sets.is_empty() {
+        return;
+    }
+    let count = sets
+        .iter()
+        .filter_map(|(_, w, j)| w.as_ref().or(j.as_ref()).map(|e| e.count))
+        .min()
+        .unwrap_or(0);
+    let components = sets.len() * 4;
+    let tolerance = UNIT_SUM_STEP * ((components - 1) / 2) as f64;
+    let (mut weight, mut joint) = ([0.0; 4], [0.0; 4]);
+    let mut used: Vec<f64> = Vec::with_capacity(components);
+    for i in 0..count {
+        let mut sum = 0.0;
+        let mut complete = true;
+        used.clear();
+        for (set, weights, joints) in &sets {
+            let weights_at = format!("{at}/attributes/WEIGHTS_{set}");
+            let joints_at = format!("{at}/attributes/JOINTS_{set}");
+            let Some(weights) = weights else {
+                complete = false;
+                continue;
+            };
+            weights.element(i, &mut weight);
+            for (c, w) in weight.iter_mut().enumerate() {
+                *w = weights.normalize(*w);
+                if *w < 0.0 {
+                    let value = *w;
+                    capped.push(&ACCESSOR_WEIGHTS_NEGATIVE, &weights_at, || {
+                        format!("the weight at index {} (component {c}) is negative: {value}", i * 4 + c)
+                    });
+                    // Reported on its own, and left out of the sum, as the reference does.
+                    continue;
+                }
+                sum += *w;
+            }
+            let Some(joints) = joints else {
+                continue;
+            };
+            joints.element(i, &mut joint);
+            for c in 0..4 {
+                let j = joint[c];
+                if weight[c] == 0.0 {
+                    if j != 0.0 {
+                        capped.push(&ACCESSOR_JOINTS_USED_ZERO_WEIGHT, &joints_at, || {
+                            format!("the joint at index {} (component {c}) is {j} with zero weight", i * 4 + c)
+                        });
+                    }
+                    continue;
+                }
+                if let Some((joints_count, skin)) = limit {
+                    if j >= joints_count as f64 {
+                        capped.push(&ACCESSOR_JOINTS_INDEX_OOB, &joints_at, || {
+                            format!(
+                                "the joint at index {} (component {c}) is {j}, past the last joint ({}) of skin {skin}",
+                                i * 4 + c,
+                                joints_count.saturating_sub(1)
+                            )
+                        });
+                    }
+                }
+                if used.contains(&j) {
+                    capped.push(&ACCESSOR_JOINTS_INDEX_DUPLICATE, &joints_at, || {
+                        format!("the joint at index {} (component {c}) is {j}, already weighted for this vertex", i * 4 + c)
+                    });
+                } else {
+                    used.push(j);
+                }
+            }
+        }
+        if complete && (sum - 1.0).abs() > tolerance {
+            for (set, _, _) in &sets {
+                capped.push(&ACCESSOR_WEIGHTS_NON_NORMALIZED, &format!("{at}/attributes/WEIGHTS_{set}"), || {
+                    format!("the weights at indices {}..{} sum to {sum}, not 1", i * 4, i * 4 + 3)
+                });
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use base64::Engine;
+
+    fn document(values: &[(&str, u64, &str, Vec<f32>)], primitive: &str, extra: &str) -> String {
+        let mut bytes = Vec::new();
+        let mut views = Vec::new();
+        let mut accessors = Vec::new();
+        for (i, (kind, component, _, data)) in values.iter().enumerate() {
+            let start = bytes.len();
+            for v in data {
+                match component {
+                    5126 => bytes.extend_from_slice(&v.to_le_bytes()),
+                    5123 => bytes.extend_from_slice(&(*v as u16).to_le_bytes()),
+                    _ => bytes.push(*v as u8),
+                }
+            }
+            while bytes.len() % 4 != 0 {
+                bytes.push(0);
+            }
+            let per = match *kind { "SCALAR" => 1, "VEC3" => 3, _ => 4 };
+            views.push(format!(r#"{{"buffer":0,"byteOffset":{start},"byteLength":{}}}"#, bytes.len() - start));
+            let bounds = if values[i].2 == "POSITION" { r#","min":[0,0,0],"max":[1,1,1]"# } else { "" };
+            accessors.push(format!(
+                r#"{{"bufferView":{i},"componentType":{component},"count":{},"type":"{kind}"{bounds}}}"#,
+                data.len() / per
+            ));
+        }
+        let data = base64::engine::general_purpose::STANDARD.encode(&bytes);
+        format!(
+            r#"{{"asset":{{"version":"2.0"}},"buffers":[{{"byteLength":{},"uri":"data:application/octet-stream;base64,{data}"}}],
+            "bufferViews":[{}],"accessors":[{}],"meshes":[{{"primitives":[{primitive}]}}]{extra}}}"#,
+            bytes.len(),
+            views.join(","),
+            accessors.join(",")
+        )
+    }
+
+    #[test]
+    fn indices_normals_tangents_and_colours_are_judged_by_their_values() {
+        let text = document(
+            &[
+                ("VEC3", 5126, "POSITION", vec![0.0; 9]),
+                ("SCALAR", 5121, "indices", vec![0.0, 1.0, 3.0, 255.0]),
+                ("VEC3", 5126, "NORMAL", vec![0.0, 0.0, 1.0, 1.0, 1.0, 1.0, 0.0, 1.0, 0.0]),
+                ("VEC4", 5126, "TANGENT", vec![1.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 2.0, 0.0, -1.0]),
+                ("VEC4", 5126, "COLOR_0", vec![0.0, 0.5, 1.5, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]),
+            ],
+            r#"{"attributes":{"POSITION":0,"NORMAL":2,"TANGENT":3,"COLOR_0":4},"indices":1}"#,
+            "",
+        );
+        assert_eq!(
+            crate::rules::findings_of(&VertexData, &text),
+            [
+                "ACCESSOR_INDEX_OOB /meshes/0/primitives/0/indices",
+                "ACCESSOR_INDEX_PRIMITIVE_RESTART /meshes/0/primitives/0/indices",
+                "ACCESSOR_VECTOR3_NON_UNIT /meshes/0/primitives/0/attributes/NORMAL",
+                "ACCESSOR_INVALID_SIGN /meshes/0/primitives/0/attributes/TANGENT",
+                "ACCESSOR_VECTOR3_NON_UNIT /meshes/0/primitives/0/attributes/TANGENT",
+                "ACCESSOR_NON_CLAMPED /meshes/0/primitives/0/attributes/COLOR_0",
+            ]
+        );
+    }
+
+    #[test]
+    fn weights_and_joints_are_judged_vertex_by_vertex() {
+        let text = document(
+            &[
+                ("VEC3", 5126, "POSITION", vec![0.0; 9]),
+                ("VEC4", 5126, "WEIGHTS_0", vec![1.0, 0.0, 0.0, 0.0, 0.5, 0.5, 0.5, 0.0, 0.5, 0.5, -0.5, 0.5]),
+                ("VEC4", 5123, "JOINTS_0", vec![0.0, 4.0, 0.0, 0.0, 1.0, 2.0, 9.0, 0.0, 1.0, 1.0, 2.0, 0.0]),
+            ],
+            r#"{"attributes":{"POSITION":0,"WEIGHTS_0":1,"JOINTS_0":2}}"#,
+            r#","nodes":[{"mesh":0,"skin":0},{},{},{}],"skins":[{"joints":[1,2,3]}]"#,
+        );
+        assert_eq!(
+            crate::rules::findings_of(&VertexData, &text),
+            [
+                "ACCESSOR_JOINTS_USED_ZERO_WEIGHT /meshes/0/primitives/0/attributes/JOINTS_0",
+                "ACCESSOR_JOINTS_INDEX_OOB /meshes/0/primitives/0/attributes/JOINTS_0",
+                "ACCESSOR_WEIGHTS_NON_NORMALIZED /meshes/0/primitives/0/attributes/WEIGHTS_0",
+                "ACCESSOR_WEIGHTS_NEGATIVE /meshes/0/primitives/0/attributes/WEIGHTS_0",
+                "ACCESSOR_JOINTS_INDEX_DUPLICATE /meshes/0/primitives/0/attributes/JOINTS_0",
+                "ACCESSOR_WEIGHTS_NON_NORMALIZED /meshes/0/primitives/0/attributes/WEIGHTS_0",
+            ]
+        );
+    }
+}
