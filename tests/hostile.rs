@@ -2339,3 +2339,554 @@ fn an_endless_list_and_a_huge_configuration_are_refused_at_their_limits() {
         "{err}"
     );
 }
+
+// ---------------------------------------------------------------------------------------------
+// Nothing lost, third round: every command and every output path
+
+/// Runs velvet with `args`, its standard output (or, `on_stderr`, its standard error) writing
+/// into /dev/full, the other captured: (exit status, the captured stream).
+#[cfg(unix)]
+fn velvet_into_a_full_disk(args: &[&str], on_stderr: bool) -> (Option<i32>, String) {
+    let full = || {
+        std::fs::OpenOptions::new()
+            .write(true)
+            .open("/dev/full")
+            .unwrap()
+    };
+    let mut command = Command::new(env!("CARGO_BIN_EXE_velvet"));
+    command.args(args).stdin(std::process::Stdio::null());
+    if on_stderr {
+        command.stderr(full()).stdout(std::process::Stdio::piped());
+    } else {
+        command.stdout(full()).stderr(std::process::Stdio::piped());
+    }
+    let out = command.output().unwrap();
+    let captured = if on_stderr { out.stdout } else { out.stderr };
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&captured).into_owned(),
+    )
+}
+
+/// A report that cannot be written (standard output on a full disk) fails the run with exit
+/// status 2 and says so on standard error, in every format and command that prints; a failed
+/// write to standard error is status 2 too, not a panic; a closed pipe stays quiet.
+#[cfg(unix)]
+#[test]
+fn a_failed_write_to_standard_output_or_error_is_status_2_never_0() {
+    let dir = tempfile::tempdir().unwrap();
+    let clean = dir.path().join("clean.gltf");
+    write(&clean, r#"{"asset":{"version":"2.0"}}"#);
+    let sheen = dir.path().join("sheen/asset.gltf");
+    write(
+        &sheen,
+        serde_json::to_string_pretty(&sheen_document("tex.png")).unwrap(),
+    );
+    write(
+        &dir.path().join("sheen/tex.png"),
+        png(4, 4, image::ExtendedColorType::Rgb8),
+    );
+    let full = "velvet: cannot write to standard output: No space left on device (os error 28)\n";
+    let runs: Vec<Vec<&str>> = vec![
+        vec!["validate", "--format", "sarif", s(&clean)],
+        vec!["validate", "--format", "json", s(&clean)],
+        vec!["validate", "--format", "text", s(&clean)],
+        vec!["migrate", "--dry-run", s(&sheen)],
+        vec!["migrate", "--dry-run", "--format", "json", s(&sheen)],
+        vec!["bake", "--dry-run", s(&sheen)],
+        vec!["config", s(dir.path())],
+        vec!["codes"],
+        vec!["man"],
+        vec!["--help"],
+    ];
+    for args in &runs {
+        // Each run passes when its output can be written.
+        let (status, out, err) = velvet(args);
+        assert_eq!(status, 0, "{args:?}: {out}{err}");
+        assert!(!out.is_empty(), "{args:?}");
+        let (status, err) = velvet_into_a_full_disk(args, false);
+        assert_eq!(status, Some(2), "{args:?}: {err}");
+        assert_eq!(err, full, "{args:?}");
+    }
+    // Standard error on a full disk: the usage error cannot be said, the status still is.
+    let missing = dir.path().join("missing.gltf");
+    let (status, out) = velvet_into_a_full_disk(&["validate", s(&missing)], true);
+    assert_eq!(status, Some(2), "{out}");
+    let (status, out) = velvet_into_a_full_disk(
+        &[
+            "migrate",
+            "--out-dir",
+            s(&dir.path().join("o")),
+            s(&missing),
+        ],
+        true,
+    );
+    assert_eq!((status, out.as_str()), (Some(2), ""));
+    // A reader that stops reading is not a failure: no message, the run's own status.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_velvet"))
+        .args(["codes"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(0));
+    assert_eq!(String::from_utf8_lossy(&out.stderr), "");
+}
+
+/// The codes of `velvet codes` at `severity`, in its order.
+fn codes_at(severity: &str) -> Vec<String> {
+    let (status, out, _) = velvet(&["codes"]);
+    assert_eq!(status, 0);
+    out.lines()
+        .filter_map(|l| {
+            let mut words = l.split_whitespace();
+            let (code, at) = (words.next()?, words.next()?);
+            (at == severity).then(|| code.to_string())
+        })
+        .collect()
+}
+
+/// A velvet.toml (or the command line) whose `only` or `ignore` would leave out every error
+/// code cannot make a file with errors pass: the errors are still reported and counted (exit
+/// status 1), and a warning names the configuration and the codes it could not hide. Leaving
+/// out some error codes is obeyed as before.
+#[test]
+fn a_configuration_that_would_hide_every_error_warns_and_its_errors_still_fail_the_run() {
+    let dir = tempfile::tempdir().unwrap();
+    // An undeclared sheen: UNDECLARED_EXTENSION, an error, and nothing else.
+    let doc = dir.path().join("a.gltf");
+    write(
+        &doc,
+        r#"{"asset":{"version":"2.0"},"materials":[{"extensions":{"KHR_materials_sheen":{"sheenRoughnessFactor":0.5}}}]}"#,
+    );
+    let errors = codes_at("error");
+    assert!(errors.contains(&"UNDECLARED_EXTENSION".to_string()));
+    let hint = codes_at("hint")[0].clone();
+    let config = dir.path().join("velvet.toml");
+    let quoted = |codes: &[String]| {
+        codes
+            .iter()
+            .map(|c| format!("\"{c}\""))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let warning = |by: &str| {
+        format!(
+            "velvet: warning: {by} leaves out every error code; a configuration cannot silence \
+             every error, so these {} codes are still reported and fail the run: {}\n",
+            errors.len(),
+            errors.join(", ")
+        )
+    };
+    for (toml, key) in [
+        (format!("only = [\"{hint}\"]\n"), "only"),
+        (format!("ignore = [{}]\n", quoted(&errors)), "ignore"),
+    ] {
+        write(&config, &toml);
+        let (status, out, err) = velvet(&["validate", s(&doc)]);
+        assert_eq!(status, 1, "{toml}: {out}{err}");
+        assert!(out.contains("error UNDECLARED_EXTENSION"), "{toml}: {out}");
+        assert!(
+            out.ends_with(
+                "1 file checked: 1 error, 0 warnings, 0 info, 0 hints; 1 fixable with --fix\n"
+            ),
+            "{toml}: {out}"
+        );
+        assert_eq!(
+            err,
+            warning(&format!("{} ({key})", config.display())),
+            "{toml}"
+        );
+        // `velvet config` says it too, as a comment.
+        let (status, out, _) = velvet(&["config", s(dir.path())]);
+        assert_eq!(status, 0);
+        assert!(
+            out.starts_with(&format!(
+                "# warning: {} ({key}) leaves out",
+                config.display()
+            )),
+            "{out}"
+        );
+    }
+    std::fs::remove_file(&config).unwrap();
+    let (status, out, err) = velvet(&["validate", "--only", &hint, s(&doc)]);
+    assert_eq!(status, 1, "{out}{err}");
+    assert_eq!(err, warning("--only"));
+    // One error code left out, another let through: obeyed, no warning.
+    let (status, out, err) = velvet(&["validate", "--ignore", "UNDECLARED_EXTENSION", s(&doc)]);
+    assert_eq!((status, err.as_str()), (0, ""), "{out}");
+    let (status, out, err) = velvet(&["validate", "--only", "TYPE_MISMATCH", s(&doc)]);
+    assert_eq!((status, err.as_str()), (0, ""), "{out}");
+}
+
+/// A file name that is not UTF-8 neither panics nor fails its file: migrate and bake write it,
+/// and their JSON reports name it lossily (U+FFFD for the byte), exit status 0.
+#[cfg(unix)]
+#[test]
+fn a_file_name_that_is_not_utf8_is_reported_lossily_without_a_panic() {
+    use std::os::unix::ffi::OsStrExt;
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in");
+    let name = std::ffi::OsStr::from_bytes(b"bad\xff.gltf");
+    write(
+        &input.join(name),
+        serde_json::to_string_pretty(&sheen_document("tex.png")).unwrap(),
+    );
+    write(
+        &input.join("tex.png"),
+        png(4, 4, image::ExtendedColorType::Rgb8),
+    );
+    for command in ["migrate", "bake"] {
+        let out_dir = dir.path().join(format!("out-{command}"));
+        let (status, out, err) = velvet(&[
+            command,
+            "--format",
+            "json",
+            "--out-dir",
+            s(&out_dir),
+            s(&input),
+        ]);
+        assert_eq!(status, 0, "{command}: {out}{err}");
+        let report: Value = serde_json::from_str(&out).unwrap();
+        let file = &report["files"][0];
+        assert_eq!(
+            file["input"],
+            json!(format!("{}/bad\u{fffd}.gltf", input.display())),
+            "{command}: {out}"
+        );
+        assert_eq!(
+            file["output"],
+            json!(format!("{}/bad\u{fffd}.gltf", out_dir.display())),
+            "{command}: {out}"
+        );
+        assert!(out_dir.join(name).is_file(), "{command}");
+        let (status, out, err) = velvet(&[command, "--out-dir", s(&out_dir), s(&input)]);
+        assert_eq!(status, 0, "{command}: {out}{err}");
+        assert!(out.contains("bad\u{fffd}.gltf"), "{command}: {out}");
+    }
+}
+
+/// An undeclared sheen, which `validate --fix` repairs by declaring it.
+const FIXABLE: &str = r#"{"asset":{"version":"2.0"},"materials":[{"extensions":{"KHR_materials_sheen":{"sheenRoughnessFactor":0.5}}}]}"#;
+const FIXED: &str = r#"{"asset":{"version":"2.0"},"extensionsUsed":["KHR_materials_sheen"],"materials":[{"extensions":{"KHR_materials_sheen":{"sheenRoughnessFactor":0.5}}}]}"#;
+
+/// `validate --fix` keeps links as `migrate --in-place` does: a link's target is fixed and the
+/// link stays a link (a folder holding both fixes the file once), and a link leading out of
+/// the folder given is refused with exit status 2 before anything is written.
+#[cfg(unix)]
+#[test]
+fn validate_fix_on_a_link_fixes_its_target_and_keeps_the_link() {
+    let dir = tempfile::tempdir().unwrap();
+    let tree = dir.path().join("tree");
+    let real = tree.join("real/asset.gltf");
+    write(&real, FIXABLE);
+    let link = tree.join("link.gltf");
+    std::os::unix::fs::symlink("real/asset.gltf", &link).unwrap();
+    let (status, out, err) = velvet(&["validate", "--fix", s(&link)]);
+    assert_eq!(status, 0, "{out}{err}");
+    assert!(std::fs::symlink_metadata(&link).unwrap().is_symlink());
+    assert_eq!(
+        std::fs::read_link(&link).unwrap(),
+        Path::new("real/asset.gltf")
+    );
+    assert_eq!(std::fs::read_to_string(&real).unwrap(), FIXED);
+
+    // The folder holding both: fixed once, both reported clean, no file changed under a check.
+    std::fs::write(&real, FIXABLE).unwrap();
+    let (status, out, err) = velvet(&["validate", "--fix", s(&tree)]);
+    assert_eq!(status, 0, "{out}{err}");
+    assert!(out.contains("2 files checked: 0 errors"), "{out}");
+    assert!(std::fs::symlink_metadata(&link).unwrap().is_symlink());
+    assert_eq!(std::fs::read_to_string(&real).unwrap(), FIXED);
+
+    // A link out of the folder given: refused, nothing written.
+    let inner = tree.join("real");
+    let outside = dir.path().join("outside/asset.gltf");
+    write(&outside, FIXABLE);
+    std::fs::write(&real, FIXABLE).unwrap();
+    std::os::unix::fs::symlink(&outside, inner.join("away.gltf")).unwrap();
+    let (status, out, err) = velvet(&["validate", "--fix", s(&inner)]);
+    assert_eq!(status, 2, "{out}{err}");
+    assert_eq!(
+        err,
+        format!(
+            "velvet: --fix: {} is a symbolic link to {}, outside {}; velvet writes only inside \
+             the folders it is given (name the target itself to fix it)\n",
+            inner.join("away.gltf").display(),
+            outside.canonicalize().unwrap().display(),
+            inner.display()
+        )
+    );
+    assert!(std::fs::symlink_metadata(inner.join("away.gltf"))
+        .unwrap()
+        .is_symlink());
+    assert_eq!(std::fs::read_to_string(&outside).unwrap(), FIXABLE);
+    assert_eq!(std::fs::read_to_string(&real).unwrap(), FIXABLE);
+}
+
+/// SIGINT and SIGTERM during `validate --fix` stop it as they stop migrate: the files fixed
+/// stay fixed, the others are left as they were (no temporary file), one line says so and
+/// the exit status is 130 or 143, never 0 for a run that did not finish.
+#[cfg(unix)]
+#[test]
+fn validate_fix_answers_sigint_and_sigterm_as_migrate_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let files = 3000;
+    let mut stopped = 0;
+    for (k, (signal, delay_ms)) in [
+        (libc::SIGINT, 300),
+        (libc::SIGTERM, 300),
+        (libc::SIGINT, 800),
+        (libc::SIGTERM, 800),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let folder = dir.path().join(format!("run-{k}"));
+        for i in 0..files {
+            write(&folder.join(format!("d{i:04}.gltf")), FIXABLE);
+        }
+        let child = Command::new(env!("CARGO_BIN_EXE_velvet"))
+            .args(["validate", "--fix", s(&folder)])
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(std::time::Duration::from_millis(delay_ms));
+        let sent = std::time::Instant::now();
+        // SAFETY: kill(2) on the child's id, which it holds until it is waited for.
+        unsafe { libc::kill(child.id() as libc::pid_t, signal) };
+        let output = child.wait_with_output().unwrap();
+        let what = format!("signal {signal} after {delay_ms} ms");
+        assert!(sent.elapsed() < std::time::Duration::from_secs(5), "{what}");
+        let err = String::from_utf8_lossy(&output.stderr);
+        let mut fixed = 0;
+        for entry in std::fs::read_dir(&folder).unwrap() {
+            let path = entry.unwrap().path();
+            let name = path.file_name().unwrap().to_string_lossy().into_owned();
+            assert!(
+                name.ends_with(".gltf") && !name.starts_with('.'),
+                "{what}: {name}"
+            );
+            let text = std::fs::read_to_string(&path).unwrap();
+            assert!(text == FIXABLE || text == FIXED, "{what}: {name}: {text}");
+            fixed += usize::from(text == FIXED);
+        }
+        match output.status.code() {
+            Some(0) => assert_eq!(fixed, files, "{what}"),
+            code => {
+                assert_eq!(code, Some(128 + signal), "{what}: {err}");
+                let name = if signal == libc::SIGINT {
+                    "SIGINT"
+                } else {
+                    "SIGTERM"
+                };
+                assert_eq!(
+                    err,
+                    format!(
+                        "velvet: stopped by {name}: {fixed} of {files} files finished (their \
+                         outputs are complete); nothing was written for the other {}\n",
+                        files - fixed
+                    ),
+                    "{what}"
+                );
+                stopped += 1;
+            }
+        }
+    }
+    assert!(
+        stopped >= 2,
+        "only {stopped} runs were stopped before they finished"
+    );
+}
+
+/// Every file under `root`, its path relative to it (links and special files included).
+fn names_under(root: &Path) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut stack = vec![root.to_path_buf()];
+    while let Some(dir) = stack.pop() {
+        let Ok(entries) = std::fs::read_dir(&dir) else {
+            continue;
+        };
+        for entry in entries {
+            let path = entry.unwrap().path();
+            if std::fs::symlink_metadata(&path).unwrap().is_dir() {
+                stack.push(path.clone());
+            }
+            out.push(
+                path.strip_prefix(root)
+                    .unwrap()
+                    .to_string_lossy()
+                    .into_owned(),
+            );
+        }
+    }
+    out.sort();
+    out
+}
+
+/// A file-size limit (`ulimit -f`) does not kill velvet with SIGXFSZ mid-write: the write that
+/// passes it fails with EFBIG, that file fails naming it (exit status 1), and no temporary file
+/// is left behind, in migrate, bake and `validate --fix`.
+#[cfg(unix)]
+#[test]
+fn a_file_size_limit_fails_the_file_cleanly_instead_of_killing_velvet() {
+    use std::os::unix::process::CommandExt;
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in");
+    let mut doc = sheen_document("tex.png");
+    doc["extras"] = json!({"padding": "x".repeat(20_000)});
+    write(
+        &input.join("big.gltf"),
+        serde_json::to_string_pretty(&doc).unwrap(),
+    );
+    write(
+        &input.join("tex.png"),
+        png(4, 4, image::ExtendedColorType::Rgb8),
+    );
+    let limited = |args: &[&str]| {
+        let mut command = Command::new(env!("CARGO_BIN_EXE_velvet"));
+        command.args(args);
+        // SAFETY: setrlimit is async-signal-safe; the child sets its own limit before exec.
+        unsafe {
+            command.pre_exec(|| {
+                let limit = libc::rlimit {
+                    rlim_cur: 8192,
+                    rlim_max: 8192,
+                };
+                if libc::setrlimit(libc::RLIMIT_FSIZE, &limit) != 0 {
+                    return Err(std::io::Error::last_os_error());
+                }
+                Ok(())
+            });
+        }
+        command.output().unwrap()
+    };
+    for command in ["migrate", "bake"] {
+        let out_dir = dir.path().join(format!("out-{command}"));
+        let output = limited(&[command, "--out-dir", s(&out_dir), s(&input)]);
+        let text = String::from_utf8_lossy(&output.stdout).into_owned()
+            + &String::from_utf8_lossy(&output.stderr);
+        use std::os::unix::process::ExitStatusExt;
+        assert_eq!(output.status.signal(), None, "{command}: {text}");
+        assert_eq!(output.status.code(), Some(1), "{command}: {text}");
+        assert!(
+            text.contains("File too large (os error 27)"),
+            "{command}: {text}"
+        );
+        assert!(!out_dir.join("big.gltf").exists(), "{command}");
+        assert!(
+            !names_under(&out_dir).iter().any(|n| n.contains(".velvet-")),
+            "{command}: {:?}",
+            names_under(&out_dir)
+        );
+    }
+    let fixable = dir.path().join("fix/big.gltf");
+    let mut doc: Value = serde_json::from_str(FIXABLE).unwrap();
+    doc["extras"] = json!({"padding": "x".repeat(20_000)});
+    let text = doc.to_string();
+    write(&fixable, &text);
+    let output = limited(&["validate", "--fix", s(&fixable)]);
+    let report = String::from_utf8_lossy(&output.stdout);
+    assert_eq!(output.status.code(), Some(1), "{report}");
+    assert!(report.contains("File too large (os error 27)"), "{report}");
+    assert_eq!(std::fs::read_to_string(&fixable).unwrap(), text);
+    assert_eq!(names_under(&dir.path().join("fix")), ["big.gltf"]);
+}
+
+/// `--config FIFO` and `--files-from FIFO` do not wait for a writer that never comes: a FIFO
+/// or a device given as a configuration is refused (exit status 2), a list in a FIFO no program
+/// writes into is refused, and a list a program writes into a pipe is read as before.
+#[cfg(unix)]
+#[test]
+fn a_fifo_given_as_configuration_or_list_is_refused_without_blocking() {
+    let dir = tempfile::tempdir().unwrap();
+    let doc = dir.path().join("a.gltf");
+    write(&doc, r#"{"asset":{"version":"2.0"}}"#);
+    let fifo = dir.path().join("fifo");
+    assert!(Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap()
+        .success());
+    let (status, out, err) = velvet_within_20s(&["validate", "--config", s(&fifo), s(&doc)]);
+    assert_eq!(status, Some(2), "{out}{err}");
+    assert_eq!(
+        err,
+        format!(
+            "velvet: {}: not a regular file (a FIFO); velvet reads a configuration from a file\n",
+            fifo.display()
+        )
+    );
+    let (status, _, err) = velvet_within_20s(&["config", "--config", "/dev/zero", s(&doc)]);
+    assert_eq!(status, Some(2), "{err}");
+    assert_eq!(
+        err,
+        "velvet: /dev/zero: not a regular file (a character device); velvet reads a \
+         configuration from a file\n"
+    );
+    for command in ["validate", "migrate", "bake"] {
+        let mut args = vec![command, "--files-from", s(&fifo)];
+        if command != "validate" {
+            args.push("--dry-run");
+        }
+        let (status, out, err) = velvet_within_20s(&args);
+        assert_eq!(status, Some(2), "{command}: {out}{err}");
+        assert!(
+            err.ends_with(&format!(
+                "velvet: --files-from {}: a FIFO no program is writing into; velvet does not \
+                 wait for one (write the list to a file, or pipe it to --files-from -)\n",
+                fifo.display()
+            )),
+            "{command}: {err}"
+        );
+    }
+    // A list written into a pipe by another program (a shell's `<(git diff …)`) is read.
+    let script = format!(
+        "{} validate --files-from <(printf '%s\\n' {})",
+        env!("CARGO_BIN_EXE_velvet"),
+        s(&doc)
+    );
+    let out = Command::new("bash").args(["-c", &script]).output().unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{text}");
+    assert!(text.contains("1 file checked"), "{text}");
+}
+
+/// Text velvet did not write reaches no terminal raw: `velvet preview` shows a material name
+/// holding ESC, BEL or U+202E as escapes, and `velvet config` a folder name holding them.
+#[cfg(unix)]
+#[test]
+fn preview_names_and_config_folders_are_escaped_on_the_terminal() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut doc = sheen_document("tex.png");
+    doc["materials"][0]["name"] = json!("\u{1b}]0;owned\u{7}cl\u{202e}oth");
+    let input = dir.path().join("in/a.gltf");
+    write(&input, serde_json::to_string_pretty(&doc).unwrap());
+    write(
+        &dir.path().join("in/tex.png"),
+        png(4, 4, image::ExtendedColorType::Rgb8),
+    );
+    let (status, out, err) = velvet(&["preview", "-o", s(&dir.path().join("p")), s(&input)]);
+    assert_eq!(status, 0, "{out}{err}");
+    assert_inert(&out, 0, "preview");
+    assert_inert(&err, 0, "preview");
+    assert!(!out.contains('\u{202e}'), "{out}");
+    assert!(out.contains("\\u001b]0;owned\\u0007cl\\u202eoth"), "{out}");
+
+    let folder = dir.path().join("odd\u{1b}]0;x\u{7}\nname");
+    write(&folder.join("velvet.toml"), "max-issues = 3\n");
+    write(&folder.join("a.gltf"), r#"{"asset":{"version":"2.0"}}"#);
+    let (status, out, err) = velvet(&["config", s(&folder)]);
+    assert_eq!(status, 0, "{err}");
+    assert_inert(&out, 0, "config");
+    assert!(
+        out.starts_with(&format!(
+            "# velvet.toml in force: {}/odd\\u001b]0;x\\u0007\\u000aname/velvet.toml\n",
+            dir.path().display()
+        )),
+        "{out}"
+    );
+}

@@ -40,6 +40,18 @@ pub fn install() {
     }
 }
 
+/// Ignores SIGXFSZ, for the whole process (Unix; elsewhere nothing). A write past a file-size
+/// limit (`ulimit -f`, `prlimit --fsize`) would otherwise kill velvet mid-write, leaving its
+/// temporary files behind; ignored, the write fails with EFBIG, which fails that file cleanly
+/// (its staged files removed) as a full disk does.
+pub fn ignore_file_size_signal() {
+    #[cfg(unix)]
+    // SAFETY: setting a signal's disposition to SIG_IGN has no handler to be unsafe in.
+    unsafe {
+        libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
+    }
+}
+
 /// The signal that asked the run to stop, if one has.
 pub fn requested() -> Option<i32> {
     match STOP.load(Ordering::SeqCst) {
