@@ -2890,3 +2890,211 @@ fn preview_names_and_config_folders_are_escaped_on_the_terminal() {
         "{out}"
     );
 }
+
+/// A real PNG of `width` × `height` 8-bit RGB texels all zero, of a few bytes per 258 of its
+/// pixel data (deflate with fixed codes: one literal zero, then matches of 258 at distance 1),
+/// made without holding its pixels: a 16384² one is 5 MB and decodes to 768 MiB.
+fn zero_rgb_png(width: u32, height: u32) -> Vec<u8> {
+    struct Bits {
+        out: Vec<u8>,
+        acc: u64,
+        n: u32,
+    }
+    impl Bits {
+        fn put(&mut self, value: u64, count: u32) {
+            self.acc |= value << self.n;
+            self.n += count;
+            while self.n >= 8 {
+                self.out.push(self.acc as u8);
+                self.acc >>= 8;
+                self.n -= 8;
+            }
+        }
+        /// A Huffman code, which deflate stores from its most significant bit.
+        fn code(&mut self, code: u64, count: u32) {
+            let reversed = (0..count).fold(0, |r, i| (r << 1) | ((code >> i) & 1));
+            self.put(reversed, count);
+        }
+    }
+    let total = u64::from(height) * (1 + u64::from(width) * 3);
+    let mut bits = Bits {
+        out: vec![0x78, 0x01],
+        acc: 0,
+        n: 0,
+    };
+    bits.put(1, 1); // the last block
+    bits.put(1, 2); // fixed codes
+    bits.code(0x30, 8); // literal 0
+    let mut left = total - 1;
+    while left >= 258 {
+        bits.code(0xC5, 8); // length 258 (symbol 285)
+        bits.code(0, 5); // distance 1
+        left -= 258;
+    }
+    for _ in 0..left {
+        bits.code(0x30, 8);
+    }
+    bits.code(0, 7); // end of block
+    bits.put(0, 7); // to a whole byte
+    let mut zlib = bits.out;
+    let adler = ((total % 65521) << 16) | 1;
+    zlib.extend_from_slice(&(adler as u32).to_be_bytes());
+    let chunk = |kind: &[u8], data: &[u8]| {
+        let mut out = (data.len() as u32).to_be_bytes().to_vec();
+        let mut body = kind.to_vec();
+        body.extend_from_slice(data);
+        out.extend_from_slice(&body);
+        out.extend_from_slice(&crc32(&body).to_be_bytes());
+        out
+    };
+    let mut ihdr = Vec::new();
+    ihdr.extend_from_slice(&width.to_be_bytes());
+    ihdr.extend_from_slice(&height.to_be_bytes());
+    ihdr.extend_from_slice(&[8, 2, 0, 0, 0]);
+    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+    png.extend(chunk(b"IHDR", &ihdr));
+    png.extend(chunk(b"IDAT", &zlib));
+    png.extend(chunk(b"IEND", &[]));
+    png
+}
+
+/// Runs velvet with `args`: (exit status, stdout, stderr, its peak resident memory in KiB).
+#[cfg(unix)]
+fn velvet_measured(args: &[&str]) -> (Option<i32>, String, String, u64) {
+    use std::io::Read;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_velvet"))
+        .args(args)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stdout = child.stdout.take().unwrap();
+    let mut stderr = child.stderr.take().unwrap();
+    let reading = std::thread::spawn(move || {
+        let mut text = String::new();
+        stderr.read_to_string(&mut text).unwrap();
+        text
+    });
+    let mut out = String::new();
+    stdout.read_to_string(&mut out).unwrap();
+    let err = reading.join().unwrap();
+    let mut status = 0;
+    // SAFETY: wait4 on the child's id, which it holds until this waits for it; the rusage
+    // is written by the call.
+    let usage = unsafe {
+        let mut usage: libc::rusage = std::mem::zeroed();
+        assert_eq!(
+            libc::wait4(child.id() as libc::pid_t, &mut status, 0, &mut usage),
+            child.id() as libc::pid_t
+        );
+        usage
+    };
+    let code = libc::WIFEXITED(status).then(|| libc::WEXITSTATUS(status));
+    (code, out, err, usage.ru_maxrss as u64)
+}
+
+/// Every decode is held to `--max-memory`, in preview and `migrate --exact` as in bake: a 5 MB
+/// all-zero 16384² RGB PNG (768 MiB decoded) under a budget of 1 GiB is refused before it is
+/// decoded, naming the flag, the process staying far below the budget. Preview draws the
+/// material from its factors and says why; migrate fails the file (exit status 1).
+#[cfg(unix)]
+#[test]
+fn every_decode_is_held_to_the_memory_budget_in_preview_and_migrate_exact() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in");
+    write(&input.join("tex.png"), zero_rgb_png(16384, 16384));
+    write(
+        &input.join("a.gltf"),
+        serde_json::to_string_pretty(&sheen_document("tex.png")).unwrap(),
+    );
+    let preview = dir.path().join("preview");
+    let (status, out, err, peak) = velvet_measured(&[
+        "preview",
+        "--max-memory",
+        "1G",
+        "-o",
+        s(&preview),
+        s(&input),
+    ]);
+    assert_eq!(status, Some(0), "{out}{err}");
+    assert!(peak < 256 * 1024, "preview took {peak} KiB");
+    let index = std::fs::read_to_string(preview.join("index.html")).unwrap();
+    assert!(
+        index.contains(
+            "sheenColorTexture not read (image 0: decoding the 16384 × 16384 Rgb8 image needs \
+             about 1.8 GiB, over the memory budget of 1.0 GiB (raise it with --max-memory); it \
+             was not decoded): sheenColorFactor alone is used"
+        ),
+        "{index}"
+    );
+    let out_dir = dir.path().join("out");
+    let (status, out, err, peak) = velvet_measured(&[
+        "migrate",
+        "--exact",
+        "--max-memory",
+        "1G",
+        "--out-dir",
+        s(&out_dir),
+        s(&input),
+    ]);
+    assert_eq!(status, Some(1), "{out}{err}");
+    assert!(peak < 256 * 1024, "migrate --exact took {peak} KiB");
+    assert!(
+        out.contains(
+            "of image 0: image 0: PNG: decoding the 16384 × 16384 Rgb8 image \
+             needs about 2.2 GiB, over the memory budget of 1.0 GiB (raise it with \
+             --max-memory); it was not decoded"
+        ),
+        "{out}"
+    );
+    assert!(!out_dir.join("a.gltf").exists());
+}
+
+/// Long work stops within a second of SIGTERM or SIGINT: `migrate --exact` of a 4096² texture
+/// (seconds of decoding, baking and encoding) exits 143 or 130 at once, nothing written.
+#[cfg(unix)]
+#[test]
+fn long_work_stops_within_a_second_of_a_signal() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in");
+    write(&input.join("tex.png"), zero_rgb_png(4096, 4096));
+    write(
+        &input.join("a.gltf"),
+        serde_json::to_string_pretty(&sheen_document("tex.png")).unwrap(),
+    );
+    for (k, (signal, delay_ms)) in [
+        (libc::SIGTERM, 300),
+        (libc::SIGINT, 1000),
+        (libc::SIGTERM, 2000),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let out_dir = dir.path().join(format!("out-{k}"));
+        let child = Command::new(env!("CARGO_BIN_EXE_velvet"))
+            .args(["migrate", "--exact", "--out-dir", s(&out_dir), s(&input)])
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(std::time::Duration::from_millis(delay_ms));
+        let sent = std::time::Instant::now();
+        // SAFETY: kill(2) on the child's id, which it holds until it is waited for.
+        unsafe { libc::kill(child.id() as libc::pid_t, signal) };
+        let output = child.wait_with_output().unwrap();
+        let took = sent.elapsed();
+        let err = String::from_utf8_lossy(&output.stderr);
+        let what = format!("signal {signal} after {delay_ms} ms");
+        assert_eq!(output.status.code(), Some(128 + signal), "{what}: {err}");
+        assert!(took < std::time::Duration::from_secs(1), "{what}: {took:?}");
+        assert!(
+            err.ends_with("nothing was written for the other 1\n"),
+            "{what}: {err}"
+        );
+        assert!(
+            names_under(&out_dir).is_empty(),
+            "{what}: {:?}",
+            names_under(&out_dir)
+        );
+    }
+}

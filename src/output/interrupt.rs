@@ -9,10 +9,8 @@
 //! if velvet had no handler (its staging files are then removed by the next run into that
 //! folder). `validate` writes nothing and keeps the default behaviour.
 
-use std::sync::atomic::{AtomicI32, Ordering};
-
-/// The signal that asked the run to stop, 0 while none has.
-static STOP: AtomicI32 = AtomicI32::new(0);
+use crate::asset::limits::STOP_SIGNAL as STOP;
+use std::sync::atomic::Ordering;
 
 /// The message of a file abandoned because the run was asked to stop.
 pub const ABANDONED: &str = "stopped before it was finished (nothing of it was written)";
