@@ -276,6 +276,14 @@ impl Layer {
             None => None,
         };
         let exclude = raw.exclude.unwrap_or_default();
+        if exclude.len() > MAX_EXCLUDE_PATTERNS {
+            return Err(format!(
+                "exclude: {} patterns, more than the {MAX_EXCLUDE_PATTERNS} velvet takes (each \
+                 file found is matched against every one); a folder's pattern (\"dir/**\") \
+                 excludes all below it",
+                exclude.len()
+            ));
+        }
         for pattern in &exclude {
             glob(pattern).map_err(|e| format!("exclude: {e}"))?;
         }
@@ -373,6 +381,10 @@ impl Layer {
 
 /// The largest velvet.toml velvet reads: 1 MiB, thousands of times a real one.
 pub const MAX_CONFIG_BYTES: u64 = 1 << 20;
+
+/// The most exclude patterns a velvet.toml may list: every file found is matched against
+/// them all, and 40,000 cost seconds a run.
+pub const MAX_EXCLUDE_PATTERNS: usize = 1000;
 
 /// An exclude pattern: `*` and `?` stay inside one path component, `**` crosses them.
 fn glob(pattern: &str) -> Result<Glob, globset::Error> {

@@ -3098,3 +3098,125 @@ fn long_work_stops_within_a_second_of_a_signal() {
         );
     }
 }
+
+/// An image's name becomes part of a new texture file's name, never a name the system refuses
+/// or one that hides: a 5,000-byte name is cut (the file keeps 64 bytes of it), and `..` or
+/// `.velvet-1-x.tmp` lose their leading dots, so that every new file is listed and no run
+/// takes it for a temporary file.
+#[test]
+fn image_names_make_visible_files_of_a_legal_length() {
+    let dir = tempfile::tempdir().unwrap();
+    let long = "é".repeat(2500);
+    for (k, name) in [long.as_str(), "..", ".velvet-1-x.tmp", "."]
+        .into_iter()
+        .enumerate()
+    {
+        let input = dir.path().join(format!("in-{k}"));
+        let mut doc = sheen_document("tex.png");
+        doc["images"][0]["name"] = json!(name);
+        write(
+            &input.join("a.gltf"),
+            serde_json::to_string_pretty(&doc).unwrap(),
+        );
+        write(
+            &input.join("tex.png"),
+            png(4, 4, image::ExtendedColorType::Rgb8),
+        );
+        for command in ["bake", "migrate"] {
+            let out_dir = dir.path().join(format!("out-{command}-{k}"));
+            let mut args = vec![command, "--out-dir", s(&out_dir), s(&input)];
+            if command == "migrate" {
+                args.insert(1, "--exact");
+            }
+            let (status, out, err) = velvet(&args);
+            let what = format!("{command}, image name of {} bytes: {name:.20}", name.len());
+            assert_eq!(status, 0, "{what}: {out}{err}");
+            let names = names_under(&out_dir);
+            let new: Vec<&String> = names
+                .iter()
+                .filter(|n| !["a.gltf", "tex.png"].contains(&n.as_str()))
+                .collect();
+            assert!(!new.is_empty(), "{what}: {names:?}");
+            for file in &new {
+                assert!(!file.starts_with('.'), "{what}: {file}");
+                assert!(file.len() <= 255, "{what}: {} bytes", file.len());
+                assert!(file.ends_with(".png"), "{what}: {file}");
+                if name == long {
+                    assert!(
+                        file.starts_with(&format!("{}.", "é".repeat(32))),
+                        "{what}: {file}"
+                    );
+                }
+            }
+            let written = std::fs::read(out_dir.join("a.gltf")).unwrap();
+            for uri in uris_of(&written) {
+                let file = percent_encoding::percent_decode_str(&uri).decode_utf8_lossy();
+                assert!(out_dir.join(&*file).is_file(), "{what}: {uri}");
+            }
+        }
+    }
+}
+
+/// `bake --out-dir NEW file.glb` creates NEW, as migrate does: a GLB writes no texture file
+/// beside it that would have made the folder first.
+#[test]
+fn bake_and_migrate_of_a_glb_create_a_new_out_dir() {
+    let dir = tempfile::tempdir().unwrap();
+    let image = png(4, 4, image::ExtendedColorType::Rgb8);
+    let padded = image.len().div_ceil(4) * 4;
+    let doc = json!({
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_materials_sheen"],
+        "materials": [{"extensions": {"KHR_materials_sheen": {
+            "sheenColorFactor": [0.5, 0.5, 0.5],
+            "sheenColorTexture": {"index": 0},
+            "sheenRoughnessFactor": 0.5
+        }}}],
+        "textures": [{"source": 0}],
+        "images": [{"bufferView": 0, "mimeType": "image/png"}],
+        "bufferViews": [{"buffer": 0, "byteLength": image.len()}],
+        "buffers": [{"byteLength": padded}]
+    });
+    let mut bin = image.clone();
+    bin.resize(padded, 0);
+    let input = dir.path().join("one.glb");
+    write(&input, glb::join(doc.to_string().as_bytes(), Some(&bin)));
+    for command in ["bake", "migrate"] {
+        let out_dir = dir.path().join(format!("new-{command}/deeper"));
+        let (status, out, err) = velvet(&[command, "--out-dir", s(&out_dir), s(&input)]);
+        assert_eq!(status, 0, "{command}: {out}{err}");
+        assert_eq!(names_under(&out_dir), ["one.glb"], "{command}");
+    }
+}
+
+/// A velvet.toml listing more than 1,000 exclude patterns is refused naming the limit (each file
+/// found is matched against every pattern: 40,000 cost seconds a run), at once.
+#[test]
+fn an_exclude_list_over_its_limit_is_refused_at_once() {
+    let dir = tempfile::tempdir().unwrap();
+    write(&dir.path().join("a.gltf"), r#"{"asset":{"version":"2.0"}}"#);
+    let patterns = |n: usize| {
+        (0..n)
+            .map(|i| format!("\"d?{i}/[ab]*.gltf\""))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let config = dir.path().join("velvet.toml");
+    write(&config, format!("exclude = [{}]\n", patterns(40_000)));
+    let started = std::time::Instant::now();
+    let (status, out, err) = velvet(&["validate", s(dir.path())]);
+    assert!(started.elapsed() < std::time::Duration::from_secs(5));
+    assert_eq!(status, 2, "{out}{err}");
+    assert_eq!(
+        err,
+        format!(
+            "velvet: {}: exclude: 40000 patterns, more than the 1000 velvet takes (each file \
+             found is matched against every one); a folder's pattern (\"dir/**\") excludes all \
+             below it\n",
+            config.display()
+        )
+    );
+    write(&config, format!("exclude = [{}]\n", patterns(1000)));
+    let (status, out, err) = velvet(&["validate", s(dir.path())]);
+    assert_eq!(status, 0, "{out}{err}");
+}
