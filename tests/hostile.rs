@@ -3220,3 +3220,52 @@ fn an_exclude_list_over_its_limit_is_refused_at_once() {
     let (status, out, err) = velvet(&["validate", s(dir.path())]);
     assert_eq!(status, 0, "{out}{err}");
 }
+
+/// A resource read for an output is held to what it was when its document was loaded, as the
+/// document is: an image replaced (a new file renamed over it) or a buffer deleted between the
+/// plan and the write fails the file naming the resource, nothing written for it (with and
+/// without `--exact`).
+#[test]
+fn a_resource_replaced_or_deleted_during_a_run_fails_its_file_without_a_write() {
+    use velvet::migrate::apply::{execute, plan_file};
+    use velvet::output::files::Claims;
+    use velvet::output::paths::Job;
+    for exact in [false, true] {
+        for deleted in [false, true] {
+            let dir = tempfile::tempdir().unwrap();
+            let input = document_with_resources(&dir.path().join("in"));
+            let out = dir.path().join("out");
+            let job = Job {
+                input: input.clone(),
+                output: Some(out.join("asset.gltf")),
+            };
+            let options = velvet::migrate::Options {
+                exact,
+                ..velvet::migrate::Options::default()
+            };
+            let mut plan = plan_file(&job, &options).unwrap();
+            let (resource, error) = if deleted {
+                let bin = dir.path().join("in/geometry.bin");
+                std::fs::remove_file(&bin).unwrap();
+                (bin, "cannot")
+            } else {
+                let png_path = dir.path().join("in/tex.png");
+                let other = dir.path().join("in/other.png");
+                write(&other, png(4, 4, image::ExtendedColorType::Rgb8));
+                std::fs::rename(&other, &png_path).unwrap();
+                (png_path, "changed while velvet worked on it")
+            };
+            let what = format!("exact {exact}, deleted {deleted}");
+            let message = execute(&mut plan, &Claims::default()).unwrap_err();
+            assert!(
+                message.contains(&resource.display().to_string()) && message.contains(error),
+                "{what}: {message}"
+            );
+            assert!(
+                names_under(&out).is_empty(),
+                "{what}: {:?}",
+                names_under(&out)
+            );
+        }
+    }
+}
