@@ -658,11 +658,12 @@ fn writing_never_follows_outside_uris_and_outputs_stay_in_the_out_dir() {
     assert_eq!(
         new,
         [
-            // The name's separators became '_': the file stays in the output folder.
-            Path::new("out/.._.._.._escaped.sheenColor.sheenRoughness.672616e9c6e7.png"),
+            // The name's separators became '_' and its leading dots went: the file stays in the
+            // output folder, and is not hidden.
+            Path::new("out/_.._.._escaped.sheenColor.sheenRoughness.672616e9c6e7.png"),
             Path::new("out/chair.gltf"),
             // migrate's fitted roughness bakes the mapped roughness texture beside its output.
-            Path::new("out/migrated/.._.._.._escaped.fuzzRoughness.665bcce6978c.png"),
+            Path::new("out/migrated/_.._.._escaped.fuzzRoughness.665bcce6978c.png"),
             Path::new("out/migrated/chair.gltf"),
         ]
     );
