@@ -36,11 +36,10 @@ pub struct StoppableReader<'a>(pub std::io::Cursor<&'a [u8]>);
 
 impl StoppableReader<'_> {
     fn check() -> std::io::Result<()> {
+        // Not ErrorKind::Interrupted: readers and writers retry a read or write that was
+        // interrupted, and would spin on this one forever.
         if stop_requested() {
-            return Err(std::io::Error::new(
-                std::io::ErrorKind::Interrupted,
-                STOPPED,
-            ));
+            return Err(std::io::Error::other(STOPPED));
         }
         Ok(())
     }
