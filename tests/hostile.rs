@@ -2960,7 +2960,9 @@ fn zero_rgb_png(width: u32, height: u32) -> Vec<u8> {
 }
 
 /// Runs velvet with `args`: (exit status, stdout, stderr, its peak resident memory in KiB).
+/// The child is waited for with wait4(2), which alone gives its own resource usage.
 #[cfg(unix)]
+#[allow(clippy::zombie_processes)]
 fn velvet_measured(args: &[&str]) -> (Option<i32>, String, String, u64) {
     use std::io::Read;
     let mut child = Command::new(env!("CARGO_BIN_EXE_velvet"))
