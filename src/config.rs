@@ -16,6 +16,7 @@
 //! to its folder.
 
 use crate::diagnostics::{FailOn, Settings, Severity};
+use crate::report::escape::terminal;
 use globset::{Glob, GlobBuilder, GlobSet, GlobSetBuilder};
 use serde::Deserialize;
 use std::collections::{BTreeMap, BTreeSet, HashMap};
@@ -281,6 +282,14 @@ impl Layer {
             None => None,
         };
         let exclude = raw.exclude.unwrap_or_default();
+        if exclude.len() > MAX_EXCLUDE_PATTERNS {
+            return Err(format!(
+                "exclude: {} patterns, more than the {MAX_EXCLUDE_PATTERNS} velvet takes (each \
+                 file found is matched against every one); a folder's pattern (\"dir/**\") \
+                 excludes all below it",
+                exclude.len()
+            ));
+        }
         for pattern in &exclude {
             glob(pattern).map_err(|e| format!("exclude: {e}"))?;
         }
@@ -342,8 +351,21 @@ impl Layer {
             source,
         };
         let mut bytes = Vec::new();
-        std::fs::File::open(path)
-            .and_then(|file| file.take(MAX_CONFIG_BYTES + 1).read_to_end(&mut bytes))
+        // A configuration is a file: a FIFO would block the run until a program writes into it,
+        // a device could never end. Opened without waiting, and refused by what was opened.
+        let file = crate::asset::discover::open_without_waiting(path).map_err(unreadable)?;
+        let meta = file.metadata().map_err(unreadable)?;
+        if !meta.is_file() {
+            return Err(ConfigError::Invalid {
+                path: path.to_path_buf(),
+                message: format!(
+                    "not a regular file ({}); velvet reads a configuration from a file",
+                    crate::asset::discover::file_kind(&meta)
+                ),
+            });
+        }
+        file.take(MAX_CONFIG_BYTES + 1)
+            .read_to_end(&mut bytes)
             .map_err(unreadable)?;
         if bytes.len() as u64 > MAX_CONFIG_BYTES {
             return Err(ConfigError::Invalid {
@@ -365,6 +387,10 @@ impl Layer {
 
 /// The largest velvet.toml velvet reads: 1 MiB, thousands of times a real one.
 pub const MAX_CONFIG_BYTES: u64 = 1 << 20;
+
+/// The most exclude patterns a velvet.toml may list: every file found is matched against
+/// them all, and 40,000 cost seconds a run.
+pub const MAX_EXCLUDE_PATTERNS: usize = 1000;
 
 /// An exclude pattern: `*` and `?` stay inside one path component, `**` crosses them.
 fn glob(pattern: &str) -> Result<Glob, globset::Error> {
@@ -389,6 +415,9 @@ pub struct Config {
     /// Patterns without a `/`, matched against every component of that path.
     component: GlobSet,
     settings: Settings,
+    /// The error codes the selection would have left out had it not left out every one
+    /// (see [`Config::warning`]); empty for a selection that lets an error code through.
+    kept_errors: Vec<String>,
 }
 
 impl Config {
@@ -438,6 +467,28 @@ impl Config {
                 .filter(|n| !codes.contains(n))
                 .collect(),
         };
+        // A selection may leave out error codes one at a time, but not every one of them: a
+        // gate that filters out all its errors passes any file, and says nothing. Such a
+        // selection keeps its error codes reported and counted (`--fail-on` judges them), and
+        // `kept_errors` names them for the run's warning.
+        let mut ignore = ignore;
+        let error_codes: Vec<&str> = crate::rules::all_codes()
+            .into_iter()
+            .filter(|c| overrides.get(c.name).map_or(c.severity, |(s, _)| *s) == Severity::Error)
+            .map(|c| c.name)
+            .collect();
+        let kept_errors: Vec<String> =
+            if !error_codes.is_empty() && error_codes.iter().all(|c| ignore.contains(*c)) {
+                error_codes
+                    .iter()
+                    .map(|c| {
+                        ignore.remove(*c);
+                        c.to_string()
+                    })
+                    .collect()
+            } else {
+                Vec::new()
+            };
         let settings = Settings {
             ignore,
             severity_overrides: overrides
@@ -457,7 +508,31 @@ impl Config {
             anchored: anchored.build().unwrap_or_else(|_| GlobSet::empty()),
             component: component.build().unwrap_or_else(|_| GlobSet::empty()),
             settings,
+            kept_errors,
         }
+    }
+
+    /// The warning a run prints when this configuration's `ignore` or `only` would leave out
+    /// every error code, naming the codes it keeps reporting anyway.
+    pub fn warning(&self) -> Option<String> {
+        if self.kept_errors.is_empty() {
+            return None;
+        }
+        let (key, source) = match &self.selection {
+            (Selection::Only(_), source) => ("only", *source),
+            (_, source) => ("ignore", *source),
+        };
+        let by = match (source, &self.file) {
+            (Source::CommandLine, _) | (_, None) => format!("--{key}"),
+            (Source::File, Some(file)) => format!("{} ({key})", file.display()),
+            (_, Some(file)) => format!("{} and the command line ({key})", file.display()),
+        };
+        Some(format!(
+            "warning: {by} leaves out every error code; a configuration cannot silence every \
+             error, so these {} codes are still reported and fail the run: {}",
+            self.kept_errors.len(),
+            self.kept_errors.join(", ")
+        ))
     }
 
     /// The settings a validator applies under this configuration.
@@ -506,10 +581,12 @@ impl Config {
         };
         match &self.file {
             Some(p) => {
+                // A folder's name is shown, not obeyed: ESC or a newline in it would act on the
+                // terminal or end the comment.
                 let _ = writeln!(
                     out,
                     "# {FILE_NAME} in force: {}",
-                    crate::asset::discover::display_path(p)
+                    terminal(&crate::asset::discover::display_path(p))
                 );
             }
             None => {
@@ -606,8 +683,11 @@ impl Flags {
         if config.excludes(&absolute(path)) {
             text += &format!(
                 "# {} is excluded by this configuration\n",
-                crate::asset::discover::display_path(path)
+                terminal(&crate::asset::discover::display_path(path))
             );
+        }
+        if let Some(warning) = config.warning() {
+            text += &format!("# {}\n", terminal(&warning));
         }
         text += &config.to_toml();
         Ok(text)
@@ -623,6 +703,8 @@ pub struct Resolver {
     by_folder: HashMap<PathBuf, Arc<Config>>,
     /// velvet.toml path → its configuration.
     by_file: HashMap<PathBuf, Arc<Config>>,
+    /// The distinct warnings of the configurations found so far ([`Config::warning`]).
+    warnings: Vec<String>,
 }
 
 pub use crate::asset::discover::absolute;
@@ -641,12 +723,31 @@ impl Resolver {
             }
             None => None,
         };
-        Ok(Resolver {
+        let mut resolver = Resolver {
             cli,
-            fixed,
+            fixed: None,
             by_folder: HashMap::new(),
             by_file: HashMap::new(),
-        })
+            warnings: Vec::new(),
+        };
+        if let Some(fixed) = &fixed {
+            resolver.warn(fixed);
+        }
+        resolver.fixed = fixed;
+        Ok(resolver)
+    }
+
+    /// The warnings of the configurations resolved so far, each once.
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
+    }
+
+    fn warn(&mut self, config: &Config) {
+        if let Some(w) = config.warning() {
+            if !self.warnings.contains(&w) {
+                self.warnings.push(w);
+            }
+        }
     }
 
     /// The configuration for a file (searched from its folder) or a folder (from itself).
@@ -676,6 +777,7 @@ impl Resolver {
                         let layer = Layer::read(&candidate)?;
                         let c =
                             Arc::new(Config::combine(Some((candidate.clone(), layer)), &self.cli));
+                        self.warn(&c);
                         self.by_file.insert(candidate, c.clone());
                         c
                     }
@@ -684,7 +786,14 @@ impl Resolver {
                 break;
             }
         }
-        let config = found.unwrap_or_else(|| Arc::new(Config::combine(None, &self.cli)));
+        let config = match found {
+            Some(config) => config,
+            None => {
+                let config = Arc::new(Config::combine(None, &self.cli));
+                self.warn(&config);
+                config
+            }
+        };
         for dir in visited {
             self.by_folder.insert(dir, config.clone());
         }

@@ -344,6 +344,7 @@ fn in_pool<T: Send>(job: impl FnOnce() -> T + Send) -> T {
 
 fn main() -> ExitCode {
     velvet::asset::pages::limit_heaps();
+    velvet::output::interrupt::ignore_file_size_signal();
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => {
@@ -357,6 +358,11 @@ fn main() -> ExitCode {
                     let message = first.strip_prefix("error: ").unwrap_or(first);
                     command::emit(report::failed_run(format, message, true).as_bytes());
                 }
+            } else {
+                // --help and --version: their text is the output, and a failure to write it
+                // fails the run as any other output's would.
+                command::stdout_written(e.print());
+                return ExitCode::from(command::finish(Status::Done).code());
             }
             e.exit()
         }
@@ -401,7 +407,7 @@ fn main() -> ExitCode {
             }
         }
     };
-    ExitCode::from(status.code())
+    ExitCode::from(command::finish(status).code())
 }
 
 /// The output format a `velvet validate` command line asks for, read from the raw arguments

@@ -665,11 +665,12 @@ fn writing_never_follows_outside_uris_and_outputs_stay_in_the_out_dir() {
     assert_eq!(
         new,
         [
-            // The name's separators became '_': the file stays in the output folder.
-            Path::new("out/.._.._.._escaped.sheenColor.sheenRoughness.672616e9c6e7.png"),
+            // The name's separators became '_' and its leading dots went: the file stays in the
+            // output folder, and is not hidden.
+            Path::new("out/_.._.._escaped.sheenColor.sheenRoughness.672616e9c6e7.png"),
             Path::new("out/chair.gltf"),
             // migrate's fitted roughness bakes the mapped roughness texture beside its output.
-            Path::new("out/migrated/.._.._.._escaped.fuzzRoughness.665bcce6978c.png"),
+            Path::new("out/migrated/_.._.._escaped.fuzzRoughness.665bcce6978c.png"),
             Path::new("out/migrated/chair.gltf"),
         ]
     );
@@ -2345,4 +2346,936 @@ fn an_endless_list_and_a_huge_configuration_are_refused_at_their_limits() {
         )),
         "{err}"
     );
+}
+
+// ---------------------------------------------------------------------------------------------
+// Nothing lost, third round: every command and every output path
+
+/// Runs velvet with `args`, its standard output (or, `on_stderr`, its standard error) writing
+/// into /dev/full, the other captured: (exit status, the captured stream).
+#[cfg(unix)]
+fn velvet_into_a_full_disk(args: &[&str], on_stderr: bool) -> (Option<i32>, String) {
+    let full = || {
+        std::fs::OpenOptions::new()
+            .write(true)
+            .open("/dev/full")
+            .unwrap()
+    };
+    let mut command = Command::new(env!("CARGO_BIN_EXE_velvet"));
+    command.args(args).stdin(std::process::Stdio::null());
+    if on_stderr {
+        command.stderr(full()).stdout(std::process::Stdio::piped());
+    } else {
+        command.stdout(full()).stderr(std::process::Stdio::piped());
+    }
+    let out = command.output().unwrap();
+    let captured = if on_stderr { out.stdout } else { out.stderr };
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&captured).into_owned(),
+    )
+}
+
+/// A report that cannot be written (standard output on a full disk) fails the run with exit
+/// status 2 and says so on standard error, in every format and command that prints; a failed
+/// write to standard error is status 2 too, not a panic; a closed pipe stays quiet.
+#[cfg(unix)]
+#[test]
+fn a_failed_write_to_standard_output_or_error_is_status_2_never_0() {
+    let dir = tempfile::tempdir().unwrap();
+    let clean = dir.path().join("clean.gltf");
+    write(&clean, r#"{"asset":{"version":"2.0"}}"#);
+    let sheen = dir.path().join("sheen/asset.gltf");
+    write(
+        &sheen,
+        serde_json::to_string_pretty(&sheen_document("tex.png")).unwrap(),
+    );
+    write(
+        &dir.path().join("sheen/tex.png"),
+        png(4, 4, image::ExtendedColorType::Rgb8),
+    );
+    let full = "velvet: cannot write to standard output: No space left on device (os error 28)\n";
+    let runs: Vec<Vec<&str>> = vec![
+        vec!["validate", "--format", "sarif", s(&clean)],
+        vec!["validate", "--format", "json", s(&clean)],
+        vec!["validate", "--format", "text", s(&clean)],
+        vec!["migrate", "--dry-run", s(&sheen)],
+        vec!["migrate", "--dry-run", "--format", "json", s(&sheen)],
+        vec!["bake", "--dry-run", s(&sheen)],
+        vec!["config", s(dir.path())],
+        vec!["codes"],
+        vec!["man"],
+        vec!["--help"],
+    ];
+    for args in &runs {
+        // Each run passes when its output can be written.
+        let (status, out, err) = velvet(args);
+        assert_eq!(status, 0, "{args:?}: {out}{err}");
+        assert!(!out.is_empty(), "{args:?}");
+        let (status, err) = velvet_into_a_full_disk(args, false);
+        assert_eq!(status, Some(2), "{args:?}: {err}");
+        assert_eq!(err, full, "{args:?}");
+    }
+    // Standard error on a full disk: the usage error cannot be said, the status still is.
+    let missing = dir.path().join("missing.gltf");
+    let (status, out) = velvet_into_a_full_disk(&["validate", s(&missing)], true);
+    assert_eq!(status, Some(2), "{out}");
+    let (status, out) = velvet_into_a_full_disk(
+        &[
+            "migrate",
+            "--out-dir",
+            s(&dir.path().join("o")),
+            s(&missing),
+        ],
+        true,
+    );
+    assert_eq!((status, out.as_str()), (Some(2), ""));
+    // A reader that stops reading is not a failure: no message, the run's own status.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_velvet"))
+        .args(["codes"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(0));
+    assert_eq!(String::from_utf8_lossy(&out.stderr), "");
+}
+
+/// The codes of `velvet codes` at `severity`, in its order.
+fn codes_at(severity: &str) -> Vec<String> {
+    let (status, out, _) = velvet(&["codes"]);
+    assert_eq!(status, 0);
+    out.lines()
+        .filter_map(|l| {
+            let mut words = l.split_whitespace();
+            let (code, at) = (words.next()?, words.next()?);
+            (at == severity).then(|| code.to_string())
+        })
+        .collect()
+}
+
+/// A velvet.toml (or the command line) whose `only` or `ignore` would leave out every error
+/// code cannot make a file with errors pass: the errors are still reported and counted (exit
+/// status 1), and a warning names the configuration and the codes it could not hide. Leaving
+/// out some error codes is obeyed as before.
+#[test]
+fn a_configuration_that_would_hide_every_error_warns_and_its_errors_still_fail_the_run() {
+    let dir = tempfile::tempdir().unwrap();
+    // An undeclared sheen: UNDECLARED_EXTENSION, an error, and nothing else.
+    let doc = dir.path().join("a.gltf");
+    write(
+        &doc,
+        r#"{"asset":{"version":"2.0"},"materials":[{"extensions":{"KHR_materials_sheen":{"sheenRoughnessFactor":0.5}}}]}"#,
+    );
+    let errors = codes_at("error");
+    assert!(errors.contains(&"UNDECLARED_EXTENSION".to_string()));
+    let hint = codes_at("hint")[0].clone();
+    let config = dir.path().join("velvet.toml");
+    let quoted = |codes: &[String]| {
+        codes
+            .iter()
+            .map(|c| format!("\"{c}\""))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let warning = |by: &str| {
+        format!(
+            "velvet: warning: {by} leaves out every error code; a configuration cannot silence \
+             every error, so these {} codes are still reported and fail the run: {}\n",
+            errors.len(),
+            errors.join(", ")
+        )
+    };
+    for (toml, key) in [
+        (format!("only = [\"{hint}\"]\n"), "only"),
+        (format!("ignore = [{}]\n", quoted(&errors)), "ignore"),
+    ] {
+        write(&config, &toml);
+        let (status, out, err) = velvet(&["validate", s(&doc)]);
+        assert_eq!(status, 1, "{toml}: {out}{err}");
+        assert!(out.contains("error UNDECLARED_EXTENSION"), "{toml}: {out}");
+        assert!(
+            out.ends_with(
+                "1 file checked: 1 error, 0 warnings, 0 info, 0 hints; 1 fixable with --fix\n"
+            ),
+            "{toml}: {out}"
+        );
+        assert_eq!(
+            err,
+            warning(&format!("{} ({key})", config.display())),
+            "{toml}"
+        );
+        // `velvet config` says it too, as a comment.
+        let (status, out, _) = velvet(&["config", s(dir.path())]);
+        assert_eq!(status, 0);
+        assert!(
+            out.starts_with(&format!(
+                "# warning: {} ({key}) leaves out",
+                config.display()
+            )),
+            "{out}"
+        );
+    }
+    std::fs::remove_file(&config).unwrap();
+    let (status, out, err) = velvet(&["validate", "--only", &hint, s(&doc)]);
+    assert_eq!(status, 1, "{out}{err}");
+    assert_eq!(err, warning("--only"));
+    // One error code left out, another let through: obeyed, no warning.
+    let (status, out, err) = velvet(&["validate", "--ignore", "UNDECLARED_EXTENSION", s(&doc)]);
+    assert_eq!((status, err.as_str()), (0, ""), "{out}");
+    let (status, out, err) = velvet(&["validate", "--only", "TYPE_MISMATCH", s(&doc)]);
+    assert_eq!((status, err.as_str()), (0, ""), "{out}");
+}
+
+/// A file name that is not UTF-8 neither panics nor fails its file: migrate and bake write it,
+/// and their JSON reports name it lossily (U+FFFD for the byte), exit status 0.
+#[cfg(unix)]
+#[test]
+fn a_file_name_that_is_not_utf8_is_reported_lossily_without_a_panic() {
+    use std::os::unix::ffi::OsStrExt;
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in");
+    let name = std::ffi::OsStr::from_bytes(b"bad\xff.gltf");
+    write(
+        &input.join(name),
+        serde_json::to_string_pretty(&sheen_document("tex.png")).unwrap(),
+    );
+    write(
+        &input.join("tex.png"),
+        png(4, 4, image::ExtendedColorType::Rgb8),
+    );
+    for command in ["migrate", "bake"] {
+        let out_dir = dir.path().join(format!("out-{command}"));
+        let (status, out, err) = velvet(&[
+            command,
+            "--format",
+            "json",
+            "--out-dir",
+            s(&out_dir),
+            s(&input),
+        ]);
+        assert_eq!(status, 0, "{command}: {out}{err}");
+        let report: Value = serde_json::from_str(&out).unwrap();
+        let file = &report["files"][0];
+        assert_eq!(
+            file["input"],
+            json!(format!("{}/bad\u{fffd}.gltf", input.display())),
+            "{command}: {out}"
+        );
+        assert_eq!(
+            file["output"],
+            json!(format!("{}/bad\u{fffd}.gltf", out_dir.display())),
+            "{command}: {out}"
+        );
+        assert!(out_dir.join(name).is_file(), "{command}");
+        let (status, out, err) = velvet(&[command, "--out-dir", s(&out_dir), s(&input)]);
+        assert_eq!(status, 0, "{command}: {out}{err}");
+        assert!(out.contains("bad\u{fffd}.gltf"), "{command}: {out}");
+    }
+}
+
+/// An undeclared sheen, which `validate --fix` repairs by declaring it.
+const FIXABLE: &str = r#"{"asset":{"version":"2.0"},"materials":[{"extensions":{"KHR_materials_sheen":{"sheenRoughnessFactor":0.5}}}]}"#;
+const FIXED: &str = r#"{"asset":{"version":"2.0"},"extensionsUsed":["KHR_materials_sheen"],"materials":[{"extensions":{"KHR_materials_sheen":{"sheenRoughnessFactor":0.5}}}]}"#;
+
+/// `validate --fix` keeps links as `migrate --in-place` does: a link's target is fixed and the
+/// link stays a link (a folder holding both fixes the file once), and a link leading out of
+/// the folder given is refused with exit status 2 before anything is written.
+#[cfg(unix)]
+#[test]
+fn validate_fix_on_a_link_fixes_its_target_and_keeps_the_link() {
+    let dir = tempfile::tempdir().unwrap();
+    let tree = dir.path().join("tree");
+    let real = tree.join("real/asset.gltf");
+    write(&real, FIXABLE);
+    let link = tree.join("link.gltf");
+    std::os::unix::fs::symlink("real/asset.gltf", &link).unwrap();
+    let (status, out, err) = velvet(&["validate", "--fix", s(&link)]);
+    assert_eq!(status, 0, "{out}{err}");
+    assert!(std::fs::symlink_metadata(&link).unwrap().is_symlink());
+    assert_eq!(
+        std::fs::read_link(&link).unwrap(),
+        Path::new("real/asset.gltf")
+    );
+    assert_eq!(std::fs::read_to_string(&real).unwrap(), FIXED);
+
+    // The folder holding both: fixed once, both reported clean, no file changed under a check.
+    std::fs::write(&real, FIXABLE).unwrap();
+    let (status, out, err) = velvet(&["validate", "--fix", s(&tree)]);
+    assert_eq!(status, 0, "{out}{err}");
+    assert!(out.contains("2 files checked: 0 errors"), "{out}");
+    assert!(std::fs::symlink_metadata(&link).unwrap().is_symlink());
+    assert_eq!(std::fs::read_to_string(&real).unwrap(), FIXED);
+
+    // A link out of the folder given: refused, nothing written.
+    let inner = tree.join("real");
+    let outside = dir.path().join("outside/asset.gltf");
+    write(&outside, FIXABLE);
+    std::fs::write(&real, FIXABLE).unwrap();
+    std::os::unix::fs::symlink(&outside, inner.join("away.gltf")).unwrap();
+    let (status, out, err) = velvet(&["validate", "--fix", s(&inner)]);
+    assert_eq!(status, 2, "{out}{err}");
+    assert_eq!(
+        err,
+        format!(
+            "velvet: --fix: {} is a symbolic link to {}, outside {}; velvet writes only inside \
+             the folders it is given (name the target itself to fix it)\n",
+            inner.join("away.gltf").display(),
+            outside.canonicalize().unwrap().display(),
+            inner.display()
+        )
+    );
+    assert!(std::fs::symlink_metadata(inner.join("away.gltf"))
+        .unwrap()
+        .is_symlink());
+    assert_eq!(std::fs::read_to_string(&outside).unwrap(), FIXABLE);
+    assert_eq!(std::fs::read_to_string(&real).unwrap(), FIXABLE);
+}
+
+/// SIGINT and SIGTERM during `validate --fix` stop it as they stop migrate: the files fixed
+/// stay fixed, the others are left as they were (no temporary file), one line says so and
+/// the exit status is 130 or 143, never 0 for a run that did not finish.
+#[cfg(unix)]
+#[test]
+fn validate_fix_answers_sigint_and_sigterm_as_migrate_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let files = 3000;
+    let mut stopped = 0;
+    for (k, (signal, delay_ms)) in [
+        (libc::SIGINT, 300),
+        (libc::SIGTERM, 300),
+        (libc::SIGINT, 800),
+        (libc::SIGTERM, 800),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let folder = dir.path().join(format!("run-{k}"));
+        for i in 0..files {
+            write(&folder.join(format!("d{i:04}.gltf")), FIXABLE);
+        }
+        let child = Command::new(env!("CARGO_BIN_EXE_velvet"))
+            .args(["validate", "--fix", s(&folder)])
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(std::time::Duration::from_millis(delay_ms));
+        let sent = std::time::Instant::now();
+        // SAFETY: kill(2) on the child's id, which it holds until it is waited for.
+        unsafe { libc::kill(child.id() as libc::pid_t, signal) };
+        let output = child.wait_with_output().unwrap();
+        let what = format!("signal {signal} after {delay_ms} ms");
+        assert!(sent.elapsed() < std::time::Duration::from_secs(5), "{what}");
+        let err = String::from_utf8_lossy(&output.stderr);
+        let mut fixed = 0;
+        for entry in std::fs::read_dir(&folder).unwrap() {
+            let path = entry.unwrap().path();
+            let name = path.file_name().unwrap().to_string_lossy().into_owned();
+            assert!(
+                name.ends_with(".gltf") && !name.starts_with('.'),
+                "{what}: {name}"
+            );
+            let text = std::fs::read_to_string(&path).unwrap();
+            assert!(text == FIXABLE || text == FIXED, "{what}: {name}: {text}");
+            fixed += usize::from(text == FIXED);
+        }
+        match output.status.code() {
+            Some(0) => assert_eq!(fixed, files, "{what}"),
+            code => {
+                assert_eq!(code, Some(128 + signal), "{what}: {err}");
+                let name = if signal == libc::SIGINT {
+                    "SIGINT"
+                } else {
+                    "SIGTERM"
+                };
+                assert_eq!(
+                    err,
+                    format!(
+                        "velvet: stopped by {name}: {fixed} of {files} files finished (their \
+                         outputs are complete); nothing was written for the other {}\n",
+                        files - fixed
+                    ),
+                    "{what}"
+                );
+                stopped += 1;
+            }
+        }
+    }
+    assert!(
+        stopped >= 2,
+        "only {stopped} runs were stopped before they finished"
+    );
+}
+
+/// Every file under `root`, its path relative to it (links and special files included).
+fn names_under(root: &Path) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut stack = vec![root.to_path_buf()];
+    while let Some(dir) = stack.pop() {
+        let Ok(entries) = std::fs::read_dir(&dir) else {
+            continue;
+        };
+        for entry in entries {
+            let path = entry.unwrap().path();
+            if std::fs::symlink_metadata(&path).unwrap().is_dir() {
+                stack.push(path.clone());
+            }
+            out.push(
+                path.strip_prefix(root)
+                    .unwrap()
+                    .to_string_lossy()
+                    .into_owned(),
+            );
+        }
+    }
+    out.sort();
+    out
+}
+
+/// A file-size limit (`ulimit -f`) does not kill velvet with SIGXFSZ mid-write: the write that
+/// passes it fails with EFBIG, that file fails naming it (exit status 1), and no temporary file
+/// is left behind, in migrate, bake and `validate --fix`.
+#[cfg(unix)]
+#[test]
+fn a_file_size_limit_fails_the_file_cleanly_instead_of_killing_velvet() {
+    use std::os::unix::process::CommandExt;
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in");
+    let mut doc = sheen_document("tex.png");
+    doc["extras"] = json!({"padding": "x".repeat(20_000)});
+    write(
+        &input.join("big.gltf"),
+        serde_json::to_string_pretty(&doc).unwrap(),
+    );
+    write(
+        &input.join("tex.png"),
+        png(4, 4, image::ExtendedColorType::Rgb8),
+    );
+    let limited = |args: &[&str]| {
+        let mut command = Command::new(env!("CARGO_BIN_EXE_velvet"));
+        command.args(args);
+        // SAFETY: setrlimit is async-signal-safe; the child sets its own limit before exec.
+        unsafe {
+            command.pre_exec(|| {
+                let limit = libc::rlimit {
+                    rlim_cur: 8192,
+                    rlim_max: 8192,
+                };
+                if libc::setrlimit(libc::RLIMIT_FSIZE, &limit) != 0 {
+                    return Err(std::io::Error::last_os_error());
+                }
+                Ok(())
+            });
+        }
+        command.output().unwrap()
+    };
+    for command in ["migrate", "bake"] {
+        let out_dir = dir.path().join(format!("out-{command}"));
+        let output = limited(&[command, "--out-dir", s(&out_dir), s(&input)]);
+        let text = String::from_utf8_lossy(&output.stdout).into_owned()
+            + &String::from_utf8_lossy(&output.stderr);
+        use std::os::unix::process::ExitStatusExt;
+        assert_eq!(output.status.signal(), None, "{command}: {text}");
+        assert_eq!(output.status.code(), Some(1), "{command}: {text}");
+        assert!(
+            text.contains("File too large (os error 27)"),
+            "{command}: {text}"
+        );
+        assert!(!out_dir.join("big.gltf").exists(), "{command}");
+        assert!(
+            !names_under(&out_dir).iter().any(|n| n.contains(".velvet-")),
+            "{command}: {:?}",
+            names_under(&out_dir)
+        );
+    }
+    let fixable = dir.path().join("fix/big.gltf");
+    let mut doc: Value = serde_json::from_str(FIXABLE).unwrap();
+    doc["extras"] = json!({"padding": "x".repeat(20_000)});
+    let text = doc.to_string();
+    write(&fixable, &text);
+    let output = limited(&["validate", "--fix", s(&fixable)]);
+    let report = String::from_utf8_lossy(&output.stdout);
+    assert_eq!(output.status.code(), Some(1), "{report}");
+    assert!(report.contains("File too large (os error 27)"), "{report}");
+    assert_eq!(std::fs::read_to_string(&fixable).unwrap(), text);
+    assert_eq!(names_under(&dir.path().join("fix")), ["big.gltf"]);
+}
+
+/// `--config FIFO` and `--files-from FIFO` do not wait for a writer that never comes: a FIFO
+/// or a device given as a configuration is refused (exit status 2), a list in a FIFO no program
+/// writes into is refused, and a list a program writes into a pipe is read as before.
+#[cfg(unix)]
+#[test]
+fn a_fifo_given_as_configuration_or_list_is_refused_without_blocking() {
+    let dir = tempfile::tempdir().unwrap();
+    let doc = dir.path().join("a.gltf");
+    write(&doc, r#"{"asset":{"version":"2.0"}}"#);
+    let fifo = dir.path().join("fifo");
+    assert!(Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap()
+        .success());
+    let (status, out, err) = velvet_within_20s(&["validate", "--config", s(&fifo), s(&doc)]);
+    assert_eq!(status, Some(2), "{out}{err}");
+    assert_eq!(
+        err,
+        format!(
+            "velvet: {}: not a regular file (a FIFO); velvet reads a configuration from a file\n",
+            fifo.display()
+        )
+    );
+    let (status, _, err) = velvet_within_20s(&["config", "--config", "/dev/zero", s(&doc)]);
+    assert_eq!(status, Some(2), "{err}");
+    assert_eq!(
+        err,
+        "velvet: /dev/zero: not a regular file (a character device); velvet reads a \
+         configuration from a file\n"
+    );
+    for command in ["validate", "migrate", "bake"] {
+        let mut args = vec![command, "--files-from", s(&fifo)];
+        if command != "validate" {
+            args.push("--dry-run");
+        }
+        let (status, out, err) = velvet_within_20s(&args);
+        assert_eq!(status, Some(2), "{command}: {out}{err}");
+        assert!(
+            err.ends_with(&format!(
+                "velvet: --files-from {}: a FIFO no program is writing into; velvet does not \
+                 wait for one (write the list to a file, or pipe it to --files-from -)\n",
+                fifo.display()
+            )),
+            "{command}: {err}"
+        );
+    }
+    // A list written into a pipe by another program (a shell's `<(git diff …)`) is read.
+    let script = format!(
+        "{} validate --files-from <(printf '%s\\n' {})",
+        env!("CARGO_BIN_EXE_velvet"),
+        s(&doc)
+    );
+    let out = Command::new("bash").args(["-c", &script]).output().unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{text}");
+    assert!(text.contains("1 file checked"), "{text}");
+}
+
+/// Text velvet did not write reaches no terminal raw: `velvet preview` shows a material name
+/// holding ESC, BEL or U+202E as escapes, and `velvet config` a folder name holding them.
+#[cfg(unix)]
+#[test]
+fn preview_names_and_config_folders_are_escaped_on_the_terminal() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut doc = sheen_document("tex.png");
+    doc["materials"][0]["name"] = json!("\u{1b}]0;owned\u{7}cl\u{202e}oth");
+    let input = dir.path().join("in/a.gltf");
+    write(&input, serde_json::to_string_pretty(&doc).unwrap());
+    write(
+        &dir.path().join("in/tex.png"),
+        png(4, 4, image::ExtendedColorType::Rgb8),
+    );
+    let (status, out, err) = velvet(&["preview", "-o", s(&dir.path().join("p")), s(&input)]);
+    assert_eq!(status, 0, "{out}{err}");
+    assert_inert(&out, 0, "preview");
+    assert_inert(&err, 0, "preview");
+    assert!(!out.contains('\u{202e}'), "{out}");
+    assert!(out.contains("\\u001b]0;owned\\u0007cl\\u202eoth"), "{out}");
+
+    let folder = dir.path().join("odd\u{1b}]0;x\u{7}\nname");
+    write(&folder.join("velvet.toml"), "max-issues = 3\n");
+    write(&folder.join("a.gltf"), r#"{"asset":{"version":"2.0"}}"#);
+    let (status, out, err) = velvet(&["config", s(&folder)]);
+    assert_eq!(status, 0, "{err}");
+    assert_inert(&out, 0, "config");
+    assert!(
+        out.starts_with(&format!(
+            "# velvet.toml in force: {}/odd\\u001b]0;x\\u0007\\u000aname/velvet.toml\n",
+            dir.path().display()
+        )),
+        "{out}"
+    );
+}
+
+/// A real PNG of `width` × `height` 8-bit RGB texels all zero, of a few bytes per 258 of its
+/// pixel data (deflate with fixed codes: one literal zero, then matches of 258 at distance 1),
+/// made without holding its pixels: a 16384² one is 5 MB and decodes to 768 MiB.
+fn zero_rgb_png(width: u32, height: u32) -> Vec<u8> {
+    struct Bits {
+        out: Vec<u8>,
+        acc: u64,
+        n: u32,
+    }
+    impl Bits {
+        fn put(&mut self, value: u64, count: u32) {
+            self.acc |= value << self.n;
+            self.n += count;
+            while self.n >= 8 {
+                self.out.push(self.acc as u8);
+                self.acc >>= 8;
+                self.n -= 8;
+            }
+        }
+        /// A Huffman code, which deflate stores from its most significant bit.
+        fn code(&mut self, code: u64, count: u32) {
+            let reversed = (0..count).fold(0, |r, i| (r << 1) | ((code >> i) & 1));
+            self.put(reversed, count);
+        }
+    }
+    let total = u64::from(height) * (1 + u64::from(width) * 3);
+    let mut bits = Bits {
+        out: vec![0x78, 0x01],
+        acc: 0,
+        n: 0,
+    };
+    bits.put(1, 1); // the last block
+    bits.put(1, 2); // fixed codes
+    bits.code(0x30, 8); // literal 0
+    let mut left = total - 1;
+    while left >= 258 {
+        bits.code(0xC5, 8); // length 258 (symbol 285)
+        bits.code(0, 5); // distance 1
+        left -= 258;
+    }
+    for _ in 0..left {
+        bits.code(0x30, 8);
+    }
+    bits.code(0, 7); // end of block
+    bits.put(0, 7); // to a whole byte
+    let mut zlib = bits.out;
+    let adler = ((total % 65521) << 16) | 1;
+    zlib.extend_from_slice(&(adler as u32).to_be_bytes());
+    let chunk = |kind: &[u8], data: &[u8]| {
+        let mut out = (data.len() as u32).to_be_bytes().to_vec();
+        let mut body = kind.to_vec();
+        body.extend_from_slice(data);
+        out.extend_from_slice(&body);
+        out.extend_from_slice(&crc32(&body).to_be_bytes());
+        out
+    };
+    let mut ihdr = Vec::new();
+    ihdr.extend_from_slice(&width.to_be_bytes());
+    ihdr.extend_from_slice(&height.to_be_bytes());
+    ihdr.extend_from_slice(&[8, 2, 0, 0, 0]);
+    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+    png.extend(chunk(b"IHDR", &ihdr));
+    png.extend(chunk(b"IDAT", &zlib));
+    png.extend(chunk(b"IEND", &[]));
+    png
+}
+
+/// Runs velvet with `args`: (exit status, stdout, stderr, its peak resident memory in KiB).
+/// The child is waited for with wait4(2), which alone gives its own resource usage.
+#[cfg(unix)]
+#[allow(clippy::zombie_processes)]
+fn velvet_measured(args: &[&str]) -> (Option<i32>, String, String, u64) {
+    use std::io::Read;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_velvet"))
+        .args(args)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stdout = child.stdout.take().unwrap();
+    let mut stderr = child.stderr.take().unwrap();
+    let reading = std::thread::spawn(move || {
+        let mut text = String::new();
+        stderr.read_to_string(&mut text).unwrap();
+        text
+    });
+    let mut out = String::new();
+    stdout.read_to_string(&mut out).unwrap();
+    let err = reading.join().unwrap();
+    let mut status = 0;
+    // SAFETY: wait4 on the child's id, which it holds until this waits for it; the rusage
+    // is written by the call.
+    let usage = unsafe {
+        let mut usage: libc::rusage = std::mem::zeroed();
+        assert_eq!(
+            libc::wait4(child.id() as libc::pid_t, &mut status, 0, &mut usage),
+            child.id() as libc::pid_t
+        );
+        usage
+    };
+    let code = libc::WIFEXITED(status).then(|| libc::WEXITSTATUS(status));
+    (code, out, err, usage.ru_maxrss as u64)
+}
+
+/// Every decode is held to `--max-memory`, in preview and `migrate --exact` as in bake: a 5 MB
+/// all-zero 16384² RGB PNG (768 MiB decoded) under a budget of 1 GiB is refused before it is
+/// decoded, naming the flag, the process staying far below the budget. Preview draws the
+/// material from its factors and says why; migrate fails the file (exit status 1).
+#[cfg(unix)]
+#[test]
+fn every_decode_is_held_to_the_memory_budget_in_preview_and_migrate_exact() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in");
+    write(&input.join("tex.png"), zero_rgb_png(16384, 16384));
+    write(
+        &input.join("a.gltf"),
+        serde_json::to_string_pretty(&sheen_document("tex.png")).unwrap(),
+    );
+    let preview = dir.path().join("preview");
+    let (status, out, err, peak) = velvet_measured(&[
+        "preview",
+        "--max-memory",
+        "1G",
+        "-o",
+        s(&preview),
+        s(&input),
+    ]);
+    assert_eq!(status, Some(0), "{out}{err}");
+    assert!(peak < 256 * 1024, "preview took {peak} KiB");
+    let index = std::fs::read_to_string(preview.join("index.html")).unwrap();
+    assert!(
+        index.contains(
+            "sheenColorTexture not read (image 0: decoding the 16384 × 16384 Rgb8 image needs \
+             about 1.8 GiB, over the memory budget of 1.0 GiB (raise it with --max-memory); it \
+             was not decoded): sheenColorFactor alone is used"
+        ),
+        "{index}"
+    );
+    let out_dir = dir.path().join("out");
+    let (status, out, err, peak) = velvet_measured(&[
+        "migrate",
+        "--exact",
+        "--max-memory",
+        "1G",
+        "--out-dir",
+        s(&out_dir),
+        s(&input),
+    ]);
+    assert_eq!(status, Some(1), "{out}{err}");
+    assert!(peak < 256 * 1024, "migrate --exact took {peak} KiB");
+    assert!(
+        out.contains(
+            "of image 0: image 0: PNG: decoding the 16384 × 16384 Rgb8 image \
+             needs about 2.2 GiB, over the memory budget of 1.0 GiB (raise it with \
+             --max-memory); it was not decoded"
+        ),
+        "{out}"
+    );
+    assert!(!out_dir.join("a.gltf").exists());
+}
+
+/// Long work stops within a second of SIGTERM or SIGINT: `migrate --exact` of a 4096² texture
+/// (seconds of decoding, baking and encoding) exits 143 or 130 at once, nothing written.
+#[cfg(unix)]
+#[test]
+fn long_work_stops_within_a_second_of_a_signal() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in");
+    write(&input.join("tex.png"), zero_rgb_png(4096, 4096));
+    write(
+        &input.join("a.gltf"),
+        serde_json::to_string_pretty(&sheen_document("tex.png")).unwrap(),
+    );
+    for (k, (signal, delay_ms)) in [
+        (libc::SIGTERM, 300),
+        (libc::SIGINT, 1000),
+        (libc::SIGTERM, 2000),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let out_dir = dir.path().join(format!("out-{k}"));
+        let child = Command::new(env!("CARGO_BIN_EXE_velvet"))
+            .args(["migrate", "--exact", "--out-dir", s(&out_dir), s(&input)])
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(std::time::Duration::from_millis(delay_ms));
+        let sent = std::time::Instant::now();
+        // SAFETY: kill(2) on the child's id, which it holds until it is waited for.
+        unsafe { libc::kill(child.id() as libc::pid_t, signal) };
+        let output = child.wait_with_output().unwrap();
+        let took = sent.elapsed();
+        let err = String::from_utf8_lossy(&output.stderr);
+        let what = format!("signal {signal} after {delay_ms} ms");
+        assert_eq!(output.status.code(), Some(128 + signal), "{what}: {err}");
+        assert!(took < std::time::Duration::from_secs(1), "{what}: {took:?}");
+        assert!(
+            err.ends_with("nothing was written for the other 1\n"),
+            "{what}: {err}"
+        );
+        assert!(
+            names_under(&out_dir).is_empty(),
+            "{what}: {:?}",
+            names_under(&out_dir)
+        );
+    }
+}
+
+/// An image's name becomes part of a new texture file's name, never a name the system refuses
+/// or one that hides: a 5,000-byte name is cut (the file keeps 64 bytes of it), and `..` or
+/// `.velvet-1-x.tmp` lose their leading dots, so that every new file is listed and no run
+/// takes it for a temporary file.
+#[test]
+fn image_names_make_visible_files_of_a_legal_length() {
+    let dir = tempfile::tempdir().unwrap();
+    let long = "é".repeat(2500);
+    for (k, name) in [long.as_str(), "..", ".velvet-1-x.tmp", "."]
+        .into_iter()
+        .enumerate()
+    {
+        let input = dir.path().join(format!("in-{k}"));
+        let mut doc = sheen_document("tex.png");
+        doc["images"][0]["name"] = json!(name);
+        write(
+            &input.join("a.gltf"),
+            serde_json::to_string_pretty(&doc).unwrap(),
+        );
+        write(
+            &input.join("tex.png"),
+            png(4, 4, image::ExtendedColorType::Rgb8),
+        );
+        for command in ["bake", "migrate"] {
+            let out_dir = dir.path().join(format!("out-{command}-{k}"));
+            let mut args = vec![command, "--out-dir", s(&out_dir), s(&input)];
+            if command == "migrate" {
+                args.insert(1, "--exact");
+            }
+            let (status, out, err) = velvet(&args);
+            let what = format!("{command}, image name of {} bytes: {name:.20}", name.len());
+            assert_eq!(status, 0, "{what}: {out}{err}");
+            let names = names_under(&out_dir);
+            let new: Vec<&String> = names
+                .iter()
+                .filter(|n| !["a.gltf", "tex.png"].contains(&n.as_str()))
+                .collect();
+            assert!(!new.is_empty(), "{what}: {names:?}");
+            for file in &new {
+                assert!(!file.starts_with('.'), "{what}: {file}");
+                assert!(file.len() <= 255, "{what}: {} bytes", file.len());
+                assert!(file.ends_with(".png"), "{what}: {file}");
+                if name == long {
+                    assert!(
+                        file.starts_with(&format!("{}.", "é".repeat(32))),
+                        "{what}: {file}"
+                    );
+                }
+            }
+            let written = std::fs::read(out_dir.join("a.gltf")).unwrap();
+            for uri in uris_of(&written) {
+                let file = percent_encoding::percent_decode_str(&uri).decode_utf8_lossy();
+                assert!(out_dir.join(&*file).is_file(), "{what}: {uri}");
+            }
+        }
+    }
+}
+
+/// `bake --out-dir NEW file.glb` creates NEW, as migrate does: a GLB writes no texture file
+/// beside it that would have made the folder first.
+#[test]
+fn bake_and_migrate_of_a_glb_create_a_new_out_dir() {
+    let dir = tempfile::tempdir().unwrap();
+    let image = png(4, 4, image::ExtendedColorType::Rgb8);
+    let padded = image.len().div_ceil(4) * 4;
+    let doc = json!({
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_materials_sheen"],
+        "materials": [{"extensions": {"KHR_materials_sheen": {
+            "sheenColorFactor": [0.5, 0.5, 0.5],
+            "sheenColorTexture": {"index": 0},
+            "sheenRoughnessFactor": 0.5
+        }}}],
+        "textures": [{"source": 0}],
+        "images": [{"bufferView": 0, "mimeType": "image/png"}],
+        "bufferViews": [{"buffer": 0, "byteLength": image.len()}],
+        "buffers": [{"byteLength": padded}]
+    });
+    let mut bin = image.clone();
+    bin.resize(padded, 0);
+    let input = dir.path().join("one.glb");
+    write(&input, glb::join(doc.to_string().as_bytes(), Some(&bin)));
+    for command in ["bake", "migrate"] {
+        let out_dir = dir.path().join(format!("new-{command}/deeper"));
+        let (status, out, err) = velvet(&[command, "--out-dir", s(&out_dir), s(&input)]);
+        assert_eq!(status, 0, "{command}: {out}{err}");
+        assert_eq!(names_under(&out_dir), ["one.glb"], "{command}");
+    }
+}
+
+/// A velvet.toml listing more than 1,000 exclude patterns is refused naming the limit (each file
+/// found is matched against every pattern: 40,000 cost seconds a run), at once.
+#[test]
+fn an_exclude_list_over_its_limit_is_refused_at_once() {
+    let dir = tempfile::tempdir().unwrap();
+    write(&dir.path().join("a.gltf"), r#"{"asset":{"version":"2.0"}}"#);
+    let patterns = |n: usize| {
+        (0..n)
+            .map(|i| format!("\"d?{i}/[ab]*.gltf\""))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let config = dir.path().join("velvet.toml");
+    write(&config, format!("exclude = [{}]\n", patterns(40_000)));
+    let started = std::time::Instant::now();
+    let (status, out, err) = velvet(&["validate", s(dir.path())]);
+    assert!(started.elapsed() < std::time::Duration::from_secs(5));
+    assert_eq!(status, 2, "{out}{err}");
+    assert_eq!(
+        err,
+        format!(
+            "velvet: {}: exclude: 40000 patterns, more than the 1000 velvet takes (each file \
+             found is matched against every one); a folder's pattern (\"dir/**\") excludes all \
+             below it\n",
+            config.display()
+        )
+    );
+    write(&config, format!("exclude = [{}]\n", patterns(1000)));
+    let (status, out, err) = velvet(&["validate", s(dir.path())]);
+    assert_eq!(status, 0, "{out}{err}");
+}
+
+/// A resource read for an output is held to what it was when its document was loaded, as the
+/// document is: an image replaced (a new file renamed over it) or a buffer deleted between the
+/// plan and the write fails the file naming the resource, nothing written for it (with and
+/// without `--exact`).
+#[test]
+fn a_resource_replaced_or_deleted_during_a_run_fails_its_file_without_a_write() {
+    use velvet::migrate::apply::{execute, plan_file};
+    use velvet::output::files::Claims;
+    use velvet::output::paths::Job;
+    for exact in [false, true] {
+        for deleted in [false, true] {
+            let dir = tempfile::tempdir().unwrap();
+            let input = document_with_resources(&dir.path().join("in"));
+            let out = dir.path().join("out");
+            let job = Job {
+                input: input.clone(),
+                output: Some(out.join("asset.gltf")),
+            };
+            let options = velvet::migrate::Options {
+                exact,
+                ..velvet::migrate::Options::default()
+            };
+            let mut plan = plan_file(&job, &options).unwrap();
+            let (resource, error) = if deleted {
+                let bin = dir.path().join("in/geometry.bin");
+                std::fs::remove_file(&bin).unwrap();
+                (bin, "cannot")
+            } else {
+                let png_path = dir.path().join("in/tex.png");
+                let other = dir.path().join("in/other.png");
+                write(&other, png(4, 4, image::ExtendedColorType::Rgb8));
+                std::fs::rename(&other, &png_path).unwrap();
+                (png_path, "changed while velvet worked on it")
+            };
+            let what = format!("exact {exact}, deleted {deleted}");
+            let message = execute(&mut plan, &Claims::default()).unwrap_err();
+            assert!(
+                message.contains(&resource.display().to_string()) && message.contains(error),
+                "{what}: {message}"
+            );
+            assert!(
+                names_under(&out).is_empty(),
+                "{what}: {:?}",
+                names_under(&out)
+            );
+        }
+    }
 }

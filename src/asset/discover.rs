@@ -169,6 +169,8 @@ pub enum InputError {
     ListedNotAPath { list: PathBuf, entry: usize },
     #[error("--files-from {}: the list is longer than {} bytes; velvet reads no further (split it, or name folders)", .list.display(), MAX_LIST_BYTES)]
     ListTooLong { list: PathBuf },
+    #[error("--files-from {}: a FIFO no program is writing into; velvet does not wait for one (write the list to a file, or pipe it to --files-from -)", .list.display())]
+    ListWithoutWriter { list: PathBuf },
 }
 
 /// The paths named on the command line and in a `--files-from` list (`-`: standard input),
@@ -209,8 +211,75 @@ pub fn check_inputs(inputs: &[PathBuf]) -> Result<(), InputError> {
     Ok(())
 }
 
+/// Opens `path` for reading without waiting: opening a FIFO blocks until a program opens it for
+/// writing, which may be never, so it is opened non-blocking (a regular file or a device reads
+/// as before; a FIFO is left non-blocking for [`read_stream_start`]).
+pub fn open_without_waiting(path: &Path) -> io::Result<std::fs::File> {
+    let mut options = std::fs::OpenOptions::new();
+    options.read(true);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        options.custom_flags(libc::O_NONBLOCK);
+    }
+    let file = options.open(path)?;
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if !file.metadata()?.file_type().is_fifo() {
+            set_blocking(&file)?;
+        }
+    }
+    Ok(file)
+}
+
+#[cfg(unix)]
+fn set_blocking(file: &std::fs::File) -> io::Result<()> {
+    use std::os::unix::io::AsRawFd;
+    // SAFETY: F_GETFL and F_SETFL on a descriptor this function's caller owns.
+    unsafe {
+        let flags = libc::fcntl(file.as_raw_fd(), libc::F_GETFL);
+        if flags < 0 || libc::fcntl(file.as_raw_fd(), libc::F_SETFL, flags & !libc::O_NONBLOCK) < 0
+        {
+            return Err(io::Error::last_os_error());
+        }
+    }
+    Ok(())
+}
+
+/// For a FIFO opened by [`open_without_waiting`]: whether a program writes into it, its first
+/// bytes read into `bytes`, the file then blocking so that the rest is read as it comes. A FIFO
+/// no program has open for writing reads as ended at once (false): a list or a configuration
+/// that is not there, which velvet refuses rather than take for an empty one. Anything else:
+/// true, nothing read.
+pub fn read_stream_start(file: &std::fs::File, bytes: &mut Vec<u8>) -> io::Result<bool> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if file.metadata()?.file_type().is_fifo() {
+            let mut first = [0u8; 4096];
+            let start = loop {
+                match (&*file).read(&mut first) {
+                    Ok(0) => return Ok(false),
+                    Ok(n) => break n,
+                    Err(e) if e.kind() == io::ErrorKind::WouldBlock => break 0,
+                    Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
+                    Err(e) => return Err(e),
+                }
+            };
+            bytes.extend_from_slice(&first[..start]);
+            set_blocking(file)?;
+        }
+    }
+    let _ = (file, bytes);
+    Ok(true)
+}
+
 /// What a file that is neither a regular file nor a folder is, for messages.
-fn file_kind(meta: &std::fs::Metadata) -> &'static str {
+pub fn file_kind(meta: &std::fs::Metadata) -> &'static str {
+    if meta.is_dir() {
+        return "a folder";
+    }
     #[cfg(unix)]
     {
         use std::os::unix::fs::FileTypeExt;
@@ -281,8 +350,14 @@ pub fn read_list(list: &Path) -> Result<Vec<PathBuf>, InputError> {
             .read_to_end(&mut bytes)
             .map_err(unreadable)?;
     } else {
-        std::fs::File::open(list)
-            .and_then(|file| file.take(MAX_LIST_BYTES + 1).read_to_end(&mut bytes))
+        let file = open_without_waiting(list).map_err(unreadable)?;
+        if !read_stream_start(&file, &mut bytes).map_err(unreadable)? {
+            return Err(InputError::ListWithoutWriter {
+                list: list.to_path_buf(),
+            });
+        }
+        file.take(MAX_LIST_BYTES + 1 - bytes.len() as u64)
+            .read_to_end(&mut bytes)
             .map_err(unreadable)?;
     }
     if bytes.len() as u64 > MAX_LIST_BYTES {

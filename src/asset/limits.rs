@@ -14,6 +14,79 @@ use super::source::FileBytes;
 use std::io::Read;
 use std::path::Path;
 
+/// The signal that asked the run to stop (SIGINT, SIGTERM), 0 while none has: set by the
+/// command's handler (`output::interrupt`), read by the long work below the commands (an
+/// image's decoding, a bake's texels, an encoding), which gives up within a fraction of a
+/// second rather than finish what will be thrown away. It lives here, with the other limits
+/// of a run, because that work cannot see the commands.
+pub static STOP_SIGNAL: std::sync::atomic::AtomicI32 = std::sync::atomic::AtomicI32::new(0);
+
+/// Whether the run was asked to stop (see [`STOP_SIGNAL`]).
+pub fn stop_requested() -> bool {
+    STOP_SIGNAL.load(std::sync::atomic::Ordering::Relaxed) != 0
+}
+
+/// The message of work given up because the run was asked to stop.
+pub const STOPPED: &str = "stopped: the run was asked to stop";
+
+/// A reader of bytes in memory that fails once the run is asked to stop: a decoder reading
+/// through it gives up at its next read, within a fraction of a second, instead of decoding a
+/// 16384² image to the end.
+pub struct StoppableReader<'a>(pub std::io::Cursor<&'a [u8]>);
+
+impl StoppableReader<'_> {
+    fn check() -> std::io::Result<()> {
+        // Not ErrorKind::Interrupted: readers and writers retry a read or write that was
+        // interrupted, and would spin on this one forever.
+        if stop_requested() {
+            return Err(std::io::Error::other(STOPPED));
+        }
+        Ok(())
+    }
+}
+
+impl Read for StoppableReader<'_> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        Self::check()?;
+        // At most 64 KiB a read, so that a decoder asking for everything at once still reads
+        // in steps that look at the flag.
+        let n = buf.len().min(1 << 16);
+        self.0.read(&mut buf[..n])
+    }
+}
+
+impl std::io::BufRead for StoppableReader<'_> {
+    fn fill_buf(&mut self) -> std::io::Result<&[u8]> {
+        Self::check()?;
+        let buf = self.0.fill_buf()?;
+        Ok(&buf[..buf.len().min(1 << 16)])
+    }
+    fn consume(&mut self, amount: usize) {
+        self.0.consume(amount)
+    }
+}
+
+impl std::io::Seek for StoppableReader<'_> {
+    fn seek(&mut self, to: std::io::SeekFrom) -> std::io::Result<u64> {
+        self.0.seek(to)
+    }
+}
+
+/// A writer into memory that fails once the run is asked to stop (an encoder writing a large
+/// image gives up at its next write).
+pub struct StoppableWriter<'a>(pub &'a mut Vec<u8>);
+
+impl std::io::Write for StoppableWriter<'_> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        StoppableReader::check()?;
+        self.0.extend_from_slice(buf);
+        Ok(buf.len())
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
 /// The deepest nesting serde_json parses (its recursion limit of 128 counts the root);
 /// `--max-json-depth` cannot go beyond it.
 pub const JSON_DEPTH_CEILING: usize = 127;

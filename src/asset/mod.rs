@@ -673,9 +673,28 @@ impl Asset {
         }
     }
 
-    /// The pixels of image `index`, decoded (PNG, JPEG or WebP). Decoding is costly: only the
-    /// steps that need texel values call this.
+    /// The pixels of image `index`, decoded, the budget reserved for them alone (see
+    /// [`Asset::decode_image_with`], for a caller that converts them).
     pub fn decode_image(&self, index: usize) -> Result<image::DynamicImage, Diagnostic> {
+        self.decode_image_with(index, 1, 0, |pixels| pixels)
+    }
+
+    /// The pixels of image `index`, decoded (PNG, JPEG or WebP), handed to `use_pixels`, whose
+    /// result is returned. Decoding is costly: only the steps that need texel values call this.
+    ///
+    /// The memory budget (`--max-memory`) is reserved for all that is held while `use_pixels`
+    /// runs, before anything is decoded: `copies` of the decoded image (1: the pixels alone; a
+    /// check for a bake that will hold more asks for as many as the bake will) and
+    /// `extra_bytes_per_pixel` for what `use_pixels` converts them into (4 for `to_rgba8`, 12
+    /// for `to_rgb32f`). Reserving the decoded copy alone let a conversion after it take twice
+    /// the budget and more.
+    pub fn decode_image_with<T>(
+        &self,
+        index: usize,
+        copies: u64,
+        extra_bytes_per_pixel: u64,
+        use_pixels: impl FnOnce(image::DynamicImage) -> T,
+    ) -> Result<T, Diagnostic> {
         let bytes = self.image_bytes(index)?;
         let pointer = format!("/images/{index}");
         let unreadable = |detail: String| {
@@ -717,7 +736,10 @@ impl Asset {
                 ))
             }
         };
-        let reader = image::ImageReader::with_format(Cursor::new(bytes.as_ref()), format);
+        let reader = image::ImageReader::with_format(
+            limits::StoppableReader(Cursor::new(bytes.as_ref())),
+            format,
+        );
         let mut decoder = reader
             .into_decoder()
             .map_err(|e| unreadable(e.to_string()))?;
@@ -725,9 +747,11 @@ impl Asset {
         // the run while this one lasts.
         let needed = u64::from(header.width)
             .saturating_mul(u64::from(header.height))
-            .saturating_mul(u64::from(
-                image::ImageDecoder::color_type(&decoder).bytes_per_pixel(),
-            ));
+            .saturating_mul(
+                u64::from(image::ImageDecoder::color_type(&decoder).bytes_per_pixel())
+                    .saturating_mul(copies.max(1))
+                    .saturating_add(extra_bytes_per_pixel),
+            );
         let what = format!(
             "decoding the {} × {} image ({} bytes a pixel)",
             header.width,
@@ -745,7 +769,9 @@ impl Asset {
         decode_limits.max_alloc = Some(self.options.max_decode_bytes());
         image::ImageDecoder::set_limits(&mut decoder, decode_limits)
             .map_err(|e| unreadable(e.to_string()))?;
-        image::DynamicImage::from_decoder(decoder).map_err(|e| unreadable(e.to_string()))
+        let pixels =
+            image::DynamicImage::from_decoder(decoder).map_err(|e| unreadable(e.to_string()))?;
+        Ok(use_pixels(pixels))
     }
 
     /// Whether the data of image `index` is whole, found once per asset by decoding it (the
@@ -765,7 +791,11 @@ impl Asset {
             return known.clone();
         }
         // Decoded outside the lock: other images are checked meanwhile.
-        let found = match self.decode_image(index) {
+        // Reserved as the bake that follows will hold the image (the decoder's buffer, the
+        // pixels and an output: bake::codec::DECODE_COPIES), so that a check is refused where
+        // its bake would be, before anything is decoded, rather than decode what cannot be
+        // baked.
+        let found = match self.decode_image_with(index, 3, 0, drop) {
             Err(d)
                 if d.code == codes::IMAGE_DATA_INVALID.name
                     || d.code == codes::IMAGE_UNEXPECTED_EOS.name =>

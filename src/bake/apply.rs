@@ -102,6 +102,21 @@ const PATH_SEGMENT: &percent_encoding::AsciiSet = &percent_encoding::NON_ALPHANU
 /// The name an image goes by: its `name`, else its URI's file stem, else `image<N>`
 /// (`images` is the document's `images` array).
 fn image_base_name(images: &Value, image: usize) -> String {
+    let name = image_given_name(images, image);
+    // A file name holds at most 255 bytes: the image's part of a new file's name is cut to
+    // MAX_IMAGE_NAME_BYTES (at a character's boundary), leaving room for the slots, the hash
+    // and the extension, so that a 5,000-byte image name cannot fail its file (ENAMETOOLONG).
+    let mut end = name.len().min(MAX_IMAGE_NAME_BYTES);
+    while !name.is_char_boundary(end) {
+        end -= 1;
+    }
+    name[..end].to_owned()
+}
+
+/// The most bytes of an image's name a new file's name keeps.
+const MAX_IMAGE_NAME_BYTES: usize = 64;
+
+fn image_given_name(images: &Value, image: usize) -> String {
     let entry = &images[image];
     if let Some(name) = entry
         .get("name")
@@ -170,9 +185,12 @@ pub fn file_uri(file: &str) -> String {
     percent_encoding::utf8_percent_encode(file, PATH_SEGMENT).to_string()
 }
 
-/// A file name made safe: path separators and control characters become '_'.
+/// A file name made safe: path separators and control characters become '_', and leading
+/// dots are dropped, so that no image name (`..`, `.velvet-1-x.tmp`) makes a hidden file, one a
+/// folder listing leaves out or a later run takes for its own temporary file.
 fn file_safe(name: &str) -> String {
-    name.chars()
+    let safe: String = name
+        .chars()
         .map(|c| {
             if c == '/' || c == '\\' || c.is_control() || c == ':' {
                 '_'
@@ -180,7 +198,11 @@ fn file_safe(name: &str) -> String {
                 c
             }
         })
-        .collect()
+        .collect();
+    match safe.trim_start_matches('.') {
+        "" => "image".to_string(),
+        kept => kept.to_string(),
+    }
 }
 
 /// The factor values a uniform output gives one slot, if every output of the slot is uniform

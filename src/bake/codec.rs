@@ -195,7 +195,10 @@ pub fn decode_within(
             message,
         });
     }
-    let reader = ImageReader::with_format(Cursor::new(bytes), image_format);
+    let reader = ImageReader::with_format(
+        crate::asset::limits::StoppableReader(Cursor::new(bytes)),
+        image_format,
+    );
     let mut decoder = reader.into_decoder().map_err(decode_error)?;
     let needed = u64::from(width)
         .saturating_mul(u64::from(height))
@@ -304,7 +307,8 @@ pub fn encode(
             &wide
         }
     };
-    let mut out = Vec::new();
+    let mut bytes_out = Vec::new();
+    let mut out = crate::asset::limits::StoppableWriter(&mut bytes_out);
     match format {
         OutputFormat::Png => {
             let compression = match options.png {
@@ -327,7 +331,7 @@ pub fn encode(
                 .map_err(encode_error)?;
         }
     }
-    Ok(out)
+    Ok(bytes_out)
 }
 
 #[cfg(test)]

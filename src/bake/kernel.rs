@@ -79,6 +79,21 @@ pub enum KernelError {
     /// The recipe reads an image that was not supplied.
     #[error("{0} is not decoded")]
     MissingImage(ImageId),
+    /// The run was asked to stop while the texels were computed; the output is incomplete.
+    #[error("{}", crate::asset::limits::STOPPED)]
+    Stopped,
+}
+
+use crate::asset::limits::stop_requested;
+
+/// `Err(Stopped)` when the run was asked to stop while `out` was computed: its bands skipped
+/// since then leave it incomplete.
+fn unless_stopped<T>(out: T) -> Result<T, KernelError> {
+    if stop_requested() {
+        Err(KernelError::Stopped)
+    } else {
+        Ok(out)
+    }
 }
 
 /// Applies `recipe` to `images` (which must hold every image the recipe reads).
@@ -88,7 +103,7 @@ pub fn apply(
     options: KernelOptions,
 ) -> Result<(Pixels, KernelStats), KernelError> {
     let plan = Plan::compile(recipe, images, options)?;
-    Ok(match plan.depth {
+    unless_stopped(match plan.depth {
         Depth::Eight => plan.run::<u8>(),
         Depth::Sixteen => plan.run::<u16>(),
     })
@@ -133,7 +148,7 @@ pub fn apply_owned(
     run_in_place(&mut codes, &tables, &offsets);
     let pixels =
         Pixels::new(width, height, layout, Samples::U8(codes)).expect("the buffer keeps its size");
-    Ok((pixels, KernelStats { channels: stats }))
+    unless_stopped((pixels, KernelStats { channels: stats }))
 }
 
 /// The fused pass over a buffer whose pixels it rewrites (output layout = input layout).
@@ -143,6 +158,10 @@ fn run_in_place(codes: &mut [u8], tables: &[[u8; 256]], offsets: &[usize]) {
         let offsets: [usize; N] = std::array::from_fn(|c| offsets[c]);
         let own = offsets.iter().enumerate().all(|(c, &o)| o == c);
         codes.par_chunks_mut(N * 65536).for_each(|band| {
+            // A band takes well under a millisecond: a stop is seen at once.
+            if stop_requested() {
+                return;
+            }
             for p in band.chunks_exact_mut(N) {
                 // Every source code of the pixel is read before any is written.
                 let src: [u8; N] = std::array::from_fn(|c| p[c]);
@@ -621,6 +640,9 @@ impl<'a> Plan<'a> {
                 out.par_chunks_mut(band_len)
                     .enumerate()
                     .map(|(b, band)| {
+                        if stop_requested() {
+                            return self.programs.iter().map(|_| Acc::default()).collect();
+                        }
                         let first_pixel = b * rows_per_band * width;
                         self.programs
                             .iter()
@@ -722,6 +744,9 @@ fn run_fused(fused: &Fused<'_>, out: &mut [u8], band_len: usize, n: usize) {
         out.par_chunks_mut(band_len)
             .enumerate()
             .for_each(|(b, band)| {
+                if stop_requested() {
+                    return;
+                }
                 let first = b * pixels_per_band;
                 let src = &fused.codes[first * S..(first + band.len() / N) * S];
                 let pairs = band.chunks_exact_mut(N).zip(src.chunks_exact(S));

@@ -56,13 +56,87 @@ impl Status {
 
 /// A request refused before anything was read or written: the message on standard error.
 pub fn usage_error(message: impl std::fmt::Display) -> Status {
-    eprintln!("velvet: {message}");
+    note(format_args!("velvet: {message}"));
     Status::Usage
 }
 
-/// Writes to standard output; a closed pipe (`velvet … | head`) is not an error.
+/// Standard output as every command writes it: each write goes to the process's standard
+/// output and a failure is recorded (see [`finish`]), so that a report lost to a full disk or a
+/// closed descriptor cannot end in exit status 0. A closed pipe (`velvet … | head`) is not a
+/// failure: the reader chose to stop, as `cat` and other tools take it.
+pub struct Stdout;
+
+impl Write for Stdout {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        let written = std::io::stdout().lock().write(buf);
+        recorded(Stream::Output, written)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        let flushed = std::io::stdout().lock().flush();
+        recorded(Stream::Output, flushed)
+    }
+}
+
+/// Writes to standard output; a failure other than a closed pipe fails the run (see [`Stdout`]).
 pub fn emit(text: &[u8]) {
-    let _ = std::io::stdout().lock().write_all(text);
+    let _ = Stdout.write_all(text);
+}
+
+/// Writes one line to standard error. `eprintln!` would panic when standard error cannot be
+/// written (exit status 101); a failure here is recorded and fails the run instead.
+/// The line is escaped as reports escape an asset's text (file names, messages quoting an
+/// asset): a control character in a folder's name must not act on the terminal.
+pub fn note(line: std::fmt::Arguments) {
+    let line = line.to_string();
+    let mut err = std::io::stderr().lock();
+    let written = writeln!(err, "{}", crate::report::escape::terminal(&line));
+    let _ = recorded(Stream::Error, written);
+}
+
+/// Records the result of a write to standard output made by other code (clap's help text).
+pub fn stdout_written(result: std::io::Result<()>) {
+    let _ = recorded(Stream::Output, result);
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Stream {
+    Output,
+    Error,
+}
+
+/// The first failed write to standard output or standard error, other than a closed pipe.
+static WRITE_FAILURE: std::sync::OnceLock<(Stream, String)> = std::sync::OnceLock::new();
+
+fn recorded<T>(stream: Stream, result: std::io::Result<T>) -> std::io::Result<T> {
+    if let Err(e) = &result {
+        if e.kind() != std::io::ErrorKind::BrokenPipe && e.kind() != std::io::ErrorKind::Interrupted
+        {
+            let _ = WRITE_FAILURE.set((stream, e.to_string()));
+        }
+    }
+    result
+}
+
+/// The status a command ends with once its output is flushed: a run whose standard output or
+/// standard error could not be written is status 2 ("velvet: cannot write to standard output:
+/// …" on standard error, when that can be written), whatever it found; a run stopped by a
+/// signal keeps its 130 or 143.
+pub fn finish(status: Status) -> Status {
+    let _ = Stdout.flush();
+    let _ = recorded(Stream::Error, std::io::stderr().lock().flush());
+    match (WRITE_FAILURE.get(), status) {
+        (_, Status::Stopped(_)) | (None, _) => status,
+        (Some((stream, error)), _) => {
+            if *stream == Stream::Output {
+                let _ = writeln!(
+                    std::io::stderr().lock(),
+                    "velvet: cannot write to standard output: {error}"
+                );
+            }
+            Status::Usage
+        }
+    }
 }
 
 /// When SIGINT or SIGTERM stopped a migrate or bake run: the one line saying what was finished
@@ -75,13 +149,13 @@ fn stopped(finished: impl Iterator<Item = bool>) -> Option<Status> {
         total += 1;
         done += usize::from(finished);
     }
-    eprintln!(
+    note(format_args!(
         "velvet: stopped by {}: {done} of {total} {} finished (their outputs are complete); \
          nothing was written for the other {}",
         crate::output::interrupt::name(signal),
         if total == 1 { "file" } else { "files" },
         total - done
-    );
+    ));
     Some(Status::Stopped(signal))
 }
 

@@ -4,6 +4,7 @@
 
 use super::Status;
 use crate::asset::{discover, LoadOptions};
+use crate::report::escape::push_line;
 use std::path::{Path, PathBuf};
 
 /// One `velvet preview` invocation.
@@ -43,7 +44,11 @@ pub fn command(request: &Request) -> Status {
 /// Prints the files that could not be previewed (each line after `prefix`); true if any.
 pub(super) fn report_failures(plan: &crate::preview::Plan, prefix: &str) -> bool {
     for f in &plan.failures {
-        eprintln!("velvet: {prefix}{}: {}", f.file.display(), f.message);
+        super::note(format_args!(
+            "velvet: {prefix}{}: {}",
+            f.file.display(),
+            f.message
+        ));
     }
     !plan.failures.is_empty()
 }
@@ -59,40 +64,51 @@ pub(super) fn write(
     let written = match crate::preview::write(plan, output, worst, !quiet) {
         Ok(written) => written,
         Err(e) => {
-            eprintln!("velvet: {e}");
+            super::note(format_args!("velvet: {e}"));
             return Some(Status::Failed);
         }
     };
     if written.stopped {
         let signal = crate::output::interrupt::requested().unwrap_or(2);
-        eprintln!(
+        super::note(format_args!(
             "velvet: stopped by {}: {} of {} sheets written (each complete); no index written",
             crate::output::interrupt::name(signal),
             written.drawn.len(),
             worst.map_or(plan.sheets.len(), |n| n.min(plan.sheets.len()))
-        );
+        ));
         return Some(Status::Stopped(signal));
     }
     if !quiet {
+        // Material names and file names come from the assets: each line is escaped (see
+        // report::escape), so that ESC or U+202E in a name does not act on the terminal.
         let mut out = String::new();
         for d in &written.drawn {
-            out += &format!(
-                "{}: {} ({})\n",
-                d.path.display(),
-                d.summary.title,
-                d.summary.verdict.text()
+            push_line(
+                &mut out,
+                &format!(
+                    "{}: {} ({})",
+                    d.path.display(),
+                    d.summary.title,
+                    d.summary.verdict.text()
+                ),
             );
         }
         for f in &plan.without_layers {
-            out += &format!("{}: no material with a sheen or fuzz layer\n", f.display());
+            push_line(
+                &mut out,
+                &format!("{}: no material with a sheen or fuzz layer", f.display()),
+            );
         }
         if let Some(index) = written.pages.first() {
-            out += &format!(
-                "{} material(s) on {} sheet(s), {} drawn; index: {}\n",
-                plan.entries.len(),
-                plan.sheets.len(),
-                written.drawn.len(),
-                index.display()
+            push_line(
+                &mut out,
+                &format!(
+                    "{} material(s) on {} sheet(s), {} drawn; index: {}",
+                    plan.entries.len(),
+                    plan.sheets.len(),
+                    written.drawn.len(),
+                    index.display()
+                ),
             );
         }
         super::emit(out.as_bytes());

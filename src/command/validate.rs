@@ -76,6 +76,25 @@ pub fn command(request: &Request) -> Status {
     let validator = validator
         .with_load_options(request.load)
         .with_positions(request.format.shows_positions());
+    if request.fix.fix {
+        // --fix writes the files in place, as `migrate --in-place` does: a link leading out of
+        // the folders given is refused before anything is written, and from here on SIGINT and
+        // SIGTERM stop the run cleanly (files already written stay, the others are not).
+        if let Err(crate::output::UsageError::LinkOutside { link, target, root }) =
+            crate::output::paths::jobs(
+                &paths,
+                &crate::output::paths::Destination::InPlace,
+                false,
+                request.shard,
+            )
+        {
+            return failed(format!(
+                "--fix: {link} is a symbolic link to {target}, outside {root}; velvet writes \
+                 only inside the folders it is given (name the target itself to fix it)"
+            ));
+        }
+        crate::output::interrupt::install();
+    }
     let progress = report::progress_bar(request.quiet);
     let options = report::Options {
         color: request.format == Format::Text && request.color.for_stdout(),
@@ -91,9 +110,11 @@ pub fn command(request: &Request) -> Status {
             unsafe_fixes: request.fix.unsafe_fixes,
             edits: matches!(request.format, Format::Json | Format::Jsonl | Format::Sarif),
         },
-    );
+    )
+    .stopping_when(|| crate::output::interrupt::requested().is_some());
+    let mut finished = 0usize;
     // Each file's report is written as soon as it is done (see report::Stream).
-    let stdout = std::io::BufWriter::new(std::io::stdout().lock());
+    let stdout = std::io::BufWriter::new(super::Stdout);
     let mut stream = report::Stream::new(request.format, options, stdout).json_array(!one_file);
     let outcome = match crate::run::check_shard_each(
         &validator,
@@ -102,13 +123,20 @@ pub fn command(request: &Request) -> Status {
         &mut resolver,
         progress.as_ref(),
         &|path, settings| fixing.check(path, settings),
-        &mut |r| match &progress {
-            // The bar is cleared while the report is written, so the two do not mix.
-            Some(bar) => bar.suspend(|| {
-                stream.push(r);
-                stream.flush();
-            }),
-            None => stream.push(r),
+        &mut |r| {
+            // A file abandoned by a stop has no report: nothing was done to it.
+            if r.fixes.write_error.as_deref() == Some(crate::fix::ABANDONED) {
+                return;
+            }
+            finished += 1;
+            match &progress {
+                // The bar is cleared while the report is written, so the two do not mix.
+                Some(bar) => bar.suspend(|| {
+                    stream.push(r);
+                    stream.flush();
+                }),
+                None => stream.push(r),
+            }
         },
     ) {
         Ok(o) => o,
@@ -120,6 +148,16 @@ pub fn command(request: &Request) -> Status {
         }
     };
     stream.finish();
+    for warning in resolver.warnings() {
+        super::note(format_args!("velvet: {warning}"));
+    }
+    if request.fix.fix {
+        let abandoned = fixing.files_abandoned();
+        let each = std::iter::repeat_n(true, finished).chain(std::iter::repeat_n(false, abandoned));
+        if let Some(stopped) = super::stopped(each) {
+            return stopped;
+        }
+    }
     // Fixed findings do not fail the run; those left do. A change fails it where it is asked to
     // be reviewed (--diff, --exit-non-zero-on-fix).
     let changed =

@@ -31,8 +31,9 @@ use crate::edit::Edit;
 use crate::validate::{FileReport, Finding, Validator};
 use rayon::prelude::*;
 use std::collections::HashMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
 
 /// One fix: the findings it repairs, how safe it is, what it does and its edits.
 #[derive(Debug, Clone, PartialEq)]
@@ -177,6 +178,30 @@ pub struct Fixing<'v> {
     validator: &'v Validator,
     mode: Mode,
     changed: AtomicUsize,
+    /// Whether the run was asked to stop (the command's SIGINT and SIGTERM handling): a file
+    /// not yet written is then abandoned, one already written stays as it is.
+    stop: fn() -> bool,
+    /// Files abandoned because the run was asked to stop.
+    abandoned: AtomicUsize,
+    /// The file each check writes, held while it is checked: a folder holding a link and its
+    /// target fixes the target once, the second check reading what the first wrote.
+    writing: Mutex<HashMap<PathBuf, Arc<Mutex<()>>>>,
+}
+
+/// The write error of a file abandoned because the run was asked to stop (nothing of it was
+/// written); its report is left out of the output.
+pub const ABANDONED: &str = "stopped before it was written (nothing of it was written)";
+
+/// The file a write to `path` must replace: for a symbolic link, the file it leads to, so that
+/// the link stays a link and its target is the file fixed (renaming a temporary file over the
+/// link would replace the link with a regular file and leave its target as it was). A link
+/// leading out of the folders given is refused before the run (`command::validate`).
+fn written_file(path: &Path) -> PathBuf {
+    let is_link = std::fs::symlink_metadata(path).is_ok_and(|m| m.is_symlink());
+    match is_link.then(|| path.canonicalize()) {
+        Some(Ok(target)) => target,
+        _ => path.to_path_buf(),
+    }
 }
 
 /// A file with fixes applied, validated again.
@@ -195,6 +220,37 @@ impl<'v> Fixing<'v> {
             validator,
             mode,
             changed: AtomicUsize::new(0),
+            stop: || false,
+            abandoned: AtomicUsize::new(0),
+            writing: Mutex::new(HashMap::new()),
+        }
+    }
+
+    /// The same, abandoning the files not yet written once `stop` says so.
+    pub fn stopping_when(self, stop: fn() -> bool) -> Fixing<'v> {
+        Fixing { stop, ..self }
+    }
+
+    /// How many files were abandoned because the run was asked to stop.
+    pub fn files_abandoned(&self) -> usize {
+        self.abandoned.load(Ordering::Relaxed)
+    }
+
+    /// The report of a file abandoned before it was written.
+    fn abandoned(&self, path: &Path) -> FileReport {
+        self.abandoned.fetch_add(1, Ordering::Relaxed);
+        let mut fixes = FileFixes::new(Vec::new());
+        fixes.write_error = Some(ABANDONED.to_string());
+        FileReport {
+            path: path.to_path_buf(),
+            container: None,
+            json_offset: 0,
+            findings: Vec::new(),
+            counts: Default::default(),
+            omitted: 0,
+            info: None,
+            missing: Default::default(),
+            fixes,
         }
     }
 
@@ -206,6 +262,21 @@ impl<'v> Fixing<'v> {
     /// The file at `path` validated under `settings`, its fixes planned and, as the mode says,
     /// applied: the report of the file as it is after the run, with its fixes.
     pub fn check(&self, path: &Path, settings: &Settings) -> FileReport {
+        if !self.mode.apply {
+            return self.check_unlocked(path, settings);
+        }
+        if (self.stop)() {
+            return self.abandoned(path);
+        }
+        let lock = {
+            let mut writing = self.writing.lock().unwrap_or_else(|e| e.into_inner());
+            writing.entry(written_file(path)).or_default().clone()
+        };
+        let _held = lock.lock().unwrap_or_else(|e| e.into_inner());
+        self.check_unlocked(path, settings)
+    }
+
+    fn check_unlocked(&self, path: &Path, settings: &Settings) -> FileReport {
         let load = &self.validator.load;
         let (loaded, snapshot) = if self.mode.apply {
             match asset::read_for_writing(path, load) {
@@ -322,12 +393,15 @@ impl<'v> Fixing<'v> {
             let after_text = fixed.asset.json_text.trim_end_matches(['\0', ' ']);
             file_fixes.diff = Some(text::unified_diff(&name, before_text, after_text));
         } else {
+            if (self.stop)() {
+                return self.abandoned(path);
+            }
             let written = match &snapshot {
                 Some(snapshot) => snapshot.unchanged(path),
                 None => Err(format!("{} could not be read for writing", path.display())),
             }
             .and_then(|()| {
-                crate::edit::write::write_atomic(path, &fixed.bytes)
+                crate::edit::write::write_atomic(&written_file(path), &fixed.bytes)
                     .map_err(|e| format!("cannot write {}: {e}", path.display()))
             });
             if let Err(e) = written {

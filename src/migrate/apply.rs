@@ -12,7 +12,7 @@ use super::bake_part::BakePart;
 use super::plan::{plan_document, DocumentPlan};
 use super::textures;
 use super::Options;
-use crate::asset::{self, Asset, FileBytes, Snapshot};
+use crate::asset::{self, Asset, FileBytes};
 use crate::bake::apply::{apply as bake_apply, ApplyOptions, OutputReport};
 use crate::bake::engine::Baked;
 use crate::bake::plan::BakePlan;
@@ -34,8 +34,9 @@ use std::sync::Mutex;
 #[derive(Debug)]
 pub struct FilePlan {
     pub input: PathBuf,
-    /// The input as it was read, compared before anything is written for it.
-    pub snapshot: Snapshot,
+    /// The input as it was read, and its resources, compared before anything is written for
+    /// it.
+    pub snapshot: crate::output::InputSnapshot,
     pub output: Option<PathBuf>,
     /// The input's bytes, kept when the plan changes nothing (then written as they are).
     pub bytes: Option<FileBytes>,

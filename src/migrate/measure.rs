@@ -41,8 +41,11 @@ pub fn attenuation(
     let mut last_error = format!("texture {index} has no image source");
     for (source, _) in texture_sources(texture, &format!("/textures/{index}")) {
         let Some(image) = source else { continue };
-        match asset.decode_image(image as usize) {
-            Ok(decoded) => return Ok(over_texels(image as usize, &decoded.to_rgb32f(), factor, w)),
+        let measured = asset.decode_image_with(image as usize, 1, 12, |decoded| {
+            over_texels(image as usize, &decoded.to_rgb32f(), factor, w)
+        });
+        match measured {
+            Ok(measured) => return Ok(measured),
             Err(d) => last_error = d.message,
         }
     }

@@ -1,18 +1,18 @@
-//! SIGINT and SIGTERM during `migrate` and `bake`: a clean stop. The handler only records the
-//! signal; the run looks at it between files and between a file's steps (before each new
-//! texture is written, before a file's outputs are put in place), abandons the files in
-//! progress, whose staged files are removed as they are dropped (see [`super::staging`]), and
-//! keeps every output already put in place. The command then prints one line saying what was
-//! finished and exits with 128 + the signal (130, 143).
+//! SIGINT and SIGTERM during `migrate`, `bake` and `validate --fix`: a clean stop. The handler
+//! only records the signal (in [`crate::asset::limits::STOP_SIGNAL`], where the long work below
+//! the commands sees it too); the run looks at it between files and between a file's steps
+//! (before each new texture is written, before a file's outputs are put in place), abandons the
+//! files in progress, whose staged files are removed as they are dropped (see
+//! [`super::staging`]), and keeps every output already put in place. The command then prints
+//! one line saying what was finished and exits with 128 + the signal (130, 143).
 //!
 //! The handler is installed with SA_RESETHAND: a second Ctrl-C ends the process at once, as
 //! if velvet had no handler (its staging files are then removed by the next run into that
-//! folder). `validate` writes nothing and keeps the default behaviour.
+//! folder). `validate --fix` installs it too (a file not yet written is abandoned, one
+//! written stays); `validate` without it writes nothing and keeps the default behaviour.
 
-use std::sync::atomic::{AtomicI32, Ordering};
-
-/// The signal that asked the run to stop, 0 while none has.
-static STOP: AtomicI32 = AtomicI32::new(0);
+use crate::asset::limits::STOP_SIGNAL as STOP;
+use std::sync::atomic::Ordering;
 
 /// The message of a file abandoned because the run was asked to stop.
 pub const ABANDONED: &str = "stopped before it was finished (nothing of it was written)";
@@ -37,6 +37,18 @@ pub fn install() {
                 libc::sigaction(signal, &action, std::ptr::null_mut());
             }
         }
+    }
+}
+
+/// Ignores SIGXFSZ, for the whole process (Unix; elsewhere nothing). A write past a file-size
+/// limit (`ulimit -f`, `prlimit --fsize`) would otherwise kill velvet mid-write, leaving its
+/// temporary files behind; ignored, the write fails with EFBIG, which fails that file cleanly
+/// (its staged files removed) as a full disk does.
+pub fn ignore_file_size_signal() {
+    #[cfg(unix)]
+    // SAFETY: setting a signal's disposition to SIG_IGN has no handler to be unsafe in.
+    unsafe {
+        libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
     }
 }
 

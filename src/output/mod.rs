@@ -149,8 +149,63 @@ pub struct Input {
     /// The file's bytes where the loader kept them (a GLB's, for an output with nothing to
     /// change, written as they are); a .gltf's are the asset's text.
     pub bytes: Option<FileBytes>,
-    /// The file as it was read, compared before anything is written for it.
-    pub snapshot: Snapshot,
+    /// The file as it was read, and its resources, compared before anything is written for it.
+    pub snapshot: InputSnapshot,
+}
+
+/// What an input and the files its URIs name (buffers, images) were when it was loaded: a
+/// resource read for its output (baked, copied beside it) is held to it as the document is,
+/// so that one deleted or replaced while velvet works fails the file, nothing written for it,
+/// rather than give an output without its .bin or baked from another image.
+#[derive(Debug, Clone)]
+pub struct InputSnapshot {
+    document: Snapshot,
+    /// Each resource file with what it was (`None`: it did not exist, and must not appear).
+    resources: Vec<(std::path::PathBuf, Option<Snapshot>)>,
+}
+
+impl InputSnapshot {
+    /// The resources `asset` names in files, as they are now.
+    fn taken(document: Snapshot, asset: &Asset) -> InputSnapshot {
+        let resources = paths::relative_uris(asset.root())
+            .iter()
+            .filter_map(|uri| match asset.resolve(uri, "") {
+                Ok(crate::asset::resource::Location::File(path)) => Some(path),
+                _ => None,
+            })
+            .map(|path| {
+                let was = Snapshot::before_reading(&path).ok();
+                (path, was)
+            })
+            .collect();
+        InputSnapshot {
+            document,
+            resources,
+        }
+    }
+
+    /// `Ok` when the input at `path` and every resource it names are as they were when it was
+    /// loaded; otherwise the message naming the one that is not.
+    pub fn unchanged(&self, path: &std::path::Path) -> Result<(), String> {
+        self.document.unchanged(path)?;
+        for (resource, was) in &self.resources {
+            match was {
+                Some(was) => was
+                    .unchanged(resource)
+                    .map_err(|e| format!("resource {e}"))?,
+                None if std::fs::symlink_metadata(resource).is_ok() => {
+                    return Err(format!(
+                        "resource {} appeared while velvet worked on {}; nothing was written \
+                         for it",
+                        resource.display(),
+                        path.display()
+                    ))
+                }
+                None => {}
+            }
+        }
+        Ok(())
+    }
 }
 
 /// Reads and loads `path` for a command that writes its output (`verb`: "migrated", "baked").
@@ -175,9 +230,9 @@ pub fn load_input(
         .collect();
     match loaded.asset {
         Some(asset) if errors.is_empty() => Ok(Input {
+            snapshot: InputSnapshot::taken(snapshot, &asset),
             asset,
             bytes,
-            snapshot,
         }),
         _ => Err(format!("cannot be {verb}: {}", errors.join("; "))),
     }

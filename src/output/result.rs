@@ -22,12 +22,31 @@ pub trait Account: Default {
 /// report lists beside the others).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FileResult<D> {
+    #[serde(serialize_with = "lossy_path")]
     pub input: PathBuf,
+    #[serde(serialize_with = "lossy_optional_path")]
     pub output: Option<PathBuf>,
     #[serde(flatten)]
     pub outcome: Outcome,
     #[serde(flatten)]
     pub detail: D,
+}
+
+/// A path in the JSON report: a file name need not be UTF-8, and serde's own serialisation of
+/// a path fails on one that is not (after the outputs were written), so it is written lossily
+/// (U+FFFD for each byte that is not UTF-8), as the text report shows it.
+fn lossy_path<S: serde::Serializer>(path: &Path, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_str(&path.to_string_lossy())
+}
+
+fn lossy_optional_path<S: serde::Serializer>(
+    path: &Option<PathBuf>,
+    s: S,
+) -> Result<S::Ok, S::Error> {
+    match path {
+        Some(path) => lossy_path(path, s),
+        None => s.serialize_none(),
+    }
 }
 
 impl<D: Account> FileResult<D> {

@@ -48,8 +48,13 @@ impl Staging {
         Ok(placed)
     }
 
-    /// Stages the output document at `path`.
+    /// Stages the output document at `path`, its folder created if need be (`--out-dir NEW`
+    /// for a file whose output writes nothing else there first).
     pub fn stage_document(&self, path: &Path, output: &Output) -> Result<(), String> {
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir)
+                .map_err(|e| format!("cannot create folder {}: {e}", dir.display()))?;
+        }
         let staged = write::stage_output(path, output)
             .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
         self.push(staged);

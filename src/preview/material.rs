@@ -617,9 +617,8 @@ fn image_stats(
     );
     cell.get_or_init(|| {
         asset
-            .decode_image(image)
+            .decode_image_with(image, 1, 4, |img| stats_by(&img.to_rgba8(), read, transfer))
             .map_err(|d| d.message)
-            .map(|img| stats_by(&img.to_rgba8(), read, transfer))
     })
     .clone()
 }
