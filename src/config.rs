@@ -88,6 +88,8 @@ pub struct Layer {
     pub overrides: BTreeMap<String, Severity>,
     pub fail_on: Option<FailOn>,
     pub exclude: Vec<String>,
+    /// `data = false`, `--no-data`: leave out the checks that read accessor data.
+    pub data: Option<bool>,
 }
 
 /// The keys of velvet.toml as written.
@@ -102,6 +104,7 @@ struct RawFile {
     overrides: Option<BTreeMap<String, RawSeverity>>,
     fail_on: Option<String>,
     exclude: Option<Vec<String>>,
+    data: Option<bool>,
 }
 
 /// An integer, with an error message that says so in the file's terms.
@@ -299,18 +302,20 @@ impl Layer {
             overrides,
             fail_on,
             exclude,
+            data: raw.data,
         })
     }
 
     /// The layer the command line sets: `--max-issues`, `--ignore` or `--only` (repeatable),
-    /// `--override CODE=SEVERITY` (repeatable) and `--fail-on`. Empty lists leave the key to
-    /// the file.
+    /// `--override CODE=SEVERITY` (repeatable), `--fail-on` and `--no-data` (`data` false).
+    /// Empty lists leave the key to the file.
     pub fn command_line(
         max_issues: Option<usize>,
         ignore: &[String],
         only: &[String],
         overrides: &[String],
         fail_on: Option<FailOn>,
+        data: Option<bool>,
     ) -> Result<Layer, ConfigError> {
         let nonempty = |l: &[String]| (!l.is_empty()).then(|| l.to_vec());
         let flag = |m: String| ConfigError::CommandLine(format!("--{m}"));
@@ -338,6 +343,7 @@ impl Layer {
             overrides: map,
             fail_on,
             exclude: Vec::new(),
+            data,
         })
     }
 
@@ -410,6 +416,8 @@ pub struct Config {
     pub overrides: BTreeMap<String, (Severity, Source)>,
     pub fail_on: (FailOn, Source),
     pub exclude: Vec<String>,
+    /// Whether the checks that read accessor data run.
+    pub data: (bool, Source),
     /// Patterns with a `/`, matched against the path below the file's folder.
     anchored: GlobSet,
     /// Patterns without a `/`, matched against every component of that path.
@@ -438,6 +446,7 @@ impl Config {
         let max_issues = pick(&cli.max_issues, &file_layer.max_issues, 0);
         let selection = combine_selection(&cli.selection, &file_layer.selection);
         let fail_on = pick(&cli.fail_on, &file_layer.fail_on, FailOn::Error);
+        let data = pick(&cli.data, &file_layer.data, true);
         let mut overrides: BTreeMap<String, (Severity, Source)> = file_layer
             .overrides
             .iter()
@@ -497,6 +506,7 @@ impl Config {
                 .collect(),
             max_issues: (max_issues.0 > 0).then_some(max_issues.0),
             fail_on: fail_on.0,
+            skip_data: !data.0,
         };
         Config {
             file: path,
@@ -504,6 +514,7 @@ impl Config {
             selection,
             overrides,
             fail_on,
+            data,
             exclude: file_layer.exclude,
             anchored: anchored.build().unwrap_or_else(|_| GlobSet::empty()),
             component: component.build().unwrap_or_else(|_| GlobSet::empty()),
@@ -634,6 +645,13 @@ impl Config {
             list(&mut self.exclude.iter()),
             source.describe()
         );
+        let (data, source) = self.data;
+        let _ = writeln!(
+            out,
+            "data = {data}  # {}{}",
+            source.describe(),
+            if data { "" } else { " (accessor data and image bytes not read)" }
+        );
         out.push_str("\n[override]\n");
         for (code, (severity, source)) in &self.overrides {
             let _ = writeln!(
@@ -660,6 +678,8 @@ pub struct Flags {
     /// `CODE=SEVERITY`, as given.
     pub overrides: Vec<String>,
     pub fail_on: Option<FailOn>,
+    /// `--no-data`: the checks that read accessor data are left out.
+    pub no_data: bool,
 }
 
 impl Flags {
@@ -671,6 +691,7 @@ impl Flags {
             &self.only,
             &self.overrides,
             self.fail_on,
+            self.no_data.then_some(false),
         )?;
         Resolver::new(self.config.as_deref(), layer)
     }
@@ -895,6 +916,7 @@ mod tests {
             .into(),
             fail_on: None,
             exclude: vec![],
+            data: Some(false),
         };
         let cli = Layer {
             max_issues: Some(2),
@@ -912,6 +934,16 @@ mod tests {
         );
         assert_eq!(c.settings().max_issues, Some(2));
         assert!(c.settings().ignore.contains("TYPE_MISMATCH"));
+        // `data = false` in the file leaves out the data checks; `--no-data` does the same
+        // from the command line; by default they run.
+        assert_eq!(c.data, (false, Source::File));
+        assert!(c.settings().skip_data);
+        let none = Config::combine(None, &Layer::default());
+        assert_eq!(none.data, (true, Source::Default));
+        assert!(!none.settings().skip_data);
+        let flag = Layer::command_line(None, &[], &[], &[], None, Some(false)).unwrap();
+        assert_eq!(Config::combine(None, &flag).data, (false, Source::CommandLine));
+        assert_eq!(Layer::parse("data = false").unwrap().data, Some(false));
     }
 
     fn codes(list: &[&str]) -> BTreeSet<String> {
@@ -923,7 +955,7 @@ mod tests {
         let file_ignore = Layer::parse("ignore = [\"TYPE_MISMATCH\"]").unwrap();
         let file_only = Layer::parse("only = [\"TYPE_MISMATCH\", \"VALUE_NOT_IN_RANGE\"]").unwrap();
         let cli =
-            Layer::command_line(None, &["UNEXPECTED_PROPERTY".into()], &[], &[], None).unwrap();
+            Layer::command_line(None, &["UNEXPECTED_PROPERTY".into()], &[], &[], None, None).unwrap();
         let file = PathBuf::from("/p/velvet.toml");
         let c = Config::combine(Some((file.clone(), file_ignore.clone())), &cli);
         assert_eq!(
@@ -941,7 +973,7 @@ mod tests {
             .to_toml()
             .contains("ignore = [\"TYPE_MISMATCH\", \"UNEXPECTED_PROPERTY\"]  # velvet.toml and command line\n"));
         let cli_only_off =
-            Layer::command_line(None, &["VALUE_NOT_IN_RANGE".into()], &[], &[], None).unwrap();
+            Layer::command_line(None, &["VALUE_NOT_IN_RANGE".into()], &[], &[], None, None).unwrap();
         let c = Config::combine(Some((file.clone(), file_only.clone())), &cli_only_off);
         assert_eq!(
             c.selection,
@@ -960,7 +992,7 @@ mod tests {
             )
         );
         let cli_only =
-            Layer::command_line(None, &[], &["VALUE_NOT_IN_RANGE".into()], &[], None).unwrap();
+            Layer::command_line(None, &[], &["VALUE_NOT_IN_RANGE".into()], &[], None, None).unwrap();
         let c = Config::combine(Some((file, file_ignore)), &cli_only);
         assert_eq!(
             c.selection,

@@ -104,6 +104,10 @@ struct SettingsArgs {
     /// The lowest severity that makes the exit status 1 [default: error].
     #[arg(long, value_enum)]
     fail_on: Option<FailOnArg>,
+    /// Check the JSON, the GLB container and image headers only: do not read accessor data
+    /// (bounds, indices, keyframes, weights, …) nor image bytes beyond their headers.
+    #[arg(long)]
+    no_data: bool,
 }
 
 /// Limits for reading assets nobody checked; each refusal names the flag that raises it.
@@ -545,6 +549,7 @@ impl SettingsArgs {
                 FailOnArg::Info => FailOn::Info,
                 FailOnArg::Hint => FailOn::Hint,
             }),
+            no_data: self.no_data,
         }
     }
 }

@@ -243,7 +243,8 @@ impl Validator {
         diagnostics: Vec<Diagnostic>,
         settings: &Settings,
     ) -> FileReport {
-        let cx = Context::new(asset, self.schemas.get_or_init(Schemas::builtin));
+        let cx = Context::new(asset, self.schemas.get_or_init(Schemas::builtin))
+            .reading_data(!settings.skip_data);
         let parallel = asset.json_text.len() >= PARALLEL_RULES_FROM;
         let (found, info) = if parallel {
             rayon::join(|| run_rules(&cx, true), || asset_info(asset.root()))

@@ -548,6 +548,7 @@ fn config_command_without_any_file_shows_defaults() {
              ignore = []  # default\n\
              fail-on = \"error\"  # default\n\
              exclude = []  # default\n\
+             data = true  # default\n\
              \n[override]\n"
         );
     }

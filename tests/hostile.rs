@@ -2217,7 +2217,7 @@ fn forged_16bit_rgba_png(width: u32, height: u32) -> Vec<u8> {
 #[test]
 fn a_16384_square_16_bit_png_over_the_memory_budget_is_refused_before_decoding() {
     let png = forged_16bit_rgba_png(16384, 16384);
-    let expected = "PNG: decoding the 16384 × 16384 Rgba16 image needs about 6.0 GiB, over \
+    let expected = "PNG: decoding the 16384 × 16384 image (8 bytes a pixel) needs about 6.0 GiB, over \
                     the memory budget of 2.0 GiB (raise it with --max-memory); it was not \
                     decoded";
     let (result, largest) =
@@ -3031,7 +3031,7 @@ fn every_decode_is_held_to_the_memory_budget_in_preview_and_migrate_exact() {
     let index = std::fs::read_to_string(preview.join("index.html")).unwrap();
     assert!(
         index.contains(
-            "sheenColorTexture not read (image 0: decoding the 16384 × 16384 Rgb8 image needs \
+            "sheenColorTexture not read (image 0: decoding the 16384 × 16384 image (3 bytes a pixel) needs \
              about 1.8 GiB, over the memory budget of 1.0 GiB (raise it with --max-memory); it \
              was not decoded): sheenColorFactor alone is used"
         ),
@@ -3051,7 +3051,7 @@ fn every_decode_is_held_to_the_memory_budget_in_preview_and_migrate_exact() {
     assert!(peak < 256 * 1024, "migrate --exact took {peak} KiB");
     assert!(
         out.contains(
-            "of image 0: image 0: PNG: decoding the 16384 × 16384 Rgb8 image \
+            "of image 0: image 0: PNG: decoding the 16384 × 16384 image (3 bytes a pixel) \
              needs about 2.2 GiB, over the memory budget of 1.0 GiB (raise it with \
              --max-memory); it was not decoded"
         ),

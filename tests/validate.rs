@@ -566,6 +566,30 @@ fn a_git_lfs_pointer_is_named_with_the_command_that_fetches_it() {
 }
 
 #[test]
+fn no_data_and_data_false_leave_out_the_checks_that_read_accessor_data() {
+    let trigger = "fixtures/validate/ACCESSOR_MIN_MISMATCH/triggers.gltf";
+    let (status, out, _) = velvet(&["validate", "--format", "jsonl", trigger]);
+    assert_eq!(status, 1, "{out}");
+    assert!(out.contains("\"ACCESSOR_MIN_MISMATCH\""), "{out}");
+    let (status, out, _) = velvet(&["validate", "--format", "jsonl", "--no-data", trigger]);
+    assert_eq!(status, 0, "{out}");
+    let report: Value = serde_json::from_str(out.trim()).unwrap();
+    assert_eq!(report["issues"]["messages"], json!([]));
+    // The same from velvet.toml, which `velvet config` shows.
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::copy(trigger, dir.path().join("a.gltf")).unwrap();
+    std::fs::write(dir.path().join("velvet.toml"), "data = false\n").unwrap();
+    let file = dir.path().join("a.gltf");
+    let (status, out, _) = velvet(&["validate", file.to_str().unwrap()]);
+    assert_eq!(status, 0, "{out}");
+    let (_, shown, _) = velvet(&["config", file.to_str().unwrap()]);
+    assert!(
+        shown.contains("data = false  # velvet.toml (accessor data and image bytes not read)"),
+        "{shown}"
+    );
+}
+
+#[test]
 fn a_header_only_glb_is_an_error_and_trailing_bytes_a_warning() {
     let dir = tempfile::tempdir().unwrap();
     let header_only = dir.path().join("header.glb");
@@ -743,17 +767,17 @@ fn extension_base() -> Value {
         "images": [{"bufferView": 1, "mimeType": "image/png"}],
         "accessors": [
             {"bufferView": 0, "componentType": 5126, "count": 1, "type": "VEC3", "min": [0, 0, 0], "max": [0, 0, 0]},
-            {"bufferView": 0, "componentType": 5126, "count": 1, "type": "VEC3"},
-            {"bufferView": 0, "componentType": 5126, "count": 1, "type": "VEC4"},
-            {"bufferView": 0, "componentType": 5126, "count": 1, "type": "VEC2"},
-            {"bufferView": 2, "componentType": 5126, "count": 1, "type": "SCALAR", "min": [0], "max": [1]},
+            {"bufferView": 0, "byteOffset": 12, "componentType": 5126, "count": 1, "type": "VEC3"},
+            {"bufferView": 0, "byteOffset": 24, "componentType": 5126, "count": 1, "type": "VEC4"},
+            {"bufferView": 0, "byteOffset": 40, "componentType": 5126, "count": 1, "type": "VEC2"},
+            {"bufferView": 2, "componentType": 5126, "count": 1, "type": "SCALAR", "min": [0], "max": [0]},
             {"bufferView": 2, "byteOffset": 4, "componentType": 5126, "count": 1, "type": "VEC3"}
         ],
         "animations": [{"channels": [{"sampler": 0, "target": {"node": 0, "path": "translation"}}],
                         "samplers": [{"input": 4, "output": 5}]}],
-        "bufferViews": [{"buffer": 0, "byteLength": 16, "byteStride": 16}, {"buffer": 0, "byteOffset": 16, "byteLength": 16},
-                        {"buffer": 0, "byteOffset": 32, "byteLength": 16}],
-        "buffers": [{"byteLength": 48, "uri": "data.bin"}]
+        "bufferViews": [{"buffer": 0, "byteLength": 48, "byteStride": 16}, {"buffer": 0, "byteOffset": 48, "byteLength": 16},
+                        {"buffer": 0, "byteOffset": 64, "byteLength": 16}],
+        "buffers": [{"byteLength": 80, "uri": "data.bin"}]
     })
 }
 
@@ -789,7 +813,7 @@ fn extension_cases() -> Vec<ExtensionCase> {
     };
     let meshopt = |extension: &'static str| {
         let view: &'static str =
-            Box::leak(format!("/bufferViews/2/extensions/{extension}").into_boxed_str());
+            Box::leak(format!("/bufferViews/3/extensions/{extension}").into_boxed_str());
         let stride: &'static str = Box::leak(format!("{view}/byteStride").into_boxed_str());
         case(
             extension,
@@ -801,7 +825,7 @@ fn extension_cases() -> Vec<ExtensionCase> {
                         as &str,
                     json!({"fallback": true}),
                 ),
-                ("/bufferViews/2", json!({"buffer": 1, "byteLength": 64})),
+                ("/bufferViews/3", json!({"buffer": 1, "byteLength": 64})),
                 (
                     view,
                     json!({"buffer": 0, "byteLength": 16, "byteStride": 4, "count": 4, "mode": "ATTRIBUTES"}),
@@ -1012,9 +1036,19 @@ fn extension_cases() -> Vec<ExtensionCase> {
     ]
 }
 
-/// Writes `doc` as a .gltf beside a data.bin of 48 bytes, and validates it.
+/// The 80 bytes of [`extension_base`]'s buffer: a vertex at the origin with a normal
+/// (0, 0, 1), a tangent (1, 0, 0, 1) and texture coordinates (0, 0); image bytes; a keyframe
+/// at time 0 moving to the origin.
+fn extension_base_data() -> Vec<u8> {
+    let floats: [f32; 12] = [0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0];
+    let mut bytes: Vec<u8> = floats.iter().flat_map(|f| f.to_le_bytes()).collect();
+    bytes.resize(80, 0);
+    bytes
+}
+
+/// Writes `doc` as a .gltf beside [`extension_base_data`] (data.bin), and validates it.
 fn validate_doc(validator: &Validator, dir: &Path, name: &str, doc: &Value) -> FileReport {
-    std::fs::write(dir.join("data.bin"), [0u8; 48]).unwrap();
+    std::fs::write(dir.join("data.bin"), extension_base_data()).unwrap();
     let path = dir.join(format!("{name}.gltf"));
     std::fs::write(&path, serde_json::to_string_pretty(doc).unwrap()).unwrap();
     validator.validate_file(&path)

@@ -625,7 +625,7 @@ mod tests {
     }
 
     #[test]
-    fn garbage_is_an_unrecognized_image_and_a_cut_png_invalid_data() {
+    fn garbage_is_an_unrecognized_image_a_cut_png_an_unexpected_end_and_a_bad_one_invalid() {
         let err = read_header(
             std::io::Cursor::new(b"hello world, not an image".to_vec()),
             "/images/1",
@@ -639,6 +639,11 @@ mod tests {
             "image 1",
         )
         .unwrap_err();
+        assert_eq!(err.code, "IMAGE_UNEXPECTED_EOS");
+        // A whole IHDR chunk whose colour type no PNG has is damage, not a cut.
+        let mut bad = b"\x89PNG\r\n\x1a\n\0\0\0\x0dIHDR\0\0\0\x01\0\0\0\x01\x08\x09\0\0\0".to_vec();
+        bad.extend_from_slice(&[0, 0, 0, 0]);
+        let err = read_header(std::io::Cursor::new(bad), "/images/1", "image 1").unwrap_err();
         assert_eq!(err.code, "IMAGE_DATA_INVALID");
     }
 }

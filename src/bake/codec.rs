@@ -205,8 +205,8 @@ pub fn decode_within(
         .saturating_mul(u64::from(decoder.color_type().bytes_per_pixel()))
         .saturating_mul(DECODE_COPIES);
     let what = format!(
-        "decoding the {width} × {height} {:?} image",
-        decoder.color_type()
+        "decoding the {width} × {height} image ({} bytes a pixel)",
+        decoder.color_type().bytes_per_pixel()
     );
     // Held against the budget with every other decode of the run until this one returns.
     let _reserved =

@@ -36,4 +36,7 @@ pub struct Settings {
     /// Cap on messages per file; the report says `truncated` when it applied.
     pub max_issues: Option<usize>,
     pub fail_on: FailOn,
+    /// Whether the checks that read accessor data and image bytes are left out (`--no-data`,
+    /// `data = false`): the JSON-level checks alone, for hooks that want them fast.
+    pub skip_data: bool,
 }

@@ -190,16 +190,8 @@ impl<'a> Elements<'a> {
         let index_bytes = part(indices, n.checked_mul(index_size)?)?;
         let values = part(values, n.checked_mul(element)?)?;
         let mut substitutions = Vec::with_capacity(n);
-        for k in 0..n {
-            let at = &index_bytes[k * index_size..(k + 1) * index_size];
-            let index = match index_size {
-                1 => usize::from(at[0]),
-                2 => usize::from(u16::from_le_bytes([at[0], at[1]])),
-                _ => usize::try_from(u32::from_le_bytes([at[0], at[1], at[2], at[3]])).ok()?,
-            };
-            if index >= count {
-                return None;
-            }
+        for (k, index) in read_indices(index_bytes, index_size).enumerate() {
+            let index = usize::try_from(index).ok().filter(|i| *i < count)?;
             substitutions.push((index, k * element));
         }
         // A later substitution of one element wins, as a loader applying them in order does:
@@ -304,6 +296,38 @@ impl<'a> Elements<'a> {
             visit(i, values);
         }
     }
+}
+
+/// Unsigned little-endian integers of `size` bytes (1, 2 or 4), one after the other.
+fn read_indices(bytes: &[u8], size: usize) -> impl Iterator<Item = u64> + '_ {
+    bytes.chunks_exact(size).map(move |at| match size {
+        1 => u64::from(at[0]),
+        2 => u64::from(u16::from_le_bytes([at[0], at[1]])),
+        _ => u64::from(u32::from_le_bytes([at[0], at[1], at[2], at[3]])),
+    })
+}
+
+/// Accessor `index`'s sparse indices as stored, with the accessor's count, when they can be
+/// read; for the rule that judges them (decoding the elements refuses indices out of range).
+pub fn sparse_indices(cx: &Context, index: usize) -> Option<(Vec<u64>, u64)> {
+    let accessor = cx.json().get("accessors")?.get(index)?;
+    let count = accessor.get("count")?.as_u64()?;
+    let sparse = accessor.get("sparse")?;
+    let n = index_of(sparse.get("count")).filter(|n| *n >= 1)?;
+    let indices = sparse.get("indices")?;
+    let size = match indices.get("componentType")?.as_u64()? {
+        5121 => 1,
+        5123 => 2,
+        5125 => 4,
+        _ => return None,
+    };
+    let view = index_of(indices.get("bufferView"))?;
+    let offset = match indices.get("byteOffset") {
+        None => 0,
+        Some(o) => usize::try_from(o.as_u64()?).ok()?,
+    };
+    let bytes = view_bytes(cx, view)?.get(offset..offset.checked_add(n.checked_mul(size)?)?)?;
+    Some((read_indices(bytes, size).collect(), count))
 }
 
 /// Every accessor index `node` names, for the rules that read the accessors of a use (a

@@ -37,6 +37,7 @@ pub mod roughness_alpha;
 pub mod schema;
 pub mod skin_data;
 pub mod skins;
+pub mod sparse_data;
 pub mod tangent_space;
 pub mod texcoord;
 pub mod texture_sources;
@@ -271,6 +272,7 @@ pub static REGISTRY: &[&dyn Rule] = &[
     &vertex_data::VertexData,
     &animation_data::AnimationData,
     &skin_data::SkinData,
+    &sparse_data::SparseData,
     &buffer_views::BufferViews,
     &node_tree::NodeTree,
     &nodes::Nodes,

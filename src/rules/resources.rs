@@ -38,6 +38,16 @@ pub const IMAGE_NON_ENABLED_MIME_TYPE: Code = Code::new(
     Severity::Error,
     "An image is WebP or KTX2 but the extension that lets textures use it is not in extensionsUsed.",
 );
+pub const URI_GLB: Code = Code::new(
+    "URI_GLB",
+    Severity::Info,
+    "A .glb's buffer or image has a URI: its data is not all in the file.",
+);
+pub const IMAGE_NPOT_DIMENSIONS: Code = Code::new(
+    "IMAGE_NPOT_DIMENSIONS",
+    Severity::Info,
+    "An image's width or height is not a power of two; some loaders and texture formats need one.",
+);
 pub const DATA_URI_GLB: Code = Code::new(
     "DATA_URI_GLB",
     Severity::Warning,
@@ -85,6 +95,8 @@ impl Rule for Resources {
             &codes::IMAGE_UNEXPECTED_EOS,
             &codes::BUFFER_BYTE_LENGTH_MISMATCH,
             &IMAGE_NON_ENABLED_MIME_TYPE,
+            &IMAGE_NPOT_DIMENSIONS,
+            &URI_GLB,
             &DATA_URI_GLB,
         ]
     }
@@ -97,6 +109,13 @@ impl Rule for Resources {
             ("images", check_image),
         ] {
             for (index, object) in array(json, key) {
+                if glb && object.get("uri").is_some_and(|u| u.is_string()) {
+                    out.push(Diagnostic::new(
+                        &URI_GLB,
+                        format!("/{key}/{index}/uri"),
+                        "a URI in a .glb: the file does not hold all its data",
+                    ));
+                }
                 // A data: URI without its payload is INVALID_URI alone.
                 let data_uri = object
                     .get("uri")
@@ -227,6 +246,16 @@ fn check_image(cx: &Context, index: usize, image: Node, out: &mut Vec<Diagnostic
             let declared_extension = |name: &&str| {
                 super::elements(cx.json().get("extensionsUsed")).any(|e| e.is_str(name))
             };
+            if !header.width.is_power_of_two() || !header.height.is_power_of_two() {
+                out.push(Diagnostic::new(
+                    &IMAGE_NPOT_DIMENSIONS,
+                    format!("/images/{index}"),
+                    format!(
+                        "image {index} is {} × {}, not a power of two in each dimension",
+                        header.width, header.height
+                    ),
+                ));
+            }
             if !enabling.is_empty() && !enabling.iter().any(declared_extension) {
                 out.push(Diagnostic::new(
                     &IMAGE_NON_ENABLED_MIME_TYPE,

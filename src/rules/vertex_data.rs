@@ -4,6 +4,8 @@
 //! - ACCESSOR_INDEX_OOB (error): an index past the primitive's vertices.
 //! - ACCESSOR_INDEX_PRIMITIVE_RESTART (error): an index equal to its type's largest value, which
 //!   some APIs take as a primitive restart.
+//! - ACCESSOR_INDEX_TRIANGLE_DEGENERATE (information): triangles that name a vertex twice, counted
+//!   once a primitive.
 //! - ACCESSOR_VECTOR3_NON_UNIT (error): a NORMAL, or a TANGENT's xyz, not of unit length.
 //! - ACCESSOR_INVALID_SIGN (error): a TANGENT's w other than 1 or -1.
 //! - ACCESSOR_NON_CLAMPED (error): a float COLOR_n component outside 0..1.
@@ -31,6 +33,11 @@ pub const ACCESSOR_INDEX_PRIMITIVE_RESTART: Code = Code::new(
     "ACCESSOR_INDEX_PRIMITIVE_RESTART",
     Severity::Error,
     "A primitive's index is its type's largest value, which some graphics APIs read as a primitive restart.",
+);
+pub const ACCESSOR_INDEX_TRIANGLE_DEGENERATE: Code = Code::new(
+    "ACCESSOR_INDEX_TRIANGLE_DEGENERATE",
+    Severity::Info,
+    "A primitive's triangles name a vertex twice: they are drawn as nothing.",
 );
 pub const ACCESSOR_VECTOR3_NON_UNIT: Code = Code::new(
     "ACCESSOR_VECTOR3_NON_UNIT",
@@ -106,6 +113,7 @@ impl Rule for VertexData {
         &[
             &ACCESSOR_INDEX_OOB,
             &ACCESSOR_INDEX_PRIMITIVE_RESTART,
+            &ACCESSOR_INDEX_TRIANGLE_DEGENERATE,
             &ACCESSOR_VECTOR3_NON_UNIT,
             &ACCESSOR_INVALID_SIGN,
             &ACCESSOR_NON_CLAMPED,
@@ -154,7 +162,8 @@ impl Rule for VertexData {
                     accessor_index(primitive.get("indices")).and_then(|i| Elements::of(cx, i)),
                     vertices,
                 ) {
-                    check_indices(&indices, vertices, &format!("{at}/indices"), &mut capped);
+                    let mode = primitive.get("mode").map_or(Some(4), |m| m.as_u64());
+                    check_indices(&indices, vertices, mode, &format!("{at}/indices"), &mut capped);
                 }
                 if let Some(normals) = read("normal", "NORMAL").filter(|e| e.components == 3) {
                     let at = format!("{at}/attributes/NORMAL");
@@ -195,8 +204,9 @@ impl Rule for VertexData {
     }
 }
 
-/// Indices against the primitive's vertices and the restart value of their type.
-fn check_indices(indices: &Elements, vertices: u64, at: &str, capped: &mut Capped) {
+/// Indices against the primitive's vertices and the restart value of their type, and for
+/// triangles, the triangles that name a vertex twice (drawn as nothing).
+fn check_indices(indices: &Elements, vertices: u64, mode: Option<u64>, at: &str, capped: &mut Capped) {
     if indices.components != 1 {
         return;
     }
@@ -207,8 +217,16 @@ fn check_indices(indices: &Elements, vertices: u64, at: &str, capped: &mut Cappe
         _ => return,
     };
     let vertices = vertices as f64;
+    let triangles = mode == Some(4);
+    let (mut corner, mut degenerate) = ([0.0; 3], 0usize);
     indices.for_each(|i, v| {
         let index = v[0];
+        if triangles {
+            corner[i % 3] = index;
+            if i % 3 == 2 && (corner[0] == corner[1] || corner[1] == corner[2] || corner[0] == corner[2]) {
+                degenerate += 1;
+            }
+        }
         if index == restart {
             capped.push(&ACCESSOR_INDEX_PRIMITIVE_RESTART, at, || {
                 format!("the index at {i} is {index}, the primitive restart value of its type")
@@ -219,6 +237,12 @@ fn check_indices(indices: &Elements, vertices: u64, at: &str, capped: &mut Cappe
             });
         }
     });
+    if degenerate > 0 {
+        let all = indices.count / 3;
+        capped.push(&ACCESSOR_INDEX_TRIANGLE_DEGENERATE, at, || {
+            format!("{degenerate} of the {all} triangles name a vertex twice and are drawn as nothing")
+        });
+    }
 }
 
 /// A vector's length (its first three components, as a loader reads them) against 1.
