@@ -85,6 +85,11 @@ pub const DUPLICATE_ELEMENTS: Code = Code::new(
     Severity::Error,
     "An array whose elements must be unique holds one twice (extensionsUsed, a scene's or node's node list).",
 );
+pub const INVALID_INDEX: Code = Code::new(
+    "INVALID_INDEX",
+    Severity::Error,
+    "An index is negative (`\"mesh\": -1`); indices are non-negative integers.",
+);
 pub const VALUE_MULTIPLE_OF: Code = Code::new(
     "VALUE_MULTIPLE_OF",
     Severity::Error,
@@ -289,9 +294,21 @@ pub(crate) fn diagnostics(
 /// - a nested array's element of the wrong type is ARRAY_TYPE_MISMATCH at the array (the
 ///   top-level arrays' elements, `/materials/0`, stay TYPE_MISMATCH at the element);
 /// - a duplicate is reported at its second occurrence, not at the array;
-/// - a node's matrix beside translation, rotation or scale is reported at the matrix.
+/// - a node's matrix beside translation, rotation or scale is reported at the matrix;
+/// - a negative index is INVALID_INDEX.
 fn reshape(found: &mut Diagnostic, json: Node) {
-    if found.code == codes::TYPE_MISMATCH.name {
+    if found.code == codes::VALUE_NOT_IN_RANGE.name
+        && super::references::is_index(&found.pointer)
+        && json
+            .pointer(&found.pointer)
+            .and_then(|v| v.as_f64())
+            .is_some_and(|v| v < 0.0)
+    {
+        // An index below 0 names nothing: the Khronos validator's INVALID_INDEX.
+        found.code = INVALID_INDEX.name;
+        found.severity = INVALID_INDEX.severity;
+        found.message = format!("{}: an index is a non-negative integer", found.message);
+    } else if found.code == codes::TYPE_MISMATCH.name {
         if let Some((array, last)) = found.pointer.rsplit_once('/') {
             let nested = array.matches('/').count() >= 2;
             if nested && last.parse::<usize>().is_ok() && json.pointer(array).is_some_and(|a| a.is_array()) {
@@ -630,6 +647,7 @@ impl Rule for CoreStructure {
             &NODE_MATRIX_TRS,
             &VALUE_MULTIPLE_OF,
             &ARRAY_TYPE_MISMATCH,
+            &INVALID_INDEX,
         ]
     }
 

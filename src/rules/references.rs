@@ -91,6 +91,20 @@ pub const LINKS: &[(&str, &str)] = &[
     ("/materials/*/extensions/*/*Texture/index", "/textures"),
 ];
 
+/// Whether `pointer` stands where [`LINKS`] declares an index (`/nodes/3/mesh`).
+pub fn is_index(pointer: &str) -> bool {
+    let tokens: Vec<Cow<str>> = pointer.split('/').skip(1).map(pointer::unescape).collect();
+    LINKS.iter().any(|(pattern, _)| {
+        let segments: Vec<&str> = pattern.split('/').skip(1).collect();
+        segments.len() == tokens.len()
+            && segments.iter().zip(&tokens).all(|(segment, token)| match *segment {
+                "*" => true,
+                s if s.starts_with('*') => token.ends_with(&s[1..]),
+                s => s == token,
+            })
+    })
+}
+
 pub struct References;
 
 impl Rule for References {
