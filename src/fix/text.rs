@@ -118,23 +118,25 @@ pub fn text_edits(source: &str, replacements: &[Replacement]) -> Vec<TextEdit> {
 /// give them) in `source`, read front to back once rather than from the start for each.
 fn positions_of(source: &str, offsets: &[usize]) -> Vec<Position> {
     let mut out = Vec::with_capacity(offsets.len());
-    let (mut at, mut line, mut line_start) = (0, 1, 0);
+    // The column is carried forward with the line: counting it from the line's start for each
+    // offset made a one-line (minified) document's edits quadratic (10,000 edits of a 5 MB
+    // line took a second).
+    let (mut at, mut line, mut column) = (0, 1, 1);
     for &offset in offsets {
         if offset < at {
             out.push(position_of(source, offset));
             continue;
         }
-        for (i, b) in source.as_bytes()[at..offset.min(source.len())]
-            .iter()
-            .enumerate()
-        {
-            if *b == b'\n' {
-                line += 1;
-                line_start = at + i + 1;
+        let end = offset.min(source.len());
+        let passed = &source.as_bytes()[at..end];
+        match passed.iter().rposition(|b| *b == b'\n') {
+            Some(last) => {
+                line += passed.iter().filter(|b| **b == b'\n').count();
+                column = source[at + last + 1..end].chars().count() + 1;
             }
+            None => column += source[at..end].chars().count(),
         }
-        at = offset.min(source.len());
-        let column = source[line_start..at].chars().count() + 1;
+        at = end;
         out.push(Position {
             line,
             column,
