@@ -650,7 +650,11 @@ impl Config {
             out,
             "data = {data}  # {}{}",
             source.describe(),
-            if data { "" } else { " (accessor data and image bytes not read)" }
+            if data {
+                ""
+            } else {
+                " (accessor data and image bytes not read)"
+            }
         );
         out.push_str("\n[override]\n");
         for (code, (severity, source)) in &self.overrides {
@@ -942,7 +946,10 @@ mod tests {
         assert_eq!(none.data, (true, Source::Default));
         assert!(!none.settings().skip_data);
         let flag = Layer::command_line(None, &[], &[], &[], None, Some(false)).unwrap();
-        assert_eq!(Config::combine(None, &flag).data, (false, Source::CommandLine));
+        assert_eq!(
+            Config::combine(None, &flag).data,
+            (false, Source::CommandLine)
+        );
         assert_eq!(Layer::parse("data = false").unwrap().data, Some(false));
     }
 
@@ -954,8 +961,8 @@ mod tests {
     fn command_line_ignore_adds_to_the_files_ignore_and_takes_codes_off_its_only() {
         let file_ignore = Layer::parse("ignore = [\"TYPE_MISMATCH\"]").unwrap();
         let file_only = Layer::parse("only = [\"TYPE_MISMATCH\", \"VALUE_NOT_IN_RANGE\"]").unwrap();
-        let cli =
-            Layer::command_line(None, &["UNEXPECTED_PROPERTY".into()], &[], &[], None, None).unwrap();
+        let cli = Layer::command_line(None, &["UNEXPECTED_PROPERTY".into()], &[], &[], None, None)
+            .unwrap();
         let file = PathBuf::from("/p/velvet.toml");
         let c = Config::combine(Some((file.clone(), file_ignore.clone())), &cli);
         assert_eq!(
@@ -973,7 +980,8 @@ mod tests {
             .to_toml()
             .contains("ignore = [\"TYPE_MISMATCH\", \"UNEXPECTED_PROPERTY\"]  # velvet.toml and command line\n"));
         let cli_only_off =
-            Layer::command_line(None, &["VALUE_NOT_IN_RANGE".into()], &[], &[], None, None).unwrap();
+            Layer::command_line(None, &["VALUE_NOT_IN_RANGE".into()], &[], &[], None, None)
+                .unwrap();
         let c = Config::combine(Some((file.clone(), file_only.clone())), &cli_only_off);
         assert_eq!(
             c.selection,
@@ -992,7 +1000,8 @@ mod tests {
             )
         );
         let cli_only =
-            Layer::command_line(None, &[], &["VALUE_NOT_IN_RANGE".into()], &[], None, None).unwrap();
+            Layer::command_line(None, &[], &["VALUE_NOT_IN_RANGE".into()], &[], None, None)
+                .unwrap();
         let c = Config::combine(Some((file, file_ignore)), &cli_only);
         assert_eq!(
             c.selection,

@@ -245,7 +245,15 @@ impl Validator {
     ) -> FileReport {
         let cx = Context::new(asset, self.schemas.get_or_init(Schemas::builtin))
             .reading_data(!settings.skip_data);
-        let parallel = asset.json_text.len() >= PARALLEL_RULES_FROM;
+        // A large text, or (with the data checks) large buffers: a document whose weight is in
+        // its data has a small text and megabytes of accessors to read.
+        let data_bytes = || {
+            crate::document::elements(asset.root().get("buffers"))
+                .filter_map(|b| b.get("byteLength")?.as_u64())
+                .fold(0u64, u64::saturating_add)
+        };
+        let parallel = asset.json_text.len() >= PARALLEL_RULES_FROM
+            || (!settings.skip_data && data_bytes() >= PARALLEL_RULES_FROM as u64);
         let (found, info) = if parallel {
             rayon::join(|| run_rules(&cx, true), || asset_info(asset.root()))
         } else {

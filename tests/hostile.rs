@@ -2217,7 +2217,8 @@ fn forged_16bit_rgba_png(width: u32, height: u32) -> Vec<u8> {
 #[test]
 fn a_16384_square_16_bit_png_over_the_memory_budget_is_refused_before_decoding() {
     let png = forged_16bit_rgba_png(16384, 16384);
-    let expected = "PNG: decoding the 16384 × 16384 image (8 bytes a pixel) needs about 6.0 GiB, over \
+    let expected =
+        "PNG: decoding the 16384 × 16384 image (8 bytes a pixel) needs about 6.0 GiB, over \
                     the memory budget of 2.0 GiB (raise it with --max-memory); it was not \
                     decoded";
     let (result, largest) =

@@ -99,7 +99,11 @@ fn velvet_reproduces_the_reference_suites_json_level_errors_and_warnings() {
     let sections = sections(&std::fs::read_to_string(suite.join("ISSUES.md")).unwrap());
     let mut files = Vec::new();
     assets(&suite.join("test"), &mut files);
-    assert!(files.len() > 300, "the suite holds its assets ({})", files.len());
+    assert!(
+        files.len() > 300,
+        "the suite holds its assets ({})",
+        files.len()
+    );
     let settings = Settings {
         max_issues: None,
         ..Settings::default()

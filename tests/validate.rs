@@ -611,10 +611,7 @@ fn a_header_only_glb_is_an_error_and_trailing_bytes_a_warning() {
         ),
         "{out}"
     );
-    let (status, out, _) = velvet(&[
-        "validate",
-        "fixtures/validate/GLB_EXTRA_DATA/triggers.glb",
-    ]);
+    let (status, out, _) = velvet(&["validate", "fixtures/validate/GLB_EXTRA_DATA/triggers.glb"]);
     assert_eq!(status, 0, "{out}");
     assert!(
         out.contains("warning GLB_EXTRA_DATA: the file has 8 bytes after the 84 its GLB header declares; they are ignored"),
@@ -869,7 +866,8 @@ fn extension_cases() -> Vec<ExtensionCase> {
                     json!([{"bufferView": 1, "mimeType": "image/png"}, {"bufferView": 1, "mimeType": mime}]),
                 ),
                 (
-                    Box::leak(format!("/textures/0/extensions/{extension}").into_boxed_str()) as &str,
+                    Box::leak(format!("/textures/0/extensions/{extension}").into_boxed_str())
+                        as &str,
                     json!({ "source": 1 }),
                 ),
             ],

@@ -338,7 +338,10 @@ mod tests {
     #[test]
     fn container_faults_get_the_reference_validators_codes() {
         let json: &[u8] = b"{\"asset\":{\"version\":\"2.0\"}} ";
-        assert_eq!(split_codes(&glb_of(&[], Some(12))), ["GLB_LENGTH_TOO_SMALL"]);
+        assert_eq!(
+            split_codes(&glb_of(&[], Some(12))),
+            ["GLB_LENGTH_TOO_SMALL"]
+        );
         assert_eq!(
             split_codes(&glb_of(&[], Some(0))),
             ["GLB_LENGTH_TOO_SMALL", "GLB_LENGTH_MISMATCH"]
@@ -363,11 +366,17 @@ mod tests {
             ["GLB_EMPTY_CHUNK", "GLB_EMPTY_CHUNK", "GLB_DUPLICATE_CHUNK"]
         );
         assert_eq!(
-            split_codes(&glb_of(&[(b"JSON", json), (b"BIN\0", b"abcd"), (b"BIN\0", b"abcd")], None)),
+            split_codes(&glb_of(
+                &[(b"JSON", json), (b"BIN\0", b"abcd"), (b"BIN\0", b"abcd")],
+                None
+            )),
             ["GLB_DUPLICATE_CHUNK"]
         );
         let mut out = Vec::new();
-        let misplaced = glb_of(&[(b"JSON", json), (b"UNK\0", b"abcd"), (b"BIN\0", b"efgh")], None);
+        let misplaced = glb_of(
+            &[(b"JSON", json), (b"UNK\0", b"abcd"), (b"BIN\0", b"efgh")],
+            None,
+        );
         let parts = split(&misplaced, &mut out).expect("the JSON chunk is read");
         assert_eq!(
             codes_of(&out),

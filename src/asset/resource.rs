@@ -56,11 +56,11 @@ pub fn resolve_with(
             None => (header, false),
         };
         // RFC 2397: after the type, each parameter is `attribute=value`.
-        if media_type
-            .split(';')
-            .skip(1)
-            .any(|parameter| !parameter.split_once('=').is_some_and(|(a, _)| !a.is_empty()))
-        {
+        if media_type.split(';').skip(1).any(|parameter| {
+            !parameter
+                .split_once('=')
+                .is_some_and(|(a, _)| !a.is_empty())
+        }) {
             return Err(Diagnostic::new(
                 &codes::INVALID_URI,
                 pointer,
@@ -430,8 +430,12 @@ pub fn read_header<R: std::io::BufRead + std::io::Seek>(
     };
     let decoder: Box<dyn ImageDecoder> = match format {
         ImageFormat::Png => Box::new(image::codecs::png::PngDecoder::new(reader).map_err(damaged)?),
-        ImageFormat::Jpeg => Box::new(image::codecs::jpeg::JpegDecoder::new(reader).map_err(damaged)?),
-        ImageFormat::Webp => Box::new(image::codecs::webp::WebPDecoder::new(reader).map_err(damaged)?),
+        ImageFormat::Jpeg => {
+            Box::new(image::codecs::jpeg::JpegDecoder::new(reader).map_err(damaged)?)
+        }
+        ImageFormat::Webp => {
+            Box::new(image::codecs::webp::WebPDecoder::new(reader).map_err(damaged)?)
+        }
         ImageFormat::Ktx2 => unreachable!("handled above"),
     };
     let (width, height) = decoder.dimensions();

@@ -58,11 +58,7 @@ pub const GLB_CHUNK_TOO_BIG: Code = Code::new(
     Error,
     "A GLB chunk runs past the length the GLB header declares.",
 );
-pub const GLB_EMPTY_CHUNK: Code = Code::new(
-    "GLB_EMPTY_CHUNK",
-    Error,
-    "A GLB JSON chunk is empty.",
-);
+pub const GLB_EMPTY_CHUNK: Code = Code::new("GLB_EMPTY_CHUNK", Error, "A GLB JSON chunk is empty.");
 pub const GLB_DUPLICATE_CHUNK: Code = Code::new(
     "GLB_DUPLICATE_CHUNK",
     Error,
@@ -201,7 +197,10 @@ const RENAMED: &[(&str, &[&str])] = &[
 
 /// The codes that replace a code velvet no longer emits.
 pub fn renamed(code: &str) -> Option<&'static [&'static str]> {
-    RENAMED.iter().find(|(old, _)| *old == code).map(|(_, now)| *now)
+    RENAMED
+        .iter()
+        .find(|(old, _)| *old == code)
+        .map(|(_, now)| *now)
 }
 
 /// The codes about a run rather than a file (no asset triggers them).

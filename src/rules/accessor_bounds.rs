@@ -73,13 +73,31 @@ impl Rule for AccessorBounds {
     }
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
+        use rayon::prelude::*;
         if !cx.reads_data() {
             return;
         }
-        let accessors = cx.json().get("accessors");
-        for i in 0..accessor_count(cx) {
+        // Accessors are judged side by side (a document's weight is often in a few large
+        // ones), their findings joined in accessor order.
+        let found: Vec<Vec<Diagnostic>> = (0..accessor_count(cx))
+            .into_par_iter()
+            .map(|i| {
+                let mut out = Vec::new();
+                check_accessor(cx, i, &mut out);
+                out
+            })
+            .collect();
+        out.extend(found.into_iter().flatten());
+    }
+}
+
+/// One accessor's values against its bounds.
+fn check_accessor(cx: &Context, i: usize, out: &mut Vec<Diagnostic>) {
+    let accessors = cx.json().get("accessors");
+    {
+        {
             let Some(accessor) = accessors.and_then(|a| a.get(i)) else {
-                continue;
+                return;
             };
             let bound = |key: &str| -> Option<Vec<f64>> {
                 let values = accessor.get(key)?.as_array()?;
@@ -88,16 +106,20 @@ impl Rule for AccessorBounds {
             let (min, max) = (bound("min"), bound("max"));
             let float = accessor.get("componentType").and_then(|c| c.as_u64()) == Some(5126);
             if min.is_none() && max.is_none() && !float {
-                continue;
+                return;
             }
             let Some(elements) = Elements::of(cx, i) else {
-                continue;
+                return;
             };
             let n = elements.components;
             // Declared bounds as the data holds them: single precision for floats.
             let stored = |v: f64| if float { f64::from(v as f32) } else { v };
-            let min = min.filter(|m| m.len() == n).map(|m| m.into_iter().map(stored).collect::<Vec<_>>());
-            let max = max.filter(|m| m.len() == n).map(|m| m.into_iter().map(stored).collect::<Vec<_>>());
+            let min = min
+                .filter(|m| m.len() == n)
+                .map(|m| m.into_iter().map(stored).collect::<Vec<_>>());
+            let max = max
+                .filter(|m| m.len() == n)
+                .map(|m| m.into_iter().map(stored).collect::<Vec<_>>());
             let mut tally = Tally {
                 low: [f64::INFINITY; MAX_COMPONENTS],
                 high: [f64::NEG_INFINITY; MAX_COMPONENTS],
@@ -116,7 +138,7 @@ impl Rule for AccessorBounds {
                             ));
                         }
                         invalid += 1;
-                        continue;
+                        return;
                     }
                     tally.low[c] = tally.low[c].min(v);
                     tally.high[c] = tally.high[c].max(v);
@@ -129,8 +151,24 @@ impl Rule for AccessorBounds {
                 }
             });
             for (key, declared, actual, beyond, mismatch, outside, word) in [
-                ("min", &min, &tally.low, &tally.below, &ACCESSOR_MIN_MISMATCH, &ACCESSOR_ELEMENT_OUT_OF_MIN_BOUND, "less"),
-                ("max", &max, &tally.high, &tally.above, &ACCESSOR_MAX_MISMATCH, &ACCESSOR_ELEMENT_OUT_OF_MAX_BOUND, "greater"),
+                (
+                    "min",
+                    &min,
+                    &tally.low,
+                    &tally.below,
+                    &ACCESSOR_MIN_MISMATCH,
+                    &ACCESSOR_ELEMENT_OUT_OF_MIN_BOUND,
+                    "less",
+                ),
+                (
+                    "max",
+                    &max,
+                    &tally.high,
+                    &tally.above,
+                    &ACCESSOR_MAX_MISMATCH,
+                    &ACCESSOR_ELEMENT_OUT_OF_MAX_BOUND,
+                    "greater",
+                ),
             ] {
                 let Some(declared) = declared else {
                     continue;

@@ -124,7 +124,10 @@ impl Rule for Accessors {
             let component_type = accessor.get("componentType").and_then(|c| c.as_u64());
             let size = component_type.and_then(component_size);
             let kind = accessor.get("type").and_then(|t| t.as_str());
-            let count = accessor.get("count").and_then(|c| c.as_u64()).filter(|c| *c >= 1);
+            let count = accessor
+                .get("count")
+                .and_then(|c| c.as_u64())
+                .filter(|c| *c >= 1);
             let byte_offset = match accessor.get("byteOffset") {
                 None => Some(0),
                 Some(offset) => offset.as_u64(),
@@ -167,7 +170,10 @@ impl Rule for Accessors {
                         ),
                     ));
                 }
-                let length = stride.unwrap_or(packed).saturating_mul(count - 1).saturating_add(element);
+                let length = stride
+                    .unwrap_or(packed)
+                    .saturating_mul(count - 1)
+                    .saturating_add(element);
                 laid_over(bv, byte_offset, size, length, &at, true, out);
             }
             let Some(sparse) = accessor.get("sparse").filter(|s| s.is_object()) else {
@@ -199,14 +205,22 @@ impl Rule for Accessors {
                     ));
                 }
                 let part_size = if part == "indices" {
-                    match held.get("componentType").and_then(|c| c.as_u64()).and_then(component_size) {
+                    match held
+                        .get("componentType")
+                        .and_then(|c| c.as_u64())
+                        .and_then(component_size)
+                    {
                         Some(s) => s,
                         None => continue,
                     }
                 } else {
                     size
                 };
-                let per_element = if part == "indices" { part_size } else { size * components(&kind).unwrap_or(1) };
+                let per_element = if part == "indices" {
+                    part_size
+                } else {
+                    size * components(&kind).unwrap_or(1)
+                };
                 let offset = match held.get("byteOffset") {
                     None => 0,
                     Some(o) => match o.as_u64() {
@@ -214,7 +228,15 @@ impl Rule for Accessors {
                         None => continue,
                     },
                 };
-                laid_over(bv, offset, part_size, per_element.saturating_mul(sparse_count), &part_at, false, out);
+                laid_over(
+                    bv,
+                    offset,
+                    part_size,
+                    per_element.saturating_mul(sparse_count),
+                    &part_at,
+                    false,
+                    out,
+                );
             }
         }
     }
@@ -248,7 +270,11 @@ fn laid_over(
         if total % size != 0 {
             out.push(Diagnostic::new(
                 &ACCESSOR_TOTAL_OFFSET_ALIGNMENT,
-                if accessor { at.to_string() } else { format!("{at}/byteOffset") },
+                if accessor {
+                    at.to_string()
+                } else {
+                    format!("{at}/byteOffset")
+                },
                 format!("the total offset {total} is not a multiple of the component size {size}"),
             ));
         }

@@ -51,7 +51,9 @@ impl Rule for AnimationData {
         for (a, animation) in elements(cx.json().get("animations")).enumerate() {
             let samplers: Vec<_> = elements(animation.get("samplers")).collect();
             for (s, sampler) in samplers.iter().enumerate() {
-                let Some(input) = accessor_index(sampler.get("input")).and_then(|i| Elements::of(cx, i)) else {
+                let Some(input) =
+                    accessor_index(sampler.get("input")).and_then(|i| Elements::of(cx, i))
+                else {
                     continue;
                 };
                 if input.components != 1 {
@@ -90,19 +92,25 @@ impl Rule for AnimationData {
                     .get("target")
                     .and_then(|t| t.get("path"))
                     .is_some_and(|p| p.is_str("rotation"));
-                let Some(sampler) = accessor_index(channel.get("sampler")).and_then(|s| samplers.get(s)) else {
+                let Some(sampler) =
+                    accessor_index(channel.get("sampler")).and_then(|s| samplers.get(s))
+                else {
                     continue;
                 };
                 if !rotation {
                     continue;
                 }
-                let Some(output) = accessor_index(sampler.get("output")).and_then(|o| Elements::of(cx, o)) else {
+                let Some(output) =
+                    accessor_index(sampler.get("output")).and_then(|o| Elements::of(cx, o))
+                else {
                     continue;
                 };
                 if output.components != 4 {
                     continue;
                 }
-                let cubic = sampler.get("interpolation").is_some_and(|i| i.is_str("CUBICSPLINE"));
+                let cubic = sampler
+                    .get("interpolation")
+                    .is_some_and(|i| i.is_str("CUBICSPLINE"));
                 let at = format!("/animations/{a}/channels/{c}/sampler");
                 let mut reported = 0;
                 output.for_each(|i, q| {
@@ -110,7 +118,11 @@ impl Rule for AnimationData {
                     if cubic && i % 3 != 1 {
                         return;
                     }
-                    let length = q.iter().map(|v| output.normalize(*v).powi(2)).sum::<f64>().sqrt();
+                    let length = q
+                        .iter()
+                        .map(|v| output.normalize(*v).powi(2))
+                        .sum::<f64>()
+                        .sqrt();
                     if (length - 1.0).abs() > UNIT_LENGTH_VEC4 && reported < MAX_REPORTED {
                         reported += 1;
                         out.push(Diagnostic::new(
@@ -140,7 +152,9 @@ mod tests {
         for t in [-1.0f32, 0.0, 0.0, 1.0] {
             bytes.extend_from_slice(&t.to_le_bytes());
         }
-        for v in [0.0f32, 0.0, 0.0, 1.0, 0.5, 0.5, 0.5, 0.5, 0.1, 0.2, 0.3, 0.4, 0.0, 0.0, 0.0, 1.0] {
+        for v in [
+            0.0f32, 0.0, 0.0, 1.0, 0.5, 0.5, 0.5, 0.5, 0.1, 0.2, 0.3, 0.4, 0.0, 0.0, 0.0, 1.0,
+        ] {
             bytes.extend_from_slice(&v.to_le_bytes());
         }
         let data = base64::engine::general_purpose::STANDARD.encode(&bytes);

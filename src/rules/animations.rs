@@ -95,7 +95,10 @@ fn keyframes(accessors: Option<Node>, index: Option<Node>) -> Option<Keyframes> 
     let i = usize::try_from(index?.as_u64()?).ok()?;
     let accessor = accessors?.get(i).filter(|a| a.is_object())?;
     Some(Keyframes {
-        kind: accessor.get("type").and_then(|t| t.as_str()).map(|t| t.into_owned()),
+        kind: accessor
+            .get("type")
+            .and_then(|t| t.as_str())
+            .map(|t| t.into_owned()),
         component_type: accessor.get("componentType").and_then(|c| c.as_u64()),
         normalized: accessor.get("normalized").and_then(|n| n.as_bool()) == Some(true),
         count: accessor.get("count").and_then(|c| c.as_u64()),
@@ -180,7 +183,9 @@ impl Rule for Animations {
                         "keyframe times must have min and max",
                     ));
                 }
-                let cubic = sampler.get("interpolation").is_some_and(|i| i.is_str("CUBICSPLINE"));
+                let cubic = sampler
+                    .get("interpolation")
+                    .is_some_and(|i| i.is_str("CUBICSPLINE"));
                 if cubic && input.count.is_some_and(|c| c < 2) {
                     out.push(Diagnostic::new(
                         &ANIMATION_SAMPLER_INPUT_ACCESSOR_TOO_FEW_ELEMENTS,
@@ -231,8 +236,8 @@ impl Rule for Animations {
                     continue;
                 }
                 if let Some(Some(mine)) = targets.get(c) {
-                    if let Some(other) = (c + 1..targets.len())
-                        .find(|o| targets[*o].as_ref() == Some(mine))
+                    if let Some(other) =
+                        (c + 1..targets.len()).find(|o| targets[*o].as_ref() == Some(mine))
                     {
                         out.push(Diagnostic::new(
                             &ANIMATION_DUPLICATE_TARGETS,
@@ -314,14 +319,18 @@ impl Rule for Animations {
                 } else {
                     1
                 };
-                let cubic = sampler.get("interpolation").is_some_and(|i| i.is_str("CUBICSPLINE"));
+                let cubic = sampler
+                    .get("interpolation")
+                    .is_some_and(|i| i.is_str("CUBICSPLINE"));
                 if let (Some(keys), Some(values)) = (input.count, output.count) {
                     let expected = keys * per_keyframe * if cubic { 3 } else { 1 };
                     if values != expected {
                         out.push(Diagnostic::new(
                             &ANIMATION_SAMPLER_OUTPUT_ACCESSOR_INVALID_COUNT,
                             sampler_at,
-                            format!("the output accessor holds {values} values; {expected} expected"),
+                            format!(
+                                "the output accessor holds {values} values; {expected} expected"
+                            ),
                         ));
                     }
                 }

@@ -132,7 +132,9 @@ impl Rule for Attributes {
                 let Some(count) = (match targets {
                     None => Some(0),
                     Some(list) => (!list.is_empty()
-                        && list.iter().all(|t| t.as_object().is_some_and(|o| !o.is_empty())))
+                        && list
+                            .iter()
+                            .all(|t| t.as_object().is_some_and(|o| !o.is_empty())))
                     .then(|| list.len()),
                 }) else {
                     continue;
@@ -161,9 +163,18 @@ mod tests {
 
     #[test]
     fn indexed_sets_count_from_zero_without_gaps() {
-        assert_eq!(discontinuous("TEXCOORD", &["TEXCOORD_0", "TEXCOORD_1"]), None);
-        assert_eq!(discontinuous("TEXCOORD", &["TEXCOORD_1", "TEXCOORD_00"]), Some((2, 1)));
-        assert_eq!(discontinuous("COLOR", &["COLOR_0", "COLOR_2", "TEXCOORD_5"]), Some((3, 2)));
+        assert_eq!(
+            discontinuous("TEXCOORD", &["TEXCOORD_0", "TEXCOORD_1"]),
+            None
+        );
+        assert_eq!(
+            discontinuous("TEXCOORD", &["TEXCOORD_1", "TEXCOORD_00"]),
+            Some((2, 1))
+        );
+        assert_eq!(
+            discontinuous("COLOR", &["COLOR_0", "COLOR_2", "TEXCOORD_5"]),
+            Some((3, 2))
+        );
         assert_eq!(discontinuous("JOINTS", &["POSITION"]), None);
     }
 

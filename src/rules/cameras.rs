@@ -83,7 +83,8 @@ impl Rule for Cameras {
                         _ => {}
                     }
                 }
-                if let (Some(znear), Some(zfar)) = (number(&ortho, "znear"), number(&ortho, "zfar")) {
+                if let (Some(znear), Some(zfar)) = (number(&ortho, "znear"), number(&ortho, "zfar"))
+                {
                     zfar_beyond_znear(znear, zfar, &at, out);
                 }
             }

@@ -118,22 +118,25 @@ pub const NODE_MATRIX_TRS: Code = Code::new(
 pub(crate) fn close_open_enums(schema: &mut Value) {
     match schema {
         Value::Object(map) => {
-            let open = map.get("anyOf").and_then(Value::as_array).and_then(|branches| {
-                let listed = branches
-                    .iter()
-                    .filter(|b| b.get("const").is_some() || b.get("enum").is_some())
-                    .count();
-                let bare: Vec<&Value> = branches
-                    .iter()
-                    .filter_map(|b| {
-                        let b = b.as_object()?;
-                        let only_type = b.keys().all(|k| k == "type" || k == "description");
-                        only_type.then(|| b.get("type")).flatten()
-                    })
-                    .collect();
-                (listed > 0 && listed + 1 == branches.len() && bare.len() == 1)
-                    .then(|| bare[0].clone())
-            });
+            let open = map
+                .get("anyOf")
+                .and_then(Value::as_array)
+                .and_then(|branches| {
+                    let listed = branches
+                        .iter()
+                        .filter(|b| b.get("const").is_some() || b.get("enum").is_some())
+                        .count();
+                    let bare: Vec<&Value> = branches
+                        .iter()
+                        .filter_map(|b| {
+                            let b = b.as_object()?;
+                            let only_type = b.keys().all(|k| k == "type" || k == "description");
+                            only_type.then(|| b.get("type")).flatten()
+                        })
+                        .collect();
+                    (listed > 0 && listed + 1 == branches.len() && bare.len() == 1)
+                        .then(|| bare[0].clone())
+                });
             if let Some(kind) = open {
                 if let Some(Value::Array(branches)) = map.get_mut("anyOf") {
                     for branch in branches.iter_mut() {
@@ -211,7 +214,9 @@ pub(crate) fn diagnostics(
         let mut at = error.instance_path().as_str().to_string();
         let schema_path = error.schema_path().as_str().to_string();
         let dependent = match error.kind() {
-            ValidationErrorKind::Required { property } if schema_path.ends_with("/dependencies") => {
+            ValidationErrorKind::Required { property }
+                if schema_path.ends_with("/dependencies") =>
+            {
                 json.pointer(&at).and_then(|object| {
                     dependent_property(object, &property_name(property), |key| {
                         !seen.contains(&(
@@ -311,10 +316,16 @@ fn reshape(found: &mut Diagnostic, json: Node) {
     } else if found.code == codes::TYPE_MISMATCH.name {
         if let Some((array, last)) = found.pointer.rsplit_once('/') {
             let nested = array.matches('/').count() >= 2;
-            if nested && last.parse::<usize>().is_ok() && json.pointer(array).is_some_and(|a| a.is_array()) {
+            if nested
+                && last.parse::<usize>().is_ok()
+                && json.pointer(array).is_some_and(|a| a.is_array())
+            {
                 found.code = ARRAY_TYPE_MISMATCH.name;
                 found.severity = ARRAY_TYPE_MISMATCH.severity;
-                found.message = format!("an element of the array is not of the type its items must have ({})", found.message);
+                found.message = format!(
+                    "an element of the array is not of the type its items must have ({})",
+                    found.message
+                );
                 found.pointer = array.to_string();
             }
         }
@@ -657,17 +668,20 @@ impl Rule for CoreStructure {
         cx.schemas.core.check(json, out);
         // Values an extension adds to a core enumeration are in the list once the extension
         // is declared, as the Khronos validator reads them.
-        let declared = |name: &str| {
-            super::elements(json.get("extensionsUsed")).any(|e| e.is_str(name))
-        };
+        let declared =
+            |name: &str| super::elements(json.get("extensionsUsed")).any(|e| e.is_str(name));
         let mut kept = first;
         for at in first..out.len() {
             let d = &out[at];
             let added = d.code == codes::VALUE_NOT_IN_LIST.name
                 && json.pointer(&d.pointer).is_some_and(|value| {
-                    EXTENDED_VALUES.iter().any(|(property, value_added, extension)| {
-                        d.pointer.ends_with(property) && value.is_str(value_added) && declared(extension)
-                    })
+                    EXTENDED_VALUES
+                        .iter()
+                        .any(|(property, value_added, extension)| {
+                            d.pointer.ends_with(property)
+                                && value.is_str(value_added)
+                                && declared(extension)
+                        })
                 });
             if !added {
                 out.swap(kept, at);

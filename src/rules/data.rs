@@ -116,7 +116,10 @@ impl<'a> Elements<'a> {
                     Some(o) => usize::try_from(o.as_u64()?).ok()?,
                 };
                 let (element, packed) = element_layout(size as u64, &kind)?;
-                let (element, packed) = (usize::try_from(element).ok()?, usize::try_from(packed).ok()?);
+                let (element, packed) = (
+                    usize::try_from(element).ok()?,
+                    usize::try_from(packed).ok()?,
+                );
                 let stride = match cx
                     .json()
                     .get("bufferViews")
@@ -162,12 +165,7 @@ impl<'a> Elements<'a> {
         })
     }
 
-    fn sparse(
-        cx: &'a Context,
-        sparse: Node,
-        element: usize,
-        count: usize,
-    ) -> Option<Sparse<'a>> {
+    fn sparse(cx: &'a Context, sparse: Node, element: usize, count: usize) -> Option<Sparse<'a>> {
         let n = index_of(sparse.get("count")).filter(|n| *n >= 1 && *n <= count)?;
         let indices = sparse.get("indices")?;
         let values = sparse.get("values")?;
@@ -236,8 +234,11 @@ impl<'a> Elements<'a> {
     pub fn element(&self, i: usize, values: &mut [f64]) {
         if let Some(sparse) = &self.sparse {
             // The last substitution of an element wins.
-            let end = sparse.substitutions.partition_point(|(index, _)| *index <= i);
-            if let Some(&(index, at)) = end.checked_sub(1).and_then(|k| sparse.substitutions.get(k)) {
+            let end = sparse
+                .substitutions
+                .partition_point(|(index, _)| *index <= i);
+            if let Some(&(index, at)) = end.checked_sub(1).and_then(|k| sparse.substitutions.get(k))
+            {
                 if index == i {
                     for (c, slot) in values.iter_mut().enumerate() {
                         *slot = self.read(&sparse.values[at + c * self.size..]);
@@ -354,7 +355,11 @@ mod tests {
             "bufferViews":{views},"accessors":{accessors}}}"#,
             bytes.len()
         );
-        let loaded = load_bytes_with(std::path::Path::new("t.gltf"), text.as_bytes(), &LoadOptions::default());
+        let loaded = load_bytes_with(
+            std::path::Path::new("t.gltf"),
+            text.as_bytes(),
+            &LoadOptions::default(),
+        );
         let asset = loaded.asset.expect("the document parses");
         let schemas = super::super::schema::Schemas::builtin();
         let cx = Context::new(&asset, &schemas);

@@ -31,7 +31,9 @@ pub fn is_extension_name(name: &str) -> bool {
         return false;
     };
     !prefix.is_empty()
-        && prefix.bytes().all(|b| b.is_ascii_uppercase() || b.is_ascii_digit())
+        && prefix
+            .bytes()
+            .all(|b| b.is_ascii_uppercase() || b.is_ascii_digit())
         && !rest.is_empty()
         && rest.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'_')
 }
@@ -76,10 +78,23 @@ mod tests {
 
     #[test]
     fn extension_names_have_a_capital_prefix_and_a_name() {
-        for ok in ["KHR_materials_sheen", "EXT_texture_webp", "ADOBE_materials_thin_transparency", "MSFT_lod", "A1_x"] {
+        for ok in [
+            "KHR_materials_sheen",
+            "EXT_texture_webp",
+            "ADOBE_materials_thin_transparency",
+            "MSFT_lod",
+            "A1_x",
+        ] {
             assert!(is_extension_name(ok), "{ok}");
         }
-        for bad in ["_extension", "khr_materials_sheen", "KHR", "KHR_", "KHR_a-b", ""] {
+        for bad in [
+            "_extension",
+            "khr_materials_sheen",
+            "KHR",
+            "KHR_",
+            "KHR_a-b",
+            "",
+        ] {
             assert!(!is_extension_name(bad), "{bad}");
         }
     }

@@ -695,11 +695,10 @@ impl ShapeBuilder {
         self.known.insert(key, at);
         let mut is = vec![name.to_string()];
         let mut children = Vec::new();
-        let mut known: Option<Vec<String>> =
-            match schema.get("additionalProperties") {
-                None | Some(Value::Bool(false)) => Some(Vec::new()),
-                Some(_) => None,
-            };
+        let mut known: Option<Vec<String>> = match schema.get("additionalProperties") {
+            None | Some(Value::Bool(false)) => Some(Vec::new()),
+            Some(_) => None,
+        };
         for base in schema
             .get("allOf")
             .and_then(Value::as_array)

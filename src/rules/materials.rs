@@ -181,7 +181,12 @@ const TANGENT_SPACE_TEXTURES: [(&str, &Code); 2] = [
 /// coordinate set (KHR_texture_transform's `texCoord` counted).
 fn tangent_space_sets(cx: &Context, out: &mut Vec<Diagnostic>) {
     for (m, textures) in cx.material_textures().iter().enumerate() {
-        let set_of = |pointer: &str| textures.iter().find(|t| t.pointer == pointer).map(|t| t.set);
+        let set_of = |pointer: &str| {
+            textures
+                .iter()
+                .find(|t| t.pointer == pointer)
+                .map(|t| t.set)
+        };
         let Some(normal) = set_of("/normalTexture") else {
             continue;
         };

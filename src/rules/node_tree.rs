@@ -65,7 +65,9 @@ impl Rule for NodeTree {
                     Some(first) => out.push(Diagnostic::new(
                         &NODE_PARENT_OVERRIDE,
                         format!("/nodes/{p}/children/{j}"),
-                        format!("node {c} is already a child of node {first}; a node has one parent"),
+                        format!(
+                            "node {c} is already a child of node {first}; a node has one parent"
+                        ),
                     )),
                 }
             }

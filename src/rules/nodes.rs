@@ -214,7 +214,9 @@ mod tests {
 
     #[test]
     fn a_sheared_or_flattened_matrix_is_not_trs() {
-        let identity = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0];
+        let identity = [
+            1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0,
+        ];
         assert!(is_trs(&identity));
         let mut sheared = identity;
         sheared[4] = 0.5;

@@ -217,29 +217,31 @@ impl Rule for Primitives {
         // The first accessor found holding vertex attributes in each buffer view.
         let mut first_in_view: Vec<Option<usize>> = vec![None; strided.len()];
         // Pointers are written only for findings: a library has tens of thousands of attributes.
-        let mut vertex_attribute =
-            |at: &dyn Fn() -> String, index: usize, view: &AccessorView, out: &mut Vec<Diagnostic>| {
-                if view.component_type == Some(5125) {
-                    out.push(Diagnostic::new(
-                        &MESH_PRIMITIVE_ATTRIBUTES_ACCESSOR_UNSIGNED_INT,
-                        at(),
-                        "a vertex attribute cannot hold unsigned ints",
-                    ));
-                }
-                let Some(bv) = view.buffer_view.filter(|v| *v < strided.len()) else {
-                    return;
-                };
-                if view.byte_offset % 4 != 0 {
-                    out.push(Diagnostic::new(
-                        &MESH_PRIMITIVE_ACCESSOR_UNALIGNED,
-                        at(),
-                        format!(
-                            "the accessor's byteOffset {} is not a multiple of 4",
-                            view.byte_offset
-                        ),
-                    ));
-                }
-                match first_in_view[bv] {
+        let mut vertex_attribute = |at: &dyn Fn() -> String,
+                                    index: usize,
+                                    view: &AccessorView,
+                                    out: &mut Vec<Diagnostic>| {
+            if view.component_type == Some(5125) {
+                out.push(Diagnostic::new(
+                    &MESH_PRIMITIVE_ATTRIBUTES_ACCESSOR_UNSIGNED_INT,
+                    at(),
+                    "a vertex attribute cannot hold unsigned ints",
+                ));
+            }
+            let Some(bv) = view.buffer_view.filter(|v| *v < strided.len()) else {
+                return;
+            };
+            if view.byte_offset % 4 != 0 {
+                out.push(Diagnostic::new(
+                    &MESH_PRIMITIVE_ACCESSOR_UNALIGNED,
+                    at(),
+                    format!(
+                        "the accessor's byteOffset {} is not a multiple of 4",
+                        view.byte_offset
+                    ),
+                ));
+            }
+            match first_in_view[bv] {
                     None => first_in_view[bv] = Some(index),
                     Some(first) if first != index && !strided[bv] => out.push(Diagnostic::new(
                         &MESH_PRIMITIVE_ACCESSOR_WITHOUT_BYTESTRIDE,
@@ -248,7 +250,7 @@ impl Rule for Primitives {
                     )),
                     Some(_) => {}
                 }
-            };
+        };
         for (m, mesh) in elements(Some(meshes)).enumerate() {
             let mut targets_count = None;
             for (p, primitive) in elements(mesh.get("primitives")).enumerate() {
@@ -261,7 +263,10 @@ impl Rule for Primitives {
                     continue;
                 }
                 if targets_count.is_none() {
-                    targets_count = primitive.get("targets").and_then(|t| t.as_array()).map(|t| t.len());
+                    targets_count = primitive
+                        .get("targets")
+                        .and_then(|t| t.as_array())
+                        .map(|t| t.len());
                 }
                 if !attributes.contains_key("POSITION") {
                     out.push(Diagnostic::new(
@@ -277,7 +282,8 @@ impl Rule for Primitives {
                         "TANGENT without NORMAL: the tangents are not used",
                     ));
                 }
-                let sets = |prefix: &str| attributes.keys().filter(|k| k.starts_with(prefix)).count();
+                let sets =
+                    |prefix: &str| attributes.keys().filter(|k| k.starts_with(prefix)).count();
                 let (joints, weights) = (sets("JOINTS_"), sets("WEIGHTS_"));
                 if joints != weights {
                     out.push(Diagnostic::new(
@@ -303,11 +309,18 @@ impl Rule for Primitives {
                             Some(_) => {}
                         }
                     }
-                    if !quantized && view.component_type != Some(5125) && !format_allowed(&name, view) {
+                    if !quantized
+                        && view.component_type != Some(5125)
+                        && !format_allowed(&name, view)
+                    {
                         out.push(Diagnostic::new(
                             &MESH_PRIMITIVE_ATTRIBUTES_ACCESSOR_INVALID_FORMAT,
                             attribute_at(),
-                            format!("{name} cannot be held as {} of component type {}", view.kind.as_deref().unwrap_or("?"), view.component_type.unwrap_or(0)),
+                            format!(
+                                "{name} cannot be held as {} of component type {}",
+                                view.kind.as_deref().unwrap_or("?"),
+                                view.component_type.unwrap_or(0)
+                            ),
                         ));
                     }
                     if name == "POSITION" && !view.bounded {
@@ -323,7 +336,9 @@ impl Rule for Primitives {
                 if let Some(indices) = primitive.get("indices") {
                     if let Some((_, view)) = accessor(indices) {
                         let scalar_uint = view.kind.as_deref().is_none_or(|k| k == "SCALAR")
-                            && view.component_type.is_none_or(|c| matches!(c, 5121 | 5123 | 5125))
+                            && view
+                                .component_type
+                                .is_none_or(|c| matches!(c, 5121 | 5123 | 5125))
                             && !view.normalized;
                         if !scalar_uint {
                             out.push(Diagnostic::new(
@@ -343,7 +358,9 @@ impl Rule for Primitives {
                         out.push(Diagnostic::new(
                             &MESH_PRIMITIVE_INCOMPATIBLE_MODE,
                             at(),
-                            format!("{count} vertices or indices cannot be drawn whole in mode {mode}"),
+                            format!(
+                                "{count} vertices or indices cannot be drawn whole in mode {mode}"
+                            ),
                         ));
                     }
                 }
@@ -352,7 +369,8 @@ impl Rule for Primitives {
                         let Some((i, view)) = accessor(index) else {
                             continue;
                         };
-                        let target_at = || format!("{}/targets/{t}/{}", at(), pointer::escape(&name));
+                        let target_at =
+                            || format!("{}/targets/{t}/{}", at(), pointer::escape(&name));
                         if let (Some(count), Some(vertices)) = (view.count, vertices) {
                             if count != vertices {
                                 out.push(Diagnostic::new(

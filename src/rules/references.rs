@@ -97,11 +97,14 @@ pub fn is_index(pointer: &str) -> bool {
     LINKS.iter().any(|(pattern, _)| {
         let segments: Vec<&str> = pattern.split('/').skip(1).collect();
         segments.len() == tokens.len()
-            && segments.iter().zip(&tokens).all(|(segment, token)| match *segment {
-                "*" => true,
-                s if s.starts_with('*') => token.ends_with(&s[1..]),
-                s => s == token,
-            })
+            && segments
+                .iter()
+                .zip(&tokens)
+                .all(|(segment, token)| match *segment {
+                    "*" => true,
+                    s if s.starts_with('*') => token.ends_with(&s[1..]),
+                    s => s == token,
+                })
     })
 }
 

@@ -105,7 +105,10 @@ impl Rule for Resources {
         let json = cx.json();
         let glb = cx.asset.container == crate::asset::Container::Glb;
         for (key, check) in [
-            ("buffers", check_buffer as fn(&Context, usize, Node, &mut Vec<Diagnostic>)),
+            (
+                "buffers",
+                check_buffer as fn(&Context, usize, Node, &mut Vec<Diagnostic>),
+            ),
             ("images", check_image),
         ] {
             for (index, object) in array(json, key) {

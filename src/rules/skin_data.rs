@@ -64,7 +64,9 @@ mod tests {
     #[test]
     fn a_matrix_whose_last_row_is_not_0_0_0_1_is_found_once_a_value() {
         let mut bytes = Vec::new();
-        let identity = [1.0f32, 0., 0., 0., 0., 1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1.];
+        let identity = [
+            1.0f32, 0., 0., 0., 0., 1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1.,
+        ];
         let mut bad = identity;
         bad[3] = 1.0;
         bad[15] = 2.0;

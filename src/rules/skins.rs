@@ -199,7 +199,11 @@ impl Rule for Skins {
             }
         }
         let scenes: Vec<Vec<usize>> = elements(json.get("scenes"))
-            .map(|s| elements(s.get("nodes")).filter_map(|n| tree.node(Some(n))).collect())
+            .map(|s| {
+                elements(s.get("nodes"))
+                    .filter_map(|n| tree.node(Some(n)))
+                    .collect()
+            })
             .collect();
         let transformed = |n: usize| {
             ["translation", "rotation", "scale", "matrix"]

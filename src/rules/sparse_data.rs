@@ -27,7 +27,10 @@ pub struct SparseData;
 
 impl Rule for SparseData {
     fn codes(&self) -> &'static [&'static Code] {
-        &[&ACCESSOR_SPARSE_INDICES_NON_INCREASING, &ACCESSOR_SPARSE_INDEX_OOB]
+        &[
+            &ACCESSOR_SPARSE_INDICES_NON_INCREASING,
+            &ACCESSOR_SPARSE_INDEX_OOB,
+        ]
     }
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
@@ -56,7 +59,9 @@ impl Rule for SparseData {
                     out.push(Diagnostic::new(
                         &ACCESSOR_SPARSE_INDEX_OOB,
                         at.clone(),
-                        format!("sparse index {k} is {index}, not below the accessor's count {count}"),
+                        format!(
+                            "sparse index {k} is {index}, not below the accessor's count {count}"
+                        ),
                     ));
                 }
             }

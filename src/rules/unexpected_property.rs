@@ -92,12 +92,19 @@ fn walk<'a>(
                 }
             }
             path.pop();
-        } else if let Some((_, child, array)) =
-            shapes.children(shape).iter().find(|(name, _, _)| *name == key)
+        } else if let Some((_, child, array)) = shapes
+            .children(shape)
+            .iter()
+            .find(|(name, _, _)| *name == key)
         {
             path.push(Step::Key(key));
             if *array {
-                for (i, element) in member.as_array().into_iter().flat_map(|a| a.iter()).enumerate() {
+                for (i, element) in member
+                    .as_array()
+                    .into_iter()
+                    .flat_map(|a| a.iter())
+                    .enumerate()
+                {
                     path.push(Step::Index(i));
                     walk(shapes, element, *child, path, out);
                     path.pop();

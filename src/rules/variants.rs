@@ -20,7 +20,11 @@ impl Rule for Variants {
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
         let json = cx.json();
-        if json.members_named("KHR_materials_variants").next().is_none() {
+        if json
+            .members_named("KHR_materials_variants")
+            .next()
+            .is_none()
+        {
             return;
         }
         for (m, mesh) in elements(json.get("meshes")).enumerate() {

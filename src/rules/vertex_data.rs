@@ -148,13 +148,17 @@ impl Rule for VertexData {
         let mut judged: std::collections::HashSet<(&str, usize)> = std::collections::HashSet::new();
         for (m, mesh) in elements(Some(meshes)).enumerate() {
             for (p, primitive) in elements(mesh.get("primitives")).enumerate() {
-                let Some(attributes) = primitive.get("attributes").and_then(|a| a.as_object()) else {
+                let Some(attributes) = primitive.get("attributes").and_then(|a| a.as_object())
+                else {
                     continue;
                 };
                 let at = format!("/meshes/{m}/primitives/{p}");
                 let mut read = |kind: &'static str, name: &str| {
                     let index = accessor_index(attributes.get(name))?;
-                    judged.insert((kind, index)).then(|| Elements::of(cx, index)).flatten()
+                    judged
+                        .insert((kind, index))
+                        .then(|| Elements::of(cx, index))
+                        .flatten()
                 };
                 let vertices = accessor_index(attributes.get("POSITION"))
                     .and_then(|i| cx.json().get("accessors")?.get(i)?.get("count")?.as_u64());
@@ -163,7 +167,13 @@ impl Rule for VertexData {
                     vertices,
                 ) {
                     let mode = primitive.get("mode").map_or(Some(4), |m| m.as_u64());
-                    check_indices(&indices, vertices, mode, &format!("{at}/indices"), &mut capped);
+                    check_indices(
+                        &indices,
+                        vertices,
+                        mode,
+                        &format!("{at}/indices"),
+                        &mut capped,
+                    );
                 }
                 if let Some(normals) = read("normal", "NORMAL").filter(|e| e.components == 3) {
                     let at = format!("{at}/attributes/NORMAL");
@@ -175,14 +185,19 @@ impl Rule for VertexData {
                         let w = tangents.normalize(v[3]);
                         if w != 1.0 && w != -1.0 {
                             capped.push(&ACCESSOR_INVALID_SIGN, &at, || {
-                                format!("the tangent at indices {}..{} has w {w}; it must be 1 or -1", i * 4, i * 4 + 3)
+                                format!(
+                                    "the tangent at indices {}..{} has w {w}; it must be 1 or -1",
+                                    i * 4,
+                                    i * 4 + 3
+                                )
                             });
                         }
                         unit_length(&tangents, i, &v[..3], 4, &at, &mut capped);
                     });
                 }
                 for (name, _) in attributes.iter().filter(|(n, _)| n.starts_with("COLOR_")) {
-                    let Some(colors) = read("color", &name).filter(|e| e.component_type == 5126) else {
+                    let Some(colors) = read("color", &name).filter(|e| e.component_type == 5126)
+                    else {
                         continue;
                     };
                     let at = format!("{at}/attributes/{}", pointer::escape(&name));
@@ -191,7 +206,10 @@ impl Rule for VertexData {
                         for (c, &value) in v.iter().enumerate() {
                             if !(0.0..=1.0).contains(&value) {
                                 capped.push(&ACCESSOR_NON_CLAMPED, &at, || {
-                                    format!("the value at index {} is not within 0..1: {value}", i * n + c)
+                                    format!(
+                                        "the value at index {} is not within 0..1: {value}",
+                                        i * n + c
+                                    )
                                 });
                             }
                         }
@@ -206,7 +224,13 @@ impl Rule for VertexData {
 
 /// Indices against the primitive's vertices and the restart value of their type, and for
 /// triangles, the triangles that name a vertex twice (drawn as nothing).
-fn check_indices(indices: &Elements, vertices: u64, mode: Option<u64>, at: &str, capped: &mut Capped) {
+fn check_indices(
+    indices: &Elements,
+    vertices: u64,
+    mode: Option<u64>,
+    at: &str,
+    capped: &mut Capped,
+) {
     if indices.components != 1 {
         return;
     }
@@ -223,7 +247,9 @@ fn check_indices(indices: &Elements, vertices: u64, mode: Option<u64>, at: &str,
         let index = v[0];
         if triangles {
             corner[i % 3] = index;
-            if i % 3 == 2 && (corner[0] == corner[1] || corner[1] == corner[2] || corner[0] == corner[2]) {
+            if i % 3 == 2
+                && (corner[0] == corner[1] || corner[1] == corner[2] || corner[0] == corner[2])
+            {
                 degenerate += 1;
             }
         }
@@ -233,20 +259,32 @@ fn check_indices(indices: &Elements, vertices: u64, mode: Option<u64>, at: &str,
             });
         } else if index >= vertices {
             capped.push(&ACCESSOR_INDEX_OOB, at, || {
-                format!("the index at {i} is {index}, past the primitive's last vertex ({})", vertices - 1.0)
+                format!(
+                    "the index at {i} is {index}, past the primitive's last vertex ({})",
+                    vertices - 1.0
+                )
             });
         }
     });
     if degenerate > 0 {
         let all = indices.count / 3;
         capped.push(&ACCESSOR_INDEX_TRIANGLE_DEGENERATE, at, || {
-            format!("{degenerate} of the {all} triangles name a vertex twice and are drawn as nothing")
+            format!(
+                "{degenerate} of the {all} triangles name a vertex twice and are drawn as nothing"
+            )
         });
     }
 }
 
 /// A vector's length (its first three components, as a loader reads them) against 1.
-fn unit_length(elements: &Elements, i: usize, v: &[f64], stride: usize, at: &str, capped: &mut Capped) {
+fn unit_length(
+    elements: &Elements,
+    i: usize,
+    v: &[f64],
+    stride: usize,
+    at: &str,
+    capped: &mut Capped,
+) {
     let length = v[..3]
         .iter()
         .map(|c| elements.normalize(*c).powi(2))
@@ -269,10 +307,17 @@ fn joint_limits(cx: &Context) -> Vec<(usize, usize, usize)> {
     let skins: Vec<_> = elements(json.get("skins")).collect();
     let mut limits = Vec::new();
     for node in elements(json.get("nodes")) {
-        let (Some(mesh), Some(skin)) = (accessor_index(node.get("mesh")), accessor_index(node.get("skin"))) else {
+        let (Some(mesh), Some(skin)) = (
+            accessor_index(node.get("mesh")),
+            accessor_index(node.get("skin")),
+        ) else {
             continue;
         };
-        let Some(joints) = skins.get(skin).and_then(|s| s.get("joints")).and_then(|j| j.as_array()) else {
+        let Some(joints) = skins
+            .get(skin)
+            .and_then(|s| s.get("joints"))
+            .and_then(|j| j.as_array())
+        else {
             continue;
         };
         limits.push((mesh, joints.len(), skin));
@@ -304,9 +349,17 @@ fn check_skinning(
         if weights.is_none() && joints.is_none() {
             break;
         }
-        let weights = accessor_index(weights).and_then(|i| Elements::of(cx, i)).filter(|e| e.components == 4);
-        let joints = accessor_index(joints).and_then(|i| Elements::of(cx, i)).filter(|e| e.components == 4);
-        sets.push((set, weights, joints));
+        let weights = accessor_index(weights)
+            .and_then(|i| Elements::of(cx, i))
+            .filter(|e| e.components == 4);
+        let joints = accessor_index(joints)
+            .and_then(|i| Elements::of(cx, i))
+            .filter(|e| e.components == 4);
+        let pointers = (
+            format!("{at}/attributes/WEIGHTS_{set}"),
+            format!("{at}/attributes/JOINTS_{set}"),
+        );
+        sets.push((pointers, weights, joints));
     }
     if sets.is_empty() {
         return;
@@ -324,9 +377,7 @@ fn check_skinning(
         let mut sum = 0.0;
         let mut complete = true;
         used.clear();
-        for (set, weights, joints) in &sets {
-            let weights_at = format!("{at}/attributes/WEIGHTS_{set}");
-            let joints_at = format!("{at}/attributes/JOINTS_{set}");
+        for ((weights_at, joints_at), weights, joints) in &sets {
             let Some(weights) = weights else {
                 complete = false;
                 continue;
@@ -336,8 +387,11 @@ fn check_skinning(
                 *w = weights.normalize(*w);
                 if *w < 0.0 {
                     let value = *w;
-                    capped.push(&ACCESSOR_WEIGHTS_NEGATIVE, &weights_at, || {
-                        format!("the weight at index {} (component {c}) is negative: {value}", i * 4 + c)
+                    capped.push(&ACCESSOR_WEIGHTS_NEGATIVE, weights_at, || {
+                        format!(
+                            "the weight at index {} (component {c}) is negative: {value}",
+                            i * 4 + c
+                        )
                     });
                     // Reported on its own, and left out of the sum, as the reference does.
                     continue;
@@ -352,15 +406,18 @@ fn check_skinning(
                 let j = joint[c];
                 if weight[c] == 0.0 {
                     if j != 0.0 {
-                        capped.push(&ACCESSOR_JOINTS_USED_ZERO_WEIGHT, &joints_at, || {
-                            format!("the joint at index {} (component {c}) is {j} with zero weight", i * 4 + c)
+                        capped.push(&ACCESSOR_JOINTS_USED_ZERO_WEIGHT, joints_at, || {
+                            format!(
+                                "the joint at index {} (component {c}) is {j} with zero weight",
+                                i * 4 + c
+                            )
                         });
                     }
                     continue;
                 }
                 if let Some((joints_count, skin)) = limit {
                     if j >= joints_count as f64 {
-                        capped.push(&ACCESSOR_JOINTS_INDEX_OOB, &joints_at, || {
+                        capped.push(&ACCESSOR_JOINTS_INDEX_OOB, joints_at, || {
                             format!(
                                 "the joint at index {} (component {c}) is {j}, past the last joint ({}) of skin {skin}",
                                 i * 4 + c,
@@ -370,7 +427,7 @@ fn check_skinning(
                     }
                 }
                 if used.contains(&j) {
-                    capped.push(&ACCESSOR_JOINTS_INDEX_DUPLICATE, &joints_at, || {
+                    capped.push(&ACCESSOR_JOINTS_INDEX_DUPLICATE, joints_at, || {
                         format!("the joint at index {} (component {c}) is {j}, already weighted for this vertex", i * 4 + c)
                     });
                 } else {
@@ -379,9 +436,13 @@ fn check_skinning(
             }
         }
         if complete && (sum - 1.0).abs() > tolerance {
-            for (set, _, _) in &sets {
-                capped.push(&ACCESSOR_WEIGHTS_NON_NORMALIZED, &format!("{at}/attributes/WEIGHTS_{set}"), || {
-                    format!("the weights at indices {}..{} sum to {sum}, not 1", i * 4, i * 4 + 3)
+            for ((weights_at, _), _, _) in &sets {
+                capped.push(&ACCESSOR_WEIGHTS_NON_NORMALIZED, weights_at, || {
+                    format!(
+                        "the weights at indices {}..{} sum to {sum}, not 1",
+                        i * 4,
+                        i * 4 + 3
+                    )
                 });
             }
         }
@@ -409,9 +470,20 @@ mod tests {
             while bytes.len() % 4 != 0 {
                 bytes.push(0);
             }
-            let per = match *kind { "SCALAR" => 1, "VEC3" => 3, _ => 4 };
-            views.push(format!(r#"{{"buffer":0,"byteOffset":{start},"byteLength":{}}}"#, bytes.len() - start));
-            let bounds = if values[i].2 == "POSITION" { r#","min":[0,0,0],"max":[1,1,1]"# } else { "" };
+            let per = match *kind {
+                "SCALAR" => 1,
+                "VEC3" => 3,
+                _ => 4,
+            };
+            views.push(format!(
+                r#"{{"buffer":0,"byteOffset":{start},"byteLength":{}}}"#,
+                bytes.len() - start
+            ));
+            let bounds = if values[i].2 == "POSITION" {
+                r#","min":[0,0,0],"max":[1,1,1]"#
+            } else {
+                ""
+            };
             accessors.push(format!(
                 r#"{{"bufferView":{i},"componentType":{component},"count":{},"type":"{kind}"{bounds}}}"#,
                 data.len() / per
@@ -433,9 +505,24 @@ mod tests {
             &[
                 ("VEC3", 5126, "POSITION", vec![0.0; 9]),
                 ("SCALAR", 5121, "indices", vec![0.0, 1.0, 3.0, 255.0]),
-                ("VEC3", 5126, "NORMAL", vec![0.0, 0.0, 1.0, 1.0, 1.0, 1.0, 0.0, 1.0, 0.0]),
-                ("VEC4", 5126, "TANGENT", vec![1.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 2.0, 0.0, -1.0]),
-                ("VEC4", 5126, "COLOR_0", vec![0.0, 0.5, 1.5, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]),
+                (
+                    "VEC3",
+                    5126,
+                    "NORMAL",
+                    vec![0.0, 0.0, 1.0, 1.0, 1.0, 1.0, 0.0, 1.0, 0.0],
+                ),
+                (
+                    "VEC4",
+                    5126,
+                    "TANGENT",
+                    vec![1.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 2.0, 0.0, -1.0],
+                ),
+                (
+                    "VEC4",
+                    5126,
+                    "COLOR_0",
+                    vec![0.0, 0.5, 1.5, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
+                ),
             ],
             r#"{"attributes":{"POSITION":0,"NORMAL":2,"TANGENT":3,"COLOR_0":4},"indices":1}"#,
             "",
@@ -458,8 +545,18 @@ mod tests {
         let text = document(
             &[
                 ("VEC3", 5126, "POSITION", vec![0.0; 9]),
-                ("VEC4", 5126, "WEIGHTS_0", vec![1.0, 0.0, 0.0, 0.0, 0.5, 0.5, 0.5, 0.0, 0.5, 0.5, -0.5, 0.5]),
-                ("VEC4", 5123, "JOINTS_0", vec![0.0, 4.0, 0.0, 0.0, 1.0, 2.0, 9.0, 0.0, 1.0, 1.0, 2.0, 0.0]),
+                (
+                    "VEC4",
+                    5126,
+                    "WEIGHTS_0",
+                    vec![1.0, 0.0, 0.0, 0.0, 0.5, 0.5, 0.5, 0.0, 0.5, 0.5, -0.5, 0.5],
+                ),
+                (
+                    "VEC4",
+                    5123,
+                    "JOINTS_0",
+                    vec![0.0, 4.0, 0.0, 0.0, 1.0, 2.0, 9.0, 0.0, 1.0, 1.0, 2.0, 0.0],
+                ),
             ],
             r#"{"attributes":{"POSITION":0,"WEIGHTS_0":1,"JOINTS_0":2}}"#,
             r#","nodes":[{"mesh":0,"skin":0},{},{},{}],"skins":[{"joints":[1,2,3]}]"#,
