@@ -38,14 +38,17 @@ for n in 5000 20000 80000; do
 done
 [ -f "$work/lib/library.gltf" ] || "$corpus" --library "$work/lib" > /dev/null
 [ -f "$work/min/library.gltf" ] || "$corpus" --minified-library "$work/min" > /dev/null
+# A valid document whose weight is in its data (67 MB of meshes, skins and keyframes).
+[ -f "$work/data/data.gltf" ] || "$corpus" --data-library "$work/data" > /dev/null
 # The minified library migrated (a fuzz and a note on each of its 20,000 materials); migrate
 # keeps the layout, so it is one line too.
 [ -f "$work/min-migrated/library.gltf" ] ||
     "$velvet" migrate -q --fast "$work/min/library.gltf" --out-dir "$work/min-migrated" > /dev/null
 
 # The commands, by number: label, then the command line.
-count=17
-# validate's output formats on the minified library (10-13) and its migrated output (14-17).
+count=20
+# validate's output formats on the minified library (10-13) and its migrated output (14-17);
+# the data library (18-20).
 formats="json text github sarif"
 format_of() {
     n=$(( ($1 - 10) % 4 ))
@@ -66,6 +69,9 @@ command_of() {
     9) echo "velvet migrate, library" ;;
     1[0-3]) echo "velvet validate --format $(format_of "$1"), minified library" ;;
     1[4-7]) echo "velvet validate --format $(format_of "$1"), minified library migrated" ;;
+    18) echo "velvet validate, data library" ;;
+    19) echo "Khronos validator, data library" ;;
+    20) echo "velvet validate --no-data, data library" ;;
     esac
 }
 # timed COMMAND...: runs it under time(1), which writes its peak memory (KiB) to time1.
@@ -85,6 +91,9 @@ run_command() {
     9) timed "$velvet" migrate -q "$work/lib/library.gltf" --out-dir "$work/out" ;;
     1[0-3]) timed "$velvet" validate --format "$(format_of "$1")" "$work/min/library.gltf" ;;
     1[4-7]) timed "$velvet" validate --format "$(format_of "$1")" "$work/min-migrated/library.gltf" ;;
+    18) timed "$velvet" validate --format json "$work/data/data.gltf" ;;
+    19) timed node "$anchors/validate.js" "$work/data/data.gltf" ;;
+    20) timed "$velvet" validate --format json --no-data "$work/data/data.gltf" ;;
     esac
 }
 
@@ -162,7 +171,7 @@ done
 echo
 echo "| comparison | velvet | the other tool | velvet is faster by |"
 echo "|---|---|---|---|"
-for pair in "2 3" "5 6" "7 8"; do
+for pair in "2 3" "5 6" "7 8" "18 19"; do
     set -- $pair
     awk -v label="$(command_of "$1") / $(command_of "$2")" -v a="$(median "$1")" -v b="$(median "$2")" \
         'BEGIN { printf "| %s | %s s | %s s | %.1f× |\n", label, a, b, b / a }'
