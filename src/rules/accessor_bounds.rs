@@ -94,108 +94,104 @@ impl Rule for AccessorBounds {
 /// One accessor's values against its bounds.
 fn check_accessor(cx: &Context, i: usize, out: &mut Vec<Diagnostic>) {
     let accessors = cx.json().get("accessors");
-    {
-        {
-            let Some(accessor) = accessors.and_then(|a| a.get(i)) else {
-                return;
-            };
-            let bound = |key: &str| -> Option<Vec<f64>> {
-                let values = accessor.get(key)?.as_array()?;
-                values.iter().map(|v| v.as_f64()).collect()
-            };
-            let (min, max) = (bound("min"), bound("max"));
-            let float = accessor.get("componentType").and_then(|c| c.as_u64()) == Some(5126);
-            if min.is_none() && max.is_none() && !float {
-                return;
+    let Some(accessor) = accessors.and_then(|a| a.get(i)) else {
+        return;
+    };
+    let bound = |key: &str| -> Option<Vec<f64>> {
+        let values = accessor.get(key)?.as_array()?;
+        values.iter().map(|v| v.as_f64()).collect()
+    };
+    let (min, max) = (bound("min"), bound("max"));
+    let float = accessor.get("componentType").and_then(|c| c.as_u64()) == Some(5126);
+    if min.is_none() && max.is_none() && !float {
+        return;
+    }
+    let Some(elements) = Elements::of(cx, i) else {
+        return;
+    };
+    let n = elements.components;
+    // Declared bounds as the data holds them: single precision for floats.
+    let stored = |v: f64| if float { f64::from(v as f32) } else { v };
+    let min = min
+        .filter(|m| m.len() == n)
+        .map(|m| m.into_iter().map(stored).collect::<Vec<_>>());
+    let max = max
+        .filter(|m| m.len() == n)
+        .map(|m| m.into_iter().map(stored).collect::<Vec<_>>());
+    let mut tally = Tally {
+        low: [f64::INFINITY; MAX_COMPONENTS],
+        high: [f64::NEG_INFINITY; MAX_COMPONENTS],
+        below: [0; MAX_COMPONENTS],
+        above: [0; MAX_COMPONENTS],
+    };
+    let mut invalid = 0;
+    elements.for_each(|e, values| {
+        for (c, &v) in values.iter().enumerate() {
+            if !v.is_finite() {
+                if invalid < MAX_REPORTED {
+                    out.push(Diagnostic::new(
+                        &ACCESSOR_INVALID_FLOAT,
+                        format!("/accessors/{i}"),
+                        format!("the value at index {} is {}", e * n + c, name_of(v)),
+                    ));
+                }
+                invalid += 1;
+                continue;
             }
-            let Some(elements) = Elements::of(cx, i) else {
-                return;
-            };
-            let n = elements.components;
-            // Declared bounds as the data holds them: single precision for floats.
-            let stored = |v: f64| if float { f64::from(v as f32) } else { v };
-            let min = min
-                .filter(|m| m.len() == n)
-                .map(|m| m.into_iter().map(stored).collect::<Vec<_>>());
-            let max = max
-                .filter(|m| m.len() == n)
-                .map(|m| m.into_iter().map(stored).collect::<Vec<_>>());
-            let mut tally = Tally {
-                low: [f64::INFINITY; MAX_COMPONENTS],
-                high: [f64::NEG_INFINITY; MAX_COMPONENTS],
-                below: [0; MAX_COMPONENTS],
-                above: [0; MAX_COMPONENTS],
-            };
-            let mut invalid = 0;
-            elements.for_each(|e, values| {
-                for (c, &v) in values.iter().enumerate() {
-                    if !v.is_finite() {
-                        if invalid < MAX_REPORTED {
-                            out.push(Diagnostic::new(
-                                &ACCESSOR_INVALID_FLOAT,
-                                format!("/accessors/{i}"),
-                                format!("the value at index {} is {}", e * n + c, name_of(v)),
-                            ));
-                        }
-                        invalid += 1;
-                        return;
-                    }
-                    tally.low[c] = tally.low[c].min(v);
-                    tally.high[c] = tally.high[c].max(v);
-                    if min.as_ref().is_some_and(|m| v < m[c]) {
-                        tally.below[c] += 1;
-                    }
-                    if max.as_ref().is_some_and(|m| v > m[c]) {
-                        tally.above[c] += 1;
-                    }
-                }
-            });
-            for (key, declared, actual, beyond, mismatch, outside, word) in [
-                (
-                    "min",
-                    &min,
-                    &tally.low,
-                    &tally.below,
-                    &ACCESSOR_MIN_MISMATCH,
-                    &ACCESSOR_ELEMENT_OUT_OF_MIN_BOUND,
-                    "less",
-                ),
-                (
-                    "max",
-                    &max,
-                    &tally.high,
-                    &tally.above,
-                    &ACCESSOR_MAX_MISMATCH,
-                    &ACCESSOR_ELEMENT_OUT_OF_MAX_BOUND,
-                    "greater",
-                ),
-            ] {
-                let Some(declared) = declared else {
-                    continue;
-                };
-                for c in 0..n {
-                    let at = format!("/accessors/{i}/{key}/{c}");
-                    if actual[c].is_finite() && declared[c] != actual[c] {
-                        out.push(Diagnostic::new(
-                            mismatch,
-                            at.clone(),
-                            format!(
-                                "the declared {key} of this component, {}, is not the actual {key}, {}",
-                                declared[c], actual[c]
-                            ),
-                        ));
-                    }
-                    if beyond[c] > 0 {
-                        out.push(Diagnostic::new(
-                            outside,
-                            at,
-                            format!(
-                                "{} value(s) of this component are {word} than the declared {key}, {}",
-                                beyond[c], declared[c]
-                            ),
-                        ));
-                    }
-                }
+            tally.low[c] = tally.low[c].min(v);
+            tally.high[c] = tally.high[c].max(v);
+            if min.as_ref().is_some_and(|m| v < m[c]) {
+                tally.below[c] += 1;
+            }
+            if max.as_ref().is_some_and(|m| v > m[c]) {
+                tally.above[c] += 1;
+            }
+        }
+    });
+    for (key, declared, actual, beyond, mismatch, outside, word) in [
+        (
+            "min",
+            &min,
+            &tally.low,
+            &tally.below,
+            &ACCESSOR_MIN_MISMATCH,
+            &ACCESSOR_ELEMENT_OUT_OF_MIN_BOUND,
+            "less",
+        ),
+        (
+            "max",
+            &max,
+            &tally.high,
+            &tally.above,
+            &ACCESSOR_MAX_MISMATCH,
+            &ACCESSOR_ELEMENT_OUT_OF_MAX_BOUND,
+            "greater",
+        ),
+    ] {
+        let Some(declared) = declared else {
+            continue;
+        };
+        for c in 0..n {
+            let at = format!("/accessors/{i}/{key}/{c}");
+            if actual[c].is_finite() && declared[c] != actual[c] {
+                out.push(Diagnostic::new(
+                    mismatch,
+                    at.clone(),
+                    format!(
+                        "the declared {key} of this component, {}, is not the actual {key}, {}",
+                        declared[c], actual[c]
+                    ),
+                ));
+            }
+            if beyond[c] > 0 {
+                out.push(Diagnostic::new(
+                    outside,
+                    at,
+                    format!(
+                        "{} value(s) of this component are {word} than the declared {key}, {}",
+                        beyond[c], declared[c]
+                    ),
+                ));
             }
         }
     }
@@ -243,6 +239,19 @@ mod tests {
                 "ACCESSOR_ELEMENT_OUT_OF_MIN_BOUND /accessors/0/min/0",
                 "ACCESSOR_MAX_MISMATCH /accessors/0/max/0",
             ]
+        );
+    }
+
+    #[test]
+    fn every_non_finite_component_of_an_element_is_a_finding() {
+        let mut bytes = Vec::new();
+        for v in [f32::NEG_INFINITY, f32::NAN, f32::INFINITY] {
+            bytes.extend_from_slice(&v.to_le_bytes());
+        }
+        let accessors = r#"[{"bufferView":0,"componentType":5126,"count":1,"type":"VEC3"}]"#;
+        assert_eq!(
+            found(accessors, &bytes),
+            ["ACCESSOR_INVALID_FLOAT /accessors/0"; 3]
         );
     }
 

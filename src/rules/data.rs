@@ -255,12 +255,32 @@ impl<'a> Elements<'a> {
 
     fn read_stored(&self, base: &Strided, i: usize, values: &mut [f64]) {
         let start = i * base.stride;
-        for (c, slot) in values.iter_mut().enumerate() {
-            let offset = match base.columns {
-                Some((rows, column)) => (c / rows) * column + (c % rows) * self.size,
-                None => c * self.size,
-            };
-            *slot = self.read(&base.bytes[start + offset..]);
+        if let Some((rows, column)) = base.columns {
+            for (c, slot) in values.iter_mut().enumerate() {
+                let offset = (c / rows) * column + (c % rows) * self.size;
+                *slot = self.read(&base.bytes[start + offset..]);
+            }
+            return;
+        }
+        // Packed components: the type chosen once an element, not once a component (most of
+        // a data-heavy document's reading is float vectors).
+        let packed = &base.bytes[start..start + self.size * values.len()];
+        match self.component_type {
+            5126 => {
+                for (slot, b) in values.iter_mut().zip(packed.chunks_exact(4)) {
+                    *slot = f64::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]]));
+                }
+            }
+            5125 => {
+                for (slot, b) in values.iter_mut().zip(packed.chunks_exact(4)) {
+                    *slot = f64::from(u32::from_le_bytes([b[0], b[1], b[2], b[3]]));
+                }
+            }
+            _ => {
+                for (slot, b) in values.iter_mut().zip(packed.chunks_exact(self.size)) {
+                    *slot = self.read(b);
+                }
+            }
         }
     }
 

@@ -285,12 +285,15 @@ fn unit_length(
     at: &str,
     capped: &mut Capped,
 ) {
-    let length = v[..3]
-        .iter()
-        .map(|c| elements.normalize(*c).powi(2))
-        .sum::<f64>()
-        .sqrt();
-    if (length - 1.0).abs() > UNIT_LENGTH_VEC3 {
+    // Compared squared: the root is taken only for a finding's message.
+    let squared: f64 = v[..3].iter().map(|c| elements.normalize(*c).powi(2)).sum();
+    let (low, high) = (
+        (1.0 - UNIT_LENGTH_VEC3).powi(2),
+        (1.0 + UNIT_LENGTH_VEC3).powi(2),
+    );
+    // A NaN component is ACCESSOR_INVALID_FLOAT's finding.
+    if !squared.is_nan() && !(low..=high).contains(&squared) {
+        let length = squared.sqrt();
         capped.push(&ACCESSOR_VECTOR3_NON_UNIT, at, || {
             format!(
                 "the vector at indices {}..{} is not of unit length: {length}",
