@@ -12,7 +12,10 @@
 //!   whole edited document gives;
 //! - under every migrate option, each number the plan sets (what the dry run, `--check` and the
 //!   reports show) is the number the written file holds, and the preview's "as migrated" layer
-//!   is the layer the written file holds.
+//!   is the layer the written file holds;
+//! - the data rules read any accessor layout over any bytes (every component type and type,
+//!   offsets, strides, sparse substitutions in and out of range) without a panic, and
+//!   `--no-data` leaves out their findings and nothing else.
 
 use base64::Engine;
 use proptest::prelude::*;
@@ -584,5 +587,101 @@ fn extras_of_every_json_type_are_valid() {
         });
         let (_dir, input) = written(&doc);
         assert_eq!(validation_errors(&input), Vec::<String>::new(), "{extras}");
+    }
+}
+
+/// An accessor over random bytes: any component type and type, maybe normalized, at any offset
+/// and stride of a view that may or may not hold it, maybe with sparse substitutions whose
+/// indices may be out of order or out of range, and maybe used as every kind of vertex data.
+fn data_document() -> impl Strategy<Value = (Value, Vec<u8>)> {
+    let component = prop::sample::select(vec![5120u64, 5121, 5122, 5123, 5125, 5126, 5124]);
+    let kind = prop::sample::select(vec!["SCALAR", "VEC2", "VEC3", "VEC4", "MAT2", "MAT3", "MAT4"]);
+    (
+        component,
+        kind,
+        1u64..40,
+        0u64..24,
+        prop::option::of(prop::sample::select(vec![4u64, 8, 12, 16, 20, 64])),
+        any::<bool>(),
+        prop::option::of((1u64..6, prop::sample::select(vec![5121u64, 5123, 5125]))),
+        prop::collection::vec(any::<u8>(), 0..2048),
+        any::<bool>(),
+    )
+        .prop_map(
+            |(component, kind, count, offset, stride, normalized, sparse, bytes, bounds)| {
+                let len = bytes.len() as u64;
+                let mut view = json!({"buffer": 0, "byteLength": len});
+                if let Some(stride) = stride {
+                    view["byteStride"] = json!(stride);
+                }
+                let mut accessor = json!({"bufferView": 0, "byteOffset": offset,
+                    "componentType": component, "count": count, "type": kind,
+                    "normalized": normalized});
+                if bounds {
+                    accessor["min"] = json!([0]);
+                    accessor["max"] = json!([1]);
+                }
+                if let Some((n, index_type)) = sparse {
+                    accessor["sparse"] = json!({"count": n,
+                        "indices": {"bufferView": 1, "componentType": index_type},
+                        "values": {"bufferView": 1, "byteOffset": 4}});
+                }
+                let data = base64::engine::general_purpose::STANDARD.encode(&bytes);
+                let doc = json!({
+                    "asset": {"version": "2.0"},
+                    "buffers": [{"byteLength": len,
+                        "uri": format!("data:application/octet-stream;base64,{data}")}],
+                    "bufferViews": [view, {"buffer": 0, "byteLength": len}],
+                    "accessors": [accessor],
+                    "nodes": [{"mesh": 0, "skin": 0}, {}],
+                    "skins": [{"joints": [1], "inverseBindMatrices": 0}],
+                    "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 0,
+                        "TANGENT": 0, "COLOR_0": 0, "JOINTS_0": 0, "WEIGHTS_0": 0}, "indices": 0}]}],
+                    "animations": [{"samplers": [{"input": 0, "output": 0}],
+                        "channels": [{"sampler": 0, "target": {"node": 1, "path": "rotation"}}]}],
+                });
+                (doc, bytes)
+            },
+        )
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(CASES * 2))]
+
+    /// The data rules read any accessor over any bytes without a panic, and `--no-data` leaves
+    /// every one of their findings out and nothing else.
+    #[test]
+    fn any_accessor_over_any_bytes_is_read_without_a_panic((doc, _bytes) in data_document()) {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("data.gltf");
+        std::fs::write(&path, doc.to_string()).unwrap();
+        let with = Validator::new(Schemas::builtin(), Settings::default()).validate_file(&path);
+        let without = Validator::new(
+            Schemas::builtin(),
+            Settings { skip_data: true, ..Settings::default() },
+        )
+        .validate_file(&path);
+        let data_code = |code: &str| {
+            code.starts_with("ACCESSOR_")
+                && !matches!(
+                    code,
+                    "ACCESSOR_NORMALIZED_INVALID"
+                        | "ACCESSOR_MATRIX_ALIGNMENT"
+                        | "ACCESSOR_SMALL_BYTESTRIDE"
+                        | "ACCESSOR_OFFSET_ALIGNMENT"
+                        | "ACCESSOR_TOTAL_OFFSET_ALIGNMENT"
+                        | "ACCESSOR_TOO_LONG"
+                        | "ACCESSOR_SPARSE_COUNT_OUT_OF_RANGE"
+                )
+        };
+        let kept: Vec<String> = with
+            .findings
+            .iter()
+            .map(|f| f.diagnostic.code.to_string())
+            .filter(|c| !data_code(c))
+            .collect();
+        let without: Vec<String> = without.findings.iter().map(|f| f.diagnostic.code.to_string()).collect();
+        prop_assert!(without.iter().all(|c| !data_code(c)), "{without:?}");
+        prop_assert_eq!(kept, without);
     }
 }
