@@ -5,7 +5,8 @@
 //!
 //! An accessor is decoded only when everything it names holds together: a valid component
 //! type and type, a buffer view inside its buffer, the elements inside the view, sparse indices
-//! and values inside theirs. Anything else is the JSON-level rules' finding (UNRESOLVED_REFERENCE,
+//! and values inside theirs; and when its bytes are in the file as they are read (not behind
+//! a meshopt compression extension, nor Draco's, whose accessors have no buffer view). Anything else is the JSON-level rules' finding (UNRESOLVED_REFERENCE,
 //! ACCESSOR_TOO_LONG, BUFFER_VIEW_TOO_LONG, …) and its data is not judged.
 //!
 //! Values are read as they are stored (`normalized` has no effect on `min` and `max`, as the
@@ -82,10 +83,20 @@ fn index_of(node: Option<Node>) -> Option<usize> {
     usize::try_from(node?.as_u64()?).ok()
 }
 
-/// A buffer view's bytes, when the view lies inside its buffer.
+/// A buffer view's bytes, when the view lies inside its buffer and holds them: a view that a
+/// meshopt extension decompresses into holds them only once decoded (its buffer is a
+/// fallback, often zeros or absent), so its data is not judged.
 fn view_bytes<'c>(cx: &'c Context, view: usize) -> Option<&'c [u8]> {
     let json = cx.json();
     let view = json.get("bufferViews")?.get(view)?;
+    if let Some(extensions) = view.get("extensions") {
+        if ["EXT_meshopt_compression", "KHR_meshopt_compression"]
+            .iter()
+            .any(|name| extensions.get(*name).is_some())
+        {
+            return None;
+        }
+    }
     let buffer = index_of(view.get("buffer"))?;
     let offset = match view.get("byteOffset") {
         None => 0,
@@ -421,5 +432,14 @@ mod tests {
         assert_eq!(found[2], [vec![80.0], vec![0.0], vec![70.0]]);
         // Three elements of stride 12 need 32 bytes; the view holds 24: not read.
         assert!(found[3].is_empty());
+        // A view that meshopt decompresses into holds its bytes only once decoded.
+        let compressed = r#"[{"buffer":0,"byteLength":24,"extensions":{"EXT_meshopt_compression":
+            {"buffer":0,"byteLength":24,"byteStride":8,"count":3,"mode":"ATTRIBUTES"}}}]"#;
+        let found = decoded(
+            r#"[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC2"}]"#,
+            compressed,
+            &bytes,
+        );
+        assert!(found[0].is_empty());
     }
 }
