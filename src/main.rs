@@ -440,8 +440,7 @@ fn config(path: Option<PathBuf>, settings: SettingsArgs) -> Status {
     // A path that does not exist would show the defaults of wherever it would be (a typo
     // passing for a folder without velvet.toml): refused, as validate refuses it. Only its
     // existence is checked: a folder without assets has a configuration too.
-    if std::fs::symlink_metadata(&path).is_err_and(|e| e.kind() == std::io::ErrorKind::NotFound)
-    {
+    if std::fs::symlink_metadata(&path).is_err_and(|e| e.kind() == std::io::ErrorKind::NotFound) {
         return command::usage_error(discover::InputError::Missing(path));
     }
     match settings.flags().show(&path) {

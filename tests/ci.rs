@@ -170,7 +170,9 @@ fn sarif_meets_github_code_scanning_requirements() {
 #[test]
 fn sarif_rules_carry_full_descriptions_help_and_a_help_uri() {
     let log = sarif_log();
-    let rules = log["runs"][0]["tool"]["driver"]["rules"].as_array().unwrap();
+    let rules = log["runs"][0]["tool"]["driver"]["rules"]
+        .as_array()
+        .unwrap();
     let registry = velvet::rules::all_codes();
     assert_eq!(rules.len(), registry.len());
     for (rule, code) in rules.iter().zip(&registry) {
@@ -556,7 +558,10 @@ fn a_folder_whose_every_file_is_excluded_still_exits_2() {
     // The count is of files found: the folder's file, and the same file named again.
     for (args, found) in [
         (vec!["validate", "assets/drafts"], 1),
-        (vec!["validate", "assets/drafts", "assets/drafts/wip.gltf"], 2),
+        (
+            vec!["validate", "assets/drafts", "assets/drafts/wip.gltf"],
+            2,
+        ),
     ] {
         let o = velvet(&args);
         assert_eq!(o.status.code(), Some(2), "{args:?}");
@@ -2464,7 +2469,10 @@ fn version_names_the_commit_it_was_built_from() {
     assert_eq!(o.status.code(), Some(0));
     let out = stdout(&o);
     if !manifest.join(".git").exists() {
-        eprintln!("skipped the commit check: {} has no .git", manifest.display());
+        eprintln!(
+            "skipped the commit check: {} has no .git",
+            manifest.display()
+        );
         assert_eq!(out, format!("velvet {}\n", env!("CARGO_PKG_VERSION")));
         return;
     }
@@ -2498,7 +2506,13 @@ fn unsafe_fixes_without_fix_or_diff_is_a_usage_error() {
          show the unsafe fixes too)\n"
     );
     // A machine format still gets its document of a run that could not start.
-    let o = velvet(&["validate", "--format", "sarif", "--unsafe-fixes", "assets/clean.gltf"]);
+    let o = velvet(&[
+        "validate",
+        "--format",
+        "sarif",
+        "--unsafe-fixes",
+        "assets/clean.gltf",
+    ]);
     assert_eq!(o.status.code(), Some(2));
     let log: Value = serde_json::from_str(&stdout(&o)).unwrap();
     let invocation = &log["runs"][0]["invocations"][0];
