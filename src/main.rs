@@ -18,7 +18,9 @@ use velvet::report::{self, ColorChoice, Format};
 #[derive(Parser)]
 #[command(
     name = "velvet",
-    version,
+    // The package version, and the commit it was built from when built from a checkout
+    // (build.rs).
+    version = env!("VELVET_VERSION"),
     about = "Validate, migrate and bake glTF assets that use KHR_materials_sheen and KHR_materials_fuzz"
 )]
 #[command(after_help = EXIT_STATUS_ALL)]
@@ -324,7 +326,7 @@ enum Compression {
 
 #[derive(Clone, Copy, ValueEnum)]
 enum CodesFormat {
-    /// One line per code: name, severity, description.
+    /// A header line, then one line per code: name, severity, fix, description.
     Text,
     /// A Markdown table (docs/codes.md is this output).
     Markdown,
@@ -374,16 +376,7 @@ fn main() -> ExitCode {
     let status = match cli.command {
         Command::Validate(args) => in_pool(|| validate(args, cli.color, cli.quiet)),
         Command::Migrate(args) => in_pool(|| migrate(args, cli.quiet)),
-        Command::Config { path, settings } => {
-            let path = path.unwrap_or_else(|| PathBuf::from("."));
-            match settings.flags().show(&path) {
-                Ok(text) => {
-                    command::emit(text.as_bytes());
-                    Status::Done
-                }
-                Err(e) => command::usage_error(e),
-            }
-        }
+        Command::Config { path, settings } => config(path, settings),
         Command::Bake(args) => bake(args, cli.quiet),
         Command::Preview(args) => command::preview::command(&command::preview::Request {
             inputs: args.paths,
@@ -440,6 +433,23 @@ fn validate_format_asked(args: impl Iterator<Item = std::ffi::OsString>) -> Opti
         }
     }
     format
+}
+
+fn config(path: Option<PathBuf>, settings: SettingsArgs) -> Status {
+    let path = path.unwrap_or_else(|| PathBuf::from("."));
+    // A path that does not exist would show the defaults of wherever it would be (a typo
+    // passing for a folder without velvet.toml): refused, as validate refuses it. Only its
+    // existence is checked: a folder without assets has a configuration too.
+    if std::fs::symlink_metadata(&path).is_err_and(|e| e.kind() == std::io::ErrorKind::NotFound) {
+        return command::usage_error(discover::InputError::Missing(path));
+    }
+    match settings.flags().show(&path) {
+        Ok(text) => {
+            command::emit(text.as_bytes());
+            Status::Done
+        }
+        Err(e) => command::usage_error(e),
+    }
 }
 
 fn man(dir: Option<PathBuf>) -> Status {

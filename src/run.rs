@@ -50,6 +50,10 @@ pub fn validate(
 pub struct Totals {
     /// Files left out by an exclude pattern.
     pub excluded: Vec<PathBuf>,
+    /// The excluded files that were named as inputs (not found in a folder), each with the
+    /// configuration that excludes it ("the exclude patterns of …"): the run says it skipped
+    /// them, since whoever named them (pre-commit, a list) may expect them checked.
+    pub named_excluded: Vec<(PathBuf, String)>,
     /// True when a report has a finding at or above its configuration's fail-on severity.
     pub failed: bool,
 }
@@ -99,26 +103,37 @@ pub fn check_shard_each(
     let (found, walk_errors) = discover::find(inputs, shard);
     let mut planned = Vec::with_capacity(found.len());
     let mut excluded = Vec::new();
-    let mut excluded_by = None;
-    for file in found.into_iter().map(|f| f.path) {
+    let mut named_excluded = Vec::new();
+    // What excluded the first file found in a folder (not named itself), if any was.
+    let mut walked_excluded_by = None;
+    for found in found {
+        // A file named as an input is found as itself; one found in a folder is below it.
+        let named = inputs.get(found.input) == Some(&found.path);
+        let file = found.path;
         let config = resolver.for_path(&file)?;
         if config.excludes(&crate::config::absolute(&file)) {
+            let by = match &config.file {
+                Some(file) => format!("the exclude patterns of {}", file.display()),
+                None => "the exclude patterns".to_string(),
+            };
+            if named {
+                named_excluded.push((file.clone(), by));
+            } else if walked_excluded_by.is_none() {
+                walked_excluded_by = Some(by);
+            }
             excluded.push(file);
-            excluded_by = excluded_by.or_else(|| {
-                Some(match &config.file {
-                    Some(file) => format!("the exclude patterns of {}", file.display()),
-                    None => "the exclude patterns".to_string(),
-                })
-            });
         } else {
             planned.push((file, config));
         }
     }
-    // A configuration may leave files out, but not all of them: the inputs were checked to
-    // hold assets (discover::check_inputs), and a run that checks none of them must not pass.
+    // A configuration may leave files out, but not every file of a folder given: the folders
+    // were checked to hold assets (discover::check_inputs), and a run that checks none of them
+    // must not pass (a typo'd exclude pattern would turn the gate off). Files named one by one
+    // (pre-commit passes the staged files) are another matter: skipping the excluded ones is
+    // what the exclude patterns are for, so a run left with nothing from them passes.
     // A shard may be left with nothing by the split alone, so only a whole run is held to it.
     if shard.is_none() && planned.is_empty() && walk_errors.is_empty() {
-        if let Some(by) = excluded_by {
+        if let Some(by) = walked_excluded_by {
             return Err(ConfigError::AllExcluded {
                 found: excluded.len(),
                 by,
@@ -161,5 +176,9 @@ pub fn check_shard_each(
     if let Some(bar) = progress {
         bar.finish_and_clear();
     }
-    Ok(Totals { excluded, failed })
+    Ok(Totals {
+        excluded,
+        named_excluded,
+        failed,
+    })
 }

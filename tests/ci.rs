@@ -165,6 +165,55 @@ fn sarif_meets_github_code_scanning_requirements() {
     }
 }
 
+/// Each rule carries what a SARIF viewer shows beside an alert: the code's meaning, its help
+/// (meaning, default severity, how --fix repairs it) and a link to the codes table.
+#[test]
+fn sarif_rules_carry_full_descriptions_help_and_a_help_uri() {
+    let log = sarif_log();
+    let rules = log["runs"][0]["tool"]["driver"]["rules"]
+        .as_array()
+        .unwrap();
+    let registry = velvet::rules::all_codes();
+    assert_eq!(rules.len(), registry.len());
+    for (rule, code) in rules.iter().zip(&registry) {
+        let text = |v: &Value| v.as_str().unwrap_or_default().to_string();
+        assert_eq!(text(&rule["fullDescription"]["text"]), code.doc);
+        let help = text(&rule["help"]["text"]);
+        let markdown = text(&rule["help"]["markdown"]);
+        assert!(!help.is_empty() && !markdown.is_empty(), "{rule}");
+        let severity = format!("Default severity: {}.", code.severity.as_str());
+        for h in [&help, &markdown] {
+            assert!(h.contains(code.doc), "{h}");
+            assert!(h.contains(&severity), "{h}");
+            let says_fix = match velvet::fix::fixers::fixer_for(code.name) {
+                Some(fixer) => h.contains(fixer.about) && h.contains("repairs it"),
+                None => h.contains("does not repair it"),
+            };
+            assert!(says_fix, "{}: {h}", code.name);
+        }
+        assert_eq!(
+            rule["helpUri"],
+            "https://github.com/velvet-gltf/velvet/blob/main/docs/codes.md#codes"
+        );
+    }
+    // The anchor the link names is in docs/codes.md, before the table.
+    let codes_md =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/codes.md"))
+            .unwrap();
+    assert!(codes_md.contains("<a id=\"codes\"></a>\n<!-- codes:start -->"));
+    let fixed = rules
+        .iter()
+        .find(|r| r["id"] == "KHR_MATERIALS_FUZZ_ROUGHNESS_DEFAULT_AMBIGUOUS")
+        .unwrap();
+    assert_eq!(
+        fixed["help"]["text"],
+        "KHR_MATERIALS_FUZZ_ROUGHNESS_DEFAULT_AMBIGUOUS: ".to_string()
+            + fixed["fullDescription"]["text"].as_str().unwrap()
+            + "\nDefault severity: hint.\nvelvet validate --fix repairs it (a safe fix): it \
+               writes fuzzRoughnessFactor 0.5, the value velvet assumes."
+    );
+}
+
 /// The JSON text of the value a pointer names starts with this byte.
 fn first_byte(value: &Value) -> u8 {
     serde_json::to_string(value).unwrap().as_bytes()[0]
@@ -462,6 +511,73 @@ fn excluded_files_are_skipped_when_walked_and_when_named() {
     assert_eq!(code, Some(0));
 }
 
+/// What validate says of fixtures/ci/project/assets/drafts/wip.gltf named on its command line.
+fn skipped_note() -> String {
+    format!(
+        "velvet: assets/drafts/wip.gltf: skipped, excluded by the exclude patterns of {}\n",
+        project().join("velvet.toml").display()
+    )
+}
+
+/// pre-commit names the staged files one by one: those velvet.toml excludes are skipped, each
+/// said on standard error, and a run left with nothing passes.
+#[test]
+fn an_excluded_file_named_alone_is_skipped_with_a_note_and_passes() {
+    let o = velvet(&["validate", "assets/drafts/wip.gltf"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert_eq!(
+        stdout(&o),
+        "0 files checked: 0 errors, 0 warnings, 0 info, 0 hints\n"
+    );
+    assert_eq!(stderr(&o), skipped_note());
+    // Named beside a file that is checked: the same note, the other file's report.
+    let o = velvet(&[
+        "validate",
+        "--format",
+        "jsonl",
+        "assets/drafts/wip.gltf",
+        "assets/clean.gltf",
+    ]);
+    assert_eq!(o.status.code(), Some(0));
+    assert_eq!(stderr(&o), skipped_note());
+    assert_eq!(stdout(&o).lines().count(), 1);
+    // A list (`--files-from`, as `git diff --name-only` writes it) names files as the command
+    // line does.
+    let dir = tempfile::tempdir().unwrap();
+    let list = dir.path().join("staged.txt");
+    std::fs::write(&list, "assets/drafts/wip.gltf\n").unwrap();
+    let o = velvet(&["validate", "--files-from", list.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert_eq!(stderr(&o), skipped_note());
+}
+
+/// A folder whose every asset is excluded stays a usage error: a typo'd pattern must not
+/// turn the gate off, even when the folder is named beside an excluded file.
+#[test]
+fn a_folder_whose_every_file_is_excluded_still_exits_2() {
+    // The count is of files found: the folder's file, and the same file named again.
+    for (args, found) in [
+        (vec!["validate", "assets/drafts"], 1),
+        (
+            vec!["validate", "assets/drafts", "assets/drafts/wip.gltf"],
+            2,
+        ),
+    ] {
+        let o = velvet(&args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}");
+        assert_eq!(stdout(&o), "", "{args:?}");
+        assert_eq!(
+            stderr(&o),
+            format!(
+                "velvet: no asset left to check: {found} found, all excluded by the exclude \
+                 patterns of {}; a run that checks nothing fails\n",
+                project().join("velvet.toml").display()
+            ),
+            "{args:?}"
+        );
+    }
+}
+
 #[test]
 fn unknown_key_in_velvet_toml_is_a_configuration_error_naming_file_and_key() {
     let dir = tempfile::tempdir().unwrap();
@@ -532,6 +648,24 @@ fn config_command_prints_the_effective_configuration_with_sources() {
     insta::assert_snapshot!("config_nested_with_flags", stdout(&o));
     let o = velvet(&["config", "assets/drafts/wip.gltf"]);
     assert!(stdout(&o).starts_with("# assets/drafts/wip.gltf is excluded by this configuration\n"));
+}
+
+#[test]
+fn config_command_refuses_a_path_that_does_not_exist() {
+    let o = velvet(&["config", "assets/missing.gltf"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert_eq!(stdout(&o), "");
+    assert_eq!(
+        stderr(&o),
+        "velvet: assets/missing.gltf: no such file or folder\n"
+    );
+    // The same words validate uses for it.
+    let o = velvet(&["validate", "assets/missing.gltf"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert_eq!(
+        stderr(&o),
+        "velvet: assets/missing.gltf: no such file or folder\n"
+    );
 }
 
 #[test]
@@ -2322,4 +2456,69 @@ fn readme_fixing_pre_commit_hook_fixes_fails_once_and_then_passes() {
         assert!(!ok, "{out}");
         assert!(out.contains("error UNRESOLVED_REFERENCE"), "{out}");
     }
+}
+
+// ---------------------------------------------------------------- the build, flags
+
+/// Built from a git checkout, `--version` names the commit (and "modified" when tracked files
+/// differed from it at build time); the test is skipped where there is no checkout to ask.
+#[test]
+fn version_names_the_commit_it_was_built_from() {
+    let manifest = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let o = velvet(&["--version"]);
+    assert_eq!(o.status.code(), Some(0));
+    let out = stdout(&o);
+    if !manifest.join(".git").exists() {
+        eprintln!(
+            "skipped the commit check: {} has no .git",
+            manifest.display()
+        );
+        assert_eq!(out, format!("velvet {}\n", env!("CARGO_PKG_VERSION")));
+        return;
+    }
+    let git = Command::new("git")
+        .current_dir(manifest)
+        .args(["rev-parse", "--short", "HEAD"])
+        .output();
+    let hash = match git {
+        Ok(g) if g.status.success() => String::from_utf8(g.stdout).unwrap().trim().to_string(),
+        _ => {
+            eprintln!("skipped the commit check: `git rev-parse --short HEAD` failed here");
+            return;
+        }
+    };
+    let version = env!("CARGO_PKG_VERSION");
+    assert!(
+        out == format!("velvet {version} ({hash})\n")
+            || out == format!("velvet {version} ({hash}, modified)\n"),
+        "{out:?} names {hash}"
+    );
+}
+
+#[test]
+fn unsafe_fixes_without_fix_or_diff_is_a_usage_error() {
+    let o = velvet(&["validate", "--unsafe-fixes", "assets/clean.gltf"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert_eq!(stdout(&o), "");
+    assert_eq!(
+        stderr(&o),
+        "velvet: --unsafe-fixes applies only with --fix or --diff (add one of them to fix or \
+         show the unsafe fixes too)\n"
+    );
+    // A machine format still gets its document of a run that could not start.
+    let o = velvet(&[
+        "validate",
+        "--format",
+        "sarif",
+        "--unsafe-fixes",
+        "assets/clean.gltf",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let log: Value = serde_json::from_str(&stdout(&o)).unwrap();
+    let invocation = &log["runs"][0]["invocations"][0];
+    assert_eq!(invocation["executionSuccessful"], false);
+    assert_eq!(invocation["exitCode"], 2);
+    // With --diff it is taken: a clean file has nothing to show.
+    let o = velvet(&["validate", "--unsafe-fixes", "--diff", "assets/clean.gltf"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
 }

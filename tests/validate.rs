@@ -365,8 +365,11 @@ fn folders_are_searched_recursively_and_a_missing_path_is_a_usage_error() {
 fn codes_command_lists_every_registered_code_once() {
     let (status, out, _) = velvet(&["codes"]);
     assert_eq!(status, 0);
+    let header: Vec<&str> = out.lines().next().unwrap().split_whitespace().collect();
+    assert_eq!(header, ["code", "severity", "fix", "meaning"]);
     let names: Vec<&str> = out
         .lines()
+        .skip(1)
         .map(|l| l.split_whitespace().next().unwrap())
         .collect();
     let registry: Vec<&str> = all_codes().iter().map(|c| c.name).collect();

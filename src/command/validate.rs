@@ -58,6 +58,15 @@ pub fn command(request: &Request) -> Status {
         super::emit(report::failed_run(request.format, &message, !one_file).as_bytes());
         super::usage_error(message)
     };
+    // --unsafe-fixes alone would do nothing, and whoever typed it meant something to change
+    // or be shown: refused before anything is read.
+    if request.fix.unsafe_fixes && !request.fix.fix && !request.fix.diff {
+        return failed(
+            "--unsafe-fixes applies only with --fix or --diff (add one of them to fix or show \
+             the unsafe fixes too)"
+                .to_string(),
+        );
+    }
     let paths = match discover::resolve(&request.paths, request.files_from.as_deref()) {
         Ok(p) => p,
         Err(e) => return failed(e.to_string()),
@@ -148,6 +157,14 @@ pub fn command(request: &Request) -> Status {
         }
     };
     stream.finish();
+    // A file named on the command line (or in a list) that velvet.toml excludes is skipped, as
+    // pre-commit needs; it is said, so that nobody takes it for checked.
+    for (file, by) in &outcome.named_excluded {
+        super::note(format_args!(
+            "velvet: {}: skipped, excluded by {by}",
+            file.display()
+        ));
+    }
     for warning in resolver.warnings() {
         super::note(format_args!("velvet: {warning}"));
     }

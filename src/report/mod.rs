@@ -172,18 +172,16 @@ pub fn codes_table(markdown: bool) -> String {
         return out;
     }
     let width = codes.iter().map(|c| c.name.len()).max().unwrap_or(0);
-    codes
-        .iter()
-        .map(|c| {
-            format!(
-                "{:width$}  {:7}  {:6}  {}\n",
-                c.name,
-                c.severity.as_str(),
-                c.fix_label(),
-                c.doc
-            )
-        })
-        .collect()
+    // A header naming the columns, as the Markdown table has; the severity column is as wide
+    // as its header ("severity" is longer than any severity).
+    let line = |name: &str, severity: &str, fix: &str, doc: &str| {
+        format!("{name:width$}  {severity:8}  {fix:6}  {doc}\n")
+    };
+    let mut out = line("code", "severity", "fix", "meaning");
+    for c in codes {
+        out += &line(c.name, c.severity.as_str(), c.fix_label(), c.doc);
+    }
+    out
 }
 
 /// Renders `reports` in `format`.

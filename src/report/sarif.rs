@@ -31,6 +31,14 @@ use std::path::{Component, Path};
 /// The schema URI written into the log.
 pub const SCHEMA_URI: &str = "https://json.schemastore.org/sarif-2.1.0.json";
 
+/// docs/codes.md in velvet's repository, where each rule's `helpUri` leads.
+pub const DOCS_URL: &str = "https://github.com/velvet-gltf/velvet/blob/main/docs/codes.md";
+
+/// The anchor of the codes table in [`DOCS_URL`] (`<a id="codes">` in docs/codes.md): GitHub
+/// gives table rows no anchors of their own, so every rule links to the table, which lists
+/// every code with its meaning.
+const CODES_ANCHOR: &str = "codes";
+
 /// Bytes kept as they are in a URI path segment: RFC 3986 unreserved characters.
 const SEGMENT: &AsciiSet = &NON_ALPHANUMERIC
     .remove(b'-')
@@ -116,7 +124,18 @@ struct Driver {
 struct Rule {
     id: &'static str,
     short_description: Text<'static>,
+    full_description: Text<'static>,
+    help: Help,
+    help_uri: String,
     default_configuration: Configuration,
+}
+
+/// A rule's help (SARIF 2.1.0 §3.49.13): what the code means, its default severity and how
+/// `--fix` repairs it, as plain text and as Markdown.
+#[derive(Serialize)]
+struct Help {
+    text: String,
+    markdown: String,
 }
 
 #[derive(Serialize)]
@@ -376,6 +395,9 @@ fn tool() -> Tool {
         .map(|c| Rule {
             id: c.name,
             short_description: Text { text: c.doc },
+            full_description: Text { text: c.doc },
+            help: help(c),
+            help_uri: format!("{DOCS_URL}#{CODES_ANCHOR}"),
             default_configuration: Configuration {
                 level: level(c.severity),
             },
@@ -388,6 +410,40 @@ fn tool() -> Tool {
             semantic_version: env!("CARGO_PKG_VERSION"),
             rules,
         },
+    }
+}
+
+/// A rule's help: the code's meaning, its default severity, and whether and how `velvet
+/// validate --fix` repairs it (from the fixers' table, which says what each fix does).
+fn help(code: &crate::diagnostics::Code) -> Help {
+    let fix = |quote: &str| match crate::fix::fixers::fixer_for(code.name) {
+        Some(fixer) => match fixer.safety {
+            crate::diagnostics::Safety::Safe => format!(
+                "{quote}velvet validate --fix{quote} repairs it (a safe fix): it {}.",
+                fixer.about
+            ),
+            crate::diagnostics::Safety::Unsafe => format!(
+                "{quote}velvet validate --fix --unsafe-fixes{quote} repairs it (an unsafe fix, \
+                 which changes the asset's meaning as the finding implies): it {}.",
+                fixer.about
+            ),
+        },
+        None => format!("{quote}velvet validate --fix{quote} does not repair it."),
+    };
+    let severity = code.severity.as_str();
+    Help {
+        text: format!(
+            "{}: {}\nDefault severity: {severity}.\n{}",
+            code.name,
+            code.doc,
+            fix("")
+        ),
+        markdown: format!(
+            "**{}**: {}\n\nDefault severity: {severity}.\n\n{}\n\nSee [the codes table]({DOCS_URL}#{CODES_ANCHOR}).",
+            code.name,
+            code.doc,
+            fix("`")
+        ),
     }
 }
 
