@@ -166,9 +166,10 @@ fn sarif_meets_github_code_scanning_requirements() {
 }
 
 /// Each rule carries what a SARIF viewer shows beside an alert: the code's meaning, its help
-/// (meaning, default severity, how --fix repairs it) and a link to the codes table.
+/// (meaning, default severity, how --fix repairs it) and, once Cargo.toml names the repository,
+/// a link to the codes table.
 #[test]
-fn sarif_rules_carry_full_descriptions_help_and_a_help_uri() {
+fn sarif_rules_carry_full_descriptions_help_and_a_help_uri_only_with_a_named_repository() {
     let log = sarif_log();
     let rules = log["runs"][0]["tool"]["driver"]["rules"]
         .as_array()
@@ -191,11 +192,16 @@ fn sarif_rules_carry_full_descriptions_help_and_a_help_uri() {
             };
             assert!(says_fix, "{}: {h}", code.name);
         }
-        assert_eq!(
-            rule["helpUri"],
-            "https://github.com/velvet-gltf/velvet/blob/main/docs/codes.md#codes"
-        );
+        // Cargo.toml names no repository yet: no link that may lead nowhere, and the
+        // help points at `velvet codes` instead.
+        assert_eq!(rule.get("helpUri"), None);
+        assert!(markdown.ends_with("`velvet codes` lists every code; docs/codes.md explains them."));
     }
+    assert_eq!(
+        velvet::report::sarif::codes_table_url_in("https://example.org/team/velvet.git/"),
+        Some("https://example.org/team/velvet/blob/main/docs/codes.md#codes".to_string())
+    );
+    assert_eq!(velvet::report::sarif::codes_table_url_in(" "), None);
     // The anchor the link names is in docs/codes.md, before the table.
     let codes_md =
         std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/codes.md"))

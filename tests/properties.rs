@@ -595,7 +595,9 @@ fn extras_of_every_json_type_are_valid() {
 /// indices may be out of order or out of range, and maybe used as every kind of vertex data.
 fn data_document() -> impl Strategy<Value = (Value, Vec<u8>)> {
     let component = prop::sample::select(vec![5120u64, 5121, 5122, 5123, 5125, 5126, 5124]);
-    let kind = prop::sample::select(vec!["SCALAR", "VEC2", "VEC3", "VEC4", "MAT2", "MAT3", "MAT4"]);
+    let kind = prop::sample::select(vec![
+        "SCALAR", "VEC2", "VEC3", "VEC4", "MAT2", "MAT3", "MAT4",
+    ]);
     (
         component,
         kind,

@@ -31,13 +31,24 @@ use std::path::{Component, Path};
 /// The schema URI written into the log.
 pub const SCHEMA_URI: &str = "https://json.schemastore.org/sarif-2.1.0.json";
 
-/// docs/codes.md in velvet's repository, where each rule's `helpUri` leads.
-pub const DOCS_URL: &str = "https://github.com/velvet-gltf/velvet/blob/main/docs/codes.md";
+/// The codes table (docs/codes.md, anchor `<a id="codes">`) in the repository that Cargo.toml's
+/// `repository` field names, where each rule's `helpUri` leads; None while the package names no
+/// repository, and the rules then carry no `helpUri` rather than a link that may lead nowhere.
+/// GitHub gives table rows no anchors of their own, so every rule links to the table, which
+/// lists every code with its meaning.
+pub fn codes_table_url() -> Option<String> {
+    codes_table_url_in(env!("CARGO_PKG_REPOSITORY"))
+}
 
-/// The anchor of the codes table in [`DOCS_URL`] (`<a id="codes">` in docs/codes.md): GitHub
-/// gives table rows no anchors of their own, so every rule links to the table, which lists
-/// every code with its meaning.
-const CODES_ANCHOR: &str = "codes";
+/// [`codes_table_url`] for a given `repository` field (a GitHub-style repository's web address).
+pub fn codes_table_url_in(repository: &str) -> Option<String> {
+    let repository = repository.trim().trim_end_matches('/');
+    let repository = repository.strip_suffix(".git").unwrap_or(repository);
+    if repository.is_empty() {
+        return None;
+    }
+    Some(format!("{repository}/blob/main/docs/codes.md#codes"))
+}
 
 /// Bytes kept as they are in a URI path segment: RFC 3986 unreserved characters.
 const SEGMENT: &AsciiSet = &NON_ALPHANUMERIC
@@ -126,7 +137,8 @@ struct Rule {
     short_description: Text<'static>,
     full_description: Text<'static>,
     help: Help,
-    help_uri: String,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    help_uri: Option<String>,
     default_configuration: Configuration,
 }
 
@@ -390,14 +402,15 @@ fn log<'a>(
 
 /// The tool: velvet, with every code of the registry as a rule.
 fn tool() -> Tool {
+    let docs = codes_table_url();
     let rules = crate::rules::all_codes()
         .iter()
         .map(|c| Rule {
             id: c.name,
             short_description: Text { text: c.doc },
             full_description: Text { text: c.doc },
-            help: help(c),
-            help_uri: format!("{DOCS_URL}#{CODES_ANCHOR}"),
+            help: help(c, docs.as_deref()),
+            help_uri: docs.clone(),
             default_configuration: Configuration {
                 level: level(c.severity),
             },
@@ -415,7 +428,7 @@ fn tool() -> Tool {
 
 /// A rule's help: the code's meaning, its default severity, and whether and how `velvet
 /// validate --fix` repairs it (from the fixers' table, which says what each fix does).
-fn help(code: &crate::diagnostics::Code) -> Help {
+fn help(code: &crate::diagnostics::Code, docs: Option<&str>) -> Help {
     let fix = |quote: &str| match crate::fix::fixers::fixer_for(code.name) {
         Some(fixer) => match fixer.safety {
             crate::diagnostics::Safety::Safe => format!(
@@ -431,6 +444,10 @@ fn help(code: &crate::diagnostics::Code) -> Help {
         None => format!("{quote}velvet validate --fix{quote} does not repair it."),
     };
     let severity = code.severity.as_str();
+    let table = match docs {
+        Some(url) => format!("See [the codes table]({url})."),
+        None => "`velvet codes` lists every code; docs/codes.md explains them.".to_string(),
+    };
     Help {
         text: format!(
             "{}: {}\nDefault severity: {severity}.\n{}",
@@ -439,7 +456,7 @@ fn help(code: &crate::diagnostics::Code) -> Help {
             fix("")
         ),
         markdown: format!(
-            "**{}**: {}\n\nDefault severity: {severity}.\n\n{}\n\nSee [the codes table]({DOCS_URL}#{CODES_ANCHOR}).",
+            "**{}**: {}\n\nDefault severity: {severity}.\n\n{}\n\n{table}",
             code.name,
             code.doc,
             fix("`")
