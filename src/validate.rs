@@ -248,7 +248,12 @@ impl Validator {
         // A large text, or (with the data checks) large buffers: a document whose weight is in
         // its data has a small text and megabytes of accessors to read.
         let data_bytes = || {
-            crate::document::elements(asset.root().get("buffers"))
+            asset
+                .root()
+                .get("buffers")
+                .and_then(|b| b.as_array())
+                .into_iter()
+                .flat_map(|a| a.iter())
                 .filter_map(|b| b.get("byteLength")?.as_u64())
                 .fold(0u64, u64::saturating_add)
         };

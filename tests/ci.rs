@@ -1562,7 +1562,7 @@ fn readme_pre_commit_snippet_runs_as_pre_commit_runs_it_with_mixed_case_names() 
         repo["repo"], "local",
         "no rev to name: the hook runs the installed velvet"
     );
-    let hook = &repo["hooks"][0];
+    let hook = &repo["hooks"][1];
     assert_eq!(hook["language"], "system");
     let hook = Hook {
         id: hook["id"].as_str().unwrap().to_string(),
@@ -2413,7 +2413,8 @@ fn readme_fix_diff_example_is_what_velvet_prints() {
 fn readme_fixing_pre_commit_hook_fixes_fails_once_and_then_passes() {
     let text = block_after(&readme(), "### pre-commit", "yaml");
     let config: Value = serde_yaml_ng::from_str(&text).expect("the snippet is YAML");
-    let hook = &config["repos"][0]["hooks"][1];
+    // The fixing hook comes first, as the README's text says.
+    let hook = &config["repos"][0]["hooks"][0];
     let hook = Hook {
         id: hook["id"].as_str().unwrap().to_string(),
         entry: hook["entry"].as_str().unwrap().to_string(),
