@@ -226,6 +226,10 @@ struct ValidateArgs {
     /// message and file with a count and the first positions of the others.
     #[arg(long)]
     no_fold: bool,
+    /// Show everything: every finding on its own line, as --no-fold (the flag migrate and bake
+    /// also take).
+    #[arg(long, short)]
+    verbose: bool,
     #[command(flatten)]
     settings: SettingsArgs,
     /// Read schema files from DIR instead of the built-in ones (files absent there stay built-in).
@@ -369,6 +373,12 @@ fn main() -> ExitCode {
                 // fails the run as any other output's would.
                 command::stdout_written(e.print());
                 return ExitCode::from(command::finish(Status::Done).code());
+            }
+            if e.kind() == clap::error::ErrorKind::UnknownArgument {
+                if let Some(text) = without_dash_dash_tip(&e.render().to_string()) {
+                    eprint!("{text}");
+                    return ExitCode::from(2);
+                }
             }
             e.exit()
         }
@@ -566,6 +576,28 @@ impl SettingsArgs {
 
 /// How much a migrate or bake text report says: `-q`, the default, or `-v` (which `also`
 /// implies: `--report`, and for bake `--dry-run`).
+/// clap's error for an unknown flag without its tip "to pass '--out-dir' as a value, use '--
+/// --out-dir'": what a user who typed an unknown flag meant is a flag (a path that starts with
+/// a dash is rare, and `--` before it still works), so the tip misleads; clap's other tips (a
+/// similar flag) stay. None when the error carries no such tip.
+fn without_dash_dash_tip(rendered: &str) -> Option<String> {
+    let mut kept: Vec<&str> = Vec::new();
+    let mut dropped = false;
+    for line in rendered.split_inclusive('\n') {
+        let tip = line.trim_start();
+        if tip.starts_with("tip: to pass '") && tip.contains("' as a value, use '-- ") {
+            dropped = true;
+            // The blank line that set the tip apart goes with it.
+            if kept.last().is_some_and(|l| l.trim().is_empty()) {
+                kept.pop();
+            }
+            continue;
+        }
+        kept.push(line);
+    }
+    dropped.then(|| kept.concat())
+}
+
 fn detail(quiet: bool, verbose: bool, also: bool) -> Detail {
     if quiet {
         Detail::Quiet
@@ -587,7 +619,7 @@ fn validate(args: ValidateArgs, color: ColorChoice, quiet: bool) -> Status {
         format: args.format,
         color,
         quiet,
-        no_fold: args.no_fold,
+        no_fold: args.no_fold || args.verbose,
         fix: command::validate::FixFlags {
             fix: args.fix,
             unsafe_fixes: args.unsafe_fixes,

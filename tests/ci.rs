@@ -1502,6 +1502,12 @@ fn text_output_folds_a_repeated_finding_and_lists_findings_in_file_order() {
             .to_string(),
     );
     assert_eq!(lines, expected);
+    // -v, the flag migrate and bake take for "show everything", prints the same.
+    let verbose = velvet_in(
+        dir.path(),
+        &["validate", "--color", "never", "-v", "many.gltf"],
+    );
+    assert_eq!(stdout(&verbose), stdout(&o));
 }
 
 // ---------------------------------------------------------------- the README's snippets
@@ -2528,4 +2534,24 @@ fn unsafe_fixes_without_fix_or_diff_is_a_usage_error() {
     // With --diff it is taken: a clean file has nothing to show.
     let o = velvet(&["validate", "--unsafe-fixes", "--diff", "assets/clean.gltf"]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+}
+
+/// An unknown flag is named with the usage, without clap's tip to pass it as a value after
+/// `--` (a mistyped flag is what the user meant); a tip naming a similar flag stays.
+#[test]
+fn an_unknown_flag_is_refused_without_the_dash_dash_tip() {
+    let chair = "fixtures/sample/velvet-chair.gltf";
+    let o = velvet(&["validate", "--out-dir", "x", chair]);
+    assert_eq!(o.status.code(), Some(2));
+    assert_eq!(
+        stderr(&o),
+        "error: unexpected argument '--out-dir' found\n\nUsage: velvet validate [OPTIONS] [PATHS]...\n\nFor more information, try '--help'.\n"
+    );
+    let similar = velvet(&["migrate", "--out", "x", chair]);
+    assert_eq!(similar.status.code(), Some(2));
+    assert!(
+        stderr(&similar).contains("tip: a similar argument exists: '--output'"),
+        "{}",
+        stderr(&similar)
+    );
 }
