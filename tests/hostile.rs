@@ -2189,6 +2189,18 @@ fn crc32(bytes: &[u8]) -> u32 {
 /// A PNG whose header declares `width` × `height` 16-bit RGBA and whose data is one empty
 /// IDAT: what a decoder learns before it allocates, and nothing to decode.
 fn forged_16bit_rgba_png(width: u32, height: u32) -> Vec<u8> {
+    png_of(
+        width,
+        height,
+        16,
+        6,
+        &[0x78, 0x9c, 0x03, 0x00, 0x00, 0x00, 0x00, 0x01],
+    )
+}
+
+/// A PNG of one IDAT chunk holding `zlib`, its header `width` × `height` at `bit_depth` and
+/// `colour_type` (PNG's numbers: 2 RGB, 6 RGBA), each chunk with its CRC.
+fn png_of(width: u32, height: u32, bit_depth: u8, colour_type: u8, zlib: &[u8]) -> Vec<u8> {
     let chunk = |kind: &[u8], data: &[u8]| {
         let mut out = (data.len() as u32).to_be_bytes().to_vec();
         let mut body = kind.to_vec();
@@ -2200,13 +2212,10 @@ fn forged_16bit_rgba_png(width: u32, height: u32) -> Vec<u8> {
     let mut ihdr = Vec::new();
     ihdr.extend_from_slice(&width.to_be_bytes());
     ihdr.extend_from_slice(&height.to_be_bytes());
-    ihdr.extend_from_slice(&[16, 6, 0, 0, 0]);
+    ihdr.extend_from_slice(&[bit_depth, colour_type, 0, 0, 0]);
     let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
     png.extend(chunk(b"IHDR", &ihdr));
-    png.extend(chunk(
-        b"IDAT",
-        &[0x78, 0x9c, 0x03, 0x00, 0x00, 0x00, 0x00, 0x01],
-    ));
+    png.extend(chunk(b"IDAT", zlib));
     png.extend(chunk(b"IEND", &[]));
     png
 }
@@ -2948,23 +2957,7 @@ fn zero_rgb_png(width: u32, height: u32) -> Vec<u8> {
     let mut zlib = bits.out;
     let adler = ((total % 65521) << 16) | 1;
     zlib.extend_from_slice(&(adler as u32).to_be_bytes());
-    let chunk = |kind: &[u8], data: &[u8]| {
-        let mut out = (data.len() as u32).to_be_bytes().to_vec();
-        let mut body = kind.to_vec();
-        body.extend_from_slice(data);
-        out.extend_from_slice(&body);
-        out.extend_from_slice(&crc32(&body).to_be_bytes());
-        out
-    };
-    let mut ihdr = Vec::new();
-    ihdr.extend_from_slice(&width.to_be_bytes());
-    ihdr.extend_from_slice(&height.to_be_bytes());
-    ihdr.extend_from_slice(&[8, 2, 0, 0, 0]);
-    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
-    png.extend(chunk(b"IHDR", &ihdr));
-    png.extend(chunk(b"IDAT", &zlib));
-    png.extend(chunk(b"IEND", &[]));
-    png
+    png_of(width, height, 8, 2, &zlib)
 }
 
 /// Runs velvet with `args`: (exit status, stdout, stderr, its peak resident memory in KiB).
