@@ -10,6 +10,8 @@
 
 pub mod asset;
 pub mod bake;
+#[cfg(feature = "bench")]
+pub mod bench;
 pub mod cli_docs;
 pub mod command;
 pub mod config;
@@ -23,9 +25,5 @@ pub mod output;
 pub mod preview;
 pub mod report;
 pub mod rules;
-pub mod run;
 pub mod shading;
 pub mod validate;
-
-#[cfg(test)]
-mod import_graph;

@@ -81,7 +81,7 @@ enum Command {
     /// off (docs/shading.md). Not part of the user interface: built with `--features bench`.
     #[cfg(feature = "bench")]
     #[command(subcommand, hide = true)]
-    Bench(velvet::shading::bench::BenchCommand),
+    Bench(velvet::bench::BenchCommand),
 }
 
 /// Settings shared by `validate` and `config`; each flag given beats velvet.toml.
@@ -407,12 +407,10 @@ fn main() -> ExitCode {
         }
         Command::Man { dir } => man(dir),
         #[cfg(feature = "bench")]
-        Command::Bench(cmd) => {
-            match velvet::shading::bench::run(&cmd, &mut std::io::stdout().lock()) {
-                Ok(()) => Status::Done,
-                Err(e) => command::usage_error(e),
-            }
-        }
+        Command::Bench(cmd) => match velvet::bench::run(&cmd, &mut std::io::stdout().lock()) {
+            Ok(()) => Status::Done,
+            Err(e) => command::usage_error(e),
+        },
     };
     ExitCode::from(command::finish(status).code())
 }

@@ -1,16 +1,11 @@
 //! Sheen and fuzz shading maths (f64): the Charlie sheen BRDF of KHR_materials_sheen
 //! ([`charlie`]), its directional albedo E(μ, r) by three methods behind one function
 //! ([`sheen_albedo`]: quadrature in [`albedo`], tables in [`table`], a closed-form fit in [`fit`]),
-//! the layering of sheen and fuzz over a base ([`layering`]). With the `bench` feature, the
-//! speed-against-error report (`accuracy`, drawn by `plot`, run by `velvet bench` through
-//! `bench`): developer tooling, outside the default library and binary.
+//! the layering of sheen and fuzz over a base ([`layering`]). The speed-against-error reports
+//! of these methods are developer tooling, in `crate::bench` behind the `bench` feature.
 
-#[cfg(feature = "bench")]
-pub mod accuracy;
 pub mod albedo;
 mod albedo_table32;
-#[cfg(feature = "bench")]
-pub mod bench;
 pub mod charlie;
 pub mod fit;
 pub mod fuzz;
@@ -18,8 +13,6 @@ mod fuzz_table;
 pub mod layering;
 pub mod mapping;
 mod mapping_table;
-#[cfg(feature = "bench")]
-pub mod plot;
 pub mod quadrature;
 pub mod table;
 

@@ -11,20 +11,20 @@
 //! on its own thread. The other methods are timed single-threaded over the grid, repeated until
 //! the measurement lasts long enough to be stable; the tables' generation is timed separately.
 
-use super::albedo::{
+use crate::shading::albedo::{
     albedo_quadrature, is_ordinary, AlbedoMethod, QUADRATURE_BOUND, QUADRATURE_TOL,
 };
-use super::charlie::Visibility;
-use super::fuzz::{
+use crate::shading::charlie::Visibility;
+use crate::shading::fuzz::{
     fuzz_reflectance, reflectance_quadrature, ReflectanceMethod, Scattering, REFLECTANCE_BOUND,
     REFLECTANCE_TOL, TABLE_BOUND_CORNER, TABLE_BOUND_HARD, TABLE_BOUND_ORDINARY,
 };
-use super::layering::{FuzzParams, SheenParams};
-use super::mapping::{
+use crate::shading::layering::{FuzzParams, SheenParams};
+use crate::shading::mapping::{
     self, layer_match, LayerMatch, FUZZ_FOR_SHEEN_DEVIATION, MAPPING_RMS_LOSS, POOR_MATCH_BELOW,
     SHEEN_FOR_FUZZ_DEVIATION,
 };
-use super::{sheen_albedo, table};
+use crate::shading::{sheen_albedo, table};
 use rayon::prelude::*;
 use std::fmt;
 use std::hint::black_box;

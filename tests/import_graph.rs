@@ -1,7 +1,9 @@
 //! The module graph as the source states it, held to docs/design.md: every `crate::module`
 //! path a module's code names (comments and its tests left out) must be one of the imports its
 //! row in the design's "Modules" table allows, and the modules must import each other without
-//! a circle. A circle means one module holds data another one needs: move the data.
+//! a circle. A circle means one module holds data another one needs: move the data. It reads
+//! the source tree and the design as files (from the package's folder) and needs nothing of
+//! the crate itself.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;

@@ -1,11 +1,16 @@
-//! The `velvet bench` command: its arguments and what it runs. The binary only parses and maps
-//! the outcome to an exit code; everything here is callable from tests.
+//! `velvet bench`, developer tooling behind the `bench` feature (outside the default library and
+//! binary): the speed-against-error report of the shading maths ([`accuracy`]), drawn as SVG
+//! ([`plot`]), and the command that runs them, its arguments and what it runs. The binary only
+//! parses and maps the outcome to an exit code; everything here is callable from tests.
 
-use super::accuracy::{
+pub mod accuracy;
+pub mod plot;
+
+use accuracy::{
     accuracy_report, fuzz_accuracy, mapping_accuracy, mapping_comparison, parse_points, points_csv,
     MappingReport, PointsError, REPORT_GRID,
 };
-use super::plot::{accuracy_svg, mapping_svg, MappingCurves};
+use plot::{accuracy_svg, mapping_svg, MappingCurves};
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 

@@ -1,6 +1,8 @@
 //! The validate pipeline: find the files, load each, run every registered rule, apply the run's
 //! settings, and place each finding in the source text. Files run in parallel; each file's
-//! report is independent of the others.
+//! report is independent of the others. A run over many files under their velvet.toml files
+//! (exclusions, batches, whether the run failed) is the command's, in
+//! `command::validate::batch`, as migrate's is in `command::migrate::batch`.
 
 use crate::asset::tape::Node;
 use crate::asset::{self, discover, position::Position, Container};

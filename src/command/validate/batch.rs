@@ -1,4 +1,5 @@
-//! A `velvet validate` run over many inputs: find the asset files (with `--shard`, one part of
+//! `velvet validate`'s runner over many inputs, as `command/migrate/batch.rs` is migrate's (one
+//! document is validated by [`crate::validate`]): find the asset files (with `--shard`, one part of
 //! them; see [`crate::asset::discover`]), give each the configuration
 //! found for it (see [`crate::config`]), leave out excluded files, validate the rest in
 //! parallel, and decide whether the run failed. A configuration error stops the run before any

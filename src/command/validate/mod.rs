@@ -1,7 +1,10 @@
 //! `velvet validate` as the command line runs it: the files found, each checked under its own
-//! configuration (and, with `--fix` or `--diff`, fixed through [`crate::fix`]), each report
-//! written as soon as it is done, the exit status from every finding left. A run that cannot start (a missing path, a bad velvet.toml or schema folder)
-//! still writes a report in the format asked for, recording why.
+//! configuration (the run over many files in [`batch`]; one document by [`crate::validate`]) and,
+//! with `--fix` or `--diff`, fixed through [`crate::fix`], each report written as soon as it is
+//! done, the exit status from every finding left. A run that cannot start (a missing path, a bad
+//! velvet.toml or schema folder) still writes a report in the format asked for, recording why.
+
+pub mod batch;
 
 use super::Status;
 use crate::asset::discover::{self, Shard};
@@ -125,7 +128,7 @@ pub fn command(request: &Request) -> Status {
     // Each file's report is written as soon as it is done (see report::Stream).
     let stdout = std::io::BufWriter::new(super::Stdout);
     let mut stream = report::Stream::new(request.format, options, stdout).json_array(!one_file);
-    let outcome = match crate::run::check_shard_each(
+    let outcome = match batch::check_shard_each(
         &validator,
         &paths,
         request.shard,

@@ -5,10 +5,10 @@
 //! the SVG names a font family and the viewer renders the text).
 
 use super::accuracy::AccuracyReport;
-use super::albedo::{AlbedoMethod, QUADRATURE_BOUND};
-use super::fuzz::{fuzz_reflectance, ReflectanceMethod};
-use super::mapping;
-use super::{sheen_albedo, AlbedoMethod as Method};
+use crate::shading::albedo::{AlbedoMethod, QUADRATURE_BOUND};
+use crate::shading::fuzz::{fuzz_reflectance, ReflectanceMethod};
+use crate::shading::mapping;
+use crate::shading::{sheen_albedo, AlbedoMethod as Method};
 use plotters::prelude::*;
 use rayon::prelude::*;
 
