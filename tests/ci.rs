@@ -2555,3 +2555,38 @@ fn an_unknown_flag_is_refused_without_the_dash_dash_tip() {
         stderr(&similar)
     );
 }
+
+/// On a terminal, a run over one file shows that file, its size and the time so far (a
+/// spinner), not "0/1 files checked" for as long as a large file takes; validate and migrate
+/// alike. The terminal is `script`'s pseudo-terminal; without util-linux's `script` the check
+/// is skipped.
+#[test]
+fn one_file_on_a_terminal_is_shown_with_its_size_while_it_runs() {
+    let bin = env!("CARGO_BIN_EXE_velvet");
+    let chair = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/sample/velvet-chair.gltf");
+    // util-linux's script (BSD's takes other options).
+    let usable = Command::new("script")
+        .args(["-qec", "true", "/dev/null"])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !usable {
+        eprintln!("skipped: no util-linux `script` here to give velvet a terminal");
+        return;
+    }
+    let size = std::fs::metadata(&chair).unwrap().len();
+    assert_eq!(size, 3547, "the sample's size, as the line below gives it");
+    for command in ["validate", "migrate --dry-run"] {
+        let line = format!("{bin} {command} {}", chair.display());
+        let run = Command::new("script")
+            .args(["-qec", &line, "/dev/null"])
+            .env_remove("NO_COLOR")
+            .output()
+            .expect("script runs");
+        let shown = String::from_utf8_lossy(&run.stdout);
+        assert!(
+            shown.contains(&format!("{} (3.46 KiB) 0s", chair.display())),
+            "{command}: {shown}"
+        );
+        assert!(!shown.contains("0/1"), "{command}: {shown}");
+    }
+}

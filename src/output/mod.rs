@@ -76,7 +76,17 @@ pub fn run_each<R: Send>(
         }
     }
     let claims = files::Claims::default();
-    let bar = progress_bar(scope.progress, jobs.len(), "files");
+    let bar = match jobs.as_slice() {
+        [one] if scope.progress && std::io::IsTerminal::is_terminal(&std::io::stderr()) => {
+            let bar = indicatif::ProgressBar::with_draw_target(
+                Some(1),
+                indicatif::ProgressDrawTarget::stderr(),
+            );
+            show_one_file(&bar, &one.input);
+            Some(bar)
+        }
+        _ => progress_bar(scope.progress, jobs.len(), "files"),
+    };
     let mut results: Vec<R> = walk_errors
         .into_iter()
         .map(|(path, e)| unreadable(path, e))
@@ -95,7 +105,8 @@ pub fn run_each<R: Send>(
 }
 
 /// The progress bar of a run over `count` things (`noun`: "files", "sheets"), when `wanted`:
-/// on a terminal only (logs and pipes never see one), and only for more than one.
+/// on a terminal only (logs and pipes never see one), and only for more than one (a run over
+/// one file shows it with [`show_one_file`]).
 pub fn progress_bar(wanted: bool, count: usize, noun: &str) -> Option<indicatif::ProgressBar> {
     use std::io::IsTerminal;
     (wanted && count > 1 && std::io::stderr().is_terminal()).then(|| {
@@ -107,6 +118,23 @@ pub fn progress_bar(wanted: bool, count: usize, noun: &str) -> Option<indicatif:
         }
         bar
     })
+}
+
+/// Turns `bar` into what a run over one file shows instead of "0/1": a spinner with the file's
+/// name and size and the time so far, redrawn ten times a second, so that a large file's
+/// minutes on a terminal are visibly work and not a hang. The size is the file's length on
+/// disk (one `stat`), not read.
+pub fn show_one_file(bar: &indicatif::ProgressBar, file: &std::path::Path) {
+    if let Ok(style) = indicatif::ProgressStyle::with_template("{spinner} {msg} {elapsed}") {
+        bar.set_style(style);
+    }
+    let size = std::fs::metadata(file).map(|m| m.len()).unwrap_or(0);
+    bar.set_message(format!(
+        "{} ({})",
+        file.display(),
+        indicatif::HumanBytes(size)
+    ));
+    bar.enable_steady_tick(std::time::Duration::from_millis(100));
 }
 
 /// A request velvet cannot carry out as given (exit status 2): nothing is read or written.

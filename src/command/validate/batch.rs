@@ -155,6 +155,10 @@ pub fn check_shard_each(
         sink(report);
     }
     if let Some(bar) = progress {
+        // One file is shown as itself before the length would draw "0/1".
+        if let [(file, _)] = planned.as_slice() {
+            crate::output::show_one_file(bar, file);
+        }
         bar.set_length(planned.len() as u64);
     }
     for batch in planned.chunks(BATCH) {
