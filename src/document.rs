@@ -6,6 +6,11 @@
 use crate::asset::pointer;
 use crate::asset::tape::{JsonView, Node};
 
+/// Whether the document's `extensionsUsed` names `extension`.
+pub fn declares(json: Node<'_>, extension: &str) -> bool {
+    elements(json.get("extensionsUsed")).any(|e| e.is_str(extension))
+}
+
 /// The elements of an array that may be absent or not an array (then there are none).
 pub fn elements(array: Option<Node<'_>>) -> impl Iterator<Item = Node<'_>> {
     array

@@ -357,7 +357,7 @@ fn main() -> ExitCode {
     velvet::output::interrupt::ignore_file_size_signal();
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
-        Err(e) => {
+        Err(mut e) => {
             // A validate run refused for its arguments (a mistyped flag or value) still writes
             // the report its --format asks for, as every other run that cannot start does.
             if e.use_stderr() {
@@ -374,12 +374,7 @@ fn main() -> ExitCode {
                 command::stdout_written(e.print());
                 return ExitCode::from(command::finish(Status::Done).code());
             }
-            if e.kind() == clap::error::ErrorKind::UnknownArgument {
-                if let Some(text) = without_dash_dash_tip(&e.render().to_string()) {
-                    eprint!("{text}");
-                    return ExitCode::from(2);
-                }
-            }
+            without_dash_dash_tip(&mut e);
             e.exit()
         }
     };
@@ -572,30 +567,25 @@ impl SettingsArgs {
     }
 }
 
-/// How much a migrate or bake text report says: `-q`, the default, or `-v` (which `also`
-/// implies: `--report`, and for bake `--dry-run`).
-/// clap's error for an unknown flag without its tip "to pass '--out-dir' as a value, use '--
-/// --out-dir'": what a user who typed an unknown flag meant is a flag (a path that starts with
-/// a dash is rare, and `--` before it still works), so the tip misleads; clap's other tips (a
-/// similar flag) stay. None when the error carries no such tip.
-fn without_dash_dash_tip(rendered: &str) -> Option<String> {
-    let mut kept: Vec<&str> = Vec::new();
-    let mut dropped = false;
-    for line in rendered.split_inclusive('\n') {
-        let tip = line.trim_start();
-        if tip.starts_with("tip: to pass '") && tip.contains("' as a value, use '-- ") {
-            dropped = true;
-            // The blank line that set the tip apart goes with it.
-            if kept.last().is_some_and(|l| l.trim().is_empty()) {
-                kept.pop();
-            }
-            continue;
+/// Drops clap's tip for an unknown flag "to pass '--out-dir' as a value, use '-- --out-dir'":
+/// what a user who typed an unknown flag meant is a flag (a path that starts with a dash is
+/// rare, and `--` before it still works), so the tip misleads. clap keeps its tips as the
+/// error's suggestions; a similar flag's name is kept apart from them and stays.
+fn without_dash_dash_tip(e: &mut clap::Error) {
+    use clap::error::{ContextKind, ContextValue};
+    if let Some(ContextValue::StyledStrs(tips)) = e.remove(ContextKind::Suggested) {
+        let kept: Vec<_> = tips
+            .into_iter()
+            .filter(|tip| !tip.to_string().contains("' as a value, use '-- "))
+            .collect();
+        if !kept.is_empty() {
+            e.insert(ContextKind::Suggested, ContextValue::StyledStrs(kept));
         }
-        kept.push(line);
     }
-    dropped.then(|| kept.concat())
 }
 
+/// How much a migrate or bake text report says: `-q`, the default, or `-v` (which `also`
+/// implies: `--report`, and for bake `--dry-run`).
 fn detail(quiet: bool, verbose: bool, also: bool) -> Detail {
     if quiet {
         Detail::Quiet

@@ -593,7 +593,7 @@ fn extras_of_every_json_type_are_valid() {
 /// An accessor over random bytes: any component type and type, maybe normalized, at any offset
 /// and stride of a view that may or may not hold it, maybe with sparse substitutions whose
 /// indices may be out of order or out of range, and maybe used as every kind of vertex data.
-fn data_document() -> impl Strategy<Value = (Value, Vec<u8>)> {
+fn data_document() -> impl Strategy<Value = Value> {
     let component = prop::sample::select(vec![5120u64, 5121, 5122, 5123, 5125, 5126, 5124]);
     let kind = prop::sample::select(vec![
         "SCALAR", "VEC2", "VEC3", "VEC4", "MAT2", "MAT3", "MAT4",
@@ -642,7 +642,7 @@ fn data_document() -> impl Strategy<Value = (Value, Vec<u8>)> {
                     "animations": [{"samplers": [{"input": 0, "output": 0}],
                         "channels": [{"sampler": 0, "target": {"node": 1, "path": "rotation"}}]}],
                 });
-                (doc, bytes)
+                doc
             },
         )
 }
@@ -653,7 +653,7 @@ proptest! {
     /// The data rules read any accessor over any bytes without a panic, and `--no-data` leaves
     /// every one of their findings out and nothing else.
     #[test]
-    fn any_accessor_over_any_bytes_is_read_without_a_panic((doc, _bytes) in data_document()) {
+    fn any_accessor_over_any_bytes_is_read_without_a_panic(doc in data_document()) {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("data.gltf");
         std::fs::write(&path, doc.to_string()).unwrap();

@@ -13,7 +13,7 @@
 //! Each kind is reported at most [`MAX_REPORTED`] times a sampler.
 
 use super::accessor_bounds::MAX_REPORTED;
-use super::data::{accessor_index, Elements, UNIT_LENGTH_VEC4};
+use super::data::{index_of, Elements, UNIT_LENGTH_VEC4};
 use super::{elements, Context, Rule};
 use crate::diagnostics::{Code, Diagnostic, Severity};
 
@@ -51,8 +51,7 @@ impl Rule for AnimationData {
         for (a, animation) in elements(cx.json().get("animations")).enumerate() {
             let samplers: Vec<_> = elements(animation.get("samplers")).collect();
             for (s, sampler) in samplers.iter().enumerate() {
-                let Some(input) =
-                    accessor_index(sampler.get("input")).and_then(|i| Elements::of(cx, i))
+                let Some(input) = index_of(sampler.get("input")).and_then(|i| Elements::of(cx, i))
                 else {
                     continue;
                 };
@@ -92,8 +91,7 @@ impl Rule for AnimationData {
                     .get("target")
                     .and_then(|t| t.get("path"))
                     .is_some_and(|p| p.is_str("rotation"));
-                let Some(sampler) =
-                    accessor_index(channel.get("sampler")).and_then(|s| samplers.get(s))
+                let Some(sampler) = index_of(channel.get("sampler")).and_then(|s| samplers.get(s))
                 else {
                     continue;
                 };
@@ -101,7 +99,7 @@ impl Rule for AnimationData {
                     continue;
                 }
                 let Some(output) =
-                    accessor_index(sampler.get("output")).and_then(|o| Elements::of(cx, o))
+                    index_of(sampler.get("output")).and_then(|o| Elements::of(cx, o))
                 else {
                     continue;
                 };

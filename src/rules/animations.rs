@@ -204,6 +204,15 @@ impl Rule for Animations {
                     Some((node, path))
                 })
                 .collect();
+            // Each channel's next channel with the same target, found in one pass from the end
+            // (a scan of the later channels for each would be quadratic in a long animation).
+            let mut later = std::collections::HashMap::new();
+            let mut next_same: Vec<Option<usize>> = vec![None; targets.len()];
+            for (c, target) in targets.iter().enumerate().rev() {
+                if let Some(target) = target {
+                    next_same[c] = later.insert(target, c);
+                }
+            }
             for (c, channel) in channels.iter().enumerate() {
                 let channel_at = format!("{at}/channels/{c}");
                 let Some(target) = channel.get("target").filter(|t| t.is_object()) else {
@@ -235,16 +244,12 @@ impl Rule for Animations {
                     }
                     continue;
                 }
-                if let Some(Some(mine)) = targets.get(c) {
-                    if let Some(other) =
-                        (c + 1..targets.len()).find(|o| targets[*o].as_ref() == Some(mine))
-                    {
-                        out.push(Diagnostic::new(
-                            &ANIMATION_DUPLICATE_TARGETS,
-                            format!("{channel_at}/target"),
-                            format!("the channel has the same target as channel {other}"),
-                        ));
-                    }
+                if let Some(other) = next_same[c] {
+                    out.push(Diagnostic::new(
+                        &ANIMATION_DUPLICATE_TARGETS,
+                        format!("{channel_at}/target"),
+                        format!("the channel has the same target as channel {other}"),
+                    ));
                 }
                 let Some(path) = path else {
                     continue;

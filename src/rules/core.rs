@@ -154,6 +154,20 @@ pub(crate) fn close_open_enums(schema: &mut Value) {
     }
 }
 
+/// The core schema files parsed, their open enums closed: read once for the core schema and
+/// for every extension schema that compiles.
+pub(crate) static CORE_FILES: std::sync::LazyLock<HashMap<String, Value>> =
+    std::sync::LazyLock::new(|| {
+        CORE_SCHEMAS
+            .iter()
+            .map(|(name, text)| {
+                let mut schema = serde_json::from_str(text).expect("core schemas are valid JSON");
+                close_open_enums(&mut schema);
+                (name.to_string(), schema)
+            })
+            .collect()
+    });
+
 /// The core schema compiled for one run.
 pub struct CoreSchema {
     validator: jsonschema::Validator<TapeJson>,
@@ -162,14 +176,7 @@ pub struct CoreSchema {
 impl CoreSchema {
     /// The official schemas compiled into velvet.
     pub fn builtin() -> CoreSchema {
-        let files: HashMap<String, Value> = CORE_SCHEMAS
-            .iter()
-            .map(|(name, text)| {
-                let mut schema = serde_json::from_str(text).expect("core schemas are valid JSON");
-                close_open_enums(&mut schema);
-                (name.to_string(), schema)
-            })
-            .collect();
+        let files = CORE_FILES.clone();
         let root = files["glTF.schema.json"].clone();
         let validator = jsonschema::options_for::<TapeJson>()
             .with_draft(jsonschema::Draft::Draft202012)
@@ -668,8 +675,7 @@ impl Rule for CoreStructure {
         cx.schemas.core.check(json, out);
         // Values an extension adds to a core enumeration are in the list once the extension
         // is declared, as the Khronos validator reads them.
-        let declared =
-            |name: &str| super::elements(json.get("extensionsUsed")).any(|e| e.is_str(name));
+        let declared = |name: &str| super::declares(json, name);
         let mut kept = first;
         for at in first..out.len() {
             let d = &out[at];

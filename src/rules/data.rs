@@ -78,8 +78,9 @@ pub struct Elements<'a> {
     sparse: Option<Sparse<'a>>,
 }
 
-/// The unsigned integer at `at` of `index`, when it is one that fits a `usize`.
-fn index_of(node: Option<Node>) -> Option<usize> {
+/// The index `node` holds (of an accessor, a mesh, a skin, a sampler, …): an unsigned integer
+/// that fits a `usize`.
+pub fn index_of(node: Option<Node>) -> Option<usize> {
     usize::try_from(node?.as_u64()?).ok()
 }
 
@@ -98,10 +99,7 @@ fn view_bytes<'c>(cx: &'c Context, view: usize) -> Option<&'c [u8]> {
         }
     }
     let buffer = index_of(view.get("buffer"))?;
-    let offset = match view.get("byteOffset") {
-        None => 0,
-        Some(o) => usize::try_from(o.as_u64()?).ok()?,
-    };
+    let offset = byte_offset(view)?;
     let length = index_of(view.get("byteLength"))?;
     let bytes = cx.buffer(buffer)?;
     bytes.get(offset..offset.checked_add(length)?)
@@ -122,10 +120,7 @@ impl<'a> Elements<'a> {
             Some(view) => {
                 let view = index_of(Some(view))?;
                 let bytes = view_bytes(cx, view)?;
-                let offset = match accessor.get("byteOffset") {
-                    None => 0,
-                    Some(o) => usize::try_from(o.as_u64()?).ok()?,
-                };
+                let offset = byte_offset(accessor)?;
                 let (element, packed) = element_layout(size as u64, &kind)?;
                 let (element, packed) = (
                     usize::try_from(element).ok()?,
@@ -179,25 +174,9 @@ impl<'a> Elements<'a> {
     fn sparse(cx: &'a Context, sparse: Node, element: usize, count: usize) -> Option<Sparse<'a>> {
         let n = index_of(sparse.get("count")).filter(|n| *n >= 1 && *n <= count)?;
         let indices = sparse.get("indices")?;
-        let values = sparse.get("values")?;
-        let index_type = indices.get("componentType")?.as_u64()?;
-        let index_size = match index_type {
-            5121 => 1,
-            5123 => 2,
-            5125 => 4,
-            _ => return None,
-        };
-        let part = |holder: Node, length: usize| -> Option<&'a [u8]> {
-            let view = index_of(holder.get("bufferView"))?;
-            let bytes = view_bytes(cx, view)?;
-            let offset = match holder.get("byteOffset") {
-                None => 0,
-                Some(o) => usize::try_from(o.as_u64()?).ok()?,
-            };
-            bytes.get(offset..offset.checked_add(length)?)
-        };
-        let index_bytes = part(indices, n.checked_mul(index_size)?)?;
-        let values = part(values, n.checked_mul(element)?)?;
+        let index_size = index_size(indices)?;
+        let index_bytes = sparse_part(cx, indices, n.checked_mul(index_size)?)?;
+        let values = sparse_part(cx, sparse.get("values")?, n.checked_mul(element)?)?;
         let mut substitutions = Vec::with_capacity(n);
         for (k, index) in read_indices(index_bytes, index_size).enumerate() {
             let index = usize::try_from(index).ok().filter(|i| *i < count)?;
@@ -347,25 +326,34 @@ pub fn sparse_indices(cx: &Context, index: usize) -> Option<(Vec<u64>, u64)> {
     let sparse = accessor.get("sparse")?;
     let n = index_of(sparse.get("count")).filter(|n| *n >= 1)?;
     let indices = sparse.get("indices")?;
-    let size = match indices.get("componentType")?.as_u64()? {
-        5121 => 1,
-        5123 => 2,
-        5125 => 4,
-        _ => return None,
-    };
-    let view = index_of(indices.get("bufferView"))?;
-    let offset = match indices.get("byteOffset") {
-        None => 0,
-        Some(o) => usize::try_from(o.as_u64()?).ok()?,
-    };
-    let bytes = view_bytes(cx, view)?.get(offset..offset.checked_add(n.checked_mul(size)?)?)?;
+    let size = index_size(indices)?;
+    let bytes = sparse_part(cx, indices, n.checked_mul(size)?)?;
     Some((read_indices(bytes, size).collect(), count))
 }
 
-/// Every accessor index `node` names, for the rules that read the accessors of a use (a
-/// primitive's attributes, a sampler's input).
-pub fn accessor_index(node: Option<Node>) -> Option<usize> {
-    index_of(node)
+/// The `byteOffset` of a view, an accessor or a sparse part: 0 when absent, `None` when it is
+/// not an index.
+fn byte_offset(holder: Node) -> Option<usize> {
+    holder
+        .get("byteOffset")
+        .map_or(Some(0), |o| index_of(Some(o)))
+}
+
+/// The size in bytes of sparse `indices`' component type (unsigned byte, short or int).
+fn index_size(indices: Node) -> Option<usize> {
+    match indices.get("componentType")?.as_u64()? {
+        5121 => Some(1),
+        5123 => Some(2),
+        5125 => Some(4),
+        _ => None,
+    }
+}
+
+/// The `length` bytes a sparse part (`indices` or `values`) names in its view.
+fn sparse_part<'c>(cx: &'c Context, holder: Node, length: usize) -> Option<&'c [u8]> {
+    let bytes = view_bytes(cx, index_of(holder.get("bufferView"))?)?;
+    let offset = byte_offset(holder)?;
+    bytes.get(offset..offset.checked_add(length)?)
 }
 
 /// The number of accessors of the document.

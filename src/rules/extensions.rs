@@ -857,18 +857,6 @@ impl Shapes {
     }
 }
 
-/// The core schema files, read once for every extension schema that compiles.
-static CORE_FILES: LazyLock<HashMap<String, Value>> = LazyLock::new(|| {
-    super::core::CORE_SCHEMAS
-        .iter()
-        .map(|(name, text)| {
-            let mut schema = serde_json::from_str(text).expect("core schemas are valid JSON");
-            super::core::close_open_enums(&mut schema);
-            (name.to_string(), schema)
-        })
-        .collect()
-});
-
 /// The extension schemas of one run, each compiled when a document first uses it.
 pub struct ExtensionSchemas {
     validators: Vec<OnceLock<jsonschema::Validator<TapeJson>>>,
@@ -890,7 +878,7 @@ impl ExtensionSchemas {
 }
 
 fn compile(placement: &Placement) -> jsonschema::Validator<TapeJson> {
-    let mut files = CORE_FILES.clone();
+    let mut files = super::core::CORE_FILES.clone();
     for (name, text) in folder_of(placement.extension) {
         let mut schema = serde_json::from_str(text).expect("compiled-in schemas are valid JSON");
         super::core::close_open_enums(&mut schema);
@@ -1037,12 +1025,7 @@ impl<'a> Walk<'_, 'a> {
             self.path.push('/');
             self.path.push_str(&pointer::escape(property));
             if *array {
-                for (i, element) in member
-                    .as_array()
-                    .into_iter()
-                    .flat_map(|a| a.iter())
-                    .enumerate()
-                {
+                for (i, element) in super::elements(Some(member)).enumerate() {
                     let len = self.path.len();
                     self.path.push('/');
                     self.path.push_str(&i.to_string());

@@ -166,13 +166,16 @@ impl Rule for Materials {
 }
 
 /// The textures read in the normal texture's tangent space, each with its code.
+/// KHR_materials_anisotropy's direction texture, read in the normal texture's tangent space.
+pub const ANISOTROPY_TEXTURE: &str = "/extensions/KHR_materials_anisotropy/anisotropyTexture";
+
 const TANGENT_SPACE_TEXTURES: [(&str, &Code); 2] = [
     (
         "/extensions/KHR_materials_clearcoat/clearcoatNormalTexture",
         &KHR_MATERIALS_CLEARCOAT_CLEARCOAT_NORMAL_TEXTURE_TEXCOORD,
     ),
     (
-        "/extensions/KHR_materials_anisotropy/anisotropyTexture",
+        ANISOTROPY_TEXTURE,
         &KHR_MATERIALS_ANISOTROPY_ANISOTROPY_TEXTURE_TEXCOORD,
     ),
 ];
@@ -224,10 +227,15 @@ mod tests {
             {"normalTexture":{"index":0},"extensions":{
                 "KHR_materials_clearcoat":{"clearcoatNormalTexture":{"index":0,"texCoord":1}},
                 "KHR_materials_anisotropy":{"anisotropyTexture":{"index":0,"texCoord":1,
-                    "extensions":{"KHR_texture_transform":{"texCoord":0}}}}}}]}"#;
+                    "extensions":{"KHR_texture_transform":{"texCoord":0}}}}}},
+            {"normalTexture":{"index":0},"extensions":{
+                "KHR_materials_anisotropy":{"anisotropyTexture":{"index":0,"texCoord":1}}}}]}"#;
         assert_eq!(
             found(text),
-            ["KHR_MATERIALS_CLEARCOAT_CLEARCOAT_NORMAL_TEXTURE_TEXCOORD /materials/0/extensions/KHR_materials_clearcoat/clearcoatNormalTexture"]
+            [
+                "KHR_MATERIALS_CLEARCOAT_CLEARCOAT_NORMAL_TEXTURE_TEXCOORD /materials/0/extensions/KHR_materials_clearcoat/clearcoatNormalTexture",
+                "KHR_MATERIALS_ANISOTROPY_ANISOTROPY_TEXTURE_TEXCOORD /materials/1/extensions/KHR_materials_anisotropy/anisotropyTexture"
+            ]
         );
     }
 

@@ -212,8 +212,7 @@ impl Rule for Primitives {
         let strided: Vec<bool> = elements(json.get("bufferViews"))
             .map(|v| v.get("byteStride").is_some())
             .collect();
-        let quantized =
-            elements(json.get("extensionsUsed")).any(|e| e.is_str("KHR_mesh_quantization"));
+        let quantized = super::declares(json, "KHR_mesh_quantization");
         // The first accessor found holding vertex attributes in each buffer view.
         let mut first_in_view: Vec<Option<usize>> = vec![None; strided.len()];
         // Pointers are written only for findings: a library has tens of thousands of attributes.

@@ -246,9 +246,7 @@ fn check_image(cx: &Context, index: usize, image: Node, out: &mut Vec<Diagnostic
                 ImageFormat::Ktx2 => &["KHR_texture_basisu", "EXT_texture_astc"],
                 _ => &[],
             };
-            let declared_extension = |name: &&str| {
-                super::elements(cx.json().get("extensionsUsed")).any(|e| e.is_str(name))
-            };
+            let declared_extension = |name: &&str| super::declares(cx.json(), name);
             if !header.width.is_power_of_two() || !header.height.is_power_of_two() {
                 out.push(Diagnostic::new(
                     &IMAGE_NPOT_DIMENSIONS,

@@ -4,7 +4,7 @@
 //! `inverseBindMatrices`, one finding a value, at most [`MAX_REPORTED`] a skin.
 
 use super::accessor_bounds::MAX_REPORTED;
-use super::data::{accessor_index, Elements};
+use super::data::{index_of, Elements};
 use super::{elements, Context, Rule};
 use crate::diagnostics::{Code, Diagnostic, Severity};
 
@@ -29,7 +29,7 @@ impl Rule for SkinData {
             return;
         }
         for (s, skin) in elements(cx.json().get("skins")).enumerate() {
-            let Some(matrices) = accessor_index(skin.get("inverseBindMatrices"))
+            let Some(matrices) = index_of(skin.get("inverseBindMatrices"))
                 .and_then(|i| Elements::of(cx, i))
                 .filter(|m| m.components == 16)
             else {

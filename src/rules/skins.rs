@@ -55,10 +55,13 @@ pub const NODE_SKIN_NO_SCENE: Code = Code::new(
 
 pub struct Skins;
 
-/// The node hierarchy as parents: each node's first parent, in document order.
+/// The node hierarchy as parents: each node's first parent, in document order, and each
+/// node's root.
 struct Hierarchy<'a> {
     nodes: Vec<Node<'a>>,
     parent: Vec<Option<usize>>,
+    /// The root of each node's tree; `None` for a node on or below a loop.
+    roots: Vec<Option<usize>>,
 }
 
 impl<'a> Hierarchy<'a> {
@@ -76,7 +79,12 @@ impl<'a> Hierarchy<'a> {
                 }
             }
         }
-        Hierarchy { nodes, parent }
+        let roots = roots_of(&parent);
+        Hierarchy {
+            nodes,
+            parent,
+            roots,
+        }
     }
 
     fn node(&self, index: Option<Node>) -> Option<usize> {
@@ -101,9 +109,37 @@ impl<'a> Hierarchy<'a> {
 
     /// The root of `node`'s tree; `None` on a loop.
     fn root(&self, node: usize) -> Option<usize> {
-        let top = self.ancestors(node).last().unwrap_or(node);
-        self.parent[top].is_none().then_some(top)
+        self.roots[node]
     }
+}
+
+/// Each node's root, every node walked up once: a node's walk stops at the first node whose
+/// root is known and hands that root to every node it passed (asking each joint for its root
+/// would walk a deep chain once per joint). A walk longer than the node count is a loop, and
+/// every node on it gets `None`.
+fn roots_of(parent: &[Option<usize>]) -> Vec<Option<usize>> {
+    let mut known: Vec<Option<Option<usize>>> = vec![None; parent.len()];
+    let mut walked = Vec::new();
+    for start in 0..parent.len() {
+        let mut at = start;
+        let root = loop {
+            if let Some(root) = known[at] {
+                break root;
+            }
+            if walked.len() > parent.len() {
+                break None;
+            }
+            walked.push(at);
+            match parent[at] {
+                None => break Some(at),
+                Some(up) => at = up,
+            }
+        };
+        for node in walked.drain(..) {
+            known[node] = Some(root);
+        }
+    }
+    known.into_iter().map(Option::flatten).collect()
 }
 
 impl Rule for Skins {
@@ -261,6 +297,19 @@ mod tests {
 
     fn found(text: &str) -> Vec<String> {
         crate::rules::findings_of(&Skins, text)
+    }
+
+    /// Roots through a chain, a branch and a loop: 0 ← 1 ← 2 and 0 ← 3; 4 ⇄ 5 with 6 below 5.
+    #[test]
+    fn roots_are_found_once_a_node_and_a_loop_has_none() {
+        let parent = [None, Some(0), Some(1), Some(0), Some(5), Some(4), Some(5)];
+        assert_eq!(
+            roots_of(&parent),
+            [Some(0), Some(0), Some(0), Some(0), None, None, None]
+        );
+        // A 100,000-node chain, each node's root found in one pass.
+        let chain: Vec<Option<usize>> = (0..100_000usize).map(|i| i.checked_sub(1)).collect();
+        assert!(roots_of(&chain).iter().all(|r| *r == Some(0)));
     }
 
     #[test]

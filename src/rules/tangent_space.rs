@@ -79,7 +79,7 @@ impl Rule for TangentSpace {
 /// Whether a texture is read in tangent space: a normal texture, or KHR_materials_anisotropy's
 /// direction texture.
 fn needs_tangents(texture: &super::extensions::MaterialTexture) -> bool {
-    texture.normal || texture.pointer == "/extensions/KHR_materials_anisotropy/anisotropyTexture"
+    texture.normal || texture.pointer == super::materials::ANISOTROPY_TEXTURE
 }
 
 /// The attributes of a tangent space a primitive lacks, for messages.

@@ -99,12 +99,7 @@ fn walk<'a>(
         {
             path.push(Step::Key(key));
             if *array {
-                for (i, element) in member
-                    .as_array()
-                    .into_iter()
-                    .flat_map(|a| a.iter())
-                    .enumerate()
-                {
+                for (i, element) in super::elements(Some(member)).enumerate() {
                     path.push(Step::Index(i));
                     walk(shapes, element, *child, path, out);
                     path.pop();

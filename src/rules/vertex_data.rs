@@ -19,10 +19,11 @@
 //! [`MAX_REPORTED`] times an accessor use.
 
 use super::accessor_bounds::MAX_REPORTED;
-use super::data::{accessor_index, Elements, UNIT_LENGTH_VEC3, UNIT_SUM_STEP};
+use super::data::{index_of, Elements, UNIT_LENGTH_VEC3, UNIT_SUM_STEP};
 use super::{elements, Context, Rule};
 use crate::asset::pointer;
 use crate::diagnostics::{Code, Diagnostic, Severity};
+use std::collections::HashMap;
 
 pub const ACCESSOR_INDEX_OOB: Code = Code::new(
     "ACCESSOR_INDEX_OOB",
@@ -82,7 +83,8 @@ pub const ACCESSOR_JOINTS_USED_ZERO_WEIGHT: Code = Code::new(
 
 pub struct VertexData;
 
-/// Findings of one kind at one place, counted so that each stops at [`MAX_REPORTED`].
+/// Findings of one kind at one place, counted so that each stops at [`MAX_REPORTED`]; the
+/// places are one primitive's, cleared before the next.
 struct Capped<'o> {
     out: &'o mut Vec<Diagnostic>,
     counts: Vec<(&'static str, String, usize)>,
@@ -148,22 +150,24 @@ impl Rule for VertexData {
         let mut judged: std::collections::HashSet<(&str, usize)> = std::collections::HashSet::new();
         for (m, mesh) in elements(Some(meshes)).enumerate() {
             for (p, primitive) in elements(mesh.get("primitives")).enumerate() {
+                // Every place a count keeps is inside this primitive.
+                capped.counts.clear();
                 let Some(attributes) = primitive.get("attributes").and_then(|a| a.as_object())
                 else {
                     continue;
                 };
                 let at = format!("/meshes/{m}/primitives/{p}");
                 let mut read = |kind: &'static str, name: &str| {
-                    let index = accessor_index(attributes.get(name))?;
+                    let index = index_of(attributes.get(name))?;
                     judged
                         .insert((kind, index))
                         .then(|| Elements::of(cx, index))
                         .flatten()
                 };
-                let vertices = accessor_index(attributes.get("POSITION"))
+                let vertices = index_of(attributes.get("POSITION"))
                     .and_then(|i| cx.json().get("accessors")?.get(i)?.get("count")?.as_u64());
                 if let (Some(indices), Some(vertices)) = (
-                    accessor_index(primitive.get("indices")).and_then(|i| Elements::of(cx, i)),
+                    index_of(primitive.get("indices")).and_then(|i| Elements::of(cx, i)),
                     vertices,
                 ) {
                     let mode = primitive.get("mode").map_or(Some(4), |m| m.as_u64());
@@ -215,7 +219,7 @@ impl Rule for VertexData {
                         }
                     });
                 }
-                let limit = primitive_joint_limit(&joint_limits, m);
+                let limit = joint_limits.get(&m).copied();
                 check_skinning(cx, attributes, &at, limit, &mut capped);
             }
         }
@@ -305,36 +309,29 @@ fn unit_length(
 }
 
 /// For each mesh, the smallest number of joints of the skins that draw it, with that skin.
-fn joint_limits(cx: &Context) -> Vec<(usize, usize, usize)> {
+fn joint_limits(cx: &Context) -> HashMap<usize, (usize, usize)> {
     let json = cx.json();
-    let skins: Vec<_> = elements(json.get("skins")).collect();
-    let mut limits = Vec::new();
+    let skins = json.get("skins");
+    let mut limits: HashMap<usize, (usize, usize)> = HashMap::new();
     for node in elements(json.get("nodes")) {
-        let (Some(mesh), Some(skin)) = (
-            accessor_index(node.get("mesh")),
-            accessor_index(node.get("skin")),
-        ) else {
+        let (Some(mesh), Some(skin)) = (index_of(node.get("mesh")), index_of(node.get("skin")))
+        else {
             continue;
         };
         let Some(joints) = skins
-            .get(skin)
+            .and_then(|s| s.get(skin))
             .and_then(|s| s.get("joints"))
             .and_then(|j| j.as_array())
         else {
             continue;
         };
-        limits.push((mesh, joints.len(), skin));
+        let limit = (joints.len(), skin);
+        limits
+            .entry(mesh)
+            .and_modify(|least| *least = (*least).min(limit))
+            .or_insert(limit);
     }
     limits
-}
-
-/// The smallest joint count (and its skin) of the skins drawing mesh `mesh`.
-fn primitive_joint_limit(limits: &[(usize, usize, usize)], mesh: usize) -> Option<(usize, usize)> {
-    limits
-        .iter()
-        .filter(|(m, _, _)| *m == mesh)
-        .map(|(_, joints, skin)| (*joints, *skin))
-        .min()
 }
 
 /// Weights and joints, set by set and vertex by vertex.
@@ -352,10 +349,10 @@ fn check_skinning(
         if weights.is_none() && joints.is_none() {
             break;
         }
-        let weights = accessor_index(weights)
+        let weights = index_of(weights)
             .and_then(|i| Elements::of(cx, i))
             .filter(|e| e.components == 4);
-        let joints = accessor_index(joints)
+        let joints = index_of(joints)
             .and_then(|i| Elements::of(cx, i))
             .filter(|e| e.components == 4);
         let pointers = (
