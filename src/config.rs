@@ -488,13 +488,10 @@ impl Config {
             .collect();
         let kept_errors: Vec<String> =
             if !error_codes.is_empty() && error_codes.iter().all(|c| ignore.contains(*c)) {
-                error_codes
-                    .iter()
-                    .map(|c| {
-                        ignore.remove(*c);
-                        c.to_string()
-                    })
-                    .collect()
+                for code in &error_codes {
+                    ignore.remove(*code);
+                }
+                error_codes.iter().map(|c| c.to_string()).collect()
             } else {
                 Vec::new()
             };

@@ -6,6 +6,14 @@
 use crate::asset::pointer;
 use crate::asset::tape::{JsonView, Node};
 
+/// The object at the position `index` names in `array`, when `index` is an index and the
+/// element there is an object: how a reference from one part of a document to another is
+/// followed.
+pub fn element_at<'a>(array: Option<Node<'a>>, index: Option<Node<'a>>) -> Option<Node<'a>> {
+    let i = usize::try_from(index?.as_u64()?).ok()?;
+    array?.as_array()?.get(i).filter(|o| o.is_object())
+}
+
 /// Whether the document's `extensionsUsed` names `extension`.
 pub fn declares(json: Node<'_>, extension: &str) -> bool {
     elements(json.get("extensionsUsed")).any(|e| e.is_str(extension))

@@ -2009,27 +2009,18 @@ fn sigint_and_sigterm_leave_only_finished_outputs_and_no_temporary_file() {
             .enumerate()
             {
                 let out_dir = dir.path().join(format!("out-{k}"));
-                let child = Command::new(env!("CARGO_BIN_EXE_velvet"))
-                    .args([command, s(input), "--out-dir", s(&out_dir)])
-                    .stdout(std::process::Stdio::piped())
-                    .stderr(std::process::Stdio::piped())
-                    .spawn()
-                    .unwrap();
-                std::thread::sleep(std::time::Duration::from_millis(delay_ms));
-                // SAFETY: kill(2) on the child's id, which it holds until it is waited for.
-                unsafe { libc::kill(child.id() as libc::pid_t, signal) };
-                let output = child.wait_with_output().unwrap();
+                let (output, _) = velvet_signalled(
+                    &[command, s(input), "--out-dir", s(&out_dir)],
+                    signal,
+                    delay_ms,
+                );
                 let err = String::from_utf8_lossy(&output.stderr);
                 let what = format!("{what}, signal {signal} after {delay_ms} ms");
                 match output.status.code() {
                     Some(0) => assert_eq!(tree(&out_dir), expected, "{what}"),
                     Some(code) => {
                         assert_eq!(code, 128 + signal, "{what}: {err}");
-                        let name = if signal == libc::SIGINT {
-                            "SIGINT"
-                        } else {
-                            "SIGTERM"
-                        };
+                        let name = signal_name(signal);
                         let line = err.lines().last().unwrap_or_default();
                         assert!(
                             line.starts_with(&format!("velvet: stopped by {name}: ")),
@@ -2666,19 +2657,9 @@ fn validate_fix_answers_sigint_and_sigterm_as_migrate_does() {
         for i in 0..files {
             write(&folder.join(format!("d{i:04}.gltf")), FIXABLE);
         }
-        let child = Command::new(env!("CARGO_BIN_EXE_velvet"))
-            .args(["validate", "--fix", s(&folder)])
-            .stdout(std::process::Stdio::piped())
-            .stderr(std::process::Stdio::piped())
-            .spawn()
-            .unwrap();
-        std::thread::sleep(std::time::Duration::from_millis(delay_ms));
-        let sent = std::time::Instant::now();
-        // SAFETY: kill(2) on the child's id, which it holds until it is waited for.
-        unsafe { libc::kill(child.id() as libc::pid_t, signal) };
-        let output = child.wait_with_output().unwrap();
+        let (output, took) = velvet_signalled(&["validate", "--fix", s(&folder)], signal, delay_ms);
         let what = format!("signal {signal} after {delay_ms} ms");
-        assert!(sent.elapsed() < std::time::Duration::from_secs(5), "{what}");
+        assert!(took < std::time::Duration::from_secs(5), "{what}");
         let err = String::from_utf8_lossy(&output.stderr);
         let mut fixed = 0;
         for entry in std::fs::read_dir(&folder).unwrap() {
@@ -2696,11 +2677,7 @@ fn validate_fix_answers_sigint_and_sigterm_as_migrate_does() {
             Some(0) => assert_eq!(fixed, files, "{what}"),
             code => {
                 assert_eq!(code, Some(128 + signal), "{what}: {err}");
-                let name = if signal == libc::SIGINT {
-                    "SIGINT"
-                } else {
-                    "SIGTERM"
-                };
+                let name = signal_name(signal);
                 assert_eq!(
                     err,
                     format!(
@@ -3075,18 +3052,11 @@ fn long_work_stops_within_a_second_of_a_signal() {
     .enumerate()
     {
         let out_dir = dir.path().join(format!("out-{k}"));
-        let child = Command::new(env!("CARGO_BIN_EXE_velvet"))
-            .args(["migrate", "--exact", "--out-dir", s(&out_dir), s(&input)])
-            .stdout(std::process::Stdio::piped())
-            .stderr(std::process::Stdio::piped())
-            .spawn()
-            .unwrap();
-        std::thread::sleep(std::time::Duration::from_millis(delay_ms));
-        let sent = std::time::Instant::now();
-        // SAFETY: kill(2) on the child's id, which it holds until it is waited for.
-        unsafe { libc::kill(child.id() as libc::pid_t, signal) };
-        let output = child.wait_with_output().unwrap();
-        let took = sent.elapsed();
+        let (output, took) = velvet_signalled(
+            &["migrate", "--exact", "--out-dir", s(&out_dir), s(&input)],
+            signal,
+            delay_ms,
+        );
         let err = String::from_utf8_lossy(&output.stderr);
         let what = format!("signal {signal} after {delay_ms} ms");
         assert_eq!(output.status.code(), Some(128 + signal), "{what}: {err}");
@@ -3271,5 +3241,37 @@ fn a_resource_replaced_or_deleted_during_a_run_fails_its_file_without_a_write() 
                 names_under(&out)
             );
         }
+    }
+}
+
+/// Runs velvet with `args`, sends it `signal` after `delay_ms` and waits for it: its output,
+/// and the time from the signal to its exit.
+#[cfg(unix)]
+fn velvet_signalled(
+    args: &[&str],
+    signal: i32,
+    delay_ms: u64,
+) -> (std::process::Output, std::time::Duration) {
+    let child = Command::new(env!("CARGO_BIN_EXE_velvet"))
+        .args(args)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(delay_ms));
+    let sent = std::time::Instant::now();
+    // SAFETY: kill(2) on the child's id, which it holds until it is waited for.
+    unsafe { libc::kill(child.id() as libc::pid_t, signal) };
+    let output = child.wait_with_output().unwrap();
+    (output, sent.elapsed())
+}
+
+/// The name velvet's "stopped by" line gives `signal` (SIGINT or SIGTERM).
+#[cfg(unix)]
+fn signal_name(signal: i32) -> &'static str {
+    if signal == libc::SIGINT {
+        "SIGINT"
+    } else {
+        "SIGTERM"
     }
 }

@@ -114,11 +114,8 @@ impl Rule for Accessors {
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
         let json = cx.json();
-        let views = json.get("bufferViews").and_then(|v| v.as_array());
-        let view = |index: Option<Node>| {
-            let i = usize::try_from(index?.as_u64()?).ok()?;
-            views?.get(i).filter(|v| v.is_object())
-        };
+        let views = json.get("bufferViews");
+        let view = |index| super::element_at(views, index);
         for (i, accessor) in elements(json.get("accessors")).enumerate() {
             let at = format!("/accessors/{i}");
             let component_type = accessor.get("componentType").and_then(|c| c.as_u64());

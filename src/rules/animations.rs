@@ -92,8 +92,7 @@ struct Keyframes {
 }
 
 fn keyframes(accessors: Option<Node>, index: Option<Node>) -> Option<Keyframes> {
-    let i = usize::try_from(index?.as_u64()?).ok()?;
-    let accessor = accessors?.get(i).filter(|a| a.is_object())?;
+    let accessor = super::element_at(accessors, index)?;
     Some(Keyframes {
         kind: accessor
             .get("type")
@@ -255,12 +254,7 @@ impl Rule for Animations {
                     continue;
                 };
                 let trs = matches!(path.as_ref(), "translation" | "rotation" | "scale");
-                let node = target
-                    .get("node")
-                    .and_then(|n| n.as_u64())
-                    .and_then(|n| usize::try_from(n).ok())
-                    .and_then(|n| nodes?.get(n))
-                    .filter(|n| n.is_object());
+                let node = super::element_at(nodes, target.get("node"));
                 let mut morphs = None;
                 if let Some(node) = node {
                     if trs && node.get("matrix").is_some() {

@@ -58,12 +58,6 @@ const ELEMENT_ARRAY_BUFFER: u64 = 34963;
 
 pub struct BufferViews;
 
-/// The object at `index` of `array`, when `index` is an index that names one.
-fn at_index<'a>(array: Option<Node<'a>>, index: Option<Node<'a>>) -> Option<Node<'a>> {
-    let i = usize::try_from(index?.as_u64()?).ok()?;
-    array?.as_array()?.get(i).filter(|o| o.is_object())
-}
-
 impl Rule for BufferViews {
     fn codes(&self) -> &'static [&'static Code] {
         &[
@@ -89,9 +83,11 @@ impl Rule for BufferViews {
                 Some(o) => o.as_u64(),
             };
             let length = view.get("byteLength").and_then(|l| l.as_u64());
-            if let (Some(buffer), Some(offset), Some(length)) =
-                (at_index(buffers, view.get("buffer")), offset, length)
-            {
+            if let (Some(buffer), Some(offset), Some(length)) = (
+                super::element_at(buffers, view.get("buffer")),
+                offset,
+                length,
+            ) {
                 if let Some(buffer_length) = buffer.get("byteLength").and_then(|l| l.as_u64()) {
                     if offset >= buffer_length && length > 0 {
                         out.push(Diagnostic::new(
@@ -139,9 +135,9 @@ impl BufferViews {
         let accessors = json.get("accessors");
         let views = json.get("bufferViews");
         let view_index = |accessor: Option<Node>| -> Option<usize> {
-            let accessor = at_index(accessors, accessor)?;
+            let accessor = super::element_at(accessors, accessor)?;
             let view = accessor.get("bufferView")?;
-            at_index(views, Some(view))?;
+            super::element_at(views, Some(view))?;
             usize::try_from(view.as_u64()?).ok()
         };
         let strided = |view: usize| {
@@ -239,7 +235,7 @@ impl BufferViews {
             let Some(view) = image.get("bufferView") else {
                 continue;
             };
-            if at_index(views, Some(view)).is_some_and(|v| v.get("byteStride").is_some()) {
+            if super::element_at(views, Some(view)).is_some_and(|v| v.get("byteStride").is_some()) {
                 out.push(Diagnostic::new(
                     &IMAGE_BUFFER_VIEW_WITH_BYTESTRIDE,
                     format!("/images/{i}/bufferView"),

@@ -141,6 +141,14 @@ fn check_lists(
 /// notion of "used" that the declaration rules and their fixes share (an extension object on
 /// the wrong kind of object is UNEXPECTED_EXTENSION_OBJECT, but still needs its declaration).
 pub fn is_used_anywhere(json: Node, name: &str) -> bool {
+    // No `extensions` object anywhere (extras included, a superset of what the walk visits)
+    // has the name: then no walk is needed.
+    if !json
+        .members_named("extensions")
+        .any(|extensions| extensions.get(name).is_some())
+    {
+        return false;
+    }
     let mut used = false;
     extension_objects(json, &mut Vec::new(), &mut |_, found| used |= found == name);
     used

@@ -319,7 +319,9 @@ pub fn find_code(name: &str) -> Option<&'static Code> {
     all_codes().into_iter().find(|c| c.name == name)
 }
 
-pub use crate::document::{declares, effective_tex_coord, elements, materials, texture_sources};
+pub use crate::document::{
+    declares, effective_tex_coord, element_at, elements, materials, texture_sources,
+};
 pub use crate::layers::{as_index, layer_objects, slot_pointer, slot_uses, LayerObject, SlotUse};
 
 /// The findings of `rule` alone on the document `text`, as "CODE pointer" lines: the rules'

@@ -119,12 +119,7 @@ impl Rule for Nodes {
                     ));
                 }
             }
-            let mesh = node
-                .get("mesh")
-                .and_then(|m| m.as_u64())
-                .and_then(|m| usize::try_from(m).ok())
-                .and_then(|m| meshes?.get(m))
-                .filter(|m| m.is_object());
+            let mesh = super::element_at(meshes, node.get("mesh"));
             let Some(mesh) = mesh else {
                 continue;
             };
