@@ -2,7 +2,7 @@
 //! was applied. The fixes themselves are planned by `crate::fix`; these are the plain values
 //! every report format reads (the planner's one plan, seen from the report).
 
-use super::Position;
+use super::{Diagnostic, Position};
 
 /// How much a fix may change an asset.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -62,8 +62,9 @@ pub struct FixView {
     pub safety: Safety,
     /// What it does, in a few words ("declare KHR_materials_sheen in extensionsUsed").
     pub title: String,
-    /// Its edits of the JSON text as read, apart from every other fix; none for a .glb, whose
-    /// JSON chunk cannot be edited as text (`--fix` repacks it).
+    /// Its edits of the JSON text as read (of a .glb, its JSON chunk's text without the
+    /// chunk's padding: `--fix` frames the edited text again). No two fixes of a file touch
+    /// the same text.
     pub edits: Vec<TextEdit>,
     pub status: FixStatus,
 }
@@ -94,8 +95,10 @@ pub struct FileFixes {
     pub write_error: Option<String>,
 }
 
-fn finding_key(code: &str, pointer: &str) -> String {
-    format!("{code}\0{pointer}")
+/// A finding's key: its code, pointer and message (findings of one code at one pointer differ
+/// by their message: a primitive's material may have several textures that read a missing set).
+fn finding_key(code: &str, pointer: &str, message: &str) -> String {
+    format!("{code}\0{pointer}\0{message}")
 }
 
 impl FileFixes {
@@ -104,7 +107,7 @@ impl FileFixes {
         for (i, fix) in fixes.iter().enumerate() {
             for r in &fix.repairs {
                 by_finding
-                    .entry(finding_key(r.code, &r.pointer))
+                    .entry(finding_key(r.code, &r.pointer, &r.message))
                     .or_insert(i);
             }
         }
@@ -139,20 +142,24 @@ impl FileFixes {
             .sum()
     }
 
-    /// The available fix that repairs the finding with `code` at `pointer`, if any.
-    pub fn for_finding(&self, code: &str, pointer: &str) -> Option<&FixView> {
-        self.fix_of(code, pointer)
-            .filter(|f| f.status == FixStatus::Available)
+    /// The available fix that repairs the finding `d`, if any.
+    pub fn for_finding(&self, d: &Diagnostic) -> Option<&FixView> {
+        self.fix_of(d).filter(|f| f.status == FixStatus::Available)
     }
 
-    /// The fix planned for the finding with `code` at `pointer`, whatever became of it.
-    pub fn fix_of(&self, code: &str, pointer: &str) -> Option<&FixView> {
+    /// The fix planned for the finding `d`, whatever became of it.
+    pub fn fix_of(&self, d: &Diagnostic) -> Option<&FixView> {
+        self.index_of(d).map(|i| &self.fixes[i])
+    }
+
+    /// The place in [`FileFixes::fixes`] of the fix planned for the finding `d`.
+    pub fn index_of(&self, d: &Diagnostic) -> Option<usize> {
         if self.by_finding.is_empty() {
             return None;
         }
         self.by_finding
-            .get(&finding_key(code, pointer))
-            .map(|&i| &self.fixes[i])
+            .get(&finding_key(d.code, &d.pointer, &d.message))
+            .copied()
     }
 
     /// Findings repaired by applied fixes.

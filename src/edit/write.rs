@@ -241,7 +241,7 @@ pub fn to_bytes(asset: &Asset, json: &Value, bin: Option<&[u8]>) -> Vec<u8> {
 }
 
 /// The loaded text splices are made into: a GLB chunk's padding belongs to the container.
-fn source(asset: &Asset) -> &str {
+pub fn source(asset: &Asset) -> &str {
     match asset.container {
         Container::Gltf => asset.json_text.as_str(),
         Container::Glb => asset.json_text.trim_end_matches(['\0', ' ']),

@@ -42,6 +42,9 @@ pub struct Fix {
     pub safety: Safety,
     pub title: String,
     pub edits: Vec<Edit>,
+    /// Why this fix waits for the next run: it touches what a fix of other safety changes
+    /// (see [`separate`]). A deferred fix is neither applied nor given edits in this run.
+    pub deferred: Option<String>,
 }
 
 /// The fixes for `findings` of `asset`, in the order of the findings they first repair. Fixes
@@ -73,11 +76,147 @@ pub fn plan(asset: &Asset, findings: &[Finding]) -> Vec<Fix> {
                     safety: fixer.safety,
                     title: proposal.title,
                     edits: proposal.edits,
+                    deferred: None,
                 });
             }
         }
     }
-    fixes
+    separate(asset.root(), fixes)
+}
+
+/// Where one edit acts: the value it targets, the value holding that one, and whether it
+/// changes the holder's members (a removal, a member or element added), which moves what lies
+/// beside it in the text.
+struct Site {
+    target: String,
+    holder: String,
+    reshapes: bool,
+}
+
+fn site(root: Node, edit: &Edit) -> Site {
+    let (target, reshapes) = match edit {
+        Edit::Set { pointer, .. } | Edit::Replace { pointer, .. } => {
+            (pointer.clone(), root.pointer(pointer).is_none())
+        }
+        Edit::Remove { pointer } => (pointer.clone(), true),
+        // An extension is appended to the array, or the array added to the root.
+        Edit::DeclareUsed { .. } => match root.pointer("/extensionsUsed") {
+            Some(_) => ("/extensionsUsed/-".to_string(), true),
+            None => ("/extensionsUsed".to_string(), true),
+        },
+    };
+    let holder = fixers::parent(&target).to_string();
+    Site {
+        target,
+        holder,
+        reshapes,
+    }
+}
+
+/// `fixes` with no two touching the same text, so that every fix's edits apply together in
+/// one pass, in any consumer, and give what `--fix` writes. Two fixes touch when an edit of
+/// one targets a value holding (or equal to) a value the other's edit targets, or when both
+/// add or remove members of one value (two members added to one object are inserted at the
+/// same place; two neighbours removed share a comma; a value replaced beside them is its own
+/// span). Touching
+/// fixes of one safety become one fix repairing all their findings; of a group holding both
+/// safe and unsafe fixes, the unsafe ones wait for the next run (`deferred`, with the reason),
+/// so that `--fix` alone applies exactly the safe part.
+fn separate(root: Node, fixes: Vec<Fix>) -> Vec<Fix> {
+    if fixes.len() < 2 {
+        return fixes;
+    }
+    let mut group: Vec<usize> = (0..fixes.len()).collect();
+    fn find(group: &mut [usize], mut i: usize) -> usize {
+        while group[i] != i {
+            group[i] = group[group[i]];
+            i = group[i];
+        }
+        i
+    }
+    fn join(group: &mut [usize], a: usize, b: usize) {
+        let (a, b) = (find(group, a), find(group, b));
+        if a != b {
+            group[a.max(b)] = a.min(b);
+        }
+    }
+    let sites: Vec<Vec<Site>> = fixes
+        .iter()
+        .map(|f| f.edits.iter().map(|e| site(root, e)).collect())
+        .collect();
+    let mut by_target: HashMap<&str, usize> = HashMap::new();
+    // The fixes that add or remove members of each value.
+    let mut by_holder: HashMap<&str, Vec<usize>> = HashMap::new();
+    for (i, fix_sites) in sites.iter().enumerate() {
+        for s in fix_sites {
+            if let Some(&j) = by_target.get(s.target.as_str()) {
+                join(&mut group, i, j);
+            }
+            by_target.entry(&s.target).or_insert(i);
+            if s.reshapes {
+                by_holder.entry(&s.holder).or_default().push(i);
+            }
+        }
+    }
+    for (i, fix_sites) in sites.iter().enumerate() {
+        for s in fix_sites {
+            // A value that holds this one and that another fix targets.
+            let mut at = s.holder.as_str();
+            loop {
+                if let Some(&j) = by_target.get(at) {
+                    join(&mut group, i, j);
+                }
+                if at.is_empty() {
+                    break;
+                }
+                at = fixers::parent(at);
+            }
+        }
+    }
+    for reshapers in by_holder.values() {
+        for &i in &reshapers[1..] {
+            join(&mut group, reshapers[0], i);
+        }
+    }
+    let roots: Vec<usize> = (0..fixes.len()).map(|i| find(&mut group, i)).collect();
+    if roots.iter().enumerate().all(|(i, &r)| r == i) {
+        return fixes;
+    }
+    let mut out: Vec<Fix> = Vec::with_capacity(fixes.len());
+    // Each group's fix of each safety, by the place it has in `out`.
+    let mut merged: HashMap<(usize, Safety), usize> = HashMap::new();
+    let mut safe_title: HashMap<usize, String> = HashMap::new();
+    for (fix, &r) in fixes.iter().zip(&roots) {
+        if fix.safety == Safety::Safe {
+            safe_title.entry(r).or_insert_with(|| fix.title.clone());
+        }
+    }
+    for (fix, &r) in fixes.into_iter().zip(&roots) {
+        match merged.get(&(r, fix.safety)) {
+            Some(&k) => {
+                let into = &mut out[k];
+                into.repairs.extend(fix.repairs);
+                if !into.title.split("; ").any(|t| t == fix.title) {
+                    into.title = format!("{}; {}", into.title, fix.title);
+                }
+                into.edits.extend(fix.edits);
+            }
+            None => {
+                merged.insert((r, fix.safety), out.len());
+                out.push(fix);
+            }
+        }
+    }
+    for (&(r, safety), &k) in &merged {
+        if safety == Safety::Unsafe {
+            if let Some(title) = safe_title.get(&r) {
+                out[k].deferred = Some(format!(
+                    "it touches what the safe fix \"{title}\" changes: run --fix again once that one is applied"
+                ));
+            }
+        }
+    }
+    out
 }
 
 /// The edits of `fixes` as one plan for the splice editor: each distinct edit once; removals of
@@ -333,19 +472,22 @@ impl<'v> Fixing<'v> {
         if fixes.is_empty() {
             return capped(before, settings);
         }
+        // The fixes this run would apply, tried together on the file (each try validates the
+        // fixed text again): a report carries a fix only if `--fix` would apply it, and says
+        // why it refuses the others. A run without --fix tries every fix, as --fix
+        // --unsafe-fixes would apply them; a deferred fix waits for the next run.
         let wanted: Vec<usize> = (0..fixes.len())
+            .filter(|&i| fixes[i].deferred.is_none())
             .filter(|&i| !mode.changes() || mode.applies(fixes[i].safety))
             .collect();
-        // Only a run that changes or shows the file tries its fixes (each try validates the
-        // fixed text again); a report lists them as their fixers plan them, and `--fix` or
-        // `--diff` says which it refuses and why. Trying them all on every validate run made
-        // it 40 times slower on a library with thousands of fixable findings.
-        let (accepted, refused, fixed) = if mode.changes() {
-            self.choose(path, &source, &before, &fixes, &wanted, &unlimited)
-        } else {
-            (Vec::new(), Vec::new(), None)
-        };
-        let edits = if mode.edits && source.container == Container::Gltf {
+        let (accepted, mut refused, fixed) =
+            self.choose(path, &source, &before, &fixes, &wanted, &unlimited);
+        for (i, fix) in fixes.iter().enumerate() {
+            if let Some(reason) = &fix.deferred {
+                refused.push((i, reason.clone()));
+            }
+        }
+        let edits = if mode.edits {
             all_text_edits(&source, &fixes)
         } else {
             vec![Vec::new(); fixes.len()]
@@ -359,6 +501,16 @@ impl<'v> Fixing<'v> {
                     && f.bytes != file_bytes(&source)
             })
             .is_some();
+        if mode.changes() && !changed {
+            // The fixes this mode does not apply (unsafe ones without --unsafe-fixes), tried
+            // on the file as it stays, for the report. Once the file changes, the fixes left
+            // are planned and tried against its new text.
+            let untried: Vec<usize> = (0..fixes.len())
+                .filter(|&i| fixes[i].deferred.is_none() && !mode.applies(fixes[i].safety))
+                .collect();
+            let (_, more, _) = self.choose(path, &source, &before, &fixes, &untried, &unlimited);
+            refused.extend(more);
+        }
         let mut statuses = vec![FixStatus::Available; fixes.len()];
         if changed {
             for &i in &accepted {
@@ -549,7 +701,9 @@ fn file_bytes(asset: &Asset) -> &[u8] {
 
 /// Whether the findings `after` fixing are those `before` without the ones `fixes` repair
 /// (counted by code and message: a pointer into an array moves when an element before it is
-/// removed). More are fine (a fix may repair more than it says); another, or one left, is not.
+/// removed). More are fine (a fix may repair more than it says); one left is not, nor is a new
+/// error or warning. A new info or hint is not a reason to refuse: the default a fix writes
+/// may be one a hint notes (as ruff and eslint apply a fix that leaves a note).
 fn verdict(before: &[Finding], after: &[Finding], fixes: &[&Fix]) -> Result<(), String> {
     let mut excess: HashMap<(&str, &str), i64> = HashMap::new();
     for f in after {
@@ -571,6 +725,9 @@ fn verdict(before: &[Finding], after: &[Finding], fixes: &[&Fix]) -> Result<(), 
         let key = (f.diagnostic.code, f.diagnostic.message.as_str());
         if excess.get(&key).copied().unwrap_or(0) > 0 {
             let left = repairs.iter().any(|r| (r.code, r.message.as_str()) == key);
+            if !left && f.diagnostic.severity > crate::diagnostics::Severity::Warning {
+                continue;
+            }
             return Err(if left {
                 format!("the fixed file would still have {}", f.diagnostic.code)
             } else {
@@ -644,7 +801,7 @@ fn placed_together(
     round: &[usize],
 ) -> Option<Vec<Vec<TextEdit>>> {
     let root = source.root();
-    let text = source.json_text.as_str();
+    let text = crate::edit::write::source(source);
     let together: Vec<&Fix> = round.iter().map(|&i| &fixes[i]).collect();
     let edits = combined(root, &together);
     let Ok(Some((spliced, _))) = crate::edit::splice::splice_edits(text, root, &edits) else {
@@ -702,7 +859,7 @@ fn element_of(root: Node, fix: &Fix) -> Option<(String, std::ops::Range<usize>)>
 /// The edits of the JSON text that `fix` makes alone.
 fn fix_text_edits(source: &Asset, fix: &Fix) -> Vec<TextEdit> {
     let edits = combined(source.root(), &[fix]);
-    let text = source.json_text.as_str();
+    let text = crate::edit::write::source(source);
     match crate::edit::splice::splice_edits(text, source.root(), &edits) {
         Ok(Some((spliced, true))) => text::text_edits(text, &text::replacements(text, &spliced)),
         _ => Vec::new(),
@@ -740,6 +897,7 @@ mod tests {
             safety: Safety::Safe,
             title: String::new(),
             edits,
+            deferred: None,
         }
     }
 

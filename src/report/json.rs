@@ -4,9 +4,12 @@
 //!
 //! A finding that a fix repairs carries it as `fix {applicability, message, edits[{content,
 //! location {row, column, offset}, endLocation}]}`: the replacements of the JSON text as read
-//! (rows and columns 1-based, columns in characters, offsets in bytes of the file), each fix
-//! apart from the others (an edit that several findings share is given with each; apply it
-//! once). A report with fixes ends with `fixes {fixable, fixableUnsafe, changed, applied[],
+//! (rows and columns 1-based, columns in characters, offsets in bytes of the file). No two
+//! fixes of a report touch the same text, so all their edits apply together in one pass; a fix
+//! that repairs several findings gives its edits with the first of them, and the others name
+//! that message (`editsWithMessage`, its place in `messages`). Fixes of a .glb edit its JSON
+//! chunk's text (`in: "glb JSON chunk"`, offsets and rows in the chunk's text): apply them
+//! there and rebuild the container's lengths and padding, as `--fix` does. A report with fixes ends with `fixes {fixable, fixableUnsafe, changed, applied[],
 //! refused[], diff}`: the findings a fix repairs (with `--fix`, those it did), the fixes refused
 //! with the reason, and with `--diff` the change as a unified diff. After `--fix` wrote a file,
 //! the fixes left are given against its new text.
@@ -20,6 +23,7 @@ use crate::diagnostics::fixes::{FileFixes, FixStatus, FixView};
 use crate::diagnostics::Safety;
 use crate::validate::{AssetInfo, FileReport};
 use serde::Serialize;
+use std::collections::HashMap;
 
 #[derive(Serialize)]
 #[serde(rename_all = "camelCase")]
@@ -63,10 +67,18 @@ struct RepairShape<'a> {
 }
 
 #[derive(Serialize)]
+#[serde(rename_all = "camelCase")]
 struct FixShape<'a> {
     applicability: &'static str,
     message: &'a str,
     edits: Vec<EditShape<'a>>,
+    /// For a fix that repairs several findings: the message (its place in `messages`) that
+    /// carries its edits; this one's are empty, so that each edit is given once.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    edits_with_message: Option<usize>,
+    /// For a .glb: the text the edits apply to, its JSON chunk's.
+    #[serde(rename = "in", skip_serializing_if = "Option::is_none")]
+    edits_in: Option<&'static str>,
 }
 
 #[derive(Serialize)]
@@ -117,13 +129,44 @@ struct InfoShape<'a> {
     fuzz_material_count: usize,
 }
 
+/// What a .glb's fix edits: the text of its JSON chunk.
+pub const GLB_JSON_CHUNK: &str = "glb JSON chunk";
+
 const VALIDATOR_VERSION: &str = concat!("velvet ", env!("CARGO_PKG_VERSION"));
 
-fn message_shape<'a>(report: &'a FileReport, f: &'a crate::validate::Finding) -> MessageShape<'a> {
-    let fix = report
-        .fixes
-        .for_finding(f.diagnostic.code, &f.diagnostic.pointer)
-        .map(|fix| fix_shape(report, fix));
+/// For each fix that repairs several listed findings, the place in the listing of the first:
+/// the one message that carries its edits.
+fn carriers(report: &FileReport) -> HashMap<usize, usize> {
+    let mut carriers = HashMap::new();
+    if report.fixes.fixes().iter().all(|f| f.repairs.len() < 2) {
+        return carriers;
+    }
+    for (at, f) in report.findings.iter().enumerate() {
+        if let Some(i) = report.fixes.index_of(&f.diagnostic) {
+            if report.fixes.fixes()[i].repairs.len() > 1 {
+                carriers.entry(i).or_insert(at);
+            }
+        }
+    }
+    carriers
+}
+
+/// The message of finding `f`, the `at`-th listed.
+fn message_shape<'a>(
+    report: &'a FileReport,
+    f: &'a crate::validate::Finding,
+    at: usize,
+    carriers: &HashMap<usize, usize>,
+) -> MessageShape<'a> {
+    let fix = report.fixes.index_of(&f.diagnostic).and_then(|i| {
+        let fix = report.fixes.for_finding(&f.diagnostic)?;
+        let mut shape = fix_shape(report, fix);
+        if let Some(&carrier) = carriers.get(&i).filter(|&&c| c != at) {
+            shape.edits.clear();
+            shape.edits_with_message = Some(carrier);
+        }
+        Some(shape)
+    });
     MessageShape {
         code: f.diagnostic.code,
         message: &f.diagnostic.message,
@@ -134,12 +177,17 @@ fn message_shape<'a>(report: &'a FileReport, f: &'a crate::validate::Finding) ->
 }
 
 fn fix_shape<'a>(report: &FileReport, fix: &'a FixView) -> FixShape<'a> {
+    // Offsets in the file of a .gltf (after a byte-order mark), in the chunk's text of a .glb.
+    let glb = report.container == Some(crate::asset::Container::Glb);
+    let base = if glb { 0 } else { report.json_offset };
     let at = |p: &crate::diagnostics::Position| LocationShape {
         row: p.line,
         column: p.column,
-        offset: report.json_offset + p.offset,
+        offset: base + p.offset,
     };
     FixShape {
+        edits_with_message: None,
+        edits_in: glb.then_some(GLB_JSON_CHUNK),
         applicability: fix.safety.as_str(),
         message: &fix.title,
         edits: fix
@@ -199,10 +247,12 @@ fn done_shape(fix: &FixView) -> DoneShape<'_> {
 
 fn shape(report: &FileReport) -> ReportShape<'_> {
     let mut shape = outline(report);
+    let carriers = carriers(report);
     shape.issues.messages = report
         .findings
         .iter()
-        .map(|f| message_shape(report, f))
+        .enumerate()
+        .map(|(at, f)| message_shape(report, f, at, &carriers))
         .collect();
     shape
 }
@@ -262,13 +312,14 @@ pub fn write_pretty(out: &mut impl std::io::Write, report: &FileReport) -> std::
             return out.write_all(b"\n");
         }
     };
-    let write_run = |(text, run): (&mut String, &[crate::validate::Finding])| {
+    let carriers = carriers(report);
+    let write_run = |(text, (first, run)): (&mut String, (usize, &[crate::validate::Finding]))| {
         text.clear();
         for (i, finding) in run.iter().enumerate() {
             if i > 0 {
                 text.push_str(",\n      ");
             }
-            push_message(text, &message_shape(report, finding));
+            push_message(text, &message_shape(report, finding, first + i, &carriers));
         }
     };
     // Up to the list's opening bracket, the messages, then from the comma after the list on.
@@ -287,9 +338,15 @@ pub fn write_pretty(out: &mut impl std::io::Write, report: &FileReport) -> std::
         .enumerate()
     {
         let tasks = window.len().div_ceil(MESSAGES_PER_TASK);
+        let window_start = w * MESSAGES_PER_TASK * RUNS_IN_HAND;
         runs[..tasks]
             .par_iter_mut()
-            .zip(window.par_chunks(MESSAGES_PER_TASK))
+            .zip(
+                window
+                    .par_chunks(MESSAGES_PER_TASK)
+                    .enumerate()
+                    .map(|(k, run)| (window_start + k * MESSAGES_PER_TASK, run)),
+            )
             .for_each(write_run);
         for (i, run) in runs[..tasks].iter().enumerate() {
             if w > 0 || i > 0 {

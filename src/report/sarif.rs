@@ -170,7 +170,7 @@ struct Invocation<'a> {
     tool_execution_notifications: Vec<Notification<'a>>,
 }
 
-#[derive(Serialize)]
+#[derive(Serialize, Clone)]
 struct OwnedText {
     text: String,
 }
@@ -201,12 +201,30 @@ struct SarifResult<'a> {
 struct SarifFix<'a> {
     description: Text<'a>,
     artifact_changes: [ArtifactChange<'a>; 1],
+    properties: FixProperties<'a>,
+}
+
+/// What a fix is beside its edits: how safe ("safe": `--fix` applies it; "unsafe": only with
+/// `--unsafe-fixes`) and every finding it repairs (a fix repairing several is given with the
+/// first of them only, so that each edit is given once).
+#[derive(Serialize)]
+#[serde(rename_all = "camelCase")]
+struct FixProperties<'a> {
+    applicability: &'static str,
+    repairs: Vec<FixRepair<'a>>,
+}
+
+#[derive(Serialize)]
+#[serde(rename_all = "camelCase")]
+struct FixRepair<'a> {
+    rule_id: &'a str,
+    pointer: &'a str,
 }
 
 #[derive(Serialize)]
 #[serde(rename_all = "camelCase")]
 struct ArtifactChange<'a> {
-    artifact_location: &'a ArtifactLocation,
+    artifact_location: ArtifactLocation,
     replacements: Vec<Replacement<'a>>,
 }
 
@@ -243,12 +261,14 @@ struct PhysicalLocation<'a> {
     region: Option<Region>,
 }
 
-#[derive(Serialize)]
+#[derive(Serialize, Clone)]
 #[serde(rename_all = "camelCase")]
 struct ArtifactLocation {
     uri: String,
     #[serde(skip_serializing_if = "Option::is_none")]
     uri_base_id: Option<&'static str>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    description: Option<OwnedText>,
 }
 
 #[derive(Serialize)]
@@ -278,6 +298,25 @@ fn artifact_location(path: &Path) -> ArtifactLocation {
     ArtifactLocation {
         uri,
         uri_base_id: relative.then_some("%SRCROOT%"),
+        description: None,
+    }
+}
+
+/// What a .glb's fixes change: its JSON chunk's text, named as an artifact of its own (the
+/// file's URI with the fragment `#json-chunk`). Its replacements are of that text, not of the
+/// file's bytes: a consumer applies them to the chunk's text and frames it again (lengths and
+/// padding), as `velvet validate --fix` does.
+fn json_chunk_location(file: &ArtifactLocation) -> ArtifactLocation {
+    ArtifactLocation {
+        uri: format!("{}#json-chunk", file.uri),
+        uri_base_id: file.uri_base_id,
+        description: Some(OwnedText {
+            text: format!(
+                "the JSON chunk of {}, as text without its padding; the GLB header's and the \
+                 chunk's lengths follow from it",
+                file.uri
+            ),
+        }),
     }
 }
 
@@ -287,6 +326,7 @@ fn result<'a>(
     artifact: &'a ArtifactLocation,
     f: &'a Finding,
     index: &HashMap<&str, usize>,
+    shown: &mut std::collections::HashSet<usize>,
 ) -> SarifResult<'a> {
     let d = &f.diagnostic;
     let region = f.position.map(|p| match report.container {
@@ -316,13 +356,32 @@ fn result<'a>(
         },
         fixes: report
             .fixes
-            .for_finding(d.code, &d.pointer)
+            .index_of(d)
+            .filter(|&i| shown.insert(i))
+            .and_then(|_| report.fixes.for_finding(d))
             .filter(|fix| !fix.edits.is_empty())
             .map(|fix| {
+                let glb = report.container == Some(Container::Glb);
+                let base = if glb { 0 } else { report.json_offset };
                 vec![SarifFix {
                     description: Text { text: &fix.title },
+                    properties: FixProperties {
+                        applicability: fix.safety.as_str(),
+                        repairs: fix
+                            .repairs
+                            .iter()
+                            .map(|r| FixRepair {
+                                rule_id: r.code,
+                                pointer: &r.pointer,
+                            })
+                            .collect(),
+                    },
                     artifact_changes: [ArtifactChange {
-                        artifact_location: artifact,
+                        artifact_location: if glb {
+                            json_chunk_location(artifact)
+                        } else {
+                            artifact.clone()
+                        },
                         replacements: fix
                             .edits
                             .iter()
@@ -332,7 +391,7 @@ fn result<'a>(
                                     start_column: e.start.column,
                                     end_line: e.end.line,
                                     end_column: e.end.column,
-                                    byte_offset: report.json_offset + e.start.offset,
+                                    byte_offset: base + e.start.offset,
                                     byte_length: e.end.offset - e.start.offset,
                                 },
                                 inserted_content: (!e.content.is_empty())
@@ -361,8 +420,11 @@ fn log<'a>(
     let mut results = Vec::new();
     let mut notifications = Vec::new();
     for (report, artifact) in reports.iter().zip(artifacts) {
+        // The fixes already given with a result (a fix repairing several findings is given
+        // with the first).
+        let mut shown = std::collections::HashSet::new();
         for f in super::listing(report).others {
-            results.push(result(report, artifact, f, &index));
+            results.push(result(report, artifact, f, &index, &mut shown));
         }
         if report.truncated() {
             notifications.push(Notification {
@@ -381,7 +443,8 @@ fn log<'a>(
     }
     for ((report, artifact), entry) in reports.iter().zip(artifacts).zip(missing) {
         if let Some(f) = entry {
-            results.push(result(report, artifact, f, &index));
+            let mut shown = std::collections::HashSet::new();
+            results.push(result(report, artifact, f, &index, &mut shown));
         }
     }
     Log {

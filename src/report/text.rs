@@ -100,7 +100,7 @@ pub fn render_with(reports: &[FileReport], options: &Options) -> String {
                     )
                 );
             }
-            if let Some(fix) = report.fixes.fix_of(d.code, &d.pointer) {
+            if let Some(fix) = report.fixes.fix_of(d) {
                 if fix.status != FixStatus::Applied {
                     let _ = writeln!(
                         out,

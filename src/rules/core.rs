@@ -524,13 +524,27 @@ fn diagnostic(
             &codes::TYPE_MISMATCH,
             format!("{} is not of type {}", quote(instance), type_names(kind)),
         ),
-        K::Minimum { limit } | K::ExclusiveMinimum { limit } => (
+        K::Minimum { limit } => (
             &codes::VALUE_NOT_IN_RANGE,
             format!("{} is below the minimum {limit}", quote(instance)),
         ),
-        K::Maximum { limit } | K::ExclusiveMaximum { limit } => (
+        K::ExclusiveMinimum { limit } => (
+            &codes::VALUE_NOT_IN_RANGE,
+            format!(
+                "{} is not above the exclusive minimum {limit}",
+                quote(instance)
+            ),
+        ),
+        K::Maximum { limit } => (
             &codes::VALUE_NOT_IN_RANGE,
             format!("{} is above the maximum {limit}", quote(instance)),
+        ),
+        K::ExclusiveMaximum { limit } => (
+            &codes::VALUE_NOT_IN_RANGE,
+            format!(
+                "{} is not below the exclusive maximum {limit}",
+                quote(instance)
+            ),
         ),
         K::MinItems { .. } if instance.as_array().is_some_and(Vec::is_empty) => {
             (&EMPTY_ENTITY, "the array is empty".to_string())
