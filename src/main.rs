@@ -251,6 +251,9 @@ struct ValidateArgs {
     /// With --fix: exit with status 1 when a file was changed (for pre-commit hooks).
     #[arg(long, requires = "fix")]
     exit_non_zero_on_fix: bool,
+    /// --fix, printing only the findings left unfixed (not the fixes applied): for hooks.
+    #[arg(long, conflicts_with = "diff")]
+    fix_only: bool,
 }
 
 #[derive(clap::Args)]
@@ -609,7 +612,8 @@ fn validate(args: ValidateArgs, color: ColorChoice, quiet: bool) -> Status {
         quiet,
         no_fold: args.no_fold || args.verbose,
         fix: command::validate::FixFlags {
-            fix: args.fix,
+            fix: args.fix || args.fix_only,
+            fix_only: args.fix_only,
             unsafe_fixes: args.unsafe_fixes,
             diff: args.diff,
             exit_non_zero_on_fix: args.exit_non_zero_on_fix,

@@ -353,6 +353,18 @@ impl Staged {
     }
 }
 
+/// An error when a file at `path` is read-only (no write permission for anyone): renaming
+/// over it would succeed where the folder is writable, and overwrite what its owner protected.
+fn refuse_read_only(path: &Path) -> io::Result<()> {
+    match std::fs::metadata(path) {
+        Ok(meta) if meta.is_file() && meta.permissions().readonly() => Err(io::Error::new(
+            io::ErrorKind::PermissionDenied,
+            "the file is read-only; velvet does not replace it (make it writable to let it)",
+        )),
+        _ => Ok(()),
+    }
+}
+
 /// The folder a file at `path` is written in.
 fn folder(path: &Path) -> &Path {
     match path.parent() {
@@ -364,6 +376,7 @@ fn folder(path: &Path) -> &Path {
 /// Writes `output` to a temporary file next to `path`, flushed to disk, with the mode of the
 /// file it will replace (or the umask's), to be put in place later.
 pub fn stage_output(path: &Path, output: &Output) -> io::Result<Staged> {
+    refuse_read_only(path)?;
     let tmp = temporary_in(folder(path))?;
     write_temporary(&mut HandedOn::new(tmp.as_file()), output)?;
     tmp.as_file().sync_all()?;
@@ -400,6 +413,7 @@ pub fn copy_atomic(from: &Path, to: &Path) -> io::Result<Placed> {
 /// disk. Never a hard link: an output's resource sharing the input's inode would let an edit
 /// of the output change the input.
 pub fn stage_copy(from: &Path, to: &Path) -> io::Result<(Staged, Placed)> {
+    refuse_read_only(to)?;
     let mut source = std::fs::File::open(from)?;
     if injected_fault().is_some() {
         // The fault seam covers the bytes' write, as it does every other output's.

@@ -36,6 +36,9 @@ pub const FIXERS: &[Fixer] = &[
     super::clamp::OUT_OF_RANGE,
     super::legacy::UPGRADE,
     super::texcoord::TEXCOORD,
+    super::tidy::ALPHA_CUTOFF_IGNORED,
+    super::tidy::DUPLICATE_DECLARATION,
+    super::tidy::EMPTY,
 ];
 
 /// The fixer of `code`, if it has one.

@@ -22,6 +22,7 @@ pub mod legacy;
 pub mod texcoord;
 pub mod text;
 pub mod texture;
+pub mod tidy;
 
 use crate::asset::tape::Node;
 use crate::asset::{self, Asset, Container};
@@ -543,7 +544,10 @@ impl<'v> Fixing<'v> {
             let name = crate::asset::discover::display_path(path);
             let before_text = source.json_text.trim_end_matches(['\0', ' ']);
             let after_text = fixed.asset.json_text.trim_end_matches(['\0', ' ']);
-            file_fixes.diff = Some(text::unified_diff(&name, before_text, after_text));
+            file_fixes.diff = Some(match source.container {
+                Container::Gltf => text::unified_diff(&name, before_text, after_text),
+                Container::Glb => text::glb_not_diffed(&name),
+            });
         } else {
             if (self.stop)() {
                 return self.abandoned(path);

@@ -149,11 +149,23 @@ fn positions_of(source: &str, offsets: &[usize]) -> Vec<Position> {
 /// The unified diff from `before` to `after` of the file shown as `name` (three lines of
 /// context), as `diff -u` and `git diff` write it.
 pub fn unified_diff(name: &str, before: &str, after: &str) -> String {
+    // A name with a space ends with a tab, as git writes it: `patch` reads a file name up to
+    // the first tab, or else up to the first space.
+    let end = if name.contains(' ') { "\t" } else { "" };
     similar::TextDiff::from_lines(before, after)
         .unified_diff()
         .context_radius(3)
-        .header(&format!("a/{name}"), &format!("b/{name}"))
+        .header(&format!("a/{name}{end}"), &format!("b/{name}{end}"))
         .to_string()
+}
+
+/// What `--diff` prints for a .glb in place of a diff: a line that `patch` and `git apply`
+/// pass over (text before a diff's header), saying how to apply its fixes. A text diff of the
+/// JSON chunk would be applied by `patch` to the binary file and break it.
+pub fn glb_not_diffed(name: &str) -> String {
+    format!(
+        "# {name}: not shown as a diff (a .glb is binary; patch would break it): `velvet validate --fix {name}` applies its fixes, and --format json gives its JSON chunk's edits\n"
+    )
 }
 
 #[cfg(test)]

@@ -151,6 +151,8 @@ pub struct Options {
     pub no_fold: bool,
     /// Text output: each file's fixes as a unified diff, instead of its findings (`--diff`).
     pub diff: bool,
+    /// Text output: no line for each fix applied, only the findings left (`--fix-only`).
+    pub fix_only: bool,
 }
 
 /// The table of every code that `velvet codes` prints: name, default severity, how it is

@@ -121,7 +121,9 @@ pub fn render_with(reports: &[FileReport], options: &Options) -> String {
         if report.truncated() {
             let _ = writeln!(out, "{file}: {}", super::omitted_note(report.omitted));
         }
-        out += &fixes_done(&file, &report.fixes);
+        if !options.fix_only {
+            out += &fixes_done(&file, &report.fixes);
+        }
         let c = report.counts;
         for (t, n) in totals
             .iter_mut()

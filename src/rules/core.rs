@@ -64,7 +64,8 @@ pub const EMPTY_ENTITY: Code = Code::new(
     "EMPTY_ENTITY",
     Severity::Error,
     "An array or object that glTF requires to be non-empty is empty (\"nodes\": [], \"attributes\": {}).",
-);
+)
+.fixable(crate::diagnostics::Safety::Safe);
 pub const UNSATISFIED_DEPENDENCY: Code = Code::new(
     "UNSATISFIED_DEPENDENCY",
     Severity::Error,
@@ -84,7 +85,8 @@ pub const DUPLICATE_ELEMENTS: Code = Code::new(
     "DUPLICATE_ELEMENTS",
     Severity::Error,
     "An array whose elements must be unique holds one twice (extensionsUsed, a scene's or node's node list).",
-);
+)
+.fixable(crate::diagnostics::Safety::Safe);
 pub const INVALID_INDEX: Code = Code::new(
     "INVALID_INDEX",
     Severity::Error,

@@ -24,7 +24,8 @@ pub const MATERIAL_ALPHA_CUTOFF_INVALID_MODE: Code = Code::new(
     "MATERIAL_ALPHA_CUTOFF_INVALID_MODE",
     Severity::Warning,
     "A material's alphaCutoff is ignored: its alphaMode is not MASK.",
-);
+)
+.fixable(crate::diagnostics::Safety::Safe);
 pub const KHR_MATERIALS_EMISSIVE_STRENGTH_ZERO_FACTOR: Code = Code::new(
     "KHR_MATERIALS_EMISSIVE_STRENGTH_ZERO_FACTOR",
     Severity::Warning,

@@ -46,6 +46,8 @@ pub struct FixFlags {
     pub diff: bool,
     /// `--exit-non-zero-on-fix`: with `--fix`, a changed file fails the run (pre-commit).
     pub exit_non_zero_on_fix: bool,
+    /// `--fix-only`: with `--fix`, the text report leaves out the fixes applied.
+    pub fix_only: bool,
 }
 
 /// Runs `velvet validate`, its reports on standard output.
@@ -113,6 +115,7 @@ pub fn command(request: &Request) -> Status {
         quiet: request.quiet,
         no_fold: request.no_fold,
         diff: request.fix.diff,
+        fix_only: request.fix.fix_only,
     };
     let fixing = crate::fix::Fixing::new(
         &validator,

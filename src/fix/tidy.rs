@@ -1,0 +1,65 @@
+//! Properties that say nothing, removed (safe: a conforming loader reads the asset as before):
+//!
+//! - an `alphaCutoff` on a material whose alphaMode is not MASK, which the spec says is
+//!   ignored (MATERIAL_ALPHA_CUTOFF_INVALID_MODE);
+//! - an extension named twice in `extensionsUsed` or `extensionsRequired`: the second goes
+//!   (DUPLICATE_ELEMENTS; other arrays' duplicates name objects, and which to keep is a choice);
+//! - an empty array or object that a property holds (EMPTY_ENTITY): `"extensionsUsed": []`,
+//!   `"extensions": {}`. An empty element of an array stays (removing it would renumber the
+//!   others), and so does one the schema requires (the fixed file would lack it, an error, and
+//!   the check refuses the fix).
+
+use super::fixers::{last_token, parent, Fixer, Proposal};
+use crate::asset::Asset;
+use crate::diagnostics::{Diagnostic, Safety};
+use crate::edit::Edit;
+
+pub const ALPHA_CUTOFF_IGNORED: Fixer = Fixer {
+    code: &crate::rules::materials::MATERIAL_ALPHA_CUTOFF_INVALID_MODE,
+    safety: Safety::Safe,
+    about: "removes the alphaCutoff that no alphaMode reads",
+    propose: |asset: &Asset, d: &Diagnostic| {
+        (last_token(&d.pointer)? == "alphaCutoff").then_some(())?;
+        asset.root().pointer(&d.pointer)?.as_f64()?;
+        Some(Proposal {
+            title: "remove alphaCutoff, which only alphaMode MASK reads".to_string(),
+            edits: vec![Edit::remove(d.pointer.clone())],
+        })
+    },
+};
+
+pub const DUPLICATE_DECLARATION: Fixer = Fixer {
+    code: &crate::rules::core::DUPLICATE_ELEMENTS,
+    safety: Safety::Safe,
+    about: "removes an extension's second entry from extensionsUsed or extensionsRequired",
+    propose: |asset: &Asset, d: &Diagnostic| {
+        let list = parent(&d.pointer);
+        if list != "/extensionsUsed" && list != "/extensionsRequired" {
+            return None;
+        }
+        let name = asset.root().pointer(&d.pointer)?.as_str()?.into_owned();
+        Some(Proposal {
+            title: format!("remove the second {name} from {}", &list[1..]),
+            edits: vec![Edit::remove(d.pointer.clone())],
+        })
+    },
+};
+
+pub const EMPTY: Fixer = Fixer {
+    code: &crate::rules::core::EMPTY_ENTITY,
+    safety: Safety::Safe,
+    about: "removes an empty array or object held by a property",
+    propose: |asset: &Asset, d: &Diagnostic| {
+        let key = last_token(&d.pointer)?;
+        if crate::asset::pointer::array_index(&key).is_some() {
+            return None;
+        }
+        let value = asset.root().pointer(&d.pointer)?;
+        let empty = value.as_array().is_some_and(|a| a.is_empty())
+            || value.as_object().is_some_and(|o| o.is_empty());
+        empty.then(|| Proposal {
+            title: format!("remove the empty {key}"),
+            edits: vec![Edit::remove(d.pointer.clone())],
+        })
+    },
+};
