@@ -274,17 +274,22 @@ fn json_report_replacements(report: &Value) -> Vec<Replacement> {
         .collect()
 }
 
-/// `source` with `replacements` made: each distinct one once, in order of place.
+/// `source` with `replacements` made in one pass, in order of place, as ruff's and eslint's
+/// consumers apply fixes: no two may overlap, nor insert at one place (their order would be
+/// a guess), and each is applied as given (an edit given twice is applied twice).
 fn apply_replacements(source: &[u8], mut replacements: Vec<Replacement>) -> Vec<u8> {
     replacements.sort();
-    replacements.dedup();
+    for pair in replacements.windows(2) {
+        let (a, b) = (&pair[0], &pair[1]);
+        assert!(
+            a.end <= b.start && !(a.start == a.end && a.start == b.start),
+            "overlapping edits: {a:?} and {b:?}"
+        );
+    }
     let mut out = Vec::new();
     let mut at = 0;
     for r in replacements {
-        assert!(
-            r.start >= at && r.end >= r.start,
-            "overlapping edits: {r:?}"
-        );
+        assert!(r.end >= r.start, "an edit ends before it starts: {r:?}");
         out.extend_from_slice(&source[at..r.start]);
         out.extend_from_slice(r.text.as_bytes());
         at = r.end;
@@ -839,4 +844,250 @@ fn a_byte_order_mark_stays_with_its_finding_and_the_fix_edits_count_it() {
         expected
     );
     assert!(stdout(&o).contains("error BOM_PRESENT"));
+}
+
+#[path = "support/one_pass.rs"]
+mod one_pass;
+
+/// Every .gltf and .glb under `dir`, sorted.
+fn assets_under(dir: &Path, out: &mut Vec<PathBuf>) {
+    let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    entries.sort();
+    for path in entries {
+        if path.is_dir() {
+            assets_under(&path, out);
+        } else if matches!(
+            path.extension().and_then(|e| e.to_str()),
+            Some("gltf" | "glb")
+        ) {
+            out.push(path);
+        }
+    }
+}
+
+#[test]
+fn every_fixtures_report_edits_applied_in_one_pass_give_what_fix_unsafe_fixes_writes() {
+    let mut assets = Vec::new();
+    assets_under(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures"),
+        &mut assets,
+    );
+    let mut with_edits = Vec::new();
+    let mut failures = Vec::new();
+    for path in &assets {
+        match one_pass::check(path) {
+            Ok(true) => with_edits.push(path),
+            Ok(false) => {}
+            Err(e) => failures.push(e),
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n\n"));
+    // The fixable codes' triggers, the CI fixtures' .glb and the migrate fixtures with fixes.
+    let glbs = with_edits
+        .iter()
+        .filter(|p| p.extension().is_some_and(|e| e == "glb"))
+        .count();
+    assert!(
+        with_edits.len() >= 20,
+        "{} files with edits",
+        with_edits.len()
+    );
+    assert!(glbs >= 1, "{glbs} .glb files with edits");
+}
+
+#[test]
+fn findings_of_one_code_at_one_pointer_each_carry_their_own_fix() {
+    // One primitive without TEXCOORD_1 and two textures that read it: two findings at the
+    // primitive's material, each fix pointing its own texture at TEXCOORD_0.
+    let dir = tempfile::tempdir().unwrap();
+    let text = r#"{"asset":{"version":"2.0"},"materials":[{"pbrMetallicRoughness":{"baseColorTexture":{"index":0,"texCoord":1}},"normalTexture":{"index":0,"texCoord":1}}],"textures":[{}],"meshes":[{"primitives":[{"attributes":{"POSITION":0,"TEXCOORD_0":1},"material":0}]}],"accessors":[{"count":1,"componentType":5126,"type":"VEC3","min":[0,0,0],"max":[0,0,0]},{"count":1,"componentType":5126,"type":"VEC2"}]}"#;
+    std::fs::write(dir.path().join("m.gltf"), text).unwrap();
+    let o = velvet_in(dir.path(), &["validate", "--format", "json", "m.gltf"]);
+    let report: Value = serde_json::from_slice(&o.stdout).unwrap();
+    let fixed: Vec<(String, usize)> = report["issues"]["messages"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|m| m["code"] == "MESH_PRIMITIVE_TOO_FEW_TEXCOORDS")
+        .map(|m| {
+            let edits = m["fix"]["edits"].as_array().unwrap();
+            assert_eq!(edits.len(), 1, "{m}");
+            (
+                edits[0]["content"].as_str().unwrap().to_string(),
+                edits[0]["location"]["offset"].as_u64().unwrap() as usize,
+            )
+        })
+        .collect();
+    let at = |key: &str| {
+        text.find(key).unwrap()
+            + text[text.find(key).unwrap()..]
+                .find("\"texCoord\":1")
+                .unwrap()
+            + "\"texCoord\":".len()
+    };
+    assert_eq!(
+        fixed,
+        [
+            ("0".to_string(), at("baseColorTexture")),
+            ("0".to_string(), at("normalTexture"))
+        ]
+    );
+}
+
+#[test]
+fn fixes_that_edit_one_new_array_are_one_fix_whose_edits_are_given_once() {
+    // Two extensions used and none declared: both declarations create extensionsUsed.
+    let dir = tempfile::tempdir().unwrap();
+    let text = "{\n  \"asset\": {\n    \"version\": \"2.0\"\n  },\n  \"materials\": [\n    {\n      \"extensions\": {\n        \"KHR_materials_sheen\": {},\n        \"KHR_materials_fuzz\": {\n          \"fuzzRoughnessFactor\": 0.5\n        }\n      }\n    }\n  ]\n}\n";
+    std::fs::write(dir.path().join("m.gltf"), text).unwrap();
+    let o = velvet_in(dir.path(), &["validate", "--format", "json", "m.gltf"]);
+    let report: Value = serde_json::from_slice(&o.stdout).unwrap();
+    let messages = report["issues"]["messages"].as_array().unwrap();
+    let undeclared: Vec<(usize, &Value)> = messages
+        .iter()
+        .enumerate()
+        .filter(|(_, m)| m["code"] == "UNDECLARED_EXTENSION")
+        .collect();
+    assert_eq!(undeclared.len(), 2, "{report}");
+    let (first, second) = (undeclared[0], undeclared[1]);
+    assert_eq!(
+        first.1["fix"]["message"],
+        "declare KHR_materials_sheen in extensionsUsed; declare KHR_materials_fuzz in extensionsUsed"
+    );
+    assert_eq!(first.1["fix"]["edits"].as_array().unwrap().len(), 1);
+    assert_eq!(
+        first.1["fix"]["edits"][0]["content"],
+        ",\n  \"extensionsUsed\": [\n    \"KHR_materials_sheen\",\n    \"KHR_materials_fuzz\"\n  ]"
+    );
+    assert_eq!(second.1["fix"]["edits"], serde_json::json!([]));
+    assert_eq!(second.1["fix"]["editsWithMessage"], first.0);
+    assert_eq!(report["fixes"]["fixable"], 2);
+    // The SARIF log gives the fix once, with both findings it repairs and its safety.
+    let o = velvet_in(dir.path(), &["validate", "--format", "sarif", "m.gltf"]);
+    let log: Value = serde_json::from_slice(&o.stdout).unwrap();
+    let fixes: Vec<&Value> = log["runs"][0]["results"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|r| r["fixes"].as_array().into_iter().flatten())
+        .collect();
+    assert_eq!(fixes.len(), 1, "{log}");
+    assert_eq!(fixes[0]["properties"]["applicability"], "safe");
+    assert_eq!(
+        fixes[0]["properties"]["repairs"],
+        serde_json::json!([
+            {"ruleId": "UNDECLARED_EXTENSION", "pointer": "/materials/0/extensions/KHR_materials_sheen"},
+            {"ruleId": "UNDECLARED_EXTENSION", "pointer": "/materials/0/extensions/KHR_materials_fuzz"}
+        ])
+    );
+}
+
+#[test]
+fn a_read_only_file_is_not_fixed_and_the_run_fails() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = case_copy("UNDECLARED_EXTENSION");
+    let file = dir.path().join("triggers.gltf");
+    let before = std::fs::read(&file).unwrap();
+    std::fs::set_permissions(&file, std::fs::Permissions::from_mode(0o444)).unwrap();
+    let o = velvet_in(dir.path(), &["validate", "--fix", "triggers.gltf"]);
+    assert_eq!(o.status.code(), Some(1), "{}", stdout(&o));
+    assert!(
+        stdout(&o).contains("the file is read-only; velvet does not replace it"),
+        "{}",
+        stdout(&o)
+    );
+    assert_eq!(std::fs::read(&file).unwrap(), before);
+    assert_eq!(
+        std::fs::metadata(&file).unwrap().permissions().mode() & 0o777,
+        0o444
+    );
+    let leftovers: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .filter(|n| n.to_string_lossy().contains(".tmp"))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+}
+
+#[test]
+fn a_diff_of_a_path_with_spaces_is_taken_by_patch() {
+    let dir = tempfile::tempdir().unwrap();
+    let folder = dir.path().join("my assets");
+    std::fs::create_dir(&folder).unwrap();
+    let source = Path::new(FIXTURES).join("UNDECLARED_EXTENSION/triggers.gltf");
+    std::fs::copy(&source, folder.join("a chair.gltf")).unwrap();
+    let o = velvet_in(
+        dir.path(),
+        &["validate", "--diff", "my assets/a chair.gltf"],
+    );
+    let diff = stdout(&o);
+    assert!(
+        diff.starts_with("--- a/my assets/a chair.gltf\t\n+++ b/my assets/a chair.gltf\t\n"),
+        "{diff}"
+    );
+    let mut patch = Command::new("patch")
+        .args(["-p1", "--batch", "--silent"])
+        .current_dir(dir.path())
+        .stdin(std::process::Stdio::piped())
+        .spawn()
+        .expect("patch runs");
+    use std::io::Write;
+    patch
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(diff.as_bytes())
+        .unwrap();
+    assert!(patch.wait().unwrap().success());
+    assert_eq!(
+        std::fs::read(folder.join("a chair.gltf")).unwrap(),
+        expected_fixed("UNDECLARED_EXTENSION")
+    );
+}
+
+#[test]
+fn a_glb_is_not_diffed_and_patch_leaves_it_whole() {
+    let dir = tempfile::tempdir().unwrap();
+    let json =
+        std::fs::read(Path::new(FIXTURES).join("UNDECLARED_EXTENSION/triggers.gltf")).unwrap();
+    let bytes = glb(&json, &[]);
+    std::fs::write(dir.path().join("m.glb"), &bytes).unwrap();
+    let o = velvet_in(dir.path(), &["validate", "--diff", "m.glb"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert_eq!(
+        stdout(&o),
+        "# m.glb: not shown as a diff (a .glb is binary; patch would break it): `velvet validate --fix m.glb` applies its fixes, and --format json gives its JSON chunk's edits\n"
+    );
+    let mut patch = Command::new("patch")
+        .args(["-p1", "--batch", "--silent"])
+        .current_dir(dir.path())
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .expect("patch runs");
+    use std::io::Write;
+    patch.stdin.take().unwrap().write_all(&o.stdout).unwrap();
+    patch.wait().unwrap();
+    assert_eq!(std::fs::read(dir.path().join("m.glb")).unwrap(), bytes);
+    // The JSON report's edits of its chunk, applied and framed, are what --fix writes.
+    assert_eq!(one_pass::check(&dir.path().join("m.glb")), Ok(true));
+}
+
+#[test]
+fn fix_only_prints_the_findings_left_and_not_the_fixes_applied() {
+    let dir = case_copy("UNDECLARED_EXTENSION");
+    let o = velvet_in(dir.path(), &["validate", "--fix-only", "triggers.gltf"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stdout(&o));
+    assert_eq!(
+        stdout(&o),
+        "1 file checked: 0 errors, 0 warnings, 0 info, 0 hints; 1 fixed\n"
+    );
+    assert_eq!(
+        std::fs::read(dir.path().join("triggers.gltf")).unwrap(),
+        expected_fixed("UNDECLARED_EXTENSION")
+    );
 }

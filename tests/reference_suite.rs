@@ -221,3 +221,37 @@ fn the_sections_of_issues_md_are_read_by_code() {
     assert_eq!(read["TYPE_MISMATCH"], "SchemaError");
     assert_eq!(read["ACCESSOR_INVALID_FLOAT"], "DataError");
 }
+
+#[path = "support/one_pass.rs"]
+mod one_pass;
+
+/// The reports' fixes as a machine applies them: on every asset of the suite, the edits of the
+/// JSON report and of the SARIF log, each applied in one pass by an applier written apart from
+/// velvet (`support/one_pass.rs`), give the bytes `--fix --unsafe-fixes` writes.
+#[test]
+fn on_the_reference_suite_every_reports_edits_applied_in_one_pass_are_what_fix_writes() {
+    let Some(suite) = suite() else {
+        println!(
+            "skipped: the Khronos glTF-Validator suite (../shared/reference/glTF-Validator) is not here"
+        );
+        return;
+    };
+    let mut files = Vec::new();
+    assets(&suite.join("test"), &mut files);
+    let mut with_edits = 0;
+    let mut failures = Vec::new();
+    for path in &files {
+        match one_pass::check(path) {
+            Ok(true) => with_edits += 1,
+            Ok(false) => {}
+            Err(e) => failures.push(e),
+        }
+    }
+    println!(
+        "fix edits applied in one pass: {with_edits} of {} suite assets with edits give what --fix --unsafe-fixes writes ({} assets)",
+        with_edits + failures.len(),
+        files.len()
+    );
+    assert!(failures.is_empty(), "{}", failures.join("\n\n"));
+    assert!(with_edits >= 10, "{with_edits} assets with edits");
+}

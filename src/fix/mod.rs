@@ -945,6 +945,74 @@ mod tests {
     }
 
     #[test]
+    fn fixes_that_touch_one_text_are_merged_and_an_unsafe_one_beside_a_safe_one_waits() {
+        let asset = load(
+            r#"{"asset":{"version":"2.0"},"materials":[{"name":"m","alphaCutoff":0.5,"emissiveFactor":[2,0,0],"extensions":{"KHR_materials_fuzz":{"fuzzFactor":1,"fuzzTexture":{"index":0}}}}]}"#,
+        );
+        let with = |safety, title: &str, edits| Fix {
+            safety,
+            title: title.to_string(),
+            ..fix(edits)
+        };
+        let fuzz = "/materials/0/extensions/KHR_materials_fuzz";
+        let fixes = vec![
+            // Two declarations into one new extensionsUsed: one fix.
+            with(Safety::Safe, "a", vec![Edit::declare_used("A")]),
+            with(Safety::Safe, "b", vec![Edit::declare_used("B")]),
+            // Values replaced beside a member removed: apart.
+            with(
+                Safety::Unsafe,
+                "clamp",
+                vec![Edit::set(
+                    "/materials/0/emissiveFactor/0",
+                    serde_json::json!(1),
+                )],
+            ),
+            with(
+                Safety::Safe,
+                "cutoff",
+                vec![Edit::remove("/materials/0/alphaCutoff")],
+            ),
+            // A member added (safe) and one removed (unsafe) in one object: the unsafe waits.
+            with(
+                Safety::Safe,
+                "roughness",
+                vec![Edit::set(
+                    format!("{fuzz}/fuzzRoughnessFactor"),
+                    serde_json::json!(0.5),
+                )],
+            ),
+            with(
+                Safety::Unsafe,
+                "texture",
+                vec![Edit::remove(format!("{fuzz}/fuzzTexture"))],
+            ),
+        ];
+        let out = separate(asset.root(), fixes);
+        let titles: Vec<(&str, Option<&str>)> = out
+            .iter()
+            .map(|f| (f.title.as_str(), f.deferred.as_deref()))
+            .collect();
+        assert_eq!(
+            titles,
+            [
+                ("a; b", None),
+                ("clamp", None),
+                ("cutoff", None),
+                ("roughness", None),
+                (
+                    "texture",
+                    Some("it touches what the safe fix \"roughness\" changes: run --fix again once that one is applied")
+                ),
+            ]
+        );
+        assert_eq!(
+            out[0].edits,
+            [Edit::declare_used("A"), Edit::declare_used("B")]
+        );
+    }
+
+    #[test]
     fn findings_one_edit_repairs_are_one_fix() {
         use crate::rules::declaration::{UNDECLARED_EXTENSION, UNUSED_EXTENSION_REQUIRED};
         let asset = load(
@@ -992,6 +1060,13 @@ mod tests {
                     .into()
             )
         );
+        // A new info or hint is no reason to refuse; a new warning is.
+        let hint = [finding(
+            &crate::rules::fallback::FUZZ_WITHOUT_FALLBACK,
+            "/d",
+            "no fallback",
+        )];
+        assert_eq!(verdict(&before, &hint, &[&f]), Ok(()));
         // A finding that moved (an array element before it removed) is the same finding.
         let moved = [finding(&SHEEN_TEXTURE_WITHOUT_EFFECT, "/c/0", "no effect")];
         let was = [finding(&SHEEN_TEXTURE_WITHOUT_EFFECT, "/c/1", "no effect")];

@@ -2,8 +2,9 @@
 //!
 //! - an `alphaCutoff` on a material whose alphaMode is not MASK, which the spec says is
 //!   ignored (MATERIAL_ALPHA_CUTOFF_INVALID_MODE);
-//! - an extension named twice in `extensionsUsed` or `extensionsRequired`: the second goes
-//!   (DUPLICATE_ELEMENTS; other arrays' duplicates name objects, and which to keep is a choice);
+//! - an element given twice in a list that is a set (DUPLICATE_ELEMENTS): an extension in
+//!   `extensionsUsed` or `extensionsRequired`, a node in a scene's `nodes` or a node's
+//!   `children`; the second goes. A skin's `joints` stays: vertices name joints by place;
 //! - an empty array or object that a property holds (EMPTY_ENTITY): `"extensionsUsed": []`,
 //!   `"extensions": {}`. An empty element of an array stays (removing it would renumber the
 //!   others), and so does one the schema requires (the fixed file would lack it, an error, and
@@ -31,15 +32,26 @@ pub const ALPHA_CUTOFF_IGNORED: Fixer = Fixer {
 pub const DUPLICATE_DECLARATION: Fixer = Fixer {
     code: &crate::rules::core::DUPLICATE_ELEMENTS,
     safety: Safety::Safe,
-    about: "removes an extension's second entry from extensionsUsed or extensionsRequired",
+    about: "removes the second of an element given twice in extensionsUsed, extensionsRequired, a scene's nodes or a node's children",
     propose: |asset: &Asset, d: &Diagnostic| {
         let list = parent(&d.pointer);
-        if list != "/extensionsUsed" && list != "/extensionsRequired" {
+        let tokens: Vec<&str> = list.split('/').collect();
+        let a_set = match tokens[..] {
+            ["", "extensionsUsed"] | ["", "extensionsRequired"] => true,
+            ["", "scenes", _, "nodes"] | ["", "nodes", _, "children"] => true,
+            _ => false,
+        };
+        if !a_set {
             return None;
         }
-        let name = asset.root().pointer(&d.pointer)?.as_str()?.into_owned();
+        let value = asset.root().pointer(&d.pointer)?;
+        let name = match value.as_str() {
+            Some(name) => name.into_owned(),
+            None => format!("node {}", value.as_u64()?),
+        };
+        let key = tokens[tokens.len() - 1];
         Some(Proposal {
-            title: format!("remove the second {name} from {}", &list[1..]),
+            title: format!("remove the second {name} from {key}"),
             edits: vec![Edit::remove(d.pointer.clone())],
         })
     },

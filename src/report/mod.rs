@@ -439,6 +439,7 @@ mod tests {
                     quiet,
                     no_fold: false,
                     diff: false,
+                    fix_only: false,
                 };
                 for n in 0..4 {
                     let all = reports(n);
