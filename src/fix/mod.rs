@@ -313,6 +313,10 @@ const BYTE_ORDER_MARK: [u8; 3] = [0xEF, 0xBB, 0xBF];
 /// The most fixes of one file tried one by one when they fail together.
 const TRIED_ONE_BY_ONE: usize = 32;
 
+/// The most rounds of fixes tried together, each without the fixes the last round's offending
+/// findings were laid to.
+const ROUNDS_LAID_TO_FIXES: usize = 4;
+
 /// A validate run's files checked, fixed or shown with their fixes (see the module comment).
 pub struct Fixing<'v> {
     validator: &'v Validator,
@@ -606,8 +610,10 @@ impl<'v> Fixing<'v> {
 
     /// The fixes of `wanted` that can be applied together, the refused ones with the reason,
     /// and the file with the accepted ones applied. All are tried at once first; when that
-    /// fails, one by one (the first [`TRIED_ONE_BY_ONE`]), each kept if the file with it and
-    /// those kept before is still as meant.
+    /// fails, the fixes each offending finding is laid to ([`culprits`]) are refused and the
+    /// rest tried again (a few rounds); when a failure cannot be laid to a fix, one by one (the
+    /// first [`TRIED_ONE_BY_ONE`]), each kept if the file with it and those kept before is
+    /// still as meant.
     #[allow(clippy::type_complexity)]
     fn choose(
         &self,
@@ -618,17 +624,35 @@ impl<'v> Fixing<'v> {
         wanted: &[usize],
         settings: &Settings,
     ) -> (Vec<usize>, Vec<(usize, String)>, Option<Fixed>) {
-        if wanted.is_empty() {
-            return (Vec::new(), Vec::new(), None);
-        }
-        let all: Vec<&Fix> = wanted.iter().map(|&i| &fixes[i]).collect();
-        if let Ok(fixed) = self.attempt(path, source, before, &all, settings) {
-            return (wanted.to_vec(), Vec::new(), Some(fixed));
+        let mut trial = wanted.to_vec();
+        let mut refused = Vec::new();
+        for _round in 0..ROUNDS_LAID_TO_FIXES {
+            if trial.is_empty() {
+                return (Vec::new(), refused, None);
+            }
+            let all: Vec<&Fix> = trial.iter().map(|&i| &fixes[i]).collect();
+            let offences = match self.attempt(path, source, before, &all, settings) {
+                Ok(fixed) => return (trial, refused, Some(fixed)),
+                Err(Failed::Findings(offences)) => offences,
+                Err(Failed::Other(_)) => break,
+            };
+            let mut laid: Vec<(usize, String)> = Vec::new();
+            for offence in &offences {
+                for i in culprits(offence, fixes, &trial) {
+                    if !laid.iter().any(|(j, _)| *j == i) {
+                        laid.push((i, offence.reason()));
+                    }
+                }
+            }
+            if laid.is_empty() {
+                break;
+            }
+            trial.retain(|i| !laid.iter().any(|(j, _)| j == i));
+            refused.extend(laid);
         }
         let mut accepted = Vec::new();
-        let mut refused = Vec::new();
         let mut fixed = None;
-        for (n, &i) in wanted.iter().enumerate() {
+        for (n, &i) in trial.iter().enumerate() {
             if n >= TRIED_ONE_BY_ONE {
                 refused.push((
                     i,
@@ -637,16 +661,17 @@ impl<'v> Fixing<'v> {
                 ));
                 continue;
             }
-            let mut trial: Vec<&Fix> = accepted.iter().map(|&a| &fixes[a]).collect();
-            trial.push(&fixes[i]);
-            match self.attempt(path, source, before, &trial, settings) {
+            let mut one_more: Vec<&Fix> = accepted.iter().map(|&a| &fixes[a]).collect();
+            one_more.push(&fixes[i]);
+            match self.attempt(path, source, before, &one_more, settings) {
                 Ok(f) => {
                     accepted.push(i);
                     fixed = Some(f);
                 }
-                Err(reason) => refused.push((i, reason)),
+                Err(failed) => refused.push((i, failed.reason())),
             }
         }
+        refused.sort_by_key(|(i, _)| *i);
         (accepted, refused, fixed)
     }
 
@@ -660,12 +685,16 @@ impl<'v> Fixing<'v> {
         before: &FileReport,
         fixes: &[&Fix],
         settings: &Settings,
-    ) -> Result<Fixed, String> {
+    ) -> Result<Fixed, Failed> {
         let edits = combined(source.root(), fixes);
         let (output, changed) = match crate::edit::write::spliced_bytes(source, &edits) {
             Ok(Some(spliced)) => spliced,
-            Ok(None) => return Err("its edits could not be spliced into the file's text".into()),
-            Err(e) => return Err(format!("its edits do not apply: {e}")),
+            Ok(None) => {
+                return Err(Failed::Other(
+                    "its edits could not be spliced into the file's text".into(),
+                ))
+            }
+            Err(e) => return Err(Failed::Other(format!("its edits do not apply: {e}"))),
         };
         let mut bytes: Vec<u8> = match output {
             crate::edit::write::Output::Bytes(bytes) => bytes.into_owned(),
@@ -680,18 +709,35 @@ impl<'v> Fixing<'v> {
         }
         let loaded = asset::load_bytes_with(path, &bytes, &self.validator.load);
         let Some(after) = loaded.asset else {
-            return Err("the fixed file would not load".into());
+            return Err(Failed::Other("the fixed file would not load".into()));
         };
         let report = self
             .validator
             .validate_asset(path, &after, loaded.diagnostics, settings);
-        verdict(&before.findings, &report.findings, fixes)?;
+        verdict(&before.findings, &report.findings, fixes).map_err(Failed::Findings)?;
         Ok(Fixed {
             changed,
             bytes,
             asset: after,
             report,
         })
+    }
+}
+
+/// Why fixes tried together were refused.
+enum Failed {
+    /// The fixed file's findings that refuse them ([`verdict`]).
+    Findings(Vec<Offence>),
+    /// The edits did not apply, or the fixed file did not load.
+    Other(String),
+}
+
+impl Failed {
+    fn reason(&self) -> String {
+        match self {
+            Failed::Findings(offences) => offences.first().map(Offence::reason).unwrap_or_default(),
+            Failed::Other(reason) => reason.clone(),
+        }
     }
 }
 
@@ -703,12 +749,34 @@ fn file_bytes(asset: &Asset) -> &[u8] {
         .unwrap_or_else(|| asset.json_text.as_bytes())
 }
 
+/// A finding of a fixed file that refuses the fixes: one a fix was to repair, still there
+/// (`left`), or a new error or warning.
+#[derive(Debug, Clone, PartialEq)]
+struct Offence {
+    code: &'static str,
+    message: String,
+    pointer: String,
+    left: bool,
+}
+
+impl Offence {
+    fn reason(&self) -> String {
+        if self.left {
+            format!("the fixed file would still have {}", self.code)
+        } else {
+            format!("the fixed file would have {} ({})", self.code, self.message)
+        }
+    }
+}
+
 /// Whether the findings `after` fixing are those `before` without the ones `fixes` repair
 /// (counted by code and message: a pointer into an array moves when an element before it is
-/// removed). More are fine (a fix may repair more than it says); one left is not, nor is a new
-/// error or warning. A new info or hint is not a reason to refuse: the default a fix writes
-/// may be one a hint notes (as ruff and eslint apply a fix that leaves a note).
-fn verdict(before: &[Finding], after: &[Finding], fixes: &[&Fix]) -> Result<(), String> {
+/// removed; and a finding whose message quotes a value a fix changed, at the same code and
+/// pointer, is the same finding). More are fine (a fix may repair more than it says); one left
+/// is not, nor is a new error or warning. A new info or hint is not a reason to refuse: the
+/// default a fix writes may be one a hint notes (as ruff and eslint apply a fix that leaves a
+/// note). `Err` holds every offending finding of `after`, in report order.
+fn verdict(before: &[Finding], after: &[Finding], fixes: &[&Fix]) -> Result<(), Vec<Offence>> {
     let mut excess: HashMap<(&str, &str), i64> = HashMap::new();
     for f in after {
         *excess
@@ -720,29 +788,94 @@ fn verdict(before: &[Finding], after: &[Finding], fixes: &[&Fix]) -> Result<(), 
             .entry((f.diagnostic.code, f.diagnostic.message.as_str()))
             .or_default() -= 1;
     }
-    let repairs: Vec<&Repair> = fixes.iter().flat_map(|f| &f.repairs).collect();
-    for r in &repairs {
+    let mut repaired: std::collections::HashSet<(&str, &str)> = std::collections::HashSet::new();
+    for r in fixes.iter().flat_map(|f| &f.repairs) {
         *excess.entry((r.code, r.message.as_str())).or_default() += 1;
+        repaired.insert((r.code, r.message.as_str()));
     }
-    // The first finding of `after` in excess, in report order.
-    for f in after {
+    if excess.values().all(|&n| n <= 0) {
+        return Ok(());
+    }
+    // The findings before that are gone beyond what the fixes repair, by code and pointer: one
+    // of them reworded (its message quotes a value a fix changed) is no new finding.
+    let mut gone: HashMap<(&str, &str), Vec<&str>> = HashMap::new();
+    for f in before {
         let key = (f.diagnostic.code, f.diagnostic.message.as_str());
-        if excess.get(&key).copied().unwrap_or(0) > 0 {
-            let left = repairs.iter().any(|r| (r.code, r.message.as_str()) == key);
-            if !left && f.diagnostic.severity > crate::diagnostics::Severity::Warning {
-                continue;
-            }
-            return Err(if left {
-                format!("the fixed file would still have {}", f.diagnostic.code)
-            } else {
-                format!(
-                    "the fixed file would have {} ({})",
-                    f.diagnostic.code, f.diagnostic.message
-                )
-            });
+        if excess.get(&key).copied().unwrap_or(0) < 0 {
+            gone.entry((f.diagnostic.code, f.diagnostic.pointer.as_str()))
+                .or_default()
+                .push(f.diagnostic.message.as_str());
         }
     }
-    Ok(())
+    let mut offences = Vec::new();
+    for f in after {
+        let key = (f.diagnostic.code, f.diagnostic.message.as_str());
+        if excess.get(&key).copied().unwrap_or(0) <= 0 {
+            continue;
+        }
+        let left = repaired.contains(&key);
+        if !left {
+            let reworded = gone
+                .get_mut(&(f.diagnostic.code, f.diagnostic.pointer.as_str()))
+                .and_then(|messages| {
+                    let at = messages
+                        .iter()
+                        .position(|m| excess.get(&(key.0, *m)).copied().unwrap_or(0) < 0)?;
+                    Some(messages.swap_remove(at))
+                });
+            if let Some(was) = reworded {
+                *excess.entry(key).or_default() -= 1;
+                *excess.entry((key.0, was)).or_default() += 1;
+                continue;
+            }
+            if f.diagnostic.severity > crate::diagnostics::Severity::Warning {
+                continue;
+            }
+        }
+        *excess.entry(key).or_default() -= 1;
+        offences.push(Offence {
+            code: f.diagnostic.code,
+            message: f.diagnostic.message.clone(),
+            pointer: f.diagnostic.pointer.clone(),
+            left,
+        });
+    }
+    if offences.is_empty() {
+        Ok(())
+    } else {
+        Err(offences)
+    }
+}
+
+/// Whether JSON pointer `a` names `b`, a value inside it, or one holding it.
+fn related(a: &str, b: &str) -> bool {
+    let (short, long) = if a.len() <= b.len() { (a, b) } else { (b, a) };
+    long.starts_with(short) && (long.len() == short.len() || long.as_bytes()[short.len()] == b'/')
+}
+
+/// The fixes among `trial` (places in `fixes`) that `offence` is laid to: for a finding left,
+/// those meant to repair it; for a new one, those editing its value, a value in it or one
+/// holding it.
+fn culprits(offence: &Offence, fixes: &[Fix], trial: &[usize]) -> Vec<usize> {
+    trial
+        .iter()
+        .copied()
+        .filter(|&i| {
+            let fix = &fixes[i];
+            if offence.left {
+                return fix
+                    .repairs
+                    .iter()
+                    .any(|r| r.code == offence.code && r.message == offence.message);
+            }
+            fix.edits.iter().any(|e| match e {
+                Edit::Set { pointer, .. }
+                | Edit::Replace { pointer, .. }
+                | Edit::Remove { pointer } => related(pointer, &offence.pointer),
+                Edit::DeclareUsed { .. } => related("/extensionsUsed", &offence.pointer),
+            })
+        })
+        .collect()
 }
 
 /// The edits of the JSON text each of `fixes` makes alone. Fixes that edit within one element
@@ -1047,19 +1180,37 @@ mod tests {
             pointer: "/a".into(),
             message: "too big".into(),
         });
+        let reasons = |r: Result<(), Vec<Offence>>| -> Result<(), Vec<String>> {
+            r.map_err(|o| o.iter().map(Offence::reason).collect())
+        };
         assert_eq!(verdict(&before, &[], &[&f]), Ok(()));
         assert_eq!(
-            verdict(&before, &before, &[&f]),
-            Err("the fixed file would still have VALUE_NOT_IN_RANGE".into())
+            reasons(verdict(&before, &before, &[&f])),
+            Err(vec![
+                "the fixed file would still have VALUE_NOT_IN_RANGE".into()
+            ])
         );
         let brought = [finding(&SHEEN_TEXTURE_WITHOUT_EFFECT, "/b", "no effect")];
         assert_eq!(
-            verdict(&before, &brought, &[&f]),
-            Err(
+            reasons(verdict(&before, &brought, &[&f])),
+            Err(vec![
                 "the fixed file would have KHR_MATERIALS_SHEEN_TEXTURE_WITHOUT_EFFECT (no effect)"
                     .into()
-            )
+            ])
         );
+        // A finding at the same code and pointer whose message quotes a value the fix changed
+        // is the same finding.
+        use crate::diagnostics::codes::ARRAY_LENGTH_NOT_IN_LIST;
+        let was = [
+            finding(&VALUE_NOT_IN_RANGE, "/a", "too big"),
+            finding(&ARRAY_LENGTH_NOT_IN_LIST, "/c", "[1.5,0] has 2 elements"),
+        ];
+        let reworded = [finding(
+            &ARRAY_LENGTH_NOT_IN_LIST,
+            "/c",
+            "[1,0] has 2 elements",
+        )];
+        assert_eq!(verdict(&was, &reworded, &[&f]), Ok(()));
         // A new info or hint is no reason to refuse; a new warning is.
         let hint = [finding(
             &crate::rules::fallback::FUZZ_WITHOUT_FALLBACK,

@@ -36,11 +36,12 @@ pub const DUPLICATE_DECLARATION: Fixer = Fixer {
     propose: |asset: &Asset, d: &Diagnostic| {
         let list = parent(&d.pointer);
         let tokens: Vec<&str> = list.split('/').collect();
-        let a_set = match tokens[..] {
-            ["", "extensionsUsed"] | ["", "extensionsRequired"] => true,
-            ["", "scenes", _, "nodes"] | ["", "nodes", _, "children"] => true,
-            _ => false,
-        };
+        let a_set = matches!(
+            tokens[..],
+            ["", "extensionsUsed" | "extensionsRequired"]
+                | ["", "scenes", _, "nodes"]
+                | ["", "nodes", _, "children"]
+        );
         if !a_set {
             return None;
         }
