@@ -14,6 +14,7 @@
 //! ([`crate::diagnostics::Code::fix`]), from which `velvet codes` and docs/codes.md are
 //! written; a test holds the registry and this table to each other.
 
+pub mod buffer_view_target;
 pub mod clamp;
 pub mod declare;
 pub mod fixers;

@@ -8,6 +8,9 @@
 //! - BUFFER_VIEW_TARGET_OVERRIDE (error): a view used both for vertex attributes and for
 //!   indices; its declared `target`, or else its first use, decides, and the use that
 //!   contradicts it is reported, at the primitive's `indices` or attribute.
+//! - BUFFER_VIEW_TARGET_MISSING (hint): a view holding vertex attributes or indices that
+//!   declares no `target`, at its first use (the reference's hint and pointer); its fix sets
+//!   the target that use implies.
 //! - ANIMATION_SAMPLER_ACCESSOR_WITH_BYTESTRIDE, MESH_PRIMITIVE_INDICES_ACCESSOR_WITH_BYTESTRIDE,
 //!   SKIN_IBM_ACCESSOR_WITH_BYTESTRIDE, IMAGE_BUFFER_VIEW_WITH_BYTESTRIDE (errors): data that
 //!   must be tightly packed in a view with a byteStride, at the reference to it.
@@ -32,6 +35,12 @@ pub const BUFFER_VIEW_TARGET_OVERRIDE: Code = Code::new(
     Severity::Error,
     "A buffer view is used both for vertex attributes and for indices.",
 );
+pub const BUFFER_VIEW_TARGET_MISSING: Code = Code::new(
+    "BUFFER_VIEW_TARGET_MISSING",
+    Severity::Hint,
+    "A buffer view holding vertex attributes or indices declares no target (34962 or 34963), which loaders use to place it.",
+)
+.fixable(crate::diagnostics::Safety::Safe);
 pub const ANIMATION_SAMPLER_ACCESSOR_WITH_BYTESTRIDE: Code = Code::new(
     "ANIMATION_SAMPLER_ACCESSOR_WITH_BYTESTRIDE",
     Severity::Error,
@@ -65,6 +74,7 @@ impl Rule for BufferViews {
             &BUFFER_VIEW_TOO_BIG_BYTE_STRIDE,
             &super::accessors::BUFFER_VIEW_INVALID_BYTE_STRIDE,
             &BUFFER_VIEW_TARGET_OVERRIDE,
+            &BUFFER_VIEW_TARGET_MISSING,
             &ANIMATION_SAMPLER_ACCESSOR_WITH_BYTESTRIDE,
             &MESH_PRIMITIVE_INDICES_ACCESSOR_WITH_BYTESTRIDE,
             &SKIN_IBM_ACCESSOR_WITH_BYTESTRIDE,
@@ -156,12 +166,31 @@ impl BufferViews {
                     .filter(|t| matches!(*t, ARRAY_BUFFER | ELEMENT_ARRAY_BUFFER))
             })
             .collect();
+        let undeclared: Vec<bool> = (0..count)
+            .map(|i| {
+                views
+                    .and_then(|v| v.get(i))
+                    .is_some_and(|v| v.get("target").is_none())
+            })
+            .collect();
         // The pointer of a use is written only for a finding: a library has tens of thousands.
         let mut used = |view: usize,
                         target: u64,
                         at: &dyn Fn() -> String,
                         out: &mut Vec<Diagnostic>| match usage[view] {
-            None => usage[view] = Some(target),
+            None => {
+                usage[view] = Some(target);
+                if undeclared[view] {
+                    out.push(Diagnostic::new(
+                        &BUFFER_VIEW_TARGET_MISSING,
+                        at(),
+                        format!(
+                            "buffer view {view} holds {} and declares no target; set {target}",
+                            target_name(target)
+                        ),
+                    ));
+                }
+            }
             Some(first) if first != target => out.push(Diagnostic::new(
                 &BUFFER_VIEW_TARGET_OVERRIDE,
                 at(),
@@ -282,6 +311,8 @@ mod tests {
                 "BUFFER_VIEW_TOO_LONG /bufferViews/1/byteOffset",
                 "BUFFER_VIEW_TOO_BIG_BYTE_STRIDE /bufferViews/2/byteStride",
                 "BUFFER_VIEW_INVALID_BYTE_STRIDE /bufferViews/3/byteStride",
+                // View 4 declares no target: its first use, POSITION, is noted, and decides.
+                "BUFFER_VIEW_TARGET_MISSING /meshes/0/primitives/0/attributes/POSITION",
                 "BUFFER_VIEW_TARGET_OVERRIDE /meshes/0/primitives/0/indices",
                 "MESH_PRIMITIVE_INDICES_ACCESSOR_WITH_BYTESTRIDE /meshes/0/primitives/1/indices",
                 "IMAGE_BUFFER_VIEW_WITH_BYTESTRIDE /images/0/bufferView",
