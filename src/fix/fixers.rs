@@ -39,6 +39,7 @@ pub const FIXERS: &[Fixer] = &[
     super::tidy::ALPHA_CUTOFF_IGNORED,
     super::tidy::DUPLICATE_DECLARATION,
     super::tidy::EMPTY,
+    super::tidy::DEFAULT_MATRIX,
     super::buffer_view_target::TARGET,
 ];
 

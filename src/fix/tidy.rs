@@ -5,6 +5,7 @@
 //! - an element given twice in a list that is a set (DUPLICATE_ELEMENTS): an extension in
 //!   `extensionsUsed` or `extensionsRequired`, a node in a scene's `nodes` or a node's
 //!   `children`; the second goes. A skin's `joints` stays: vertices name joints by place;
+//! - a node's identity `matrix`, the default (NODE_MATRIX_DEFAULT);
 //! - an empty array or object that a property holds (EMPTY_ENTITY): `"extensionsUsed": []`,
 //!   `"extensions": {}`. An empty element of an array stays (removing it would renumber the
 //!   others), and so does one the schema requires (the fixed file would lack it, an error, and
@@ -72,6 +73,20 @@ pub const EMPTY: Fixer = Fixer {
             || value.as_object().is_some_and(|o| o.is_empty());
         empty.then(|| Proposal {
             title: format!("remove the empty {key}"),
+            edits: vec![Edit::remove(d.pointer.clone())],
+        })
+    },
+};
+
+pub const DEFAULT_MATRIX: Fixer = Fixer {
+    code: &crate::rules::nodes::NODE_MATRIX_DEFAULT,
+    safety: Safety::Safe,
+    about: "removes a node's identity matrix, the default",
+    propose: |asset: &Asset, d: &Diagnostic| {
+        (last_token(&d.pointer)? == "matrix").then_some(())?;
+        asset.root().pointer(&d.pointer)?.as_array()?;
+        Some(Proposal {
+            title: "remove the identity matrix, the default".to_string(),
             edits: vec![Edit::remove(d.pointer.clone())],
         })
     },

@@ -5,6 +5,8 @@
 //!   the Khronos validator's tolerance: a little more than signed 8-bit quantization loses).
 //! - NODE_MATRIX_NON_TRS (error): a matrix that no translation, rotation and scale make (its last
 //!   row not 0, 0, 0, 1, its 3×3 part singular or sheared), which the spec requires.
+//! - NODE_MATRIX_DEFAULT (info): a matrix that is the identity, the default it need not state;
+//!   its fix removes it.
 //! - NODE_WEIGHTS_INVALID (error): `weights` not one per morph target of the node's mesh.
 //! - NODE_SKIN_WITH_NON_SKINNED_MESH (error): a skin on a node whose mesh has no JOINTS_n.
 //! - NODE_SKINNED_MESH_WITHOUT_SKIN (warning): a mesh with JOINTS_n on a node without a skin.
@@ -25,6 +27,12 @@ pub const NODE_MATRIX_NON_TRS: Code = Code::new(
     Severity::Error,
     "A node's matrix cannot be decomposed into translation, rotation and scale.",
 );
+pub const NODE_MATRIX_DEFAULT: Code = Code::new(
+    "NODE_MATRIX_DEFAULT",
+    Severity::Info,
+    "A node's matrix is the identity, which is the default: it need not be given.",
+)
+.fixable(crate::diagnostics::Safety::Safe);
 pub const NODE_WEIGHTS_INVALID: Code = Code::new(
     "NODE_WEIGHTS_INVALID",
     Severity::Error,
@@ -50,6 +58,11 @@ pub const NODE_SKINNED_MESH_LOCAL_TRANSFORMS: Code = Code::new(
 const UNIT_TOLERANCE: f64 = super::data::UNIT_LENGTH_VEC4;
 /// How far from orthogonal (relative to their lengths) a matrix's scaled axes may be.
 const SHEAR_TOLERANCE: f64 = 1e-4;
+
+/// The identity matrix, a node's default.
+const IDENTITY: [f64; 16] = [
+    1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0,
+];
 
 /// Whether a column-major 4×4 matrix is a composition of translation, rotation and scale.
 pub fn is_trs(m: &[f64; 16]) -> bool {
@@ -88,6 +101,7 @@ impl Rule for Nodes {
         &[
             &ROTATION_NON_UNIT,
             &NODE_MATRIX_NON_TRS,
+            &NODE_MATRIX_DEFAULT,
             &NODE_WEIGHTS_INVALID,
             &NODE_SKIN_WITH_NON_SKINNED_MESH,
             &NODE_SKINNED_MESH_WITHOUT_SKIN,
@@ -111,7 +125,13 @@ impl Rule for Nodes {
                 }
             }
             if let Some(m) = numbers::<16>(node.get("matrix")) {
-                if !is_trs(&m) {
+                if m == IDENTITY {
+                    out.push(Diagnostic::new(
+                        &NODE_MATRIX_DEFAULT,
+                        format!("{at}/matrix"),
+                        "the matrix is the identity, the default: it need not be given",
+                    ));
+                } else if !is_trs(&m) {
                     out.push(Diagnostic::new(
                         &NODE_MATRIX_NON_TRS,
                         format!("{at}/matrix"),
@@ -193,7 +213,8 @@ mod tests {
                      {"matrix":[1,1,1,1,1,1,1,1,1,1,1,1,1,1,1,1]},
                      {"matrix":[2,0,0,0,0,0,3,0,0,-1,0,0,5,6,7,1]},
                      {"mesh":0,"weights":[0.5,0.5],"skin":0},
-                     {"mesh":1},{"mesh":1,"skin":0,"translation":[1,2,3]}]}"#;
+                     {"mesh":1},{"mesh":1,"skin":0,"translation":[1,2,3]},
+                     {"matrix":[1,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1.0]}]}"#;
         assert_eq!(
             found(text),
             [
@@ -203,6 +224,7 @@ mod tests {
                 "NODE_SKIN_WITH_NON_SKINNED_MESH /nodes/4",
                 "NODE_SKINNED_MESH_WITHOUT_SKIN /nodes/5",
                 "NODE_SKINNED_MESH_LOCAL_TRANSFORMS /nodes/6",
+                "NODE_MATRIX_DEFAULT /nodes/7/matrix",
             ]
         );
     }
