@@ -1926,14 +1926,14 @@ fn missing_resources_project() -> tempfile::TempDir {
         dir.path().join("a.gltf"),
         "{\n\"asset\": {\"version\": \"2.0\"},\n\"extensionsUsed\": [\"KHR_materials_sheen\"],\n\
          \"buffers\": [{\"uri\": \"Chair.bin\", \"byteLength\": 4}, {\"uri\": \"present.bin\", \"byteLength\": 4}, {\"uri\": \"data:application/octet-stream;base64,AAAAAA==\", \"byteLength\": 4}],\n\
-         \"images\": [{\"uri\": \"Chair_base.png\"}, {\"uri\": \"Chair_base.png\"}],\n\
-         \"materials\": [{\"extensions\": {\"KHR_materials_sheen\": {\"odd\": 1}}}]\n}\n",
+         \"images\": [{\"uri\": \"Chair_base.png\"}, {\"uri\": \"Chair_base.png\"}], \"textures\": [{\"source\": 0}, {\"source\": 1}],\n\
+         \"materials\": [{\"extensions\": {\"KHR_materials_sheen\": {\"odd\": 1}}}, {\"normalTexture\": {\"index\": 0}, \"emissiveTexture\": {\"index\": 1}}]\n}\n",
     )
     .unwrap();
     std::fs::write(dir.path().join("present.bin"), [0u8; 4]).unwrap();
     std::fs::write(
         dir.path().join("b.gltf"),
-        "{\n\"asset\": {\"version\": \"2.0\"},\n\"scene\": 0,\n\"images\": [{\"uri\": \"gone.png\"}]\n}\n",
+        "{\n\"asset\": {\"version\": \"2.0\"},\n\"scene\": 0,\n\"images\": [{\"uri\": \"gone.png\"}], \"textures\": [{\"source\": 0}], \"materials\": [{\"emissiveTexture\": {\"index\": 0}}]\n}\n",
     )
     .unwrap();
     dir

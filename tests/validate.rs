@@ -487,6 +487,7 @@ fn valid_gltf_that_a_typed_model_refused_is_clean() {
             "images in formats that extensions bring (DDS with its mimeType, AVIF by its name)",
             json!({"asset": asset,
                 "extensionsUsed": ["MSFT_texture_dds", "EXT_texture_avif"],
+                "materials": [{"normalTexture": {"index": 0}, "emissiveTexture": {"index": 1}}],
                 "textures": [{"extensions": {"MSFT_texture_dds": {"source": 0}}},
                              {"extensions": {"EXT_texture_avif": {"source": 1}}}],
                 "images": [{"uri": "a.dds", "mimeType": "image/vnd-ms.dds"}, {"uri": "a.avif"}]}),
@@ -542,7 +543,13 @@ fn links_are_judged_by_where_they_lead_a_linked_folder_on_the_way_included() {
     std::os::unix::fs::symlink(&outside, assets.join("tex")).unwrap();
     std::os::unix::fs::symlink(assets.join("own/a.png"), assets.join("alias.png")).unwrap();
     std::os::unix::fs::symlink(&assets, dir.path().join("via")).unwrap();
-    let doc = json!({"asset": {"version": "2.0"}, "images": [
+    let doc = json!({"asset": {"version": "2.0"},
+        "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}},
+                      {"pbrMetallicRoughness": {"baseColorTexture": {"index": 1}}},
+                      {"pbrMetallicRoughness": {"baseColorTexture": {"index": 2}}},
+                      {"pbrMetallicRoughness": {"baseColorTexture": {"index": 3}}}],
+        "textures": [{"source": 0}, {"source": 1}, {"source": 2}, {"source": 3}],
+        "images": [
         {"uri": "fabric.png"}, {"uri": "tex/a.png"}, {"uri": "alias.png"}, {"uri": "own/a.png"}
     ]});
     let path = assets.join("links.gltf");

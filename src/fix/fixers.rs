@@ -41,6 +41,7 @@ pub const FIXERS: &[Fixer] = &[
     super::tidy::EMPTY,
     super::tidy::DEFAULT_MATRIX,
     super::buffer_view_target::TARGET,
+    super::prune::UNUSED,
 ];
 
 /// The fixer of `code`, if it has one.

@@ -20,6 +20,7 @@ pub mod declare;
 pub mod fixers;
 pub mod fuzz_roughness;
 pub mod legacy;
+pub mod prune;
 pub mod texcoord;
 pub mod text;
 pub mod texture;
@@ -88,14 +89,15 @@ pub fn plan(asset: &Asset, findings: &[Finding]) -> Vec<Fix> {
 
 /// Where one edit acts: the value it targets, the value holding that one, and whether it
 /// changes the holder's members (a removal, a member or element added), which moves what lies
-/// beside it in the text.
+/// beside it in the text. An element's removal also reshapes what holds its array, since an
+/// array emptied goes whole ([`combined`]): that second site targets no value of its own.
 struct Site {
-    target: String,
+    target: Option<String>,
     holder: String,
     reshapes: bool,
 }
 
-fn site(root: Node, edit: &Edit) -> Site {
+fn sites(root: Node, edit: &Edit) -> Vec<Site> {
     let (target, reshapes) = match edit {
         Edit::Set { pointer, .. } | Edit::Replace { pointer, .. } => {
             (pointer.clone(), root.pointer(pointer).is_none())
@@ -108,11 +110,20 @@ fn site(root: Node, edit: &Edit) -> Site {
         },
     };
     let holder = fixers::parent(&target).to_string();
-    Site {
-        target,
+    let mut out = Vec::with_capacity(2);
+    if matches!(edit, Edit::Remove { .. }) && root.pointer(&holder).is_some_and(|h| h.is_array()) {
+        out.push(Site {
+            target: None,
+            holder: fixers::parent(&holder).to_string(),
+            reshapes: true,
+        });
+    }
+    out.push(Site {
+        target: Some(target),
         holder,
         reshapes,
-    }
+    });
+    out
 }
 
 /// `fixes` with no two touching the same text, so that every fix's edits apply together in
@@ -144,24 +155,26 @@ fn separate(root: Node, fixes: Vec<Fix>) -> Vec<Fix> {
     }
     let sites: Vec<Vec<Site>> = fixes
         .iter()
-        .map(|f| f.edits.iter().map(|e| site(root, e)).collect())
+        .map(|f| f.edits.iter().flat_map(|e| sites(root, e)).collect())
         .collect();
     let mut by_target: HashMap<&str, usize> = HashMap::new();
     // The fixes that add or remove members of each value.
     let mut by_holder: HashMap<&str, Vec<usize>> = HashMap::new();
     for (i, fix_sites) in sites.iter().enumerate() {
         for s in fix_sites {
-            if let Some(&j) = by_target.get(s.target.as_str()) {
-                join(&mut group, i, j);
+            if let Some(target) = &s.target {
+                if let Some(&j) = by_target.get(target.as_str()) {
+                    join(&mut group, i, j);
+                }
+                by_target.entry(target).or_insert(i);
             }
-            by_target.entry(&s.target).or_insert(i);
             if s.reshapes {
                 by_holder.entry(&s.holder).or_default().push(i);
             }
         }
     }
     for (i, fix_sites) in sites.iter().enumerate() {
-        for s in fix_sites {
+        for s in fix_sites.iter().filter(|s| s.target.is_some()) {
             // A value that holds this one and that another fix targets.
             let mut at = s.holder.as_str();
             loop {

@@ -12,10 +12,21 @@
 use super::{as_index, Context, Rule};
 use crate::asset::pointer;
 use crate::asset::tape::{KeyId, Node};
-use crate::diagnostics::{codes, Code, Diagnostic};
+use crate::diagnostics::{codes, Code, Diagnostic, Severity};
 use std::borrow::Cow;
 
 pub use codes::UNRESOLVED_REFERENCE;
+
+pub const UNUSED_OBJECT: Code = Code::new(
+    "UNUSED_OBJECT",
+    Severity::Info,
+    "A texture, image or sampler that nothing in the document refers to (the reference reports other objects too).",
+)
+.fixable(crate::diagnostics::Safety::Unsafe);
+
+/// The arrays whose unused elements are reported: what a material's textures hold, which a
+/// library's assets collect as they are edited (and `gltf-transform prune` removes).
+pub const PRUNED: [&str; 3] = ["/textures", "/images", "/samplers"];
 
 /// (where an index stands, the array it indexes).
 pub const LINKS: &[(&str, &str)] = &[
@@ -117,7 +128,11 @@ impl Rule for References {
     }
 
     fn codes(&self) -> &'static [&'static Code] {
-        &[&UNRESOLVED_REFERENCE, &super::core::UNSATISFIED_DEPENDENCY]
+        &[
+            &UNRESOLVED_REFERENCE,
+            &super::core::UNSATISFIED_DEPENDENCY,
+            &UNUSED_OBJECT,
+        ]
     }
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
@@ -137,11 +152,18 @@ impl Rule for References {
         // compares numbers.
         let ids: Vec<Option<KeyId>> = steps.keys.iter().map(|key| json.key_id(key)).collect();
         let mut found: Vec<(usize, Diagnostic)> = Vec::new();
+        // Which elements of each of PRUNED something refers to.
+        let mut used: Vec<Vec<bool>> = PRUNED.iter().map(|a| vec![false; array_len(a)]).collect();
         let mut found_at = |link: usize, path: &[Token], value: Node| {
             let Some(index) = as_index(value) else {
                 return; // not an index: the schema check reports the type
             };
             let target = LINKS[link].1;
+            if let Some(k) = PRUNED.iter().position(|a| *a == target) {
+                if let Some(slot) = usize::try_from(index).ok().and_then(|i| used[k].get_mut(i)) {
+                    *slot = true;
+                }
+            }
             let (target, len) = match fixed_len[link] {
                 Some(len) if index < len as u64 => return,
                 Some(len) => (target.to_string(), len),
@@ -176,6 +198,16 @@ impl Rule for References {
             }
         };
         walk(json, &steps.root, &ids, &mut Vec::new(), &mut found_at);
+        for (array, used) in PRUNED.iter().zip(&used) {
+            for (i, _) in used.iter().enumerate().filter(|(_, u)| !**u) {
+                let kind = array.trim_start_matches('/').trim_end_matches('s');
+                out.push(Diagnostic::new(
+                    &UNUSED_OBJECT,
+                    format!("{array}/{i}"),
+                    format!("{kind} {i} is not used: nothing in the document refers to it"),
+                ));
+            }
+        }
         // Reported link by link, in the table's order, each in document order.
         found.sort_by_key(|(link, _)| *link);
         let mut dependent: Vec<String> = Vec::new();
@@ -209,6 +241,27 @@ impl Rule for References {
             out.push(d);
         }
     }
+}
+
+/// Every index [`LINKS`] declares in the document: its pointer, the array it indexes and the
+/// index (indices that are not non-negative integers left out).
+pub fn index_sites(json: Node) -> Vec<(String, &'static str, u64)> {
+    let steps = steps();
+    let ids: Vec<Option<KeyId>> = steps.keys.iter().map(|key| json.key_id(key)).collect();
+    let mut sites = Vec::new();
+    let mut found_at = |link: usize, path: &[Token], value: Node| {
+        let Some(index) = as_index(value) else {
+            return;
+        };
+        let mut at = String::new();
+        for token in path {
+            at.push('/');
+            pointer::push_escaped(&mut at, &token.text());
+        }
+        sites.push((at, LINKS[link].1, index));
+    };
+    walk(json, &steps.root, &ids, &mut Vec::new(), &mut found_at);
+    sites
 }
 
 /// "sheenColorTexture names texture 5, but the asset has 2 textures".
@@ -380,7 +433,7 @@ mod tests {
     use super::*;
     use serde_json::{json, Value};
 
-    fn unresolved(doc: Value) -> Vec<String> {
+    fn found(doc: Value, unused: bool) -> Vec<String> {
         let asset =
             crate::asset::load_bytes(std::path::Path::new("t.gltf"), doc.to_string().as_bytes())
                 .asset
@@ -389,7 +442,33 @@ mod tests {
         let cx = Context::new(&asset, &schemas);
         let mut out = Vec::new();
         References.check(&cx, &mut out);
-        out.into_iter().map(|d| d.pointer).collect()
+        out.into_iter()
+            .filter(|d| (d.code == UNUSED_OBJECT.name) == unused)
+            .map(|d| d.pointer)
+            .collect()
+    }
+
+    fn unresolved(doc: Value) -> Vec<String> {
+        found(doc, false)
+    }
+
+    #[test]
+    fn textures_images_and_samplers_nothing_refers_to_are_unused() {
+        // Texture 1 is unused, but its image and sampler are referred to (by it): only what
+        // nothing refers to is reported, as the reference reports it.
+        let doc = json!({
+            "asset": {"version": "2.0"},
+            "materials": [{"normalTexture": {"index": 0}},
+                          {"extensions": {"KHR_materials_sheen": {"sheenColorTexture": {"index": 2}}}}],
+            "textures": [{"source": 0}, {"source": 1, "sampler": 0},
+                         {"extensions": {"EXT_texture_webp": {"source": 2}}}],
+            "images": [{"uri": "a.png"}, {"uri": "b.png"}, {"uri": "c.webp"}, {"uri": "d.png"}],
+            "samplers": [{}, {}]
+        });
+        assert_eq!(
+            found(doc, true),
+            ["/textures/1", "/images/3", "/samplers/1"]
+        );
     }
 
     #[test]
