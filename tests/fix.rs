@@ -849,31 +849,11 @@ fn a_byte_order_mark_stays_with_its_finding_and_the_fix_edits_count_it() {
 #[path = "support/one_pass.rs"]
 mod one_pass;
 
-/// Every .gltf and .glb under `dir`, sorted.
-fn assets_under(dir: &Path, out: &mut Vec<PathBuf>) {
-    let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .collect();
-    entries.sort();
-    for path in entries {
-        if path.is_dir() {
-            assets_under(&path, out);
-        } else if matches!(
-            path.extension().and_then(|e| e.to_str()),
-            Some("gltf" | "glb")
-        ) {
-            out.push(path);
-        }
-    }
-}
-
 #[test]
 fn every_fixtures_report_edits_applied_in_one_pass_give_what_fix_unsafe_fixes_writes() {
-    let mut assets = Vec::new();
-    assets_under(
+    let assets = one_pass::files_under(
         &Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures"),
-        &mut assets,
+        &|path| matches!(path.extension()?.to_str()?, "gltf" | "glb").then(|| path.to_path_buf()),
     );
     let mut with_edits = Vec::new();
     let mut failures = Vec::new();

@@ -13,6 +13,9 @@
 //! - every code the two disagree on (one missed, or an error or warning velvet reports that the
 //!   reference does not) listed in docs/codes.md's table of differences, with its reason.
 
+#[path = "support/one_pass.rs"]
+mod one_pass;
+
 use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::path::{Path, PathBuf};
 use velvet::diagnostics::Settings;
@@ -49,25 +52,12 @@ fn sections(issues: &str) -> HashMap<String, String> {
     out
 }
 
+/// The suite's assets that have a golden report.
 fn assets(dir: &Path, out: &mut Vec<PathBuf>) {
-    let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .collect();
-    entries.sort();
-    for path in entries {
-        if path.is_dir() {
-            assets(&path, out);
-        } else if let Some(asset) = path
-            .to_str()
-            .and_then(|p| p.strip_suffix(".report.json"))
-            .map(PathBuf::from)
-        {
-            if asset.is_file() {
-                out.push(asset);
-            }
-        }
-    }
+    out.extend(one_pass::files_under(dir, &|path| {
+        let asset = PathBuf::from(path.to_str()?.strip_suffix(".report.json")?);
+        asset.is_file().then_some(asset)
+    }));
 }
 
 /// The codes docs/codes.md lists as differences from the reference.
@@ -221,9 +211,6 @@ fn the_sections_of_issues_md_are_read_by_code() {
     assert_eq!(read["TYPE_MISMATCH"], "SchemaError");
     assert_eq!(read["ACCESSOR_INVALID_FLOAT"], "DataError");
 }
-
-#[path = "support/one_pass.rs"]
-mod one_pass;
 
 /// The reports' fixes as a machine applies them: on every asset of the suite, the edits of the
 /// JSON report and of the SARIF log, each applied in one pass by an applier written apart from

@@ -12,6 +12,16 @@ use crate::diagnostics::{Diagnostic, Safety};
 use crate::edit::Edit;
 use crate::rules::references::{index_sites, PRUNED};
 
+/// Whether `at` lies within an element of [`PRUNED`] that `gone` says goes.
+fn within_gone(at: &str, gone: &[Vec<bool>]) -> bool {
+    PRUNED.iter().enumerate().any(|(k, array)| {
+        at.strip_prefix(array)
+            .and_then(|rest| rest.strip_prefix('/'))
+            .and_then(|rest| rest.split('/').next()?.parse::<usize>().ok())
+            .is_some_and(|i| gone[k].get(i).copied().unwrap_or(false))
+    })
+}
+
 /// For each array of [`PRUNED`], which elements go: those nothing refers to, then those only
 /// elements that go refer to, until nothing more goes.
 fn removed(root: Node, sites: &[(String, &'static str, u64)]) -> Vec<Vec<bool>> {
@@ -25,13 +35,7 @@ fn removed(root: Node, sites: &[(String, &'static str, u64)]) -> Vec<Vec<bool>> 
         let mut used: Vec<Vec<bool>> = gone.iter().map(|g| vec![false; g.len()]).collect();
         for (at, target, index) in sites {
             // A reference from an element that goes does not keep anything.
-            let inside_gone = PRUNED.iter().enumerate().any(|(k, array)| {
-                at.strip_prefix(array)
-                    .and_then(|rest| rest.strip_prefix('/'))
-                    .and_then(|rest| rest.split('/').next()?.parse::<usize>().ok())
-                    .is_some_and(|i| gone[k].get(i).copied().unwrap_or(false))
-            });
-            if inside_gone {
+            if within_gone(at, &gone) {
                 continue;
             }
             if let Some(k) = PRUNED.iter().position(|a| a == target) {
@@ -75,16 +79,10 @@ fn prune(asset: &Asset, d: &Diagnostic) -> Option<Proposal> {
         let Some(k) = PRUNED.iter().position(|a| a == target) else {
             continue;
         };
-        let in_gone = PRUNED.iter().enumerate().any(|(j, array)| {
-            at.strip_prefix(array)
-                .and_then(|rest| rest.strip_prefix('/'))
-                .and_then(|rest| rest.split('/').next()?.parse::<usize>().ok())
-                .is_some_and(|i| gone[j].get(i).copied().unwrap_or(false))
-        });
         let Ok(index) = usize::try_from(*index) else {
             continue;
         };
-        if in_gone || index >= gone[k].len() {
+        if within_gone(at, &gone) || index >= gone[k].len() {
             continue;
         }
         let before = gone[k][..index].iter().filter(|g| **g).count();

@@ -7,6 +7,28 @@ use serde_json::Value;
 use std::path::Path;
 use std::process::Command;
 
+/// The files below `dir` (sorted, folders walked in order) that `keep` maps to a path, as it
+/// maps them.
+pub fn files_under(
+    dir: &Path,
+    keep: &dyn Fn(&Path) -> Option<std::path::PathBuf>,
+) -> Vec<std::path::PathBuf> {
+    let mut entries: Vec<std::path::PathBuf> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    entries.sort();
+    let mut out = Vec::new();
+    for path in entries {
+        if path.is_dir() {
+            out.extend(files_under(&path, keep));
+        } else if let Some(kept) = keep(&path) {
+            out.push(kept);
+        }
+    }
+    out
+}
+
 /// One replacement: bytes `start..end` of the text become `text`.
 #[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord)]
 pub struct Edit {
