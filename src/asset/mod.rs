@@ -59,6 +59,9 @@ pub struct Asset {
     pub tape: tape::Tape,
     /// Byte offset of `json_text` in the file (20 in a GLB, 3 after a byte-order mark).
     pub json_offset: usize,
+    /// Whether a byte-order mark precedes `json_text` in its file or JSON chunk (its 3 bytes
+    /// are in `json_offset`).
+    pub byte_order_mark: bool,
     /// The GLB BIN chunk, if any.
     pub bin: Option<Vec<u8>>,
     /// A GLB's chunks of unknown types, whole, in file order: written back after BIN.
@@ -239,6 +242,7 @@ pub fn load_bytes_with(path: &Path, bytes: &[u8], options: &LoadOptions) -> Load
             diagnostics,
         };
     }
+    let byte_order_mark = json_bytes.starts_with(b"\xEF\xBB\xBF");
     let (json_bytes, json_offset) = match json_bytes.strip_prefix(b"\xEF\xBB\xBF") {
         Some(rest) => {
             diagnostics.push(Diagnostic::new(
@@ -295,6 +299,7 @@ pub fn load_bytes_with(path: &Path, bytes: &[u8], options: &LoadOptions) -> Load
     );
     if let Some(asset) = &mut loaded.asset {
         asset.other_chunks = other_chunks;
+        asset.byte_order_mark = byte_order_mark;
     }
     loaded
 }
@@ -383,6 +388,7 @@ fn load_text(
             tape: index,
             json_text,
             json_offset,
+            byte_order_mark: false,
             bin,
             other_chunks: Vec::new(),
             options: *options,

@@ -17,7 +17,8 @@ pub const BOM_PRESENT: Code = Code::new(
     "BOM_PRESENT",
     Error,
     "The JSON starts with a UTF-8 byte-order mark, which glTF forbids; the rest was checked.",
-);
+)
+.fixable(super::Safety::Safe);
 pub const GLB_INVALID_MAGIC: Code = Code::new(
     "GLB_INVALID_MAGIC",
     Error,

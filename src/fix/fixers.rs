@@ -42,6 +42,7 @@ pub const FIXERS: &[Fixer] = &[
     super::tidy::DEFAULT_MATRIX,
     super::buffer_view_target::TARGET,
     super::prune::UNUSED,
+    super::byte_order_mark::BYTE_ORDER_MARK,
 ];
 
 /// The fixer of `code`, if it has one.

@@ -15,6 +15,7 @@
 //! written; a test holds the registry and this table to each other.
 
 pub mod buffer_view_target;
+pub mod byte_order_mark;
 pub mod clamp;
 pub mod declare;
 pub mod fixers;
@@ -48,6 +49,9 @@ pub struct Fix {
     /// Why this fix waits for the next run: it touches what a fix of other safety changes
     /// (see [`separate`]). A deferred fix is neither applied nor given edits in this run.
     pub deferred: Option<String>,
+    /// The fix removes the byte-order mark before the JSON text (which no edit of the text
+    /// can say).
+    pub drops_byte_order_mark: bool,
 }
 
 /// The fixes for `findings` of `asset`, in the order of the findings they first repair. Fixes
@@ -69,7 +73,11 @@ pub fn plan(asset: &Asset, findings: &[Finding]) -> Vec<Fix> {
             pointer: d.pointer.clone(),
             message: d.message.clone(),
         };
-        let key = format!("{:?} {:?}", fixer.safety, proposal.edits);
+        let drops_byte_order_mark = fixer.code.name == crate::diagnostics::codes::BOM_PRESENT.name;
+        let key = format!(
+            "{:?} {:?} {drops_byte_order_mark}",
+            fixer.safety, proposal.edits
+        );
         match by_edits.get(&key) {
             Some(&i) => fixes[i].repairs.push(repair),
             None => {
@@ -80,6 +88,7 @@ pub fn plan(asset: &Asset, findings: &[Finding]) -> Vec<Fix> {
                     title: proposal.title,
                     edits: proposal.edits,
                     deferred: None,
+                    drops_byte_order_mark,
                 });
             }
         }
@@ -517,7 +526,7 @@ impl<'v> Fixing<'v> {
                 mode.changes()
                     && !accepted.is_empty()
                     && f.changed
-                    && f.bytes != file_bytes(&source)
+                    && !same_as_read(&source, &f.bytes)
             })
             .is_some();
         if mode.changes() && !changed {
@@ -553,6 +562,7 @@ impl<'v> Fixing<'v> {
             .collect();
         let mut file_fixes = FileFixes::new(views);
         file_fixes.changed = changed;
+        file_fixes.text_start = edits_text_start(&source);
         let Some(fixed) = fixed.filter(|_| changed) else {
             let mut report = capped(before, settings);
             report.fixes = file_fixes;
@@ -560,10 +570,17 @@ impl<'v> Fixing<'v> {
         };
         if mode.diff {
             let name = crate::asset::discover::display_path(path);
-            let before_text = source.json_text.trim_end_matches(['\0', ' ']);
-            let after_text = fixed.asset.json_text.trim_end_matches(['\0', ' ']);
             file_fixes.diff = Some(match source.container {
-                Container::Gltf => text::unified_diff(&name, before_text, after_text),
+                // The files' texts, a byte-order mark (U+FEFF) and its removal included.
+                Container::Gltf => text::unified_diff(
+                    &name,
+                    &format!(
+                        "{}{}",
+                        if source.byte_order_mark { "\u{feff}" } else { "" },
+                        source.json_text.as_str()
+                    ),
+                    &String::from_utf8_lossy(&fixed.bytes),
+                ),
                 Container::Glb => text::glb_not_diffed(&name),
             });
         } else {
@@ -617,8 +634,10 @@ impl<'v> Fixing<'v> {
             .cloned()
             .collect();
         all.extend(report.fixes.fixes().iter().cloned());
+        let text_start = report.fixes.text_start;
         report.fixes = FileFixes::new(all);
         report.fixes.changed = true;
+        report.fixes.text_start = text_start;
         report
     }
 
@@ -714,9 +733,11 @@ impl<'v> Fixing<'v> {
             crate::edit::write::Output::Bytes(bytes) => bytes.into_owned(),
             crate::edit::write::Output::Spliced(spliced) => spliced.to_text().into_bytes(),
         };
-        if source.container == Container::Gltf && source.json_offset > 0 {
-            // What came before the text (a byte-order mark, which has its own finding) stays:
-            // a fix changes only what it says.
+        let drops_byte_order_mark = fixes.iter().any(|f| f.drops_byte_order_mark);
+        let changed = changed || (drops_byte_order_mark && source.byte_order_mark);
+        if source.container == Container::Gltf && source.json_offset > 0 && !drops_byte_order_mark {
+            // What came before the text (a byte-order mark, which has its own finding) stays
+            // unless its fix is applied: a fix changes only what it says.
             let mut file = BYTE_ORDER_MARK[..source.json_offset.min(3)].to_vec();
             file.append(&mut bytes);
             bytes = file;
@@ -755,12 +776,34 @@ impl Failed {
     }
 }
 
-/// The file's bytes as read, when the asset kept them (a .gltf); otherwise the JSON text (for
-/// comparing a fixed .gltf; a .glb's fixed bytes never equal its JSON).
-fn file_bytes(asset: &Asset) -> &[u8] {
-    asset
-        .file_bytes()
-        .unwrap_or_else(|| asset.json_text.as_bytes())
+/// Where `asset`'s JSON text starts in what its fixes' edits are given against: its file (a
+/// .gltf, after a byte-order mark) or its JSON chunk (a .glb: after a mark, or at 0).
+fn edits_text_start(asset: &Asset) -> usize {
+    match asset.container {
+        Container::Gltf => asset.json_offset,
+        Container::Glb => {
+            if asset.byte_order_mark {
+                BYTE_ORDER_MARK.len()
+            } else {
+                0
+            }
+        }
+    }
+}
+
+/// Whether `bytes` are the file `asset` was read from: a .gltf's text (after its byte-order
+/// mark, if it had one); a .glb's fixed bytes are its container rebuilt, never compared equal.
+fn same_as_read(asset: &Asset, bytes: &[u8]) -> bool {
+    let text = asset.json_text.as_bytes();
+    match asset.container {
+        Container::Gltf => {
+            let lead = asset.json_offset;
+            bytes.len() == lead + text.len()
+                && bytes[..lead] == BYTE_ORDER_MARK[..lead.min(3)]
+                && &bytes[lead..] == text
+        }
+        Container::Glb => false,
+    }
 }
 
 /// A finding of a fixed file that refuses the fixes: one a fix was to repair, still there
@@ -1007,8 +1050,22 @@ fn element_of(root: Node, fix: &Fix) -> Option<(String, std::ops::Range<usize>)>
     unit
 }
 
-/// The edits of the JSON text that `fix` makes alone.
+/// The edits of the JSON text that `fix` makes alone (with the removal of a byte-order mark
+/// before it, for the fix that removes one).
 fn fix_text_edits(source: &Asset, fix: &Fix) -> Vec<TextEdit> {
+    if fix.drops_byte_order_mark {
+        let mut edits = vec![text::lead_removed()];
+        if !fix.edits.is_empty() {
+            edits.extend(fix_text_edits(
+                source,
+                &Fix {
+                    drops_byte_order_mark: false,
+                    ..fix.clone()
+                },
+            ));
+        }
+        return edits;
+    }
     let edits = combined(source.root(), &[fix]);
     let text = crate::edit::write::source(source);
     match crate::edit::splice::splice_edits(text, source.root(), &edits) {
@@ -1049,6 +1106,7 @@ mod tests {
             title: String::new(),
             edits,
             deferred: None,
+            drops_byte_order_mark: false,
         }
     }
 

@@ -110,8 +110,25 @@ pub fn text_edits(source: &str, replacements: &[Replacement]) -> Vec<TextEdit> {
             start: p[0],
             end: p[1],
             content: r.text.clone(),
+            lead: false,
         })
         .collect()
+}
+
+/// The edit that removes a byte-order mark, which precedes the JSON text: the mark is the
+/// first character of the file's first line (U+FEFF), the text's first position ends it.
+pub fn lead_removed() -> TextEdit {
+    let at = |column| Position {
+        line: 1,
+        column,
+        offset: 0,
+    };
+    TextEdit {
+        start: at(1),
+        end: at(2),
+        content: String::new(),
+        lead: true,
+    }
 }
 
 /// The positions of `offsets` (on character boundaries, in increasing order as replacements

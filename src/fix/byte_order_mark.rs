@@ -1,0 +1,20 @@
+//! A byte-order mark before the JSON text, which glTF forbids (BOM_PRESENT), removed. Safe: a
+//! loader that reads the file at all reads the same JSON. Its fix has no edit of the JSON text:
+//! the planner marks it ([`super::Fix::drops_byte_order_mark`]), the file is written without
+//! the mark, and the reports give an edit of the bytes before the text.
+
+use super::fixers::{Fixer, Proposal};
+use crate::asset::Asset;
+use crate::diagnostics::{codes::BOM_PRESENT, Diagnostic, Safety};
+
+pub const BYTE_ORDER_MARK: Fixer = Fixer {
+    code: &BOM_PRESENT,
+    safety: Safety::Safe,
+    about: "removes the byte-order mark before the JSON text",
+    propose: |asset: &Asset, _: &Diagnostic| {
+        asset.byte_order_mark.then(|| Proposal {
+            title: "remove the byte-order mark".to_string(),
+            edits: Vec::new(),
+        })
+    },
+};
