@@ -36,6 +36,27 @@ fn fixable_codes() -> Vec<&'static Code> {
         .collect()
 }
 
+/// The file extension of `code`'s fixtures: "glb" for a container's codes, else "gltf".
+fn extension_of(code: &str) -> &'static str {
+    if Path::new(FIXTURES)
+        .join(code)
+        .join("triggers.glb")
+        .is_file()
+    {
+        "glb"
+    } else {
+        "gltf"
+    }
+}
+
+/// The fixable codes whose fixtures are .gltf text (a .glb's are binary: no diff, no text).
+fn text_fixable_codes() -> Vec<&'static Code> {
+    fixable_codes()
+        .into_iter()
+        .filter(|c| extension_of(c.name) == "gltf")
+        .collect()
+}
+
 /// The fixture folder of `code`, copied into a temporary folder (the resources its trigger
 /// names come along).
 fn case_copy(code: &str) -> tempfile::TempDir {
@@ -58,7 +79,9 @@ fn fix_flags(code: &Code) -> Vec<&'static str> {
 }
 
 fn expected_fixed(code: &str) -> Vec<u8> {
-    let path = Path::new(FIXTURES).join(code).join("fixed.gltf");
+    let path = Path::new(FIXTURES)
+        .join(code)
+        .join(format!("fixed.{}", extension_of(code)));
     std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
 
@@ -73,16 +96,20 @@ fn every_fixable_code_has_its_trigger_fixed_to_the_expected_bytes_and_no_longer_
     assert!(codes.len() >= 5, "{} fixable codes", codes.len());
     for code in codes {
         let dir = case_copy(code.name);
-        let file = dir.path().join("triggers.gltf");
+        let ext = extension_of(code.name);
+        let trigger = format!("triggers.{ext}");
+        let file = dir.path().join(&trigger);
         let before = std::fs::read(&file).unwrap();
         assert!(codes_in(&file).contains(&code.name), "{}", code.name);
         let mut args = vec!["validate"];
         args.extend(fix_flags(code));
-        args.push("triggers.gltf");
+        args.push(&trigger);
         let o = velvet_in(dir.path(), &args);
         let out = stdout(&o);
         let after = std::fs::read(&file).unwrap();
-        let golden = Path::new(FIXTURES).join(code.name).join("fixed.gltf");
+        let golden = Path::new(FIXTURES)
+            .join(code.name)
+            .join(format!("fixed.{ext}"));
         if std::env::var_os("VELVET_BLESS").is_some() {
             std::fs::write(&golden, &after).unwrap();
         }
@@ -90,7 +117,7 @@ fn every_fixable_code_has_its_trigger_fixed_to_the_expected_bytes_and_no_longer_
         assert_eq!(
             String::from_utf8_lossy(&after),
             String::from_utf8_lossy(&expected_fixed(code.name)),
-            "{}: the fixed file differs from fixed.gltf",
+            "{}: the fixed file differs from fixed.{ext}",
             code.name
         );
         assert!(
@@ -131,9 +158,10 @@ fn a_safe_fix_is_not_applied_without_unsafe_fixes_and_an_unsafe_one_is_said_to_n
         .filter(|c| c.fix == Some(Safety::Unsafe))
     {
         let dir = case_copy(code.name);
-        let file = dir.path().join("triggers.gltf");
+        let trigger = format!("triggers.{}", extension_of(code.name));
+        let file = dir.path().join(&trigger);
         let before = std::fs::read(&file).unwrap();
-        let o = velvet_in(dir.path(), &["validate", "--fix", "triggers.gltf"]);
+        let o = velvet_in(dir.path(), &["validate", "--fix", &trigger]);
         assert_eq!(std::fs::read(&file).unwrap(), before, "{}", code.name);
         let out = stdout(&o);
         assert!(
@@ -207,7 +235,7 @@ fn apply_unified_diff(source: &str, patch: &str) -> String {
 
 #[test]
 fn diff_prints_the_change_that_fix_writes_and_writes_nothing() {
-    for code in fixable_codes() {
+    for code in text_fixable_codes() {
         let dir = case_copy(code.name);
         let file = dir.path().join("triggers.gltf");
         let before = std::fs::read_to_string(&file).unwrap();
@@ -317,7 +345,7 @@ fn applicable(code: &Code, applicability: &str) -> bool {
 
 #[test]
 fn json_and_sarif_fixes_applied_apart_from_velvet_give_the_fixed_bytes() {
-    for code in fixable_codes() {
+    for code in text_fixable_codes() {
         let dir = case_copy(code.name);
         let source = std::fs::read_to_string(dir.path().join("triggers.gltf")).unwrap();
         let expected = expected_fixed(code.name);
@@ -439,9 +467,10 @@ fn a_safe_fix_leaves_what_migrate_plans_for_the_file_as_it_was() {
             // unused fuzz declaration was removed declares fuzz again.)
             velvet::migrate::plan_document(&asset, &velvet::migrate::Options::default()).materials
         };
+        let ext = extension_of(code.name);
         assert_eq!(
-            plan(case.join("triggers.gltf")),
-            plan(case.join("fixed.gltf")),
+            plan(case.join(format!("triggers.{ext}"))),
+            plan(case.join(format!("fixed.{ext}"))),
             "{}: the safe fix changed what the file renders as",
             code.name
         );
@@ -463,7 +492,7 @@ fn fix_leaves_a_clean_file_byte_identical_and_unwritten() {
                 std::fs::copy(&path, case.join(&name)).unwrap();
             }
         }
-        files.push(case.join("clean.gltf"));
+        files.push(case.join(format!("clean.{}", extension_of(code.name))));
     }
     let sample = dir.path().join("sample");
     std::fs::create_dir(&sample).unwrap();

@@ -33,7 +33,8 @@ pub const GLB_LENGTH_MISMATCH: Code = Code::new(
     "GLB_LENGTH_MISMATCH",
     Error,
     "The length in the GLB header differs from the file's length.",
-);
+)
+.fixable(super::Safety::Unsafe);
 pub const GLB_UNEXPECTED_END_OF_HEADER: Code = Code::new(
     "GLB_UNEXPECTED_END_OF_HEADER",
     Error,
@@ -74,7 +75,8 @@ pub const GLB_CHUNK_LENGTH_UNALIGNED: Code = Code::new(
     "GLB_CHUNK_LENGTH_UNALIGNED",
     Error,
     "A GLB chunk's length is not a multiple of 4.",
-);
+)
+.fixable(super::Safety::Safe);
 pub const GLB_UNEXPECTED_FIRST_CHUNK: Code = Code::new(
     "GLB_UNEXPECTED_FIRST_CHUNK",
     Error,
@@ -89,7 +91,8 @@ pub const GLB_INVALID_PADDING: Code = Code::new(
     "GLB_INVALID_PADDING",
     Warning,
     "A GLB chunk's trailing padding is not spaces (JSON) or zeros (BIN).",
-);
+)
+.fixable(super::Safety::Safe);
 pub const URI_NOT_FOLLOWED: Code = Code::new(
     "URI_NOT_FOLLOWED",
     Error,
@@ -145,7 +148,8 @@ pub const GLB_EXTRA_DATA: Code = Code::new(
     "GLB_EXTRA_DATA",
     Warning,
     "A .glb file has bytes after the length its header declares; loaders ignore them.",
-);
+)
+.fixable(super::Safety::Safe);
 
 pub const DOCUMENT_TOO_LARGE: Code = Code::new(
     "DOCUMENT_TOO_LARGE",

@@ -43,6 +43,10 @@ pub const FIXERS: &[Fixer] = &[
     super::buffer_view_target::TARGET,
     super::prune::UNUSED,
     super::byte_order_mark::BYTE_ORDER_MARK,
+    super::container::EXTRA_DATA,
+    super::container::UNALIGNED,
+    super::container::PADDING,
+    super::container::LENGTH,
 ];
 
 /// The fixer of `code`, if it has one.

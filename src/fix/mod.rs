@@ -17,6 +17,7 @@
 pub mod buffer_view_target;
 pub mod byte_order_mark;
 pub mod clamp;
+pub mod container;
 pub mod declare;
 pub mod fixers;
 pub mod fuzz_roughness;
@@ -52,6 +53,8 @@ pub struct Fix {
     /// The fix removes the byte-order mark before the JSON text (which no edit of the text
     /// can say).
     pub drops_byte_order_mark: bool,
+    /// The fix rebuilds a .glb's container (which no edit of the JSON text can say).
+    pub rebuilds_container: bool,
 }
 
 /// The fixes for `findings` of `asset`, in the order of the findings they first repair. Fixes
@@ -74,8 +77,9 @@ pub fn plan(asset: &Asset, findings: &[Finding]) -> Vec<Fix> {
             message: d.message.clone(),
         };
         let drops_byte_order_mark = fixer.code.name == crate::diagnostics::codes::BOM_PRESENT.name;
+        let rebuilds_container = container::CODES.contains(&fixer.code.name);
         let key = format!(
-            "{:?} {:?} {drops_byte_order_mark}",
+            "{:?} {:?} {drops_byte_order_mark} {rebuilds_container}",
             fixer.safety, proposal.edits
         );
         match by_edits.get(&key) {
@@ -89,6 +93,7 @@ pub fn plan(asset: &Asset, findings: &[Finding]) -> Vec<Fix> {
                     edits: proposal.edits,
                     deferred: None,
                     drops_byte_order_mark,
+                    rebuilds_container,
                 });
             }
         }
@@ -576,7 +581,11 @@ impl<'v> Fixing<'v> {
                     &name,
                     &format!(
                         "{}{}",
-                        if source.byte_order_mark { "\u{feff}" } else { "" },
+                        if source.byte_order_mark {
+                            "\u{feff}"
+                        } else {
+                            ""
+                        },
                         source.json_text.as_str()
                     ),
                     &String::from_utf8_lossy(&fixed.bytes),
@@ -734,7 +743,10 @@ impl<'v> Fixing<'v> {
             crate::edit::write::Output::Spliced(spliced) => spliced.to_text().into_bytes(),
         };
         let drops_byte_order_mark = fixes.iter().any(|f| f.drops_byte_order_mark);
-        let changed = changed || (drops_byte_order_mark && source.byte_order_mark);
+        let rebuilds_container = fixes.iter().any(|f| f.rebuilds_container);
+        let changed = changed
+            || (drops_byte_order_mark && source.byte_order_mark)
+            || (rebuilds_container && source.container == Container::Glb);
         if source.container == Container::Gltf && source.json_offset > 0 && !drops_byte_order_mark {
             // What came before the text (a byte-order mark, which has its own finding) stays
             // unless its fix is applied: a fix changes only what it says.
@@ -1107,6 +1119,7 @@ mod tests {
             edits,
             deferred: None,
             drops_byte_order_mark: false,
+            rebuilds_container: false,
         }
     }
 
