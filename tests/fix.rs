@@ -904,6 +904,12 @@ fn every_fixtures_report_edits_applied_in_one_pass_give_what_fix_unsafe_fixes_wr
             Err(e) => failures.push(e),
         }
     }
+    println!(
+        "fix edits applied in one pass: {} of {} fixtures with fixes give what --fix --unsafe-fixes writes ({} assets)",
+        with_edits.len(),
+        with_edits.len() + failures.len(),
+        assets.len()
+    );
     assert!(failures.is_empty(), "{}", failures.join("\n\n"));
     // The fixable codes' triggers, the CI fixtures' .glb and the migrate fixtures with fixes.
     let glbs = with_edits
