@@ -23,6 +23,7 @@ pub mod layers;
 pub mod migrate;
 pub mod output;
 pub mod preview;
+pub mod progress;
 pub mod report;
 pub mod rules;
 pub mod shading;

@@ -91,6 +91,7 @@ pub fn load(path: &Path) -> Loaded {
 
 /// Reads and parses one file under `options`. Never fails: faults become diagnostics.
 pub fn load_with(path: &Path, options: &LoadOptions) -> Loaded {
+    crate::progress::stage("reading", 0);
     match read(path, options) {
         Ok(bytes) => load_owned(path, bytes, options),
         Err(d) => Loaded {
@@ -179,6 +180,7 @@ pub fn load_read(
     bytes: FileBytes,
     options: &LoadOptions,
 ) -> (Loaded, Option<FileBytes>) {
+    crate::progress::stage("indexing", 0);
     let plain = !bytes.starts_with(b"glTF")
         && !bytes.starts_with(b"\xEF\xBB\xBF")
         && !path

@@ -501,10 +501,12 @@ impl<'v> Fixing<'v> {
             max_issues: None,
             ..settings.clone()
         };
+        crate::progress::stage("planning fixes", 0);
         let fixes = plan(&source, &before.findings);
         if fixes.is_empty() {
             return capped(before, settings);
         }
+        crate::progress::stage("trying fixes", 0);
         // The fixes this run would apply, tried together on the file (each try validates the
         // fixed text again): a report carries a fix only if `--fix` would apply it, and says
         // why it refuses the others. A run without --fix tries every fix, as --fix

@@ -121,12 +121,18 @@ pub fn progress_bar(wanted: bool, count: usize, noun: &str) -> Option<indicatif:
 }
 
 /// Turns `bar` into what a run over one file shows instead of "0/1": a spinner with the file's
-/// name and size and the time so far, redrawn ten times a second, so that a large file's
-/// minutes on a terminal are visibly work and not a hang. The size is the file's length on
-/// disk (one `stat`), not read.
+/// name and size, the stage the work is at (`crate::progress`: "checking rules 12/61") and the
+/// time so far, redrawn ten times a second, so that a large file's minutes on a terminal are
+/// visibly work and not a hang. The size is the file's length on disk (one `stat`), not read.
 pub fn show_one_file(bar: &indicatif::ProgressBar, file: &std::path::Path) {
-    if let Ok(style) = indicatif::ProgressStyle::with_template("{spinner} {msg} {elapsed}") {
-        bar.set_style(style);
+    if let Ok(style) = indicatif::ProgressStyle::with_template("{spinner} {msg} {stage} {elapsed}")
+    {
+        bar.set_style(style.with_key(
+            "stage",
+            |_: &indicatif::ProgressState, w: &mut dyn std::fmt::Write| {
+                let _ = w.write_str(&crate::progress::describe());
+            },
+        ));
     }
     let size = std::fs::metadata(file).map(|m| m.len()).unwrap_or(0);
     bar.set_message(format!(

@@ -380,6 +380,7 @@ fn missing_resources(
 /// Every registered rule's findings, in registry order, a list per rule. In parallel each
 /// rule keeps its own list, so the report does not depend on which rule finished first.
 fn run_rules(cx: &Context, parallel: bool) -> Vec<Vec<Diagnostic>> {
+    crate::progress::stage("checking rules", rules::REGISTRY.len());
     if parallel {
         // Each rule is a task of its own, taken dearest first by whichever thread is free
         // (split in registry order, three of the four dear rules fell to one core and the
@@ -398,6 +399,7 @@ fn run_rules(cx: &Context, parallel: bool) -> Vec<Vec<Diagnostic>> {
                         let mut out = Vec::new();
                         rules::REGISTRY[i].check(cx, &mut out);
                         let _ = found[i].set(out);
+                        crate::progress::advance(1);
                     }
                 });
             }
@@ -410,6 +412,7 @@ fn run_rules(cx: &Context, parallel: bool) -> Vec<Vec<Diagnostic>> {
         let mut out = Vec::new();
         for rule in rules::REGISTRY {
             rule.check(cx, &mut out);
+            crate::progress::advance(1);
         }
         vec![out]
     }
