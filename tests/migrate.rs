@@ -2154,3 +2154,103 @@ fn every_write_strategy_writes_the_document_the_rewrite_writes() {
         "each strategy is chosen for one of the runs"
     );
 }
+
+/// A dry run's edits (each material's, then the file's, then the bakes') applied to the
+/// input's JSON, in the order the report lists them.
+fn dry_run_document(input: &Path, result: &migrating::FileResult) -> Value {
+    let mut json: Value = serde_json::from_slice(&std::fs::read(input).unwrap()).unwrap();
+    for m in &result.detail.materials {
+        velvet::edit::apply(&mut json, &m.edits).unwrap();
+    }
+    velvet::edit::apply(&mut json, &result.detail.edits).unwrap();
+    velvet::edit::apply(&mut json, &result.detail.bake_edits).unwrap();
+    json
+}
+
+#[test]
+fn a_dry_runs_edits_applied_to_the_input_give_the_written_document_bakes_included() {
+    let variants: [(&str, fn(&mut Options)); 3] = [
+        ("default", |_| {}),
+        ("exact", |o| o.exact = true),
+        ("budget exact", |o| {
+            o.budget = migrate::budget::Budget::Exact
+        }),
+    ];
+    let mut with_new_images = Vec::new();
+    for case in cases() {
+        for (label, set) in variants {
+            let mut options = options_for(&case);
+            set(&mut options);
+            let dir = tempfile::tempdir().unwrap();
+            let input = dir.path().join("in").join(case.file_name().unwrap());
+            std::fs::create_dir_all(input.parent().unwrap()).unwrap();
+            std::fs::copy(&case, &input).unwrap();
+            let out_dir = dir.path().join("out");
+            let mut run = request(
+                vec![input.clone()],
+                Destination::Dir(out_dir.clone()),
+                options,
+            );
+            run.dry_run = true;
+            let planned = migrating::run(&run).unwrap().files.remove(0);
+            assert!(
+                matches!(planned.outcome, FileOutcome::Planned { .. }),
+                "{} ({label}): {:?}",
+                stem(&case),
+                planned.outcome
+            );
+            assert!(!out_dir.exists(), "a dry run writes nothing");
+            run.dry_run = false;
+            let written = migrating::run(&run).unwrap().files.remove(0);
+            let output = out_dir.join(case.file_name().unwrap());
+            let expected: Value = match written.outcome {
+                FileOutcome::Changed | FileOutcome::Copied => {
+                    serde_json::from_slice(&std::fs::read(&output).unwrap()).unwrap()
+                }
+                ref other => panic!("{} ({label}): {other:?}", stem(&case)),
+            };
+            assert_eq!(
+                dry_run_document(&input, &planned),
+                expected,
+                "{} ({label})",
+                stem(&case)
+            );
+            let new_images: Vec<String> = planned
+                .detail
+                .bake_edits
+                .iter()
+                .filter_map(|e| match e {
+                    velvet::edit::Edit::Replace { pointer, value }
+                        if pointer.starts_with("/images/") =>
+                    {
+                        value.get("uri").and_then(Value::as_str).map(str::to_owned)
+                    }
+                    _ => None,
+                })
+                .collect();
+            for uri in &new_images {
+                assert!(out_dir.join(uri).is_file(), "{uri} is written as named");
+            }
+            if !new_images.is_empty() {
+                with_new_images.push(format!("{} ({label}): {}", stem(&case), new_images.len()));
+            }
+        }
+    }
+    // The fixtures whose bakes add images, and how many each adds (legacy's roughness bake,
+    // sheen-textures' mapped roughness, --exact's fuzz and fuzz colour textures).
+    assert_eq!(
+        with_new_images,
+        [
+            "fuzz-textures (default): 3",
+            "fuzz-textures (exact): 3",
+            "fuzz-textures (budget exact): 3",
+            "legacy-texcoord (exact): 2",
+            "legacy (default): 2",
+            "legacy (exact): 4",
+            "legacy (budget exact): 2",
+            "sheen-textures (default): 1",
+            "sheen-textures (exact): 5",
+            "sheen-textures (budget exact): 1",
+        ]
+    );
+}

@@ -493,3 +493,109 @@ fn baked_by_part<'a>(
     };
     Ok(Some((bytes, changed, applied.outputs)))
 }
+
+/// The edits a dry run adds for the plan's bakes: the textures baked in memory (nothing is
+/// written) and applied to the document the plan's other edits give, then the difference as
+/// edits (`set` of each value the bake changes or adds, the new `images` and `textures`
+/// entries among them under the names they get, `remove` of what it drops). Applied after the
+/// materials' edits, the declarations and the URI rewrites, in that order, they give the
+/// document a run writes. A new image is named after a hash of its bytes, so only a bake can
+/// say its name. Empty when the plan bakes nothing.
+pub fn dry_run_bake_edits(plan: &FilePlan, claims: &Claims) -> Result<Vec<edit::Edit>, String> {
+    let bake_plan = textures::bake_plan(plan.document.materials.iter().flat_map(|m| &m.bakes))
+        .map_err(|e| format!("{}: {e}", plan.input.display()))?;
+    if bake_plan.is_empty() {
+        return Ok(Vec::new());
+    }
+    let options = BakeOptions {
+        kernel: KernelOptions {
+            exact: false,
+            measure: false,
+        },
+        max_image_pixels: crate::bake::engine::MaxImagePixels(plan.asset.options.max_image_pixels),
+        max_memory: crate::bake::engine::MaxMemory(plan.asset.options.max_memory),
+        ..BakeOptions::default()
+    };
+    let mut baked = Vec::with_capacity(bake_plan.recipes.len());
+    for (info, result) in
+        bake_plan
+            .outputs
+            .iter()
+            .zip(bake_into(&bake_plan.recipes, &plan.asset, &options, None))
+    {
+        baked.push(result.map_err(|e| {
+            format!(
+                "{}: cannot bake {} of image {}: {e}",
+                plan.input.display(),
+                info.labels.join(" + "),
+                info.image
+            )
+        })?);
+    }
+    let fail = |e: edit::EditError| format!("{}: {e}", plan.input.display());
+    let mut before = plan.asset.root().to_value();
+    for edits in plan
+        .document
+        .materials
+        .iter()
+        .map(|m| m.edits.as_slice())
+        .chain([
+            plan.document.declarations.as_slice(),
+            plan.relocation.edits.as_slice(),
+        ])
+    {
+        edit::apply(&mut before, edits).map_err(fail)?;
+    }
+    // Named as the run names them: next to the output (the input itself without one).
+    let output = plan.output.as_deref().unwrap_or(&plan.input);
+    let mut names = FileNames::next_to(claims, &plan.asset, &plan.input, output, &plan.relocation);
+    let applied = bake_apply(
+        before.clone(),
+        plan.asset.bin.clone(),
+        plan.asset.container,
+        &bake_plan,
+        &mut baked,
+        ApplyOptions { embed: plan.embed },
+        &mut names,
+    );
+    let mut edits = Vec::new();
+    difference("", &before, &applied.json, &mut edits);
+    Ok(edits)
+}
+
+/// The edits that turn `from` into `to` (at `pointer`): members and elements compared one by
+/// one, so that each edit names the value it changes; an array that grows keeps its elements
+/// and gains the new ones at its end (`set` at its length appends).
+fn difference(
+    pointer: &str,
+    from: &serde_json::Value,
+    to: &serde_json::Value,
+    out: &mut Vec<edit::Edit>,
+) {
+    use serde_json::Value;
+    match (from, to) {
+        _ if from == to => {}
+        (Value::Object(a), Value::Object(b)) => {
+            for (key, value) in a {
+                let at = crate::asset::pointer::join(pointer, key);
+                match b.get(key) {
+                    Some(new) => difference(&at, value, new, out),
+                    None => out.push(edit::Edit::remove(at)),
+                }
+            }
+            for (key, value) in b.iter().filter(|(k, _)| !a.contains_key(*k)) {
+                let at = crate::asset::pointer::join(pointer, key);
+                out.push(edit::Edit::replace(at, value.clone()));
+            }
+        }
+        (Value::Array(a), Value::Array(b)) if a.len() <= b.len() => {
+            for (i, (old, new)) in a.iter().zip(b).enumerate() {
+                difference(&format!("{pointer}/{i}"), old, new, out);
+            }
+            for (i, new) in b.iter().enumerate().skip(a.len()) {
+                out.push(edit::Edit::replace(format!("{pointer}/{i}"), new.clone()));
+            }
+        }
+        _ => out.push(edit::Edit::replace(pointer.to_string(), to.clone())),
+    }
+}

@@ -38,6 +38,12 @@ pub struct MigrateDetail {
     pub materials: Vec<MaterialPlan>,
     /// Edits outside the materials: declarations and URI rewrites.
     pub edits: Vec<Edit>,
+    /// A dry run's edits of the bakes, applied after the materials' edits and `edits`: the
+    /// new `images` and `textures` entries (under the names they will have) and the slots
+    /// that read them (see [`crate::migrate::apply::dry_run_bake_edits`]). Empty in a run
+    /// that writes: the bakes' outcome is in `textures_added` and the notes.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub bake_edits: Vec<Edit>,
     pub copies: Vec<ResourceCopy>,
     #[serde(serialize_with = "crate::migrate::material::notes_json")]
     pub notes: Vec<Note>,
@@ -108,9 +114,16 @@ fn migrate_one(
     let sheets = sheets.then(|| {
         crate::preview::material::materials(&plan.asset, &plan.document, options.roughness)
     });
+    let mut bake_edits = Vec::new();
     let outcome = if dry_run {
-        FileOutcome::Planned {
-            changes: plan.changes(),
+        match crate::migrate::apply::dry_run_bake_edits(&plan, claims) {
+            Ok(edits) => {
+                bake_edits = edits;
+                FileOutcome::Planned {
+                    changes: plan.changes(),
+                }
+            }
+            Err(error) => FileOutcome::Failed { error },
         }
     } else {
         match execute(&mut plan, claims) {
@@ -167,6 +180,7 @@ fn migrate_one(
                 .chain(&plan.relocation.edits)
                 .cloned()
                 .collect(),
+            bake_edits,
             materials: plan.document.materials,
             copies: plan.relocation.copies,
             notes,

@@ -108,7 +108,7 @@ pub fn file_text(f: &FileResult, plan: bool) -> String {
         );
     }
     if plan {
-        for edit in &f.detail.edits {
+        for edit in f.detail.edits.iter().chain(&f.detail.bake_edits) {
             push_line(&mut out, &format!("  {edit}"));
         }
         for copy in &f.detail.copies {
