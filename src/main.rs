@@ -637,6 +637,9 @@ fn migrate(args: MigrateArgs, quiet: bool) -> Status {
             fast: args.fast,
             budget: args.roughness_budget,
             rewrite_uris: args.rewrite_uris,
+            // The speed paths leave the verdict out unless a view reads it.
+            skip_verdict: (args.fast || matches!(args.roughness, RoughnessArg::Identity))
+                && args.preview.is_none(),
             load: args.load.options(),
         },
         dry_run: args.dry_run || args.check,

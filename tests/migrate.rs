@@ -854,7 +854,7 @@ fn dry_run_prints_the_plan_and_writes_nothing() {
     );
     let text = render::text(&report, Detail::Verbose);
     assert!(
-        text.contains("  material 0 \"champagne\": sheen → fuzz\n"),
+        text.contains("  material 0 \"champagne\": sheen → fuzz; verdict close (ꟻLIP 0.161 in the furnace, 0.272 under the light)\n"),
         "{text}"
     );
     assert!(text.contains(
@@ -864,7 +864,7 @@ fn dry_run_prints_the_plan_and_writes_nothing() {
         text.contains("  declare KHR_materials_fuzz in /extensionsUsed\n"),
         "{text}"
     );
-    assert!(text.ends_with("1 file: 1 would change, 0 unchanged, 0 failed; no texture to add\nmaterials: 3 migrated (3 sheen → fuzz); 0 skipped; 0 warnings\n"), "{text}");
+    assert!(text.ends_with("1 file: 1 would change, 0 unchanged, 0 failed; no texture to add\nmaterials: 3 migrated (3 sheen → fuzz); 0 skipped; 0 warnings\nverdicts: 0 same, 3 close, 0 visible\n"), "{text}");
     let json: Value = serde_json::from_str(&render::json(&report)).unwrap();
     assert_eq!(json["files"][0]["status"], "planned");
     assert_eq!(json["files"][0]["materials"][0]["edits"][0]["op"], "set");
@@ -873,6 +873,14 @@ fn dry_run_prints_the_plan_and_writes_nothing() {
         serde_json::json!({"op": "declare-used", "extension": "KHR_materials_fuzz"})
     );
     assert_eq!(json["summary"]["conversions"]["sheen-to-fuzz"], 3);
+    assert_eq!(
+        json["files"][0]["materials"][1]["verdict"],
+        serde_json::json!({"label": "close", "flip": 0.1112, "furnace": 0.1112, "light": 0.1473})
+    );
+    assert_eq!(
+        json["summary"]["verdicts"],
+        serde_json::json!({"same": 0, "close": 3, "visible": 0})
+    );
 }
 
 fn velvet(args: &[&str]) -> (i32, String, String) {
@@ -2169,7 +2177,8 @@ fn dry_run_document(input: &Path, result: &migrating::FileResult) -> Value {
 
 #[test]
 fn a_dry_runs_edits_applied_to_the_input_give_the_written_document_bakes_included() {
-    let variants: [(&str, fn(&mut Options)); 3] = [
+    type Variant = (&'static str, fn(&mut Options));
+    let variants: [Variant; 3] = [
         ("default", |_| {}),
         ("exact", |o| o.exact = true),
         ("budget exact", |o| {

@@ -37,8 +37,8 @@ fn materials_with(
     asset: &velvet::asset::Asset,
     options: &velvet::migrate::Options,
 ) -> Vec<material::Material> {
-    let plan = velvet::migrate::plan_document(asset, options);
-    material::materials(asset, &plan, options.roughness)
+    let mut plan = velvet::migrate::plan_document(asset, options);
+    velvet::preview::verdict::judge(asset, &mut plan, options)
 }
 
 /// Interior pixels (whole pixel on the sphere) of a sphere of `size`.
@@ -821,7 +821,7 @@ fn materials_with_the_same_values_share_one_sheet_which_lists_them() {
 }
 
 #[test]
-fn worst_n_draws_exactly_the_n_sheets_the_plans_metric_ranks_highest() {
+fn worst_n_draws_exactly_the_n_sheets_the_plans_verdict_ranks_highest() {
     let dir = tempfile::tempdir().unwrap();
     // Roughness from very low (held at migrate's floor: a large difference) to high.
     let roughness = [0.9, 0.02, 0.5, 0.05, 0.3, 0.7, 0.1, 0.2];
@@ -831,13 +831,13 @@ fn worst_n_draws_exactly_the_n_sheets_the_plans_metric_ranks_highest() {
         .map(|(i, r)| sheen(&format!("s{i}"), 0.9, *r))
         .collect();
     let input = write(dir.path(), "ranked.gltf", &gltf(&materials.join(", ")));
-    // The metric of each material, computed here from its own columns.
+    // The plan's verdict on each material, measured here from its own columns.
     let asset = load(&input);
     let mut by_metric: Vec<(f64, String)> = materials_of(&asset)
         .iter()
         .map(|m| {
             (
-                m.plan_metric(),
+                velvet::preview::verdict::measure_pairs(&velvet::preview::verdict::pairs(m)).flip,
                 format!("ranked-m{}-{}.png", m.index, m.name.as_deref().unwrap()),
             )
         })
@@ -899,7 +899,7 @@ fn a_library_larger_than_a_page_gets_pages_linked_from_the_first() {
     let metrics: Vec<f64> = written
         .drawn
         .iter()
-        .map(|d| plan.sheets[d.sheet].metric)
+        .map(|d| plan.sheets[d.sheet].verdict.flip)
         .collect();
     assert!(metrics.windows(2).all(|w| w[0] >= w[1]));
 }
@@ -1063,15 +1063,15 @@ fn the_verdict_sends_a_floored_fallback_to_look_and_passes_a_good_match() {
     let good = sheet::render("good", &m[0]).summary;
     let sharp = sheet::render("sharp", &m[1]).summary;
     assert_ne!(
-        good.verdict,
-        sheet::Verdict::Visible,
+        good.verdict.label,
+        sheet::Label::Visible,
         "{}",
         good.verdict_line()
     );
     assert!(good.flip[0] <= sheet::CLOSE_FLIP);
     assert_eq!(
-        sharp.verdict,
-        sheet::Verdict::Visible,
+        sharp.verdict.label,
+        sheet::Label::Visible,
         "{}",
         sharp.verdict_line()
     );

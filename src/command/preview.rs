@@ -89,7 +89,7 @@ pub(super) fn write(
                     "{}: {} ({})",
                     d.path.display(),
                     d.summary.title,
-                    d.summary.verdict.text()
+                    d.summary.verdict.label.text()
                 ),
             );
         }

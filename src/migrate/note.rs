@@ -215,6 +215,14 @@ pub enum Note {
         /// `None`: the exact setting.
         budget: Option<f64>,
     },
+    /// The material as written looks visibly different from the material as authored (the
+    /// plan's verdict is "visible"); `remedy` is the run that would bring it to a better label,
+    /// when one would, and `tried` the flags measured.
+    VisibleDifference {
+        verdict: super::verdict::Verdict,
+        remedy: Option<super::verdict::Remedy>,
+        tried: Vec<String>,
+    },
     /// The best roughness lies below the floor renderers honour alike: the floor is written.
     RoughnessFloor {
         property: String,
@@ -292,6 +300,7 @@ impl Note {
             | Note::LegacyTextureIntensity
             | Note::LegacyMixed { .. }
             | Note::TextureDropped { .. }
+            | Note::VisibleDifference { .. }
             | Note::ResourceMissing { .. } => Level::Warning,
         }
     }
@@ -422,6 +431,34 @@ impl Note {
                     "{property}: {}, {factor_key} {factor}; largest roughness difference from the exact mapping {max_error:.4}, {verdict}",
                     plan.describe()
                 )
+            }
+            Note::VisibleDifference { verdict, remedy, tried } => {
+                let mut m = format!(
+                    "the migrated material looks visibly different from the authored one: ꟻLIP {:.3} in the furnace (above {}), {:.3} under the light",
+                    verdict.furnace,
+                    super::verdict::CLOSE_FLIP,
+                    verdict.light
+                );
+                match (remedy, tried.is_empty()) {
+                    (Some(r), _) => m += &format!(
+                        "; {} would bring it to {}",
+                        r.flags,
+                        r.verdict.describe()
+                    ),
+                    (None, true) => m += "; no other plan velvet offers changes this material (no texture to bake): look at the preview before trusting it",
+                    (None, false) => m += &format!(
+                        "; {} {}: look at the preview before trusting it",
+                        match tried.len() {
+                            1 => tried[0].clone(),
+                            _ => format!("neither {}", tried.join(" nor ")),
+                        },
+                        match tried.len() {
+                            1 => "would not bring it closer",
+                            _ => "would bring it closer",
+                        }
+                    ),
+                }
+                m
             }
             Note::RoughnessFloor { property, best, written } => format!(
                 "{property}: the best match, {best:.4}, lies below {written} (the floor renderers honour alike), so {written} is written: {:.4} rougher than the best match",

@@ -100,9 +100,9 @@ fn html(plan: &Plan, sheets: &[Drawn], page: usize, total: usize, drawn: usize) 
         h += "<section>\n";
         h += &format!("<h2>{}. {}</h2>\n", d.sheet + 1, escape(&sum.title));
         h += &format!(
-            "<p>{} (plan measure {:.4})</p>\n",
+            "<p>{} (the plan's verdict: {})</p>\n",
             escape(sum.kind),
-            planned.metric
+            planned.verdict.describe()
         );
         h += &format!(
             "<a href=\"{0}\"><img src=\"{0}\" alt=\"{1}\"></a>\n",
@@ -136,11 +136,7 @@ fn html(plan: &Plan, sheets: &[Drawn], page: usize, total: usize, drawn: usize) 
                 plan.sheets.len() - drawn
             );
             for s in &plan.sheets[drawn..] {
-                h += &format!(
-                    "<li>{} (plan measure {:.4})</li>\n",
-                    escape(&s.title),
-                    s.metric
-                );
+                h += &format!("<li>{} ({})</li>\n", escape(&s.title), s.verdict.describe());
             }
             h += "</ul>\n";
         }

@@ -103,6 +103,9 @@ pub struct Material {
     /// The roughness mapping of the run the plan was made for; the sheet's other column
     /// shows the other one.
     pub mapping: RoughnessMapping,
+    /// The plan's verdict on it (`preview::verdict`), once measured: the sheet's label and the
+    /// run's ranking.
+    pub verdict: Option<crate::migrate::verdict::Verdict>,
 }
 
 impl Material {
@@ -124,37 +127,6 @@ impl Material {
                 self.mapping
             )
         )
-    }
-
-    /// How far the migration moves the material's look, from the plan's numbers alone (nothing
-    /// rendered), to rank a library's materials before any sheet is drawn: the largest
-    /// |max3·E − w·R| between the authored layer and the one the migrated file adds or keeps
-    /// for loaders without fuzz (columns 0 and 1), at the factors, over views with μ ≥ 0.1 (the
-    /// report's "max_ordinary"). E and R come from their tables (a few ns each where
-    /// quadrature takes tens of µs, so a 20,000-material library is ranked in well under a
-    /// second); there the tables are within 6e-3 (E, r ≥ 0.25) and 1e-3 (R) of quadrature
-    /// (docs/shading.md), while at grazing views and small roughness the E table's error
-    /// reaches units, which is why grazing views are left out. 0 when the columns hold no
-    /// sheen–fuzz pair.
-    pub fn plan_metric(&self) -> f64 {
-        use crate::shading::layering::{FuzzReflectance, SheenAlbedo};
-        use crate::shading::{AlbedoMethod, ReflectanceMethod};
-        let cols = columns(self, &self.factors);
-        match cols
-            .get(1)
-            .and_then(|c| layer_pair(&cols[0].look.layer, &c.look.layer))
-        {
-            Some((sheen, fuzz)) => {
-                crate::shading::mapping::layer_match_with(
-                    sheen,
-                    fuzz,
-                    &SheenAlbedo(AlbedoMethod::Lut32),
-                    &FuzzReflectance(ReflectanceMethod::Table),
-                )
-                .max_ordinary
-            }
-            None => 0.0,
-        }
     }
 }
 
@@ -180,19 +152,22 @@ pub struct TextureStats {
 /// exclude both layers, so migrate leaves them), and a switched-off sheen or fuzz alone (to
 /// which migrate adds nothing), are left out.
 pub fn materials(asset: &Asset, plan: &DocumentPlan, mapping: RoughnessMapping) -> Vec<Material> {
-    let images = ImageCache::default();
-    // Each material's plan by index (the first, as a search in order would find it).
-    let mut planned: std::collections::HashMap<usize, &MaterialPlan> = Default::default();
-    for p in &plan.materials {
-        planned.entry(p.index).or_insert(p);
-    }
-    layers::materials(asset.json())
+    materials_with(asset, plan, mapping, &ImageCache::default())
+}
+
+/// [`materials`], the images' statistics read through `images` (shared by the reads of one
+/// document). Only the materials `plan` holds are read: the planner plans every material with
+/// a sheen or fuzz layer, and a plan of some materials alone gives those.
+pub(super) fn materials_with(
+    asset: &Asset,
+    plan: &DocumentPlan,
+    mapping: RoughnessMapping,
+    images: &ImageCache,
+) -> Vec<Material> {
+    let all = layers::materials(asset.json());
+    plan.materials
         .par_iter()
-        .enumerate()
-        .filter_map(|(index, m)| {
-            let planned = planned.get(&index).copied();
-            read(asset, index, m, planned, mapping, &images)
-        })
+        .filter_map(|p| read(asset, p.index, all.get(p.index)?, Some(p), mapping, images))
         .collect()
 }
 
@@ -222,7 +197,7 @@ fn migrated(material: &Value, index: usize, plan: &MaterialPlan) -> Result<Value
 /// Each image's statistics per way of reading it, computed once however many materials (on
 /// however many threads) read it: the first to ask computes them, the others wait for them.
 #[derive(Default)]
-struct ImageCache {
+pub(super) struct ImageCache {
     stats: std::sync::Mutex<HashMap<(usize, Read, Transfer), StatsCell>>,
 }
 
@@ -417,6 +392,7 @@ fn read(
         notes,
         fuzz_roughness_assumed,
         mapping,
+        verdict: None,
     })
 }
 
@@ -929,6 +905,7 @@ mod tests {
             notes: vec![],
             fuzz_roughness_assumed: false,
             mapping: RoughnessMapping::Fitted,
+            verdict: None,
         };
         let cols = columns(&m, &m.factors);
         assert_eq!(cols.len(), 3);

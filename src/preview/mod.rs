@@ -24,6 +24,7 @@ pub mod material;
 pub mod overview;
 pub mod shade;
 pub mod sheet;
+pub mod verdict;
 
 use crate::asset::discover;
 use crate::edit::write::write_atomic;
@@ -68,8 +69,8 @@ pub struct SheetPlan {
     pub material: material::Material,
     /// The entries it shows, in input order.
     pub entries: Vec<usize>,
-    /// [`material::Material::plan_metric`].
-    pub metric: f64,
+    /// The plan's verdict on the material ([`verdict`]): the sheet's label and its rank.
+    pub verdict: crate::migrate::verdict::Verdict,
 }
 
 /// What a preview run draws, decided before anything is drawn.
@@ -184,8 +185,8 @@ pub fn plan(inputs: &[PathBuf], options: &crate::migrate::Options) -> Plan {
             let loaded = crate::asset::load_with(&file, &options.load);
             let materials = match loaded.asset {
                 Some(asset) => {
-                    let plan = crate::migrate::plan_document(&asset, options);
-                    Ok(material::materials(&asset, &plan, options.roughness))
+                    let mut plan = crate::migrate::plan_document(&asset, options);
+                    Ok(verdict::judge(&asset, &mut plan, options))
                 }
                 None => Err(loaded
                     .diagnostics
@@ -262,7 +263,9 @@ pub fn assemble(files: Vec<FileMaterials>, walk_errors: WalkErrors) -> Plan {
         .map(|&e| SheetPlan {
             name: sheet_name(&plan.entries[e]),
             title: plan.entries[e].title(),
-            metric: materials[e].plan_metric(),
+            verdict: materials[e]
+                .verdict
+                .unwrap_or_else(|| verdict::measure_pairs(&verdict::pairs(&materials[e]))),
             material: materials[e].clone(),
             entries: Vec::new(),
         })
@@ -279,14 +282,14 @@ pub fn assemble(files: Vec<FileMaterials>, walk_errors: WalkErrors) -> Plan {
             );
         }
     }
-    // Worst first; a NaN metric (none is expected) ranks as the worst.
+    // Worst first by the plan's verdict; a NaN (none is expected) ranks as the worst.
     let mut order: Vec<usize> = (0..sheets.len()).collect();
     order.sort_by(|&a, &b| {
         let key = |s: &SheetPlan| {
-            if s.metric.is_nan() {
+            if s.verdict.flip.is_nan() {
                 f64::INFINITY
             } else {
-                s.metric
+                s.verdict.flip
             }
         };
         key(&sheets[b]).total_cmp(&key(&sheets[a])).then(a.cmp(&b))
@@ -371,13 +374,17 @@ pub fn write(
     if written.stopped {
         return Ok(written);
     }
-    let flips: Vec<f64> = written.drawn.iter().map(|d| d.summary.flip[0]).collect();
+    let flips: Vec<f64> = written
+        .drawn
+        .iter()
+        .map(|d| d.summary.verdict.flip)
+        .collect();
     let path = out_dir.join("overview.png");
     let chosen_sheets: Vec<(f64, bool)> = plan
         .sheets
         .iter()
         .enumerate()
-        .map(|(s, sheet)| (sheet.metric, s < chosen))
+        .map(|(s, sheet)| (sheet.verdict.flip, s < chosen))
         .collect();
     write_atomic(
         &path,

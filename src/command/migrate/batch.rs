@@ -7,6 +7,7 @@ use crate::edit::Edit;
 use crate::migrate::apply::{execute, plan_file, Written};
 use crate::migrate::material::MaterialPlan;
 use crate::migrate::note::{Conversion, Level, Note, Skip};
+use crate::migrate::verdict::LabelCounts;
 use crate::migrate::Options;
 use crate::output::files::Claims;
 use crate::output::paths::{Destination, Job, ResourceCopy};
@@ -80,6 +81,8 @@ pub struct Summary {
     pub materials_migrated: usize,
     pub conversions: BTreeMap<Conversion, usize>,
     pub skipped: BTreeMap<Skip, usize>,
+    /// The migrated materials by their plan's verdict (those measured).
+    pub verdicts: LabelCounts,
 }
 
 /// The outcome of a run: every file in input order, and the totals.
@@ -111,9 +114,11 @@ fn migrate_one(
         Ok(plan) => plan,
         Err(error) => return FileResult::failed(&job.input, job.output.as_deref(), error),
     };
-    let sheets = sheets.then(|| {
-        crate::preview::material::materials(&plan.asset, &plan.document, options.roughness)
-    });
+    // The plan's verdict, measured by the preview's renderer as soon as the plan is made; the
+    // materials it reads are the sheets' when `--preview` asks for them.
+    let judged = (sheets || !options.skip_verdict)
+        .then(|| crate::preview::verdict::judge(&plan.asset, &mut plan.document, options));
+    let sheets = judged.filter(|_| sheets);
     let mut bake_edits = Vec::new();
     let outcome = if dry_run {
         match crate::migrate::apply::dry_run_bake_edits(&plan, claims) {
@@ -246,6 +251,9 @@ fn summarise(files: &[FileResult]) -> Summary {
             }
             for c in &material.conversions {
                 *s.conversions.entry(*c).or_default() += 1;
+            }
+            if let (true, Some(v)) = (material.migrated(), material.verdict) {
+                s.verdicts.add(v.label);
             }
             if let Some(why) = material.skipped {
                 *s.skipped.entry(why).or_default() += 1;

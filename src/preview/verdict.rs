@@ -1,0 +1,258 @@
+//! The plan's verdict, measured: for each material a sheet shows, the material as authored
+//! (column 0) against the material as written (column 1) at each swatch, the textures reduced
+//! as the sheets reduce them ([`super::material`]), rendered as small spheres ([`SPHERE`]
+//! pixels across, at the sheets' viewing angle: ꟻLIP's pixels per degree scaled with the size)
+//! in the white furnace and under the directional light, with the sheets' own shading
+//! ([`super::shade`] at [`Quality::Verdict`]) and ꟻLIP pooled as the sheets pool it (the 99th
+//! percentile over the sphere, the largest over the swatches). The furnace's value decides the
+//! label by the thresholds of [`crate::migrate::verdict`], as the sheets' did.
+//!
+//! This module owns that measurement and writes it into migrate's plan ([`judge`]): the
+//! preview lies above migrate (it draws from migrate's plan), so the plan's verdict is measured
+//! here, right after planning, by every command that plans (migrate, preview). Each distinct
+//! set of material values is measured once per document; each measurement depends on its
+//! values alone, so the verdicts do not depend on the thread count. A "visible" material that
+//! a migration changes is planned again, alone, with the flags that could bring it closer
+//! (`--exact`, `--roughness-budget exact`, both), and the best verdict one reaches is its
+//! warning's remedy.
+
+use super::material::{self, columns, Material};
+use super::shade::{render_sphere, Light, Look, Quality, Shaded};
+use super::sheet;
+use crate::asset::Asset;
+use crate::migrate::budget::Budget;
+use crate::migrate::verdict::{Label, Remedy, Verdict};
+use crate::migrate::{DocumentPlan, Note, Options};
+use rayon::prelude::*;
+use std::collections::HashMap;
+
+/// The verdict's sphere, in pixels across: a quarter of a sheet's, at a sixteenth of the
+/// pixels.
+pub const SPHERE: usize = 24;
+
+/// The step every value of a look is rounded to before it is measured (colours and weights
+/// linear, roughness): materials whose values differ by less share one measurement. A step
+/// (0.002) is half an 8-bit code of mid-grey linear light and a fifth of migrate's default
+/// roughness budget (0.01, itself a difference chosen as one no one sees, docs/migrate.md);
+/// a library whose every factor differs by a little is measured in a fraction of the time
+/// (the 20,000-material library's verdicts take 1.4 s of its 3.5 s, where at a step of 1/1024
+/// they took 8 s). The verdict is the rounded look's, so it is still a function of the
+/// material's own values.
+pub const VALUE_STEP: f64 = 1.0 / 512.0;
+
+/// `look` with every value rounded to [`VALUE_STEP`].
+pub fn rounded(look: Look) -> Look {
+    use super::shade::Layer;
+    let r = |v: f64| (v / VALUE_STEP).round() * VALUE_STEP;
+    Look {
+        base: look.base.map(r),
+        base_metallic: r(look.base_metallic),
+        base_roughness: r(look.base_roughness),
+        layer: match look.layer {
+            Layer::None => Layer::None,
+            Layer::Sheen { color, roughness } => Layer::Sheen {
+                color: color.map(r),
+                roughness: r(roughness),
+            },
+            Layer::Fuzz {
+                color,
+                weight,
+                roughness,
+            } => Layer::Fuzz {
+                color: color.map(r),
+                weight: r(weight),
+                roughness: r(roughness),
+            },
+        },
+    }
+}
+
+/// ꟻLIP's pixels per degree for the verdict's spheres: the default (a sheet's) scaled with the
+/// sphere, so that a small sphere subtends the angle a sheet's does and the metric's filters
+/// cover the same part of it.
+pub fn pixels_per_degree() -> f32 {
+    nv_flip::DEFAULT_PIXELS_PER_DEGREE * SPHERE as f32 / sheet::SPHERE as f32
+}
+
+/// The looks a verdict compares at each swatch: the material as authored and as written, each
+/// [`rounded`].
+pub fn pairs(material: &Material) -> Vec<(Look, Look)> {
+    material
+        .swatches
+        .iter()
+        .filter_map(|s| {
+            let cols = columns(material, s);
+            Some((rounded(cols.first()?.look), rounded(cols.get(1)?.look)))
+        })
+        .collect()
+}
+
+/// The verdict on the pairs of looks of one material.
+pub fn measure_pairs(pairs: &[(Look, Look)]) -> Verdict {
+    let on_sphere: Vec<bool> = render_sphere(
+        &Shaded::with_quality(pairs.first().map_or(BLANK, |p| p.0), Quality::Verdict),
+        Light::Furnace,
+        SPHERE,
+    )
+    .coverage
+    .iter()
+    .map(|&c| c > 0.5)
+    .collect();
+    let mut flips = [0.0f64; 2];
+    for (authored, written) in pairs {
+        let (a, b) = (
+            Shaded::with_quality(*authored, Quality::Verdict),
+            Shaded::with_quality(*written, Quality::Verdict),
+        );
+        for (slot, light) in [Light::Furnace, Light::Directional].into_iter().enumerate() {
+            let codes = |s: &Shaded| sheet::sphere_codes_clamped(&render_sphere(s, light, SPHERE));
+            let flip = sheet::flip_p99_at(&codes(&a), &codes(&b), &on_sphere, pixels_per_degree());
+            flips[slot] = flips[slot].max(flip);
+        }
+    }
+    Verdict::new(flips[0], flips[1])
+}
+
+/// A look with no layer, for a material without pairs (its coverage is all that is read).
+const BLANK: Look = Look {
+    base: [0.0; 3],
+    base_metallic: 0.0,
+    base_roughness: 1.0,
+    layer: super::shade::Layer::None,
+};
+
+/// The verdict of each of `materials`, each distinct set of looks measured once (in parallel).
+pub fn measure_all(materials: &[Material]) -> Vec<Verdict> {
+    let keys: Vec<(String, Vec<(Look, Look)>)> = materials
+        .par_iter()
+        .map(|m| {
+            let pairs = pairs(m);
+            (format!("{pairs:?}"), pairs)
+        })
+        .collect();
+    let mut first_of: HashMap<&str, usize> = HashMap::new();
+    let mut distinct: Vec<usize> = Vec::new();
+    let slot: Vec<usize> = keys
+        .iter()
+        .enumerate()
+        .map(|(i, (key, _))| {
+            *first_of.entry(key.as_str()).or_insert_with(|| {
+                distinct.push(i);
+                distinct.len() - 1
+            })
+        })
+        .collect();
+    let verdicts: Vec<Verdict> = distinct
+        .par_iter()
+        .map(|&i| measure_pairs(&keys[i].1))
+        .collect();
+    slot.into_iter().map(|s| verdicts[s]).collect()
+}
+
+/// The flags that could bring a material closer, beyond `options`, with the options they give.
+fn remedies(options: &Options) -> Vec<(&'static str, Options)> {
+    let mut out = Vec::new();
+    if !options.exact {
+        out.push((
+            "--exact",
+            Options {
+                exact: true,
+                ..options.clone()
+            },
+        ));
+    }
+    if options.budget != Budget::Exact {
+        out.push((
+            "--roughness-budget exact",
+            Options {
+                budget: Budget::Exact,
+                ..options.clone()
+            },
+        ));
+    }
+    if out.len() == 2 {
+        out.push((
+            "--exact --roughness-budget exact",
+            Options {
+                exact: true,
+                budget: Budget::Exact,
+                ..options.clone()
+            },
+        ));
+    }
+    out
+}
+
+/// Measures the verdict of every material of `plan` a sheet shows, writes it into the plan
+/// (and a warning on each "visible" material the migration changes, with the run that would
+/// bring it closer when one would), and returns the materials as the sheets show them, in
+/// document order, each with its verdict.
+pub fn judge(asset: &Asset, plan: &mut DocumentPlan, options: &Options) -> Vec<Material> {
+    let cache = material::ImageCache::default();
+    let mut materials = material::materials_with(asset, plan, options.roughness, &cache);
+    let verdicts = measure_all(&materials);
+    let mut at: HashMap<usize, usize> = HashMap::new();
+    for (k, m) in plan.materials.iter().enumerate() {
+        at.entry(m.index).or_insert(k);
+    }
+    let mut visible: Vec<usize> = Vec::new();
+    for (m, v) in materials.iter_mut().zip(verdicts) {
+        m.verdict = Some(v);
+        if let Some(&k) = at.get(&m.index) {
+            plan.materials[k].verdict = Some(v);
+            if v.label == Label::Visible && plan.materials[k].migrated() {
+                visible.push(k);
+            }
+        }
+    }
+    if visible.is_empty() {
+        return materials;
+    }
+    // Each visible material planned again, alone, with each remedy's flags; a remedy that
+    // leaves its plan as it was is not one for it.
+    let indices: Vec<usize> = visible.iter().map(|&k| plan.materials[k].index).collect();
+    let mut tried: Vec<Vec<String>> = vec![Vec::new(); visible.len()];
+    let mut best: Vec<Option<Remedy>> = vec![None; visible.len()];
+    for (flags, alternative) in remedies(options) {
+        let other = crate::migrate::plan::plan_materials(asset, &indices, &alternative);
+        let read = material::materials_with(asset, &other, alternative.roughness, &cache);
+        let measured = measure_all(&read);
+        for (j, &k) in visible.iter().enumerate() {
+            let current = &plan.materials[k];
+            let Some(changed) = other.materials.iter().find(|p| p.index == current.index) else {
+                continue;
+            };
+            if changed.edits == current.edits && changed.bakes == current.bakes {
+                continue;
+            }
+            tried[j].push(flags.to_string());
+            let Some(v) = read
+                .iter()
+                .zip(&measured)
+                .find(|(m, _)| m.index == current.index)
+                .map(|(_, v)| *v)
+            else {
+                continue;
+            };
+            let better = match &best[j] {
+                Some(b) => (v.label, v.flip) < (b.verdict.label, b.verdict.flip),
+                None => v.label < Label::Visible,
+            };
+            if better {
+                best[j] = Some(Remedy {
+                    flags: flags.to_string(),
+                    verdict: v,
+                });
+            }
+        }
+    }
+    for ((k, tried), remedy) in visible.into_iter().zip(tried).zip(best) {
+        let verdict = plan.materials[k].verdict.expect("measured above");
+        plan.materials[k].notes.push(Note::VisibleDifference {
+            verdict,
+            remedy,
+            tried,
+        });
+    }
+    materials
+}
