@@ -2263,3 +2263,51 @@ fn a_dry_runs_edits_applied_to_the_input_give_the_written_document_bakes_include
         ]
     );
 }
+
+#[test]
+fn a_visible_material_is_a_warning_naming_the_flags_that_bring_it_closer() {
+    use velvet::migrate::verdict::Label;
+    let (_dir, _output, result) = migrate_case(&fixtures().join("sheen-textures.gltf"));
+    let cloth = &result.detail.materials[0];
+    assert_eq!(cloth.name.as_deref(), Some("cloth"));
+    assert_eq!(cloth.verdict.map(|v| v.label), Some(Label::Visible));
+    let visible: Vec<&Note> = cloth
+        .notes
+        .iter()
+        .filter(|n| matches!(n, Note::VisibleDifference { .. }))
+        .collect();
+    assert_eq!(visible.len(), 1);
+    let Note::VisibleDifference {
+        verdict,
+        remedy,
+        tried,
+    } = visible[0]
+    else {
+        unreachable!("filtered above")
+    };
+    assert_eq!(visible[0].level(), migrate::Level::Warning);
+    assert_eq!(Some(*verdict), cloth.verdict);
+    assert_eq!(
+        tried,
+        &[
+            "--exact",
+            "--roughness-budget exact",
+            "--exact --roughness-budget exact"
+        ]
+        .map(String::from)
+    );
+    let remedy = remedy.as_ref().expect("--exact brings the cloth closer");
+    assert_eq!(remedy.flags, "--exact");
+    assert_eq!(remedy.verdict.label, Label::Close);
+    assert!(visible[0].message().contains(&format!(
+        "--exact would bring it to {}",
+        remedy.verdict.describe()
+    )));
+    // The tinted material is not visible, and has no such warning.
+    let tinted = &result.detail.materials[1];
+    assert_eq!(tinted.verdict.map(|v| v.label), Some(Label::Same));
+    assert!(!tinted
+        .notes
+        .iter()
+        .any(|n| matches!(n, Note::VisibleDifference { .. })));
+}

@@ -1341,3 +1341,100 @@ fn migrate_preview_draws_the_plans_migrate_wrote_and_no_sheet_for_a_file_it_refu
     );
     assert_eq!(pngs(&sheets), ["good-m0-cloth.png"]);
 }
+
+#[test]
+fn every_fixture_material_gets_from_the_preview_the_verdict_migrate_reports() {
+    use velvet::command::migrate::{self as migrating, FileOutcome};
+    let fixtures = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/migrate");
+    let report = migrating::run(&migrating::Request {
+        inputs: vec![fixtures.clone()],
+        destination: velvet::output::paths::Destination::None,
+        options: velvet::migrate::Options::default(),
+        dry_run: true,
+        progress: false,
+    })
+    .unwrap();
+    let preview = velvet::preview::plan(&[fixtures], &velvet::migrate::Options::default());
+    let mut labels = Vec::new();
+    for entry in &preview.entries {
+        let file = report
+            .files
+            .iter()
+            .find(|f| f.input == entry.file)
+            .expect("migrate planned every file the preview read");
+        assert!(matches!(file.outcome, FileOutcome::Planned { .. }));
+        let planned = file
+            .detail
+            .materials
+            .iter()
+            .find(|m| m.index == entry.index)
+            .and_then(|m| m.verdict)
+            .expect("a verdict on every material a sheet shows");
+        let sheet = &preview.sheets[entry.sheet];
+        assert_eq!(planned, sheet.verdict, "{}", entry.title());
+        // The sheet drawn says the plan's word.
+        let drawn = sheet::render(&sheet.title, &sheet.material);
+        assert_eq!(drawn.summary.verdict, planned, "{}", entry.title());
+        labels.push(format!("{} {}", entry.title(), planned.label.as_str()));
+    }
+    assert_eq!(
+        labels,
+        [
+            "both-refresh.expected.gltf: material 0 \"stale\" close",
+            "both-refresh.expected.gltf: material 1 \"up to date\" close",
+            "both-refresh.expected.gltf: material 2 \"legacy fallback\" visible",
+            "both-refresh.gltf: material 0 \"stale\" visible",
+            "both-refresh.gltf: material 1 \"up to date\" close",
+            "both-refresh.gltf: material 2 \"legacy fallback\" visible",
+            "both.gltf: material 0 \"both\" close",
+            "clearcoat.expected.gltf: material 0 \"coated sheen\" close",
+            "clearcoat.expected.gltf: material 1 \"coated fuzz\" close",
+            "clearcoat.gltf: material 0 \"coated sheen\" close",
+            "clearcoat.gltf: material 1 \"coated fuzz\" close",
+            "fuzz-only.expected.gltf: material 0 \"half white\" close",
+            "fuzz-only.expected.gltf: material 1 \"dark over bright\" visible",
+            "fuzz-only.expected.gltf: material 2 \"no roughness\" close",
+            "fuzz-only.expected.gltf: material 4 \"defaults\" close",
+            "fuzz-only.expected.gltf: material 5 \"black\" visible",
+            "fuzz-only.gltf: material 0 \"half white\" close",
+            "fuzz-only.gltf: material 1 \"dark over bright\" visible",
+            "fuzz-only.gltf: material 2 \"no roughness\" close",
+            "fuzz-only.gltf: material 4 \"defaults\" close",
+            "fuzz-only.gltf: material 5 \"black\" visible",
+            "fuzz-textures.expected.gltf: material 0 \"colour and roughness textures\" visible",
+            "fuzz-textures.expected.gltf: material 1 \"intensity texture\" visible",
+            "fuzz-textures.expected.gltf: material 2 \"different sets\" visible",
+            "fuzz-textures.expected.gltf: material 3 \"same set\" visible",
+            "fuzz-textures.gltf: material 0 \"colour and roughness textures\" visible",
+            "fuzz-textures.gltf: material 1 \"intensity texture\" close",
+            "fuzz-textures.gltf: material 2 \"different sets\" visible",
+            "fuzz-textures.gltf: material 3 \"same set\" close",
+            "legacy-texcoord.expected.gltf: material 0 \"every primitive has TEXCOORD_1\" visible",
+            "legacy-texcoord.expected.gltf: material 1 \"one primitive lacks TEXCOORD_1\" close",
+            "legacy-texcoord.gltf: material 0 \"every primitive has TEXCOORD_1\" visible",
+            "legacy-texcoord.gltf: material 1 \"one primitive lacks TEXCOORD_1\" close",
+            "legacy.expected.gltf: material 0 \"clamped\" visible",
+            "legacy.expected.gltf: material 1 \"factor only\" close",
+            "legacy.expected.gltf: material 3 \"mixed\" close",
+            "legacy.expected.gltf: material 4 \"dangling texture\" close",
+            "legacy.gltf: material 0 \"clamped\" visible",
+            "legacy.gltf: material 1 \"factor only\" close",
+            "legacy.gltf: material 3 \"mixed\" close",
+            "legacy.gltf: material 4 \"dangling texture\" close",
+            "minified.expected.gltf: material 0 \"m\" same",
+            "minified.gltf: material 0 \"m\" same",
+            "sheen-factors.expected.gltf: material 0 \"champagne\" close",
+            "sheen-factors.expected.gltf: material 1 \"navy\" close",
+            "sheen-factors.expected.gltf: material 2 \"pale\" close",
+            "sheen-factors.gltf: material 0 \"champagne\" close",
+            "sheen-factors.gltf: material 1 \"navy\" close",
+            "sheen-factors.gltf: material 2 \"pale\" close",
+            "sheen-textures.expected.gltf: material 0 \"cloth\" visible",
+            "sheen-textures.expected.gltf: material 1 \"tinted\" same",
+            "sheen-textures.gltf: material 0 \"cloth\" visible",
+            "sheen-textures.gltf: material 1 \"tinted\" same",
+            "undeclared.expected.gltf: material 0 \"m\" same",
+            "undeclared.gltf: material 0 \"m\" same",
+        ]
+    );
+}
