@@ -494,6 +494,10 @@ struct MigrateArgs {
     /// Write nothing; exit with status 1 when a file would change (for CI and pre-commit).
     #[arg(long, conflicts_with_all = ["output", "out_dir", "in_place"])]
     check: bool,
+    /// With --check: judge appearance instead of change, and fail on a material that would
+    /// migrate visibly (also `fail-on-visible = true` in velvet.toml).
+    #[arg(long, requires = "check")]
+    fail_on_visible: bool,
     /// Output format.
     #[arg(long, value_enum, default_value_t = ReportFormat::Text)]
     format: ReportFormat,
@@ -639,7 +643,8 @@ fn migrate(args: MigrateArgs, quiet: bool) -> Status {
             rewrite_uris: args.rewrite_uris,
             // The speed paths leave the verdict out unless a view reads it.
             skip_verdict: (args.fast || matches!(args.roughness, RoughnessArg::Identity))
-                && args.preview.is_none(),
+                && args.preview.is_none()
+                && !args.check,
             load: args.load.options(),
         },
         dry_run: args.dry_run || args.check,
@@ -649,6 +654,7 @@ fn migrate(args: MigrateArgs, quiet: bool) -> Status {
         format: args.format,
         detail: detail(quiet, args.verbose, args.report),
         check: args.check,
+        fail_on_visible: args.fail_on_visible,
         preview: args.preview,
     };
     command::migrate::command(&request, args.input.shard, &view)

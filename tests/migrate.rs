@@ -2311,3 +2311,63 @@ fn a_visible_material_is_a_warning_naming_the_flags_that_bring_it_closer() {
         .iter()
         .any(|n| matches!(n, Note::VisibleDifference { .. })));
 }
+
+#[test]
+fn check_with_the_visible_gate_fails_on_visible_materials_only_from_the_flag_or_velvet_toml() {
+    let dir = tempfile::tempdir().unwrap();
+    for case in ["sheen-factors.gltf", "sheen-textures.gltf"] {
+        std::fs::copy(fixtures().join(case), dir.path().join(case)).unwrap();
+    }
+    let path = |case: &str| dir.path().join(case).to_string_lossy().into_owned();
+    // Without the gate, a file that would change fails the check.
+    let (code, _, _) = velvet(&["migrate", "--check", "-q", &path("sheen-factors.gltf")]);
+    assert_eq!(code, 1);
+    // With it, appearance decides: three close materials pass, the visible cloth fails.
+    let (code, _, err) = velvet(&[
+        "migrate",
+        "--check",
+        "--fail-on-visible",
+        "-q",
+        &path("sheen-factors.gltf"),
+    ]);
+    assert_eq!((code, err.as_str()), (0, ""));
+    let (code, _, err) = velvet(&[
+        "migrate",
+        "--check",
+        "--fail-on-visible",
+        "-q",
+        &path("sheen-textures.gltf"),
+    ]);
+    assert_eq!(code, 1);
+    assert_eq!(
+        err,
+        format!(
+            "velvet: --check: {}: material 0 \"cloth\": visible (ꟻLIP 0.551 in the furnace, 0.415 under the light)\n",
+            path("sheen-textures.gltf")
+        )
+    );
+    // --fast still measures the verdict the gate reads.
+    let (code, _, _) = velvet(&[
+        "migrate",
+        "--check",
+        "--fail-on-visible",
+        "--fast",
+        "-q",
+        &path("sheen-textures.gltf"),
+    ]);
+    assert_eq!(code, 1);
+    // The velvet.toml key turns the gate on for the files below it.
+    std::fs::write(dir.path().join("velvet.toml"), "fail-on-visible = true\n").unwrap();
+    let (code, _, _) = velvet(&["migrate", "--check", "-q", &path("sheen-factors.gltf")]);
+    assert_eq!(code, 0);
+    let (code, _, _) = velvet(&["migrate", "--check", "-q", &path("sheen-textures.gltf")]);
+    assert_eq!(code, 1);
+    // The flag needs --check.
+    let (code, _, _) = velvet(&[
+        "migrate",
+        "--fail-on-visible",
+        "--dry-run",
+        &path("sheen-factors.gltf"),
+    ]);
+    assert_eq!(code, 2);
+}

@@ -519,6 +519,7 @@ fn identical_inputs_give_identical_bytes_at_one_and_two_threads() {
             "a-m0-sheen.png",
             "a-m2-fuzz.png",
             "index.html",
+            "index.json",
             "overview.png",
             "sub_b-m0.png"
         ]
@@ -939,14 +940,15 @@ fn an_interrupted_preview_leaves_the_sheets_written_so_far_and_no_partial_file()
                     .collect()
             })
             .unwrap_or_default();
-        // Every file there is a complete sheet (or, after a finished run, an index page).
+        // Every file there is a complete sheet, index.json or (after a finished run) an index
+        // page.
         for name in &files {
             let path = out.join(name);
             if name.ends_with(".png") {
                 image::open(&path).unwrap_or_else(|e| panic!("{name} is not whole: {e}"));
             } else {
                 assert!(
-                    name.starts_with("index") && name.ends_with(".html"),
+                    name == "index.json" || (name.starts_with("index") && name.ends_with(".html")),
                     "{name}"
                 );
             }
@@ -957,15 +959,18 @@ fn an_interrupted_preview_leaves_the_sheets_written_so_far_and_no_partial_file()
                 assert_eq!(code, 128 + signal, "{err}");
                 assert!(
                     err.starts_with("velvet: stopped by SIG")
-                        && err.contains("sheets written (each complete); no index written"),
+                        && err.contains("sheets written (each complete), listed in index.json"),
                     "{err}"
                 );
                 assert!(
                     files
                         .iter()
-                        .all(|n| n.ends_with(".png") && n != "overview.png"),
+                        .all(|n| (n.ends_with(".png") && n != "overview.png") || n == "index.json"),
                     "{files:?}"
                 );
+                // The index of a stopped run lists exactly the sheets it finished.
+                let index = std::fs::read_to_string(out.join("index.json")).unwrap();
+                assert_eq!(velvet::preview::index::listed_sheets(&index), pngs(&out));
                 assert!(pngs(&out).len() < 400);
                 stopped += 1;
             }
@@ -1437,4 +1442,86 @@ fn every_fixture_material_gets_from_the_preview_the_verdict_migrate_reports() {
             "undeclared.gltf: material 0 \"m\" same",
         ]
     );
+}
+
+#[test]
+fn index_json_lists_every_material_with_its_verdict_and_a_rerun_removes_only_the_sheets_it_listed()
+{
+    let dir = tempfile::tempdir().unwrap();
+    let roughness = [0.9, 0.02, 0.5, 0.3];
+    let materials: Vec<String> = roughness
+        .iter()
+        .enumerate()
+        .map(|(i, r)| sheen(&format!("s{i}"), 0.9, *r))
+        .collect();
+    let input = write(dir.path(), "ranked.gltf", &gltf(&materials.join(", ")));
+    let out = dir.path().join("out");
+    let plan = velvet::preview::plan(
+        std::slice::from_ref(&input),
+        &velvet::migrate::Options::default(),
+    );
+    let written = velvet::preview::write(&plan, &out, None, false).unwrap();
+    assert_eq!(written.index_json, Some(out.join("index.json")));
+    let index: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("index.json")).unwrap()).unwrap();
+    let records = index["sheets"].as_array().unwrap();
+    assert_eq!(records.len(), 4);
+    // In the pages' order, each with its sheet, the plan's verdict and the values as written.
+    for (record, sheet) in records.iter().zip(&plan.sheets) {
+        let entry = &plan.entries[sheet.entries[0]];
+        let fuzz = sheet.material.factors.written_fuzz.unwrap();
+        let kept = sheet.material.factors.written_sheen.unwrap();
+        assert_eq!(
+            record,
+            &serde_json::json!({
+                "file": sheet.name,
+                "asset": "ranked.gltf",
+                "material": entry.index,
+                "name": entry.name,
+                "label": sheet.verdict.label.as_str(),
+                "flip": sheet.verdict.flip,
+                "furnace": sheet.verdict.furnace,
+                "light": sheet.verdict.light,
+                "drawn": true,
+                "written": {
+                    "sheen": {"color": kept.color, "roughness": kept.roughness},
+                    "fuzz": {"weight": fuzz.weight, "color": fuzz.color, "roughness": fuzz.roughness},
+                },
+            })
+        );
+        assert!(out.join(&sheet.name).is_file());
+    }
+    let flips: Vec<f64> = records
+        .iter()
+        .map(|r| r["flip"].as_f64().unwrap())
+        .collect();
+    assert!(flips.windows(2).all(|w| w[0] >= w[1]), "{flips:?}");
+    // A file velvet did not write stays; a rerun drawing the worst sheet alone removes the
+    // three others, and lists them undrawn.
+    std::fs::write(out.join("mine.png"), b"not velvet's").unwrap();
+    let again = velvet::preview::write(&plan, &out, Some(1), false).unwrap();
+    let mut removed: Vec<String> = again
+        .removed
+        .iter()
+        .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
+        .collect();
+    removed.sort();
+    let mut others: Vec<String> = plan.sheets[1..].iter().map(|s| s.name.clone()).collect();
+    others.sort();
+    assert_eq!(removed, others);
+    let mut left = vec![plan.sheets[0].name.clone(), "mine.png".to_string()];
+    left.sort();
+    assert_eq!(pngs(&out), left);
+    let index = std::fs::read_to_string(out.join("index.json")).unwrap();
+    assert_eq!(
+        velvet::preview::index::listed_sheets(&index),
+        [plan.sheets[0].name.clone()]
+    );
+    let drawn: Vec<bool> = serde_json::from_str::<serde_json::Value>(&index).unwrap()["sheets"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r["drawn"].as_bool().unwrap())
+        .collect();
+    assert_eq!(drawn, [true, false, false, false]);
 }

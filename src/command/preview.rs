@@ -71,7 +71,7 @@ pub(super) fn write(
     if written.stopped {
         let signal = crate::output::interrupt::requested().unwrap_or(2);
         super::note(format_args!(
-            "velvet: stopped by {}: {} of {} sheets written (each complete); no index written",
+            "velvet: stopped by {}: {} of {} sheets written (each complete), listed in index.json",
             crate::output::interrupt::name(signal),
             written.drawn.len(),
             worst.map_or(plan.sheets.len(), |n| n.min(plan.sheets.len()))
@@ -90,6 +90,15 @@ pub(super) fn write(
                     d.path.display(),
                     d.summary.title,
                     d.summary.verdict.label.text()
+                ),
+            );
+        }
+        if !written.removed.is_empty() {
+            push_line(
+                &mut out,
+                &format!(
+                    "{} sheet(s) of an earlier run that this one does not write removed",
+                    written.removed.len()
                 ),
             );
         }
