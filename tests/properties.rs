@@ -571,8 +571,6 @@ proptest! {
     }
 }
 
-/// Found by the properties above: glTF allows `extras` of any JSON type (an object is only
-/// recommended), and the core structure check refused arrays and scalars.
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(CASES))]
 
@@ -613,6 +611,8 @@ proptest! {
     }
 }
 
+/// Found by the properties above: glTF allows `extras` of any JSON type (an object is only
+/// recommended), and the core structure check refused arrays and scalars.
 #[test]
 fn extras_of_every_json_type_are_valid() {
     for extras in [

@@ -165,35 +165,6 @@ fn html(plan: &Plan, sheets: &[Drawn], page: usize, total: usize, drawn: usize) 
     h
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn escapes_markup() {
-        assert_eq!(
-            escape("<a href='x'>&\"</a>"),
-            "&lt;a href=&#39;x&#39;&gt;&amp;&quot;&lt;/a&gt;"
-        );
-    }
-
-    #[test]
-    fn an_empty_run_is_one_valid_page_that_says_so() {
-        let pages = pages(&Plan::default(), &[]);
-        assert_eq!(pages.len(), 1);
-        assert!(pages[0].starts_with("<!DOCTYPE html>") && pages[0].ends_with("</html>\n"));
-        assert!(pages[0].contains("<p>0 material(s) on 0 sheet(s)"));
-    }
-
-    #[test]
-    fn pages_are_named_index_then_numbered_from_two() {
-        assert_eq!(
-            [0, 1, 9].map(page_name),
-            ["index.html", "index-2.html", "index-10.html"]
-        );
-    }
-}
-
 /// The machine-readable index of a run, `index.json`: one record per material, in the order
 /// of the pages (worst first by the plan's verdict, then the materials a sheet shows in input
 /// order), each with its sheet's file name (`file`, in the output folder), the asset
@@ -268,4 +239,33 @@ pub fn listed_sheets(index_json: &str) -> Vec<String> {
     names.sort();
     names.dedup();
     names
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn escapes_markup() {
+        assert_eq!(
+            escape("<a href='x'>&\"</a>"),
+            "&lt;a href=&#39;x&#39;&gt;&amp;&quot;&lt;/a&gt;"
+        );
+    }
+
+    #[test]
+    fn an_empty_run_is_one_valid_page_that_says_so() {
+        let pages = pages(&Plan::default(), &[]);
+        assert_eq!(pages.len(), 1);
+        assert!(pages[0].starts_with("<!DOCTYPE html>") && pages[0].ends_with("</html>\n"));
+        assert!(pages[0].contains("<p>0 material(s) on 0 sheet(s)"));
+    }
+
+    #[test]
+    fn pages_are_named_index_then_numbered_from_two() {
+        assert_eq!(
+            [0, 1, 9].map(page_name),
+            ["index.html", "index-2.html", "index-10.html"]
+        );
+    }
 }
