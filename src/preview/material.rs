@@ -164,10 +164,16 @@ pub(super) fn materials_with(
     mapping: RoughnessMapping,
     images: &ImageCache,
 ) -> Vec<Material> {
-    let all = layers::materials(asset.json());
+    // Each material is read from the document's index into a value of its own: the whole
+    // document is not built (for the 20,000-material library, that would double migrate's
+    // memory).
+    let all = asset.root().get("materials");
     plan.materials
         .par_iter()
-        .filter_map(|p| read(asset, p.index, all.get(p.index)?, Some(p), mapping, images))
+        .filter_map(|p| {
+            let material = all?.get(p.index)?.to_value();
+            read(asset, p.index, &material, Some(p), mapping, images)
+        })
         .collect()
 }
 
@@ -545,7 +551,7 @@ fn image_index(asset: &Asset, info: &Value) -> Result<usize, String> {
         .and_then(layers::as_index)
         .ok_or("no texture index")?;
     let source = asset
-        .json()
+        .root()
         .pointer(&format!("/textures/{texture}/source"))
         .and_then(layers::as_index)
         .ok_or_else(|| format!("texture {texture} has no source image"))?;
