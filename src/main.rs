@@ -527,6 +527,11 @@ struct MigrateArgs {
     /// material, before a dearer plan is taken; `exact` bakes one texture per material.
     #[arg(long, value_name = "DIFFERENCE|exact", default_value = "0.01")]
     roughness_budget: migrate::budget::Budget,
+    /// The most new textures (MiB, uncompressed, per file) the default may bake to bring a
+    /// material whose migration would be visible to close, as --exact or an exact roughness
+    /// bake would; 0 takes none.
+    #[arg(long, value_name = "MIB", default_value_t = migrate::verdict::DEFAULT_CLOSER_BUDGET_MIB)]
+    closer_budget: u64,
     /// Regenerate the sheen fallback of materials that already have fuzz and sheen.
     #[arg(long)]
     refresh_fallback: bool,
@@ -645,6 +650,9 @@ fn migrate(args: MigrateArgs, quiet: bool) -> Status {
             skip_verdict: (args.fast || matches!(args.roughness, RoughnessArg::Identity))
                 && args.preview.is_none()
                 && !args.check,
+            closer_budget: migrate::verdict::CloserBudget(
+                args.closer_budget.saturating_mul(1 << 20),
+            ),
             load: args.load.options(),
         },
         dry_run: args.dry_run || args.check,

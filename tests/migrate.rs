@@ -2246,28 +2246,38 @@ fn a_dry_runs_edits_applied_to_the_input_give_the_written_document_bakes_include
         }
     }
     // The fixtures whose bakes add images, and how many each adds (legacy's roughness bake,
-    // sheen-textures' mapped roughness, --exact's fuzz and fuzz colour textures).
+    // sheen-textures' mapped roughness, --exact's fuzz and fuzz colour textures, which the
+    // default takes too where they bring a visible material to close).
     assert_eq!(
         with_new_images,
         [
             "fuzz-textures (default): 3",
             "fuzz-textures (exact): 3",
             "fuzz-textures (budget exact): 3",
+            "legacy-texcoord (default): 2",
             "legacy-texcoord (exact): 2",
-            "legacy (default): 2",
+            "legacy-texcoord (budget exact): 2",
+            "legacy (default): 4",
             "legacy (exact): 4",
-            "legacy (budget exact): 2",
-            "sheen-textures (default): 1",
+            "legacy (budget exact): 4",
+            "sheen-textures (default): 3",
             "sheen-textures (exact): 5",
-            "sheen-textures (budget exact): 1",
+            "sheen-textures (budget exact): 3",
         ]
     );
 }
 
 #[test]
 fn a_visible_material_is_a_warning_naming_the_flags_that_bring_it_closer() {
-    use velvet::migrate::verdict::Label;
-    let (_dir, _output, result) = migrate_case(&fixtures().join("sheen-textures.gltf"));
+    use velvet::migrate::verdict::{BeyondBudget, CloserBudget, Label};
+    // With no budget to bake more, the cloth keeps its plan and is a warning.
+    let (_dir, _output, result) = migrate_case_with(
+        &fixtures().join("sheen-textures.gltf"),
+        Options {
+            closer_budget: CloserBudget(0),
+            ..options_for(&fixtures().join("sheen-textures.gltf"))
+        },
+    );
     let cloth = &result.detail.materials[0];
     assert_eq!(cloth.name.as_deref(), Some("cloth"));
     assert_eq!(cloth.verdict.map(|v| v.label), Some(Label::Visible));
@@ -2281,6 +2291,7 @@ fn a_visible_material_is_a_warning_naming_the_flags_that_bring_it_closer() {
         verdict,
         remedy,
         tried,
+        beyond_budget,
     } = visible[0]
     else {
         unreachable!("filtered above")
@@ -2299,14 +2310,34 @@ fn a_visible_material_is_a_warning_naming_the_flags_that_bring_it_closer() {
     let remedy = remedy.as_ref().expect("--exact brings the cloth closer");
     assert_eq!(remedy.flags, "--exact");
     assert_eq!(remedy.verdict.label, Label::Close);
+    // --exact bakes a fuzzTexture and a fuzzColorTexture from the 2×2 colour image (its
+    // roughness bake is the one the plan has): (4 + 4) texels of 4 bytes.
+    assert_eq!(*beyond_budget, Some(BeyondBudget { bytes: 32, left: 0 }));
     assert!(visible[0].message().contains(&format!(
-        "--exact would bring it to {}",
+        "--exact would bring it to {}, but its new textures (32 bytes uncompressed) pass what \
+         is left of the --closer-budget (0 bytes), so the default does not take it",
         remedy.verdict.describe()
     )));
     // The tinted material is not visible, and has no such warning.
     let tinted = &result.detail.materials[1];
     assert_eq!(tinted.verdict.map(|v| v.label), Some(Label::Same));
     assert!(!tinted
+        .notes
+        .iter()
+        .any(|n| matches!(n, Note::VisibleDifference { .. })));
+
+    // The default budget takes the plan --exact gives: the cloth is close, and says why.
+    let (_dir, _output, default) = migrate_case(&fixtures().join("sheen-textures.gltf"));
+    let cloth_taken = &default.detail.materials[0];
+    assert_eq!(cloth_taken.verdict, Some(remedy.verdict));
+    assert!(cloth_taken.notes.contains(&Note::CloserPlanTaken {
+        flags: "--exact".into(),
+        before: *verdict,
+        after: remedy.verdict,
+        bytes: 32,
+    }));
+    assert!(cloth_taken.notes.contains(&Note::ExactBaked));
+    assert!(!cloth_taken
         .notes
         .iter()
         .any(|n| matches!(n, Note::VisibleDifference { .. })));
@@ -2331,10 +2362,22 @@ fn check_with_the_visible_gate_fails_on_visible_materials_only_from_the_flag_or_
         &path("sheen-factors.gltf"),
     ]);
     assert_eq!((code, err.as_str()), (0, ""));
+    // With no budget to bake it closer, the cloth would migrate visibly and fails the gate;
+    // with the default budget it is baked closer and passes.
+    let (code, _, _) = velvet(&[
+        "migrate",
+        "--check",
+        "--fail-on-visible",
+        "-q",
+        &path("sheen-textures.gltf"),
+    ]);
+    assert_eq!(code, 0);
     let (code, _, err) = velvet(&[
         "migrate",
         "--check",
         "--fail-on-visible",
+        "--closer-budget",
+        "0",
         "-q",
         &path("sheen-textures.gltf"),
     ]);
@@ -2360,7 +2403,14 @@ fn check_with_the_visible_gate_fails_on_visible_materials_only_from_the_flag_or_
     std::fs::write(dir.path().join("velvet.toml"), "fail-on-visible = true\n").unwrap();
     let (code, _, _) = velvet(&["migrate", "--check", "-q", &path("sheen-factors.gltf")]);
     assert_eq!(code, 0);
-    let (code, _, _) = velvet(&["migrate", "--check", "-q", &path("sheen-textures.gltf")]);
+    let (code, _, _) = velvet(&[
+        "migrate",
+        "--check",
+        "--closer-budget",
+        "0",
+        "-q",
+        &path("sheen-textures.gltf"),
+    ]);
     assert_eq!(code, 1);
     // The flag needs --check.
     let (code, _, _) = velvet(&[
@@ -2370,4 +2420,67 @@ fn check_with_the_visible_gate_fails_on_visible_materials_only_from_the_flag_or_
         &path("sheen-factors.gltf"),
     ]);
     assert_eq!(code, 2);
+}
+
+#[test]
+fn on_the_fixtures_the_default_is_never_visible_where_exact_is_close() {
+    use velvet::migrate::verdict::Label;
+    let labels = |options: Options| -> Vec<(String, usize, Label)> {
+        let mut run = request(vec![fixtures()], Destination::None, options);
+        run.dry_run = true;
+        migrating::run(&run)
+            .unwrap()
+            .files
+            .iter()
+            .flat_map(|f| {
+                f.detail
+                    .materials
+                    .iter()
+                    // A draft sheen switched off is upgraded but shows nothing: no verdict.
+                    .filter(|m| m.migrated() && m.verdict.is_some())
+                    .map(|m| (stem(&f.input), m.index, m.verdict.unwrap().label))
+            })
+            .collect()
+    };
+    let default = labels(Options::default());
+    let exact = labels(Options {
+        exact: true,
+        ..Options::default()
+    });
+    assert_eq!(default.len(), exact.len());
+    let mut brought = Vec::new();
+    for (d, e) in default.iter().zip(&exact) {
+        assert_eq!((&d.0, d.1), (&e.0, e.1));
+        assert!(
+            !(d.2 == Label::Visible && e.2 < Label::Visible),
+            "{} material {}: visible by default, {:?} with --exact",
+            d.0,
+            d.1,
+            e.2
+        );
+        if e.2 == Label::Close && d.2 == Label::Close {
+            brought.push(format!("{} {}", d.0, d.1));
+        }
+    }
+    // The materials --exact brings to close are close by default too (the default takes its
+    // plan for the three that would be visible), among the others close either way.
+    // What stays visible by default is what no plan velvet offers brings closer.
+    let visible: Vec<String> = default
+        .iter()
+        .filter(|d| d.2 == Label::Visible)
+        .map(|d| format!("{} {}", d.0, d.1))
+        .collect();
+    assert_eq!(
+        visible,
+        ["fuzz-only 1", "fuzz-textures 0", "fuzz-textures 2"]
+    );
+    assert!(
+        brought.contains(&"sheen-textures 0".to_string()),
+        "{brought:?}"
+    );
+    assert!(brought.contains(&"legacy 0".to_string()), "{brought:?}");
+    assert!(
+        brought.contains(&"legacy-texcoord 0".to_string()),
+        "{brought:?}"
+    );
 }

@@ -54,6 +54,9 @@ pub struct Options {
     /// every material right after planning: `--fast` and `--roughness identity` do, to stay
     /// the speed paths, unless a view needs it (`--fail-on-visible`, `--preview`).
     pub skip_verdict: bool,
+    /// How many bytes of new textures (uncompressed, per file) the default may add to bring
+    /// "visible" materials closer ([`verdict::CloserBudget`]).
+    pub closer_budget: verdict::CloserBudget,
     /// Limits and URI policy for reading inputs and their resources.
     pub load: crate::asset::LoadOptions,
 }

@@ -222,6 +222,19 @@ pub enum Note {
         verdict: super::verdict::Verdict,
         remedy: Option<super::verdict::Remedy>,
         tried: Vec<String>,
+        /// The remedy was not taken by default: its new textures pass the size budget.
+        #[serde(skip_serializing_if = "Option::is_none")]
+        beyond_budget: Option<super::verdict::BeyondBudget>,
+    },
+    /// The default took a plan with more bakes (what `flags` would plan) because it brings a
+    /// "visible" material to a better verdict, within the size budget.
+    CloserPlanTaken {
+        flags: String,
+        /// The verdict of the plan it replaced.
+        before: super::verdict::Verdict,
+        after: super::verdict::Verdict,
+        /// The new textures' uncompressed size, in bytes.
+        bytes: u64,
     },
     /// The best roughness lies below the floor renderers honour alike: the floor is written.
     RoughnessFloor {
@@ -269,6 +282,7 @@ impl Note {
             | Note::ExactBaked
             | Note::BakeError { .. }
             | Note::LegacyRoughnessBaked { .. }
+            | Note::CloserPlanTaken { .. }
             | Note::RoughnessFloor { .. } => Level::Info,
             Note::RoughnessPlan {
                 max_error, budget, ..
@@ -432,7 +446,13 @@ impl Note {
                     plan.describe()
                 )
             }
-            Note::VisibleDifference { verdict, remedy, tried } => {
+            Note::CloserPlanTaken { flags, before, after, bytes } => format!(
+                "the plan with more bakes that {flags} gives is taken, as it brings this material from {} to {}; its new textures take {} uncompressed, within the --closer-budget",
+                before.describe(),
+                after.describe(),
+                crate::output::summary::bytes(*bytes as usize)
+            ),
+            Note::VisibleDifference { verdict, remedy, tried, beyond_budget } => {
                 let mut m = format!(
                     "the migrated material looks visibly different from the authored one: ꟻLIP {:.3} in the furnace (above {}), {:.3} under the light",
                     verdict.furnace,
@@ -440,11 +460,16 @@ impl Note {
                     verdict.light
                 );
                 match (remedy, tried.is_empty()) {
-                    (Some(r), _) => m += &format!(
-                        "; {} would bring it to {}",
-                        r.flags,
-                        r.verdict.describe()
-                    ),
+                    (Some(r), _) => {
+                        m += &format!("; {} would bring it to {}", r.flags, r.verdict.describe());
+                        if let Some(b) = beyond_budget {
+                            m += &format!(
+                                ", but its new textures ({} uncompressed) pass what is left of the --closer-budget ({}), so the default does not take it",
+                                crate::output::summary::bytes(b.bytes as usize),
+                                crate::output::summary::bytes(b.left as usize)
+                            );
+                        }
+                    }
                     (None, true) => m += "; no other plan velvet offers changes this material (no texture to bake): look at the preview before trusting it",
                     (None, false) => m += &format!(
                         "; {} {}: look at the preview before trusting it",

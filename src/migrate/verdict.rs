@@ -107,6 +107,32 @@ pub struct Remedy {
     pub verdict: Verdict,
 }
 
+/// The size budget within which the default takes, for a material whose migration is
+/// "visible", the plan with more bakes that brings it to "close" or "same" (`--exact`, an exact
+/// roughness bake): the uncompressed size (width × height × 4 bytes, which a PNG does not
+/// exceed by much and mostly stays well under) of the new textures such plans add, per file,
+/// taken in material order. 0 takes none. The default, 16 MiB, is 64 textures of 256².
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CloserBudget(pub u64);
+
+/// The default [`CloserBudget`], in MiB.
+pub const DEFAULT_CLOSER_BUDGET_MIB: u64 = 16;
+
+impl Default for CloserBudget {
+    fn default() -> Self {
+        CloserBudget(DEFAULT_CLOSER_BUDGET_MIB << 20)
+    }
+}
+
+/// A remedy left untaken: the new textures it needs would pass the budget.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub struct BeyondBudget {
+    /// The new textures' uncompressed size, in bytes.
+    pub bytes: u64,
+    /// What was left of the file's budget, in bytes.
+    pub left: u64,
+}
+
 /// Counts of materials by label, for a run's summary.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
 pub struct LabelCounts {

@@ -14,15 +14,20 @@
 //! values alone, so the verdicts do not depend on the thread count. A "visible" material that
 //! a migration changes is planned again, alone, with the flags that could bring it closer
 //! (`--exact`, `--roughness-budget exact`, both), and the best verdict one reaches is its
-//! warning's remedy.
+//! remedy. The default takes a remedy that brings the material to "close" or "same" while the
+//! new textures it bakes fit the run's [`crate::migrate::verdict::CloserBudget`] (per file, in
+//! material order): the material's plan becomes that plan, with a note saying so; otherwise
+//! the material keeps its plan and gets a warning naming the remedy and, when the budget was
+//! what stopped it, the size. This choice is made here, not in migrate's planner, because only
+//! the renderer can tell which plan looks closer.
 
 use super::material::{self, columns, Material};
 use super::shade::{render_sphere, Light, Look, Quality, Shaded};
 use super::sheet;
 use crate::asset::Asset;
 use crate::migrate::budget::Budget;
-use crate::migrate::verdict::{Label, Remedy, Verdict};
-use crate::migrate::{DocumentPlan, Note, Options};
+use crate::migrate::verdict::{BeyondBudget, Label, Remedy, Verdict};
+use crate::migrate::{DocumentPlan, MaterialPlan, Note, Options};
 use rayon::prelude::*;
 use std::collections::HashMap;
 
@@ -89,15 +94,6 @@ pub fn pairs(material: &Material) -> Vec<(Look, Look)> {
 
 /// The verdict on the pairs of looks of one material.
 pub fn measure_pairs(pairs: &[(Look, Look)]) -> Verdict {
-    let on_sphere: Vec<bool> = render_sphere(
-        &Shaded::with_quality(pairs.first().map_or(BLANK, |p| p.0), Quality::Verdict),
-        Light::Furnace,
-        SPHERE,
-    )
-    .coverage
-    .iter()
-    .map(|&c| c > 0.5)
-    .collect();
     let mut flips = [0.0f64; 2];
     for (authored, written) in pairs {
         let (a, b) = (
@@ -105,21 +101,23 @@ pub fn measure_pairs(pairs: &[(Look, Look)]) -> Verdict {
             Shaded::with_quality(*written, Quality::Verdict),
         );
         for (slot, light) in [Light::Furnace, Light::Directional].into_iter().enumerate() {
-            let codes = |s: &Shaded| sheet::sphere_codes_clamped(&render_sphere(s, light, SPHERE));
-            let flip = sheet::flip_p99_at(&codes(&a), &codes(&b), &on_sphere, pixels_per_degree());
+            let (sphere_a, sphere_b) = (
+                render_sphere(&a, light, SPHERE),
+                render_sphere(&b, light, SPHERE),
+            );
+            // The outline is the same for every look and light.
+            let on_sphere: Vec<bool> = sphere_a.coverage.iter().map(|&c| c > 0.5).collect();
+            let flip = sheet::flip_p99_at(
+                &sheet::sphere_codes_clamped(&sphere_a),
+                &sheet::sphere_codes_clamped(&sphere_b),
+                &on_sphere,
+                pixels_per_degree(),
+            );
             flips[slot] = flips[slot].max(flip);
         }
     }
     Verdict::new(flips[0], flips[1])
 }
-
-/// A look with no layer, for a material without pairs (its coverage is all that is read).
-const BLANK: Look = Look {
-    base: [0.0; 3],
-    base_metallic: 0.0,
-    base_roughness: 1.0,
-    layer: super::shade::Layer::None,
-};
 
 /// The verdict of each of `materials`, each distinct set of looks measured once (in parallel).
 pub fn measure_all(materials: &[Material]) -> Vec<Verdict> {
@@ -212,7 +210,7 @@ pub fn judge(asset: &Asset, plan: &mut DocumentPlan, options: &Options) -> Vec<M
     // leaves its plan as it was is not one for it.
     let indices: Vec<usize> = visible.iter().map(|&k| plan.materials[k].index).collect();
     let mut tried: Vec<Vec<String>> = vec![Vec::new(); visible.len()];
-    let mut best: Vec<Option<Remedy>> = vec![None; visible.len()];
+    let mut best: Vec<Option<(Remedy, MaterialPlan, Material)>> = vec![None; visible.len()];
     for (flags, alternative) in remedies(options) {
         let other = crate::migrate::plan::plan_materials(asset, &indices, &alternative);
         let read = material::materials_with(asset, &other, alternative.roughness, &cache);
@@ -226,33 +224,77 @@ pub fn judge(asset: &Asset, plan: &mut DocumentPlan, options: &Options) -> Vec<M
                 continue;
             }
             tried[j].push(flags.to_string());
-            let Some(v) = read
+            let Some((shown, v)) = read
                 .iter()
                 .zip(&measured)
                 .find(|(m, _)| m.index == current.index)
-                .map(|(_, v)| *v)
             else {
                 continue;
             };
             let better = match &best[j] {
-                Some(b) => (v.label, v.flip) < (b.verdict.label, b.verdict.flip),
+                Some((b, _, _)) => (v.label, v.flip) < (b.verdict.label, b.verdict.flip),
                 None => v.label < Label::Visible,
             };
             if better {
-                best[j] = Some(Remedy {
-                    flags: flags.to_string(),
-                    verdict: v,
-                });
+                let mut shown = shown.clone();
+                shown.verdict = Some(*v);
+                best[j] = Some((
+                    Remedy {
+                        flags: flags.to_string(),
+                        verdict: *v,
+                    },
+                    changed.clone(),
+                    shown,
+                ));
             }
         }
     }
-    for ((k, tried), remedy) in visible.into_iter().zip(tried).zip(best) {
+    // The default takes each remedy, in material order, while the new textures fit the budget.
+    let mut left = options.closer_budget.0;
+    for ((k, tried), best) in visible.into_iter().zip(tried).zip(best) {
         let verdict = plan.materials[k].verdict.expect("measured above");
+        let mut beyond_budget = None;
+        if let Some((remedy, taken, shown)) = &best {
+            match new_texture_bytes(asset, &plan.materials[k], taken) {
+                Some(bytes) if bytes <= left => {
+                    left -= bytes;
+                    let mut taken = taken.clone();
+                    taken.verdict = Some(remedy.verdict);
+                    taken.notes.push(Note::CloserPlanTaken {
+                        flags: remedy.flags.clone(),
+                        before: verdict,
+                        after: remedy.verdict,
+                        bytes,
+                    });
+                    if let Some(m) = materials.iter_mut().find(|m| m.index == taken.index) {
+                        *m = shown.clone();
+                    }
+                    plan.materials[k] = taken;
+                    continue;
+                }
+                Some(bytes) => beyond_budget = Some(BeyondBudget { bytes, left }),
+                None => {}
+            }
+        }
         plan.materials[k].notes.push(Note::VisibleDifference {
             verdict,
-            remedy,
+            remedy: best.map(|(r, _, _)| r),
             tried,
+            beyond_budget,
         });
     }
     materials
+}
+
+/// The uncompressed size (width × height × 4 bytes) of the textures `taken` bakes that
+/// `current` does not, from the source images' headers; `None` when a header cannot be read
+/// (the size cannot be bounded, so the plan is not taken).
+fn new_texture_bytes(asset: &Asset, current: &MaterialPlan, taken: &MaterialPlan) -> Option<u64> {
+    let mut bytes = 0u64;
+    for bake in taken.bakes.iter().filter(|b| !current.bakes.contains(b)) {
+        let (_, image) = *bake.sources.first()?;
+        let header = asset.image_header(image).ok()?;
+        bytes += u64::from(header.width) * u64::from(header.height) * 4;
+    }
+    Some(bytes)
 }
