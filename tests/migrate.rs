@@ -854,7 +854,7 @@ fn dry_run_prints_the_plan_and_writes_nothing() {
     );
     let text = render::text(&report, Detail::Verbose);
     assert!(
-        text.contains("  material 0 \"champagne\": sheen → fuzz; verdict close (ꟻLIP 0.161 in the furnace, 0.272 under the light)\n"),
+        text.contains("  material 0 \"champagne\": sheen → fuzz; verdict close (ꟻLIP 0.165 in the furnace, 0.271 under the light)\n"),
         "{text}"
     );
     assert!(text.contains(
@@ -875,7 +875,7 @@ fn dry_run_prints_the_plan_and_writes_nothing() {
     assert_eq!(json["summary"]["conversions"]["sheen-to-fuzz"], 3);
     assert_eq!(
         json["files"][0]["materials"][1]["verdict"],
-        serde_json::json!({"label": "close", "flip": 0.1112, "furnace": 0.1112, "light": 0.1473})
+        serde_json::json!({"label": "close", "flip": 0.1112, "furnace": 0.1112, "light": 0.1448})
     );
     assert_eq!(
         json["summary"]["verdicts"],
@@ -2385,7 +2385,7 @@ fn check_with_the_visible_gate_fails_on_visible_materials_only_from_the_flag_or_
     assert_eq!(
         err,
         format!(
-            "velvet: --check: {}: material 0 \"cloth\": visible (ꟻLIP 0.551 in the furnace, 0.415 under the light)\n",
+            "velvet: --check: {}: material 0 \"cloth\": visible (ꟻLIP 0.552 in the furnace, 0.414 under the light)\n",
             path("sheen-textures.gltf")
         )
     );

@@ -541,9 +541,11 @@ proptest! {
                 }
             }
         }
+        // The plan as migrate's spine completes it: judged, with the plans the default takes
+        // for materials that would migrate visibly.
         let asset = velvet::asset::load(&input).asset.unwrap();
-        let plan = migrate::plan::plan_document(&asset, &options);
-        for m in velvet::preview::material::materials(&asset, &plan, options.roughness) {
+        let mut plan = migrate::plan::plan_document(&asset, &options);
+        for m in velvet::preview::verdict::judge(&asset, &mut plan, &options) {
             let extensions = &file["materials"][m.index]["extensions"];
             match m.kind {
                 velvet::preview::material::Kind::SheenToFuzz => {
