@@ -516,14 +516,14 @@ pub fn dry_run_bake_edits(plan: &FilePlan, claims: &Claims) -> Result<Vec<edit::
         max_memory: crate::bake::engine::MaxMemory(plan.asset.options.max_memory),
         ..BakeOptions::default()
     };
-    let mut baked = Vec::with_capacity(bake_plan.recipes.len());
+    let mut baked_images = Vec::with_capacity(bake_plan.recipes.len());
     for (info, result) in
         bake_plan
             .outputs
             .iter()
             .zip(bake_into(&bake_plan.recipes, &plan.asset, &options, None))
     {
-        baked.push(result.map_err(|e| {
+        baked_images.push(result.map_err(|e| {
             format!(
                 "{}: cannot bake {} of image {}: {e}",
                 plan.input.display(),
@@ -533,33 +533,135 @@ pub fn dry_run_bake_edits(plan: &FilePlan, claims: &Claims) -> Result<Vec<edit::
         })?);
     }
     let fail = |e: edit::EditError| format!("{}: {e}", plan.input.display());
-    let mut before = plan.asset.root().to_value();
-    for edits in plan
+    // Named as the run names them: next to the output (the input itself without one).
+    let output = plan.output.as_deref().unwrap_or(&plan.input);
+    // Each way below names anew: a name one claimed is the same name with the same bytes for
+    // the run's claims, but taken for the names of one output.
+    let names_for =
+        || FileNames::next_to(claims, &plan.asset, &plan.input, output, &plan.relocation);
+    // New images that are files, as a run writes them: the bake applied to the part of the
+    // document it reads and changes, as the run applies it, so that a dry run of a large
+    // document does not build it whole.
+    if plan.asset.container == asset::Container::Gltf && !plan.embed {
+        if let Some(mut part) = BakePart::new(&plan.asset, &bake_plan, &plan.document) {
+            let mut json = std::mem::take(&mut part.json);
+            for e in plan.document.edits().chain(&plan.relocation.edits) {
+                if part.holds(e) {
+                    edit::apply(&mut json, std::slice::from_ref(e)).map_err(fail)?;
+                }
+            }
+            let before = json.clone();
+            let mut images = baked_images.clone();
+            let applied = bake_apply(
+                json,
+                None,
+                plan.asset.container,
+                &bake_plan,
+                &mut images,
+                ApplyOptions { embed: false },
+                &mut names_for(),
+            );
+            if applied.dropped == crate::bake::prune::Dropped::default() {
+                let mut edits = Vec::new();
+                for e in part.into_edits(&plan.asset, applied.json) {
+                    match &e {
+                        edit::Edit::Replace { pointer, value } => match before.pointer(pointer) {
+                            Some(old) => difference(pointer, old, value, &mut edits),
+                            None => edits.push(e),
+                        },
+                        _ => edits.push(e),
+                    }
+                }
+                return Ok(edits);
+            }
+        }
+    }
+    let edited = || -> Result<serde_json::Value, String> {
+        let mut before = plan.asset.root().to_value();
+        for edits in plan
+            .document
+            .materials
+            .iter()
+            .map(|m| m.edits.as_slice())
+            .chain([
+                plan.document.declarations.as_slice(),
+                plan.relocation.edits.as_slice(),
+            ])
+        {
+            edit::apply(&mut before, edits).map_err(fail)?;
+        }
+        Ok(before)
+    };
+    let before = edited()?;
+    // What the bake may change, kept to compare with: the members besides the materials, and
+    // the materials it bakes into (a whole copy of a large document would double the memory).
+    let baked: std::collections::BTreeSet<usize> = plan
         .document
         .materials
         .iter()
-        .map(|m| m.edits.as_slice())
-        .chain([
-            plan.document.declarations.as_slice(),
-            plan.relocation.edits.as_slice(),
-        ])
-    {
-        edit::apply(&mut before, edits).map_err(fail)?;
-    }
-    // Named as the run names them: next to the output (the input itself without one).
-    let output = plan.output.as_deref().unwrap_or(&plan.input);
-    let mut names = FileNames::next_to(claims, &plan.asset, &plan.input, output, &plan.relocation);
+        .filter(|m| !m.bakes.is_empty())
+        .map(|m| m.index)
+        .collect();
+    let kept_members: serde_json::Map<String, serde_json::Value> = before
+        .as_object()
+        .into_iter()
+        .flatten()
+        .filter(|(key, _)| *key != "materials")
+        .map(|(key, value)| (key.clone(), value.clone()))
+        .collect();
+    let kept_materials: Vec<(usize, serde_json::Value)> = baked
+        .iter()
+        .filter_map(|&i| Some((i, before.get("materials")?.get(i)?.clone())))
+        .collect();
+    let materials_before = before
+        .get("materials")
+        .and_then(serde_json::Value::as_array)
+        .map_or(0, Vec::len);
     let applied = bake_apply(
-        before.clone(),
+        before,
         plan.asset.bin.clone(),
         plan.asset.container,
         &bake_plan,
-        &mut baked,
+        &mut baked_images,
         ApplyOptions { embed: plan.embed },
-        &mut names,
+        &mut names_for(),
     );
     let mut edits = Vec::new();
-    difference("", &before, &applied.json, &mut edits);
+    let materials_after = applied.json.get("materials");
+    if applied.dropped != crate::bake::prune::Dropped::default()
+        || materials_after
+            .and_then(serde_json::Value::as_array)
+            .map_or(0, Vec::len)
+            != materials_before
+    {
+        // A bake that drops a texture renumbers references in any material: the whole
+        // document is compared.
+        difference("", &edited()?, &applied.json, &mut edits);
+        return Ok(edits);
+    }
+    for (i, material) in &kept_materials {
+        if let Some(after) = materials_after.and_then(|m| m.get(*i)) {
+            difference(&format!("/materials/{i}"), material, after, &mut edits);
+        }
+    }
+    let empty = serde_json::Map::new();
+    let after_members = applied.json.as_object().unwrap_or(&empty);
+    for (key, value) in &kept_members {
+        let at = crate::asset::pointer::join("", key);
+        match after_members.get(key) {
+            Some(new) => difference(&at, value, new, &mut edits),
+            None => edits.push(edit::Edit::remove(at)),
+        }
+    }
+    for (key, value) in after_members
+        .iter()
+        .filter(|(k, _)| *k != "materials" && !kept_members.contains_key(*k))
+    {
+        edits.push(edit::Edit::replace(
+            crate::asset::pointer::join("", key),
+            value.clone(),
+        ));
+    }
     Ok(edits)
 }
 
