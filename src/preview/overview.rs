@@ -157,7 +157,7 @@ pub fn png(flips: &[f64], metrics: &[(f64, bool)], worst: &[Worst]) -> Vec<u8> {
     c.text(
         MARGIN,
         MARGIN + LINE_HEIGHT,
-        "the plan's ꟻLIP in the furnace (99th percentile over the sphere), authored against migrated",
+        "the plan's ꟻLIP in the furnace, authored against migrated",
         DIM,
     );
     let colour = |v: Verdict| match v {
