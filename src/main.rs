@@ -304,7 +304,7 @@ struct BakeArgs {
 
 #[derive(clap::Args)]
 #[command(
-    after_help = "Exit status: 0 done, 1 a file could not be previewed or an output not written (the other sheets are still written), 2 usage error (nothing written), 130 / 143 stopped by SIGINT / SIGTERM (the sheets written are complete, no index)."
+    after_help = "Exit status: 0 done, 1 a file could not be previewed or an output not written (the other sheets are still written), 2 usage error (nothing written), 130 / 143 stopped by SIGINT / SIGTERM (the sheets written are complete and listed in index.json)."
 )]
 struct PreviewArgs {
     /// Files and folders (folders are searched for *.gltf and *.glb, in any letter case).
@@ -313,8 +313,8 @@ struct PreviewArgs {
     /// The folder the sheets and index pages are written into.
     #[arg(short, long, value_name = "DIR", default_value = "velvet-preview")]
     output: PathBuf,
-    /// Draw only the N sheets whose migration moves the look most, by the plan's numbers
-    /// (found before anything is drawn); the index lists the others.
+    /// Draw only the N sheets the plan's verdict ranks worst (its ꟻLIP in the furnace, known
+    /// before anything is drawn); the index lists the others.
     #[arg(long, value_name = "N")]
     worst: Option<usize>,
     #[command(flatten)]
