@@ -283,6 +283,11 @@ fn the_fallback_of_a_black_fuzz_shows_no_layer() {
     assert_eq!(m.kind, Kind::FuzzFallback);
     let cols = columns(m, &m.factors);
     assert_eq!(cols.len(), 3);
+    // No fallback is written, and the column says so.
+    assert_eq!(
+        (cols[1].title.as_str(), cols[1].detail.as_str()),
+        ("no fuzz: sheen", "none written: base alone")
+    );
     let bare = Shaded::new(Look {
         base: m.base,
         base_metallic: m.base_metallic,
@@ -1524,4 +1529,38 @@ fn index_json_lists_every_material_with_its_verdict_and_a_rerun_removes_only_the
         .map(|r| r["drawn"].as_bool().unwrap())
         .collect();
     assert_eq!(drawn, [true, false, false, false]);
+}
+
+#[test]
+fn with_fast_a_copied_roughness_texture_is_labelled_copied_not_fitted() {
+    let dir = tempfile::tempdir().unwrap();
+    let rough: Vec<[u8; 4]> = (0..4).map(|i| [255, 255, 255, (i * 60) as u8]).collect();
+    let text = format!(
+        r#"{{"asset": {{"version": "2.0"}},
+            "images": [{{"uri": "{}"}}],
+            "textures": [{{"source": 0}}],
+            "materials": [{{"name": "textured",
+              "extensions": {{"KHR_materials_sheen": {{"sheenColorFactor": [1, 1, 1], "sheenRoughnessFactor": 0.5,
+                  "sheenRoughnessTexture": {{"index": 0}}}}}}}}]}}"#,
+        png_data_uri(&rough)
+    );
+    let path = write(dir.path(), "fast.gltf", &text);
+    let asset = load(&path);
+    let fast = &materials_with(
+        &asset,
+        &velvet::migrate::Options {
+            fast: true,
+            ..velvet::migrate::Options::default()
+        },
+    )[0];
+    assert!(fast.roughness_copied_by_fast);
+    assert_eq!(
+        columns(fast, &fast.factors)[1].detail,
+        "α 0.500 copied (--fast)"
+    );
+    let fitted = &materials_of(&asset)[0];
+    assert!(!fitted.roughness_copied_by_fast);
+    assert!(columns(fitted, &fitted.factors)[1]
+        .detail
+        .ends_with(" fitted"));
 }

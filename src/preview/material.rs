@@ -100,6 +100,9 @@ pub struct Material {
     pub notes: Vec<String>,
     /// fuzzRoughnessFactor was absent: the table default 0.5 is used.
     pub fuzz_roughness_assumed: bool,
+    /// `--fast` copied the roughness (a roughness texture it would have baked mapped): the
+    /// migrated column's roughness is copied, whatever the run's mapping.
+    pub roughness_copied_by_fast: bool,
     /// The roughness mapping of the run the plan was made for; the sheet's other column
     /// shows the other one.
     pub mapping: RoughnessMapping,
@@ -124,6 +127,7 @@ impl Material {
                 &self.swatches,
                 &self.notes,
                 self.fuzz_roughness_assumed,
+                self.roughness_copied_by_fast,
                 self.mapping
             )
         )
@@ -397,6 +401,11 @@ fn read(
         swatches,
         notes,
         fuzz_roughness_assumed,
+        roughness_copied_by_fast: plan.is_some_and(|p| {
+            p.notes
+                .iter()
+                .any(|n| matches!(n, crate::migrate::Note::RoughnessTextureFast { .. }))
+        }),
         mapping,
         verdict: None,
     })
@@ -749,7 +758,12 @@ pub fn columns(material: &Material, swatch: &Swatch) -> Vec<Column> {
                 },
                 Column {
                     title: "migrated: fuzz".into(),
-                    detail: format!("α {} {}", rough(migrated.roughness), mapping_word(mapping)),
+                    detail: match material.roughness_copied_by_fast {
+                        true => format!("α {} copied (--fast)", rough(migrated.roughness)),
+                        false => {
+                            format!("α {} {}", rough(migrated.roughness), mapping_word(mapping))
+                        }
+                    },
                     look: look(fuzz_layer(migrated)),
                 },
                 Column {
@@ -808,9 +822,17 @@ pub fn columns(material: &Material, swatch: &Swatch) -> Vec<Column> {
                     roughness: carried(f.roughness, Direction::FuzzToSheen, other(mapping)),
                     ..migrated
                 };
+                // A black fuzz gets no fallback: the column shows the base alone, and says so
+                // rather than describe a sheen the file does not hold.
+                let no_fallback = material.factors.written_sheen.is_none() && max3(color) <= 0.0;
                 cols.push(Column {
                     title: "no fuzz: sheen".into(),
-                    detail: format!("r {} {}", rough(migrated.roughness), mapping_word(mapping)),
+                    detail: match no_fallback {
+                        true => "none written: base alone".into(),
+                        false => {
+                            format!("r {} {}", rough(migrated.roughness), mapping_word(mapping))
+                        }
+                    },
                     look: look(sheen_layer(migrated)),
                 });
                 cols.push(Column {
@@ -910,6 +932,7 @@ mod tests {
             swatches: vec![],
             notes: vec![],
             fuzz_roughness_assumed: false,
+            roughness_copied_by_fast: false,
             mapping: RoughnessMapping::Fitted,
             verdict: None,
         };
