@@ -34,6 +34,14 @@ pub fn command(request: &Request) -> Status {
             ..crate::migrate::Options::default()
         },
     );
+    // A stop during planning (the verdicts take a library seconds) writes nothing.
+    if let Some(signal) = crate::output::interrupt::requested() {
+        super::note(format_args!(
+            "velvet: stopped by {} while planning: nothing written",
+            crate::output::interrupt::name(signal)
+        ));
+        return Status::Stopped(signal);
+    }
     let failed = report_failures(&plan, "");
     match write(&plan, &request.output, request.worst, request.quiet) {
         Some(status) => status,

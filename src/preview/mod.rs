@@ -343,6 +343,14 @@ pub fn write(
     count: Option<usize>,
     progress: bool,
 ) -> Result<Written, String> {
+    // A run stopped before it draws (while its plan was made) writes nothing: its verdicts
+    // were left unmeasured.
+    if crate::output::interrupt::requested().is_some() {
+        return Ok(Written {
+            stopped: true,
+            ..Written::default()
+        });
+    }
     std::fs::create_dir_all(out_dir)
         .map_err(|e| format!("cannot create the folder {}: {e}", out_dir.display()))?;
     let chosen = count.map_or(plan.sheets.len(), |n| n.min(plan.sheets.len()));

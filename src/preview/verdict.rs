@@ -140,9 +140,14 @@ pub fn measure_all(materials: &[Material]) -> Vec<Verdict> {
             })
         })
         .collect();
+    // A stop (SIGINT, SIGTERM) ends the measuring at once: what is left reads 0, and every
+    // caller checks for the stop before it uses a verdict (see [`judge`]).
     let verdicts: Vec<Verdict> = distinct
         .par_iter()
-        .map(|&i| measure_pairs(&keys[i].1))
+        .map(|&i| match crate::output::interrupt::requested() {
+            Some(_) => Verdict::new(0.0, 0.0),
+            None => measure_pairs(&keys[i].1),
+        })
         .collect();
     slot.into_iter().map(|s| verdicts[s]).collect()
 }
@@ -184,7 +189,9 @@ fn remedies(options: &Options) -> Vec<(&'static str, Options)> {
 /// Measures the verdict of every material of `plan` a sheet shows, writes it into the plan
 /// (and a warning on each "visible" material the migration changes, with the run that would
 /// bring it closer when one would), and returns the materials as the sheets show them, in
-/// document order, each with its verdict.
+/// document order, each with its verdict. A stop (SIGINT, SIGTERM) during the measuring ends it
+/// within a measurement: the verdicts are then not to be used, and the callers, which check
+/// for the stop right after, use none.
 pub fn judge(asset: &Asset, plan: &mut DocumentPlan, options: &Options) -> Vec<Material> {
     let cache = material::ImageCache::default();
     let mut materials = material::materials_with(asset, plan, options.roughness, &cache);
@@ -203,7 +210,7 @@ pub fn judge(asset: &Asset, plan: &mut DocumentPlan, options: &Options) -> Vec<M
             }
         }
     }
-    if visible.is_empty() {
+    if visible.is_empty() || crate::output::interrupt::requested().is_some() {
         return materials;
     }
     // Each visible material planned again, alone, with each remedy's flags; a remedy that

@@ -118,6 +118,10 @@ fn migrate_one(
     // materials it reads are the sheets' when `--preview` asks for them.
     let judged = (sheets || !options.skip_verdict)
         .then(|| crate::preview::verdict::judge(&plan.asset, &mut plan.document, options));
+    // A stop during the measuring leaves verdicts that are not to be reported.
+    if let Err(stopped) = crate::output::interrupt::check() {
+        return FileResult::failed(&job.input, job.output.as_deref(), stopped);
+    }
     let sheets = judged.filter(|_| sheets);
     let mut bake_edits = Vec::new();
     let outcome = if dry_run {
