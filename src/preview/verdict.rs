@@ -301,7 +301,9 @@ fn new_texture_bytes(asset: &Asset, current: &MaterialPlan, taken: &MaterialPlan
     for bake in taken.bakes.iter().filter(|b| !current.bakes.contains(b)) {
         let (_, image) = *bake.sources.first()?;
         let header = asset.image_header(image).ok()?;
-        bytes += u64::from(header.width) * u64::from(header.height) * 4;
+        // Saturating: a header may claim any size up to 2³² a side.
+        let texture = (u64::from(header.width) * u64::from(header.height)).saturating_mul(4);
+        bytes = bytes.saturating_add(texture);
     }
     Some(bytes)
 }
