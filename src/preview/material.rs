@@ -607,6 +607,8 @@ fn image_stats(
             .or_default(),
     );
     cell.get_or_init(|| {
+        // Nothing is decoded once the run is asked to stop.
+        crate::output::interrupt::check()?;
         asset
             .decode_image_with(image, 1, 4, |img| stats_by(&img.to_rgba8(), read, transfer))
             .map_err(|d| d.message)
@@ -631,7 +633,12 @@ fn stats_by(img: &image::RgbaImage, read: Read, transfer: Transfer) -> TextureSt
     // Per rank (the largest channel's code, or the channel's code): texel count and sums.
     let mut count = [0u64; 256];
     let mut sums = vec![[0.0f64; 3]; 256];
-    for p in img.pixels() {
+    for (i, p) in img.pixels().enumerate() {
+        // A stop (SIGINT, SIGTERM) ends a large image's pass early: the statistics are then
+        // partial, and the callers, which check for the stop next, use none of them.
+        if i % (1 << 16) == 0 && crate::output::interrupt::requested().is_some() {
+            break;
+        }
         let [r, g, b, a] = p.0;
         let (rank, values) = match read {
             Read::Rgb => (
