@@ -47,7 +47,7 @@ fn main() {
         args.iter().map(Into::into).collect()
     };
     let plan = velvet::preview::plan(&inputs, &velvet::migrate::Options::default());
-    println!("sheet,light,swatch,plan_metric,max_codes,share_over_10,flip_mean,flip_p50,flip_p95,flip_p99,flip_max");
+    println!("sheet,light,swatch,plan_flip,max_codes,share_over_10,flip_mean,flip_p50,flip_p95,flip_p99,flip_max");
     for s in &plan.sheets {
         let m = &s.material;
         for swatch in &m.swatches {
@@ -95,7 +95,7 @@ fn main() {
                     s.title.replace('"', "'"),
                     light,
                     swatch.label,
-                    s.metric,
+                    s.verdict.flip,
                     max_codes,
                     over,
                     mean,

@@ -20,7 +20,7 @@ Exit status:
   0  validate: no file has an issue at or above --fail-on (with --fix: none is left after fixing); migrate, bake: every file done, or nothing to do; preview: every sheet written
   1  validate: a file has an issue at or above --fail-on (a file that cannot be read or parsed has an error), --diff shows a change, or --fix --exit-non-zero-on-fix changed a file; migrate: a file failed (the others are still written) or, with --check, a file would change; bake: a file failed (the others are still written); preview: a file could not be previewed or a sheet not written
   2  usage or configuration error in validate, migrate, bake or preview (bad flag, unknown code, invalid velvet.toml, a path that does not exist or is not a regular file or folder, a folder without .gltf/.glb files, every file found in the folders given excluded, a refused output); migrate, bake and preview then write nothing
-  130  migrate, bake: stopped by SIGINT (143: by SIGTERM); the files finished before are complete, nothing is left of the others; preview: the sheets written are complete, no index is written";
+  130  migrate, bake: stopped by SIGINT (143: by SIGTERM); the files finished before are complete, nothing is left of the others; preview: the sheets written are complete and listed in index.json";
 
 const HEADING: &str = "Exit status:\n";
 

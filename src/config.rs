@@ -5,7 +5,8 @@
 //! (the nearest one wins; `--config FILE` names one for every input instead). The keys have the
 //! meanings of the Khronos glTF-Validator's config file where the two overlap (`max-issues`
 //! with 0 for no limit, `ignore`, `only`, `override` with severities 0–3 or their names); velvet
-//! adds `fail-on` and `exclude`. An unknown key, an unknown code or a bad value is an error that
+//! adds `fail-on` and `exclude`, and `fail-on-visible` for `velvet migrate --check` (a file
+//! fails the check when a material it holds would migrate visibly). An unknown key, an unknown code or a bad value is an error that
 //! names it: a typo in a CI configuration must not silently switch a check off.
 //!
 //! Precedence is per key: a command-line flag over the file, the file over the built-in
@@ -90,6 +91,9 @@ pub struct Layer {
     pub exclude: Vec<String>,
     /// `data = false`, `--no-data`: leave out the checks that read accessor data.
     pub data: Option<bool>,
+    /// `fail-on-visible = true`, `migrate --check --fail-on-visible`: a material whose
+    /// migration the plan's verdict calls "visible" fails the check.
+    pub fail_on_visible: Option<bool>,
 }
 
 /// The keys of velvet.toml as written.
@@ -105,6 +109,7 @@ struct RawFile {
     fail_on: Option<String>,
     exclude: Option<Vec<String>>,
     data: Option<bool>,
+    fail_on_visible: Option<bool>,
 }
 
 /// An integer, with an error message that says so in the file's terms.
@@ -303,6 +308,7 @@ impl Layer {
             fail_on,
             exclude,
             data: raw.data,
+            fail_on_visible: raw.fail_on_visible,
         })
     }
 
@@ -344,6 +350,7 @@ impl Layer {
             fail_on,
             exclude: Vec::new(),
             data,
+            fail_on_visible: None,
         })
     }
 
@@ -418,6 +425,8 @@ pub struct Config {
     pub exclude: Vec<String>,
     /// Whether the checks that read accessor data run.
     pub data: (bool, Source),
+    /// Whether `migrate --check` fails a file with a material that would migrate visibly.
+    pub fail_on_visible: (bool, Source),
     /// Patterns with a `/`, matched against the path below the file's folder.
     anchored: GlobSet,
     /// Patterns without a `/`, matched against every component of that path.
@@ -447,6 +456,7 @@ impl Config {
         let selection = combine_selection(&cli.selection, &file_layer.selection);
         let fail_on = pick(&cli.fail_on, &file_layer.fail_on, FailOn::Error);
         let data = pick(&cli.data, &file_layer.data, true);
+        let fail_on_visible = pick(&cli.fail_on_visible, &file_layer.fail_on_visible, false);
         let mut overrides: BTreeMap<String, (Severity, Source)> = file_layer
             .overrides
             .iter()
@@ -512,6 +522,7 @@ impl Config {
             overrides,
             fail_on,
             data,
+            fail_on_visible,
             exclude: file_layer.exclude,
             anchored: anchored.build().unwrap_or_else(|_| GlobSet::empty()),
             component: component.build().unwrap_or_else(|_| GlobSet::empty()),
@@ -652,6 +663,12 @@ impl Config {
             } else {
                 " (accessor data and image bytes not read)"
             }
+        );
+        let (fail_on_visible, source) = self.fail_on_visible;
+        let _ = writeln!(
+            out,
+            "fail-on-visible = {fail_on_visible}  # {} (migrate --check)",
+            source.describe()
         );
         out.push_str("\n[override]\n");
         for (code, (severity, source)) in &self.overrides {
@@ -906,6 +923,19 @@ mod tests {
     }
 
     #[test]
+    fn fail_on_visible_is_a_boolean_key() {
+        assert_eq!(
+            Layer::parse("fail-on-visible = true\n")
+                .unwrap()
+                .fail_on_visible,
+            Some(true)
+        );
+        assert_eq!(Layer::parse("").unwrap().fail_on_visible, None);
+        let e = Layer::parse("fail-on-visible = \"yes\"\n").unwrap_err();
+        assert!(e.starts_with("line 1, column 19: fail-on-visible: "), "{e}");
+    }
+
+    #[test]
     fn command_line_beats_file_beats_default_per_key() {
         let file = Layer {
             max_issues: Some(7),
@@ -918,6 +948,7 @@ mod tests {
             fail_on: None,
             exclude: vec![],
             data: Some(false),
+            fail_on_visible: Some(true),
         };
         let cli = Layer {
             max_issues: Some(2),
@@ -927,6 +958,7 @@ mod tests {
         let c = Config::combine(Some((PathBuf::from("/p/velvet.toml"), file)), &cli);
         assert_eq!(c.max_issues, (2, Source::CommandLine));
         assert_eq!(c.selection.1, Source::File);
+        assert_eq!(c.fail_on_visible, (true, Source::File));
         assert_eq!(c.fail_on, (FailOn::Error, Source::Default));
         assert_eq!(c.overrides["TYPE_MISMATCH"], (Severity::Info, Source::File));
         assert_eq!(

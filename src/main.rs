@@ -307,7 +307,7 @@ struct BakeArgs {
 
 #[derive(clap::Args)]
 #[command(
-    after_help = "Exit status: 0 done, 1 a file could not be previewed or an output not written (the other sheets are still written), 2 usage error (nothing written), 130 / 143 stopped by SIGINT / SIGTERM (the sheets written are complete, no index)."
+    after_help = "Exit status: 0 done, 1 a file could not be previewed or an output not written (the other sheets are still written), 2 usage error (nothing written), 130 / 143 stopped by SIGINT / SIGTERM (the sheets written are complete and listed in index.json)."
 )]
 struct PreviewArgs {
     /// Files and folders (folders are searched for *.gltf and *.glb, in any letter case).
@@ -316,8 +316,8 @@ struct PreviewArgs {
     /// The folder the sheets and index pages are written into.
     #[arg(short, long, value_name = "DIR", default_value = "velvet-preview")]
     output: PathBuf,
-    /// Draw only the N sheets whose migration moves the look most, by the plan's numbers
-    /// (found before anything is drawn); the index lists the others.
+    /// Draw only the N sheets the plan's verdict ranks worst (its ꟻLIP in the furnace, known
+    /// before anything is drawn); the index lists the others.
     #[arg(long, value_name = "N")]
     worst: Option<usize>,
     #[command(flatten)]
@@ -497,6 +497,10 @@ struct MigrateArgs {
     /// Write nothing; exit with status 1 when a file would change (for CI and pre-commit).
     #[arg(long, conflicts_with_all = ["output", "out_dir", "in_place"])]
     check: bool,
+    /// With --check: judge appearance instead of change, and fail on a material that would
+    /// migrate visibly (also `fail-on-visible = true` in velvet.toml).
+    #[arg(long, requires = "check")]
+    fail_on_visible: bool,
     /// Output format.
     #[arg(long, value_enum, default_value_t = ReportFormat::Text)]
     format: ReportFormat,
@@ -526,6 +530,11 @@ struct MigrateArgs {
     /// material, before a dearer plan is taken; `exact` bakes one texture per material.
     #[arg(long, value_name = "DIFFERENCE|exact", default_value = "0.01")]
     roughness_budget: migrate::budget::Budget,
+    /// The most new textures (MiB, uncompressed, per file) the default may bake to bring a
+    /// material whose migration would be visible to close, as --exact or an exact roughness
+    /// bake would; 0 takes none.
+    #[arg(long, value_name = "MIB", default_value_t = migrate::verdict::DEFAULT_CLOSER_BUDGET_MIB)]
+    closer_budget: u64,
     /// Regenerate the sheen fallback of materials that already have fuzz and sheen.
     #[arg(long)]
     refresh_fallback: bool,
@@ -641,6 +650,13 @@ fn migrate(args: MigrateArgs, quiet: bool) -> Status {
             fast: args.fast,
             budget: args.roughness_budget,
             rewrite_uris: args.rewrite_uris,
+            // The speed paths leave the verdict out unless a view reads it.
+            skip_verdict: (args.fast || matches!(args.roughness, RoughnessArg::Identity))
+                && args.preview.is_none()
+                && !args.check,
+            closer_budget: migrate::verdict::CloserBudget(
+                args.closer_budget.saturating_mul(1 << 20),
+            ),
             load: args.load.options(),
         },
         dry_run: args.dry_run || args.check,
@@ -650,6 +666,7 @@ fn migrate(args: MigrateArgs, quiet: bool) -> Status {
         format: args.format,
         detail: detail(quiet, args.verbose, args.report),
         check: args.check,
+        fail_on_visible: args.fail_on_visible,
         preview: args.preview,
     };
     command::migrate::command(&request, args.input.shard, &view)

@@ -689,6 +689,7 @@ fn config_command_without_any_file_shows_defaults() {
              fail-on = \"error\"  # default\n\
              exclude = []  # default\n\
              data = true  # default\n\
+             fail-on-visible = false  # default (migrate --check)\n\
              \n[override]\n"
         );
     }

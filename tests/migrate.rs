@@ -854,7 +854,7 @@ fn dry_run_prints_the_plan_and_writes_nothing() {
     );
     let text = render::text(&report, Detail::Verbose);
     assert!(
-        text.contains("  material 0 \"champagne\": sheen → fuzz\n"),
+        text.contains("  material 0 \"champagne\": sheen → fuzz; verdict close (ꟻLIP 0.165 in the furnace, 0.271 under the light)\n"),
         "{text}"
     );
     assert!(text.contains(
@@ -864,7 +864,7 @@ fn dry_run_prints_the_plan_and_writes_nothing() {
         text.contains("  declare KHR_materials_fuzz in /extensionsUsed\n"),
         "{text}"
     );
-    assert!(text.ends_with("1 file: 1 would change, 0 unchanged, 0 failed; no texture to add\nmaterials: 3 migrated (3 sheen → fuzz); 0 skipped; 0 warnings\n"), "{text}");
+    assert!(text.ends_with("1 file: 1 would change, 0 unchanged, 0 failed; no texture to add\nmaterials: 3 migrated (3 sheen → fuzz); 0 skipped; 0 warnings\nverdicts: 0 same, 3 close, 0 visible\n"), "{text}");
     let json: Value = serde_json::from_str(&render::json(&report)).unwrap();
     assert_eq!(json["files"][0]["status"], "planned");
     assert_eq!(json["files"][0]["materials"][0]["edits"][0]["op"], "set");
@@ -873,6 +873,14 @@ fn dry_run_prints_the_plan_and_writes_nothing() {
         serde_json::json!({"op": "declare-used", "extension": "KHR_materials_fuzz"})
     );
     assert_eq!(json["summary"]["conversions"]["sheen-to-fuzz"], 3);
+    assert_eq!(
+        json["files"][0]["materials"][1]["verdict"],
+        serde_json::json!({"label": "close", "flip": 0.1112, "furnace": 0.1112, "light": 0.1448})
+    );
+    assert_eq!(
+        json["summary"]["verdicts"],
+        serde_json::json!({"same": 0, "close": 3, "visible": 0})
+    );
 }
 
 fn velvet(args: &[&str]) -> (i32, String, String) {
@@ -2152,5 +2160,334 @@ fn every_write_strategy_writes_the_document_the_rewrite_writes() {
         chosen.into_iter().collect::<Vec<_>>(),
         ["BakePart", "Rewrite", "Splice"],
         "each strategy is chosen for one of the runs"
+    );
+}
+
+/// A dry run's edits (each material's, then the file's, then the bakes') applied to the
+/// input's JSON, in the order the report lists them.
+fn dry_run_document(input: &Path, result: &migrating::FileResult) -> Value {
+    let mut json: Value = serde_json::from_slice(&std::fs::read(input).unwrap()).unwrap();
+    for m in &result.detail.materials {
+        velvet::edit::apply(&mut json, &m.edits).unwrap();
+    }
+    velvet::edit::apply(&mut json, &result.detail.edits).unwrap();
+    velvet::edit::apply(&mut json, &result.detail.bake_edits).unwrap();
+    json
+}
+
+#[test]
+fn a_dry_runs_edits_applied_to_the_input_give_the_written_document_bakes_included() {
+    type Variant = (&'static str, fn(&mut Options));
+    // `--embed` writes new images as data: URIs: its dry run bakes on the whole document, where
+    // the others bake on the part a bake changes.
+    let variants: [Variant; 4] = [
+        ("default", |_| {}),
+        ("exact", |o| o.exact = true),
+        ("budget exact", |o| {
+            o.budget = migrate::budget::Budget::Exact
+        }),
+        ("embed", |o| o.embed = true),
+    ];
+    let mut with_new_images = Vec::new();
+    for case in cases() {
+        for (label, set) in variants {
+            let mut options = options_for(&case);
+            set(&mut options);
+            let dir = tempfile::tempdir().unwrap();
+            let input = dir.path().join("in").join(case.file_name().unwrap());
+            std::fs::create_dir_all(input.parent().unwrap()).unwrap();
+            std::fs::copy(&case, &input).unwrap();
+            let out_dir = dir.path().join("out");
+            let mut run = request(
+                vec![input.clone()],
+                Destination::Dir(out_dir.clone()),
+                options,
+            );
+            run.dry_run = true;
+            let planned = migrating::run(&run).unwrap().files.remove(0);
+            assert!(
+                matches!(planned.outcome, FileOutcome::Planned { .. }),
+                "{} ({label}): {:?}",
+                stem(&case),
+                planned.outcome
+            );
+            assert!(!out_dir.exists(), "a dry run writes nothing");
+            run.dry_run = false;
+            let written = migrating::run(&run).unwrap().files.remove(0);
+            let output = out_dir.join(case.file_name().unwrap());
+            let expected: Value = match written.outcome {
+                FileOutcome::Changed | FileOutcome::Copied => {
+                    serde_json::from_slice(&std::fs::read(&output).unwrap()).unwrap()
+                }
+                ref other => panic!("{} ({label}): {other:?}", stem(&case)),
+            };
+            assert_eq!(
+                dry_run_document(&input, &planned),
+                expected,
+                "{} ({label})",
+                stem(&case)
+            );
+            let new_images: Vec<String> = planned
+                .detail
+                .bake_edits
+                .iter()
+                .filter_map(|e| match e {
+                    velvet::edit::Edit::Replace { pointer, value }
+                        if pointer.starts_with("/images/") =>
+                    {
+                        value.get("uri").and_then(Value::as_str).map(str::to_owned)
+                    }
+                    _ => None,
+                })
+                .collect();
+            for uri in new_images.iter().filter(|u| !u.starts_with("data:")) {
+                assert!(out_dir.join(uri).is_file(), "{uri} is written as named");
+            }
+            if !new_images.is_empty() {
+                with_new_images.push(format!("{} ({label}): {}", stem(&case), new_images.len()));
+            }
+        }
+    }
+    // The fixtures whose bakes add images, and how many each adds (legacy's roughness bake,
+    // sheen-textures' mapped roughness, --exact's fuzz and fuzz colour textures, which the
+    // default takes too where they bring a visible material to close).
+    assert_eq!(
+        with_new_images,
+        [
+            "fuzz-textures (default): 3",
+            "fuzz-textures (exact): 3",
+            "fuzz-textures (budget exact): 3",
+            "fuzz-textures (embed): 3",
+            "legacy-texcoord (default): 2",
+            "legacy-texcoord (exact): 2",
+            "legacy-texcoord (budget exact): 2",
+            "legacy-texcoord (embed): 2",
+            "legacy (default): 4",
+            "legacy (exact): 4",
+            "legacy (budget exact): 4",
+            "legacy (embed): 4",
+            "sheen-textures (default): 3",
+            "sheen-textures (exact): 5",
+            "sheen-textures (budget exact): 3",
+            "sheen-textures (embed): 3",
+        ]
+    );
+}
+
+#[test]
+fn a_visible_material_is_a_warning_naming_the_flags_that_bring_it_closer() {
+    use velvet::migrate::verdict::{BeyondBudget, CloserBudget, Label};
+    // With no budget to bake more, the cloth keeps its plan and is a warning.
+    let (_dir, _output, result) = migrate_case_with(
+        &fixtures().join("sheen-textures.gltf"),
+        Options {
+            closer_budget: CloserBudget(0),
+            ..options_for(&fixtures().join("sheen-textures.gltf"))
+        },
+    );
+    let cloth = &result.detail.materials[0];
+    assert_eq!(cloth.name.as_deref(), Some("cloth"));
+    assert_eq!(cloth.verdict.map(|v| v.label), Some(Label::Visible));
+    let visible: Vec<&Note> = cloth
+        .notes
+        .iter()
+        .filter(|n| matches!(n, Note::VisibleDifference { .. }))
+        .collect();
+    assert_eq!(visible.len(), 1);
+    let Note::VisibleDifference {
+        verdict,
+        remedy,
+        tried,
+        beyond_budget,
+    } = visible[0]
+    else {
+        unreachable!("filtered above")
+    };
+    assert_eq!(visible[0].level(), migrate::Level::Warning);
+    assert_eq!(Some(*verdict), cloth.verdict);
+    assert_eq!(
+        tried,
+        &[
+            "--exact",
+            "--roughness-budget exact",
+            "--exact --roughness-budget exact"
+        ]
+        .map(String::from)
+    );
+    let remedy = remedy.as_ref().expect("--exact brings the cloth closer");
+    assert_eq!(remedy.flags, "--exact");
+    assert_eq!(remedy.verdict.label, Label::Close);
+    // --exact bakes a fuzzTexture and a fuzzColorTexture from the 2×2 colour image (its
+    // roughness bake is the one the plan has): (4 + 4) texels of 4 bytes.
+    assert_eq!(*beyond_budget, Some(BeyondBudget { bytes: 32, left: 0 }));
+    assert!(visible[0].message().contains(&format!(
+        "--exact would bring it to {}, but its new textures (32 bytes uncompressed) pass what \
+         is left of the --closer-budget (0 bytes), so the default does not take it",
+        remedy.verdict.describe()
+    )));
+    // The tinted material is not visible, and has no such warning.
+    let tinted = &result.detail.materials[1];
+    assert_eq!(tinted.verdict.map(|v| v.label), Some(Label::Same));
+    assert!(!tinted
+        .notes
+        .iter()
+        .any(|n| matches!(n, Note::VisibleDifference { .. })));
+
+    // The default budget takes the plan --exact gives: the cloth is close, and says why.
+    let (_dir, _output, default) = migrate_case(&fixtures().join("sheen-textures.gltf"));
+    let cloth_taken = &default.detail.materials[0];
+    assert_eq!(cloth_taken.verdict, Some(remedy.verdict));
+    assert!(cloth_taken.notes.contains(&Note::CloserPlanTaken {
+        flags: "--exact".into(),
+        before: *verdict,
+        after: remedy.verdict,
+        bytes: 32,
+    }));
+    assert!(cloth_taken.notes.contains(&Note::ExactBaked));
+    assert!(!cloth_taken
+        .notes
+        .iter()
+        .any(|n| matches!(n, Note::VisibleDifference { .. })));
+}
+
+#[test]
+fn check_with_the_visible_gate_fails_on_visible_materials_only_from_the_flag_or_velvet_toml() {
+    let dir = tempfile::tempdir().unwrap();
+    for case in ["sheen-factors.gltf", "sheen-textures.gltf"] {
+        std::fs::copy(fixtures().join(case), dir.path().join(case)).unwrap();
+    }
+    let path = |case: &str| dir.path().join(case).to_string_lossy().into_owned();
+    // Without the gate, a file that would change fails the check.
+    let (code, _, _) = velvet(&["migrate", "--check", "-q", &path("sheen-factors.gltf")]);
+    assert_eq!(code, 1);
+    // With it, appearance decides: three close materials pass, the visible cloth fails.
+    let (code, _, err) = velvet(&[
+        "migrate",
+        "--check",
+        "--fail-on-visible",
+        "-q",
+        &path("sheen-factors.gltf"),
+    ]);
+    assert_eq!((code, err.as_str()), (0, ""));
+    // With no budget to bake it closer, the cloth would migrate visibly and fails the gate;
+    // with the default budget it is baked closer and passes.
+    let (code, _, _) = velvet(&[
+        "migrate",
+        "--check",
+        "--fail-on-visible",
+        "-q",
+        &path("sheen-textures.gltf"),
+    ]);
+    assert_eq!(code, 0);
+    let (code, _, err) = velvet(&[
+        "migrate",
+        "--check",
+        "--fail-on-visible",
+        "--closer-budget",
+        "0",
+        "-q",
+        &path("sheen-textures.gltf"),
+    ]);
+    assert_eq!(code, 1);
+    assert_eq!(
+        err,
+        format!(
+            "velvet: --check: {}: material 0 \"cloth\": visible (ꟻLIP 0.552 in the furnace, 0.414 under the light)\n",
+            path("sheen-textures.gltf")
+        )
+    );
+    // --fast still measures the verdict the gate reads.
+    let (code, _, _) = velvet(&[
+        "migrate",
+        "--check",
+        "--fail-on-visible",
+        "--fast",
+        "-q",
+        &path("sheen-textures.gltf"),
+    ]);
+    assert_eq!(code, 1);
+    // The velvet.toml key turns the gate on for the files below it.
+    std::fs::write(dir.path().join("velvet.toml"), "fail-on-visible = true\n").unwrap();
+    let (code, _, _) = velvet(&["migrate", "--check", "-q", &path("sheen-factors.gltf")]);
+    assert_eq!(code, 0);
+    let (code, _, _) = velvet(&[
+        "migrate",
+        "--check",
+        "--closer-budget",
+        "0",
+        "-q",
+        &path("sheen-textures.gltf"),
+    ]);
+    assert_eq!(code, 1);
+    // The flag needs --check.
+    let (code, _, _) = velvet(&[
+        "migrate",
+        "--fail-on-visible",
+        "--dry-run",
+        &path("sheen-factors.gltf"),
+    ]);
+    assert_eq!(code, 2);
+}
+
+#[test]
+fn on_the_fixtures_the_default_is_never_visible_where_exact_is_close() {
+    use velvet::migrate::verdict::Label;
+    let labels = |options: Options| -> Vec<(String, usize, Label)> {
+        let mut run = request(vec![fixtures()], Destination::None, options);
+        run.dry_run = true;
+        migrating::run(&run)
+            .unwrap()
+            .files
+            .iter()
+            .flat_map(|f| {
+                f.detail
+                    .materials
+                    .iter()
+                    // A draft sheen switched off is upgraded but shows nothing: no verdict.
+                    .filter(|m| m.migrated() && m.verdict.is_some())
+                    .map(|m| (stem(&f.input), m.index, m.verdict.unwrap().label))
+            })
+            .collect()
+    };
+    let default = labels(Options::default());
+    let exact = labels(Options {
+        exact: true,
+        ..Options::default()
+    });
+    assert_eq!(default.len(), exact.len());
+    let mut brought = Vec::new();
+    for (d, e) in default.iter().zip(&exact) {
+        assert_eq!((&d.0, d.1), (&e.0, e.1));
+        assert!(
+            !(d.2 == Label::Visible && e.2 < Label::Visible),
+            "{} material {}: visible by default, {:?} with --exact",
+            d.0,
+            d.1,
+            e.2
+        );
+        if e.2 == Label::Close && d.2 == Label::Close {
+            brought.push(format!("{} {}", d.0, d.1));
+        }
+    }
+    // The materials --exact brings to close are close by default too (the default takes its
+    // plan for the three that would be visible), among the others close either way.
+    // What stays visible by default is what no plan velvet offers brings closer.
+    let visible: Vec<String> = default
+        .iter()
+        .filter(|d| d.2 == Label::Visible)
+        .map(|d| format!("{} {}", d.0, d.1))
+        .collect();
+    assert_eq!(
+        visible,
+        ["fuzz-only 1", "fuzz-textures 0", "fuzz-textures 2"]
+    );
+    assert!(
+        brought.contains(&"sheen-textures 0".to_string()),
+        "{brought:?}"
+    );
+    assert!(brought.contains(&"legacy 0".to_string()), "{brought:?}");
+    assert!(
+        brought.contains(&"legacy-texcoord 0".to_string()),
+        "{brought:?}"
     );
 }

@@ -37,8 +37,8 @@ fn materials_with(
     asset: &velvet::asset::Asset,
     options: &velvet::migrate::Options,
 ) -> Vec<material::Material> {
-    let plan = velvet::migrate::plan_document(asset, options);
-    material::materials(asset, &plan, options.roughness)
+    let mut plan = velvet::migrate::plan_document(asset, options);
+    velvet::preview::verdict::judge(asset, &mut plan, options)
 }
 
 /// Interior pixels (whole pixel on the sphere) of a sphere of `size`.
@@ -283,6 +283,11 @@ fn the_fallback_of_a_black_fuzz_shows_no_layer() {
     assert_eq!(m.kind, Kind::FuzzFallback);
     let cols = columns(m, &m.factors);
     assert_eq!(cols.len(), 3);
+    // No fallback is written, and the column says so.
+    assert_eq!(
+        (cols[1].title.as_str(), cols[1].detail.as_str()),
+        ("no fuzz: sheen", "none written: base alone")
+    );
     let bare = Shaded::new(Look {
         base: m.base,
         base_metallic: m.base_metallic,
@@ -519,6 +524,7 @@ fn identical_inputs_give_identical_bytes_at_one_and_two_threads() {
             "a-m0-sheen.png",
             "a-m2-fuzz.png",
             "index.html",
+            "index.json",
             "overview.png",
             "sub_b-m0.png"
         ]
@@ -821,7 +827,7 @@ fn materials_with_the_same_values_share_one_sheet_which_lists_them() {
 }
 
 #[test]
-fn worst_n_draws_exactly_the_n_sheets_the_plans_metric_ranks_highest() {
+fn worst_n_draws_exactly_the_n_sheets_the_plans_verdict_ranks_highest() {
     let dir = tempfile::tempdir().unwrap();
     // Roughness from very low (held at migrate's floor: a large difference) to high.
     let roughness = [0.9, 0.02, 0.5, 0.05, 0.3, 0.7, 0.1, 0.2];
@@ -831,13 +837,13 @@ fn worst_n_draws_exactly_the_n_sheets_the_plans_metric_ranks_highest() {
         .map(|(i, r)| sheen(&format!("s{i}"), 0.9, *r))
         .collect();
     let input = write(dir.path(), "ranked.gltf", &gltf(&materials.join(", ")));
-    // The metric of each material, computed here from its own columns.
+    // The plan's verdict on each material, measured here from its own columns.
     let asset = load(&input);
     let mut by_metric: Vec<(f64, String)> = materials_of(&asset)
         .iter()
         .map(|m| {
             (
-                m.plan_metric(),
+                velvet::preview::verdict::measure_pairs(&velvet::preview::verdict::pairs(m)).flip,
                 format!("ranked-m{}-{}.png", m.index, m.name.as_deref().unwrap()),
             )
         })
@@ -899,7 +905,7 @@ fn a_library_larger_than_a_page_gets_pages_linked_from_the_first() {
     let metrics: Vec<f64> = written
         .drawn
         .iter()
-        .map(|d| plan.sheets[d.sheet].metric)
+        .map(|d| plan.sheets[d.sheet].verdict.flip)
         .collect();
     assert!(metrics.windows(2).all(|w| w[0] >= w[1]));
 }
@@ -939,33 +945,43 @@ fn an_interrupted_preview_leaves_the_sheets_written_so_far_and_no_partial_file()
                     .collect()
             })
             .unwrap_or_default();
-        // Every file there is a complete sheet (or, after a finished run, an index page).
+        // Every file there is a complete sheet, index.json or (after a finished run) an index
+        // page.
         for name in &files {
             let path = out.join(name);
             if name.ends_with(".png") {
                 image::open(&path).unwrap_or_else(|e| panic!("{name} is not whole: {e}"));
             } else {
                 assert!(
-                    name.starts_with("index") && name.ends_with(".html"),
+                    name == "index.json" || (name.starts_with("index") && name.ends_with(".html")),
                     "{name}"
                 );
             }
         }
         match output.status.code() {
             Some(0) => assert_eq!(pngs(&out).len(), 400),
+            Some(code) if err.contains("while planning: nothing written") => {
+                // Stopped before a sheet was drawn: nothing at all.
+                assert_eq!(code, 128 + signal, "{err}");
+                assert_eq!(files, Vec::<String>::new());
+                stopped += 1;
+            }
             Some(code) => {
                 assert_eq!(code, 128 + signal, "{err}");
                 assert!(
                     err.starts_with("velvet: stopped by SIG")
-                        && err.contains("sheets written (each complete); no index written"),
+                        && err.contains("sheets written (each complete), listed in index.json"),
                     "{err}"
                 );
                 assert!(
                     files
                         .iter()
-                        .all(|n| n.ends_with(".png") && n != "overview.png"),
+                        .all(|n| (n.ends_with(".png") && n != "overview.png") || n == "index.json"),
                     "{files:?}"
                 );
+                // The index of a stopped run lists exactly the sheets it finished.
+                let index = std::fs::read_to_string(out.join("index.json")).unwrap();
+                assert_eq!(velvet::preview::index::listed_sheets(&index), pngs(&out));
                 assert!(pngs(&out).len() < 400);
                 stopped += 1;
             }
@@ -1063,15 +1079,15 @@ fn the_verdict_sends_a_floored_fallback_to_look_and_passes_a_good_match() {
     let good = sheet::render("good", &m[0]).summary;
     let sharp = sheet::render("sharp", &m[1]).summary;
     assert_ne!(
-        good.verdict,
-        sheet::Verdict::Visible,
+        good.verdict.label,
+        sheet::Label::Visible,
         "{}",
         good.verdict_line()
     );
     assert!(good.flip[0] <= sheet::CLOSE_FLIP);
     assert_eq!(
-        sharp.verdict,
-        sheet::Verdict::Visible,
+        sharp.verdict.label,
+        sheet::Label::Visible,
         "{}",
         sharp.verdict_line()
     );
@@ -1340,4 +1356,217 @@ fn migrate_preview_draws_the_plans_migrate_wrote_and_no_sheet_for_a_file_it_refu
         "{err}"
     );
     assert_eq!(pngs(&sheets), ["good-m0-cloth.png"]);
+}
+
+#[test]
+fn every_fixture_material_gets_from_the_preview_the_verdict_migrate_reports() {
+    use velvet::command::migrate::{self as migrating, FileOutcome};
+    let fixtures = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/migrate");
+    let report = migrating::run(&migrating::Request {
+        inputs: vec![fixtures.clone()],
+        destination: velvet::output::paths::Destination::None,
+        options: velvet::migrate::Options::default(),
+        dry_run: true,
+        progress: false,
+    })
+    .unwrap();
+    let preview = velvet::preview::plan(&[fixtures], &velvet::migrate::Options::default());
+    let mut labels = Vec::new();
+    for entry in &preview.entries {
+        let file = report
+            .files
+            .iter()
+            .find(|f| f.input == entry.file)
+            .expect("migrate planned every file the preview read");
+        assert!(matches!(file.outcome, FileOutcome::Planned { .. }));
+        let planned = file
+            .detail
+            .materials
+            .iter()
+            .find(|m| m.index == entry.index)
+            .and_then(|m| m.verdict)
+            .expect("a verdict on every material a sheet shows");
+        let sheet = &preview.sheets[entry.sheet];
+        assert_eq!(planned, sheet.verdict, "{}", entry.title());
+        // The sheet drawn says the plan's word.
+        let drawn = sheet::render(&sheet.title, &sheet.material);
+        assert_eq!(drawn.summary.verdict, planned, "{}", entry.title());
+        labels.push(format!("{} {}", entry.title(), planned.label.as_str()));
+    }
+    assert_eq!(
+        labels,
+        [
+            "both-refresh.expected.gltf: material 0 \"stale\" close",
+            "both-refresh.expected.gltf: material 1 \"up to date\" close",
+            "both-refresh.expected.gltf: material 2 \"legacy fallback\" visible",
+            "both-refresh.gltf: material 0 \"stale\" visible",
+            "both-refresh.gltf: material 1 \"up to date\" close",
+            "both-refresh.gltf: material 2 \"legacy fallback\" visible",
+            "both.gltf: material 0 \"both\" close",
+            "clearcoat.expected.gltf: material 0 \"coated sheen\" close",
+            "clearcoat.expected.gltf: material 1 \"coated fuzz\" close",
+            "clearcoat.gltf: material 0 \"coated sheen\" close",
+            "clearcoat.gltf: material 1 \"coated fuzz\" close",
+            "fuzz-only.expected.gltf: material 0 \"half white\" close",
+            "fuzz-only.expected.gltf: material 1 \"dark over bright\" visible",
+            "fuzz-only.expected.gltf: material 2 \"no roughness\" close",
+            "fuzz-only.expected.gltf: material 4 \"defaults\" close",
+            "fuzz-only.expected.gltf: material 5 \"black\" visible",
+            "fuzz-only.gltf: material 0 \"half white\" close",
+            "fuzz-only.gltf: material 1 \"dark over bright\" visible",
+            "fuzz-only.gltf: material 2 \"no roughness\" close",
+            "fuzz-only.gltf: material 4 \"defaults\" close",
+            "fuzz-only.gltf: material 5 \"black\" visible",
+            "fuzz-textures.expected.gltf: material 0 \"colour and roughness textures\" visible",
+            "fuzz-textures.expected.gltf: material 1 \"intensity texture\" visible",
+            "fuzz-textures.expected.gltf: material 2 \"different sets\" visible",
+            "fuzz-textures.expected.gltf: material 3 \"same set\" visible",
+            "fuzz-textures.gltf: material 0 \"colour and roughness textures\" visible",
+            "fuzz-textures.gltf: material 1 \"intensity texture\" close",
+            "fuzz-textures.gltf: material 2 \"different sets\" visible",
+            "fuzz-textures.gltf: material 3 \"same set\" close",
+            "legacy-texcoord.expected.gltf: material 0 \"every primitive has TEXCOORD_1\" visible",
+            "legacy-texcoord.expected.gltf: material 1 \"one primitive lacks TEXCOORD_1\" close",
+            "legacy-texcoord.gltf: material 0 \"every primitive has TEXCOORD_1\" close",
+            "legacy-texcoord.gltf: material 1 \"one primitive lacks TEXCOORD_1\" close",
+            "legacy.expected.gltf: material 0 \"clamped\" visible",
+            "legacy.expected.gltf: material 1 \"factor only\" close",
+            "legacy.expected.gltf: material 3 \"mixed\" close",
+            "legacy.expected.gltf: material 4 \"dangling texture\" close",
+            "legacy.gltf: material 0 \"clamped\" close",
+            "legacy.gltf: material 1 \"factor only\" close",
+            "legacy.gltf: material 3 \"mixed\" close",
+            "legacy.gltf: material 4 \"dangling texture\" close",
+            "minified.expected.gltf: material 0 \"m\" same",
+            "minified.gltf: material 0 \"m\" same",
+            "sheen-factors.expected.gltf: material 0 \"champagne\" close",
+            "sheen-factors.expected.gltf: material 1 \"navy\" close",
+            "sheen-factors.expected.gltf: material 2 \"pale\" close",
+            "sheen-factors.gltf: material 0 \"champagne\" close",
+            "sheen-factors.gltf: material 1 \"navy\" close",
+            "sheen-factors.gltf: material 2 \"pale\" close",
+            "sheen-textures.expected.gltf: material 0 \"cloth\" visible",
+            "sheen-textures.expected.gltf: material 1 \"tinted\" same",
+            "sheen-textures.gltf: material 0 \"cloth\" close",
+            "sheen-textures.gltf: material 1 \"tinted\" same",
+            "undeclared.expected.gltf: material 0 \"m\" same",
+            "undeclared.gltf: material 0 \"m\" same",
+        ]
+    );
+}
+
+#[test]
+fn index_json_lists_every_material_with_its_verdict_and_a_rerun_removes_only_the_sheets_it_listed()
+{
+    let dir = tempfile::tempdir().unwrap();
+    let roughness = [0.9, 0.02, 0.5, 0.3];
+    let materials: Vec<String> = roughness
+        .iter()
+        .enumerate()
+        .map(|(i, r)| sheen(&format!("s{i}"), 0.9, *r))
+        .collect();
+    let input = write(dir.path(), "ranked.gltf", &gltf(&materials.join(", ")));
+    let out = dir.path().join("out");
+    let plan = velvet::preview::plan(
+        std::slice::from_ref(&input),
+        &velvet::migrate::Options::default(),
+    );
+    let written = velvet::preview::write(&plan, &out, None, false).unwrap();
+    assert_eq!(written.index_json, Some(out.join("index.json")));
+    let index: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("index.json")).unwrap()).unwrap();
+    let records = index["sheets"].as_array().unwrap();
+    assert_eq!(records.len(), 4);
+    // In the pages' order, each with its sheet, the plan's verdict and the values as written.
+    for (record, sheet) in records.iter().zip(&plan.sheets) {
+        let entry = &plan.entries[sheet.entries[0]];
+        let fuzz = sheet.material.factors.written_fuzz.unwrap();
+        let kept = sheet.material.factors.written_sheen.unwrap();
+        assert_eq!(
+            record,
+            &serde_json::json!({
+                "file": sheet.name,
+                "asset": "ranked.gltf",
+                "material": entry.index,
+                "name": entry.name,
+                "label": sheet.verdict.label.as_str(),
+                "flip": sheet.verdict.flip,
+                "furnace": sheet.verdict.furnace,
+                "light": sheet.verdict.light,
+                "drawn": true,
+                "written": {
+                    "sheen": {"color": kept.color, "roughness": kept.roughness},
+                    "fuzz": {"weight": fuzz.weight, "color": fuzz.color, "roughness": fuzz.roughness},
+                },
+            })
+        );
+        assert!(out.join(&sheet.name).is_file());
+    }
+    let flips: Vec<f64> = records
+        .iter()
+        .map(|r| r["flip"].as_f64().unwrap())
+        .collect();
+    assert!(flips.windows(2).all(|w| w[0] >= w[1]), "{flips:?}");
+    // A file velvet did not write stays; a rerun drawing the worst sheet alone removes the
+    // three others, and lists them undrawn.
+    std::fs::write(out.join("mine.png"), b"not velvet's").unwrap();
+    let again = velvet::preview::write(&plan, &out, Some(1), false).unwrap();
+    let mut removed: Vec<String> = again
+        .removed
+        .iter()
+        .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
+        .collect();
+    removed.sort();
+    let mut others: Vec<String> = plan.sheets[1..].iter().map(|s| s.name.clone()).collect();
+    others.sort();
+    assert_eq!(removed, others);
+    let mut left = vec![plan.sheets[0].name.clone(), "mine.png".to_string()];
+    left.sort();
+    assert_eq!(pngs(&out), left);
+    let index = std::fs::read_to_string(out.join("index.json")).unwrap();
+    assert_eq!(
+        velvet::preview::index::listed_sheets(&index),
+        [plan.sheets[0].name.clone()]
+    );
+    let drawn: Vec<bool> = serde_json::from_str::<serde_json::Value>(&index).unwrap()["sheets"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r["drawn"].as_bool().unwrap())
+        .collect();
+    assert_eq!(drawn, [true, false, false, false]);
+}
+
+#[test]
+fn with_fast_a_copied_roughness_texture_is_labelled_copied_not_fitted() {
+    let dir = tempfile::tempdir().unwrap();
+    let rough: Vec<[u8; 4]> = (0..4).map(|i| [255, 255, 255, (i * 60) as u8]).collect();
+    let text = format!(
+        r#"{{"asset": {{"version": "2.0"}},
+            "images": [{{"uri": "{}"}}],
+            "textures": [{{"source": 0}}],
+            "materials": [{{"name": "textured",
+              "extensions": {{"KHR_materials_sheen": {{"sheenColorFactor": [1, 1, 1], "sheenRoughnessFactor": 0.5,
+                  "sheenRoughnessTexture": {{"index": 0}}}}}}}}]}}"#,
+        png_data_uri(&rough)
+    );
+    let path = write(dir.path(), "fast.gltf", &text);
+    let asset = load(&path);
+    let fast = &materials_with(
+        &asset,
+        &velvet::migrate::Options {
+            fast: true,
+            ..velvet::migrate::Options::default()
+        },
+    )[0];
+    assert!(fast.roughness_copied_by_fast);
+    assert_eq!(
+        columns(fast, &fast.factors)[1].detail,
+        "α 0.500 copied (--fast)"
+    );
+    let fitted = &materials_of(&asset)[0];
+    assert!(!fitted.roughness_copied_by_fast);
+    assert!(columns(fitted, &fitted.factors)[1]
+        .detail
+        .ends_with(" fitted"));
 }

@@ -13,6 +13,8 @@
 //! - under every migrate option, each number the plan sets (what the dry run, `--check` and the
 //!   reports show) is the number the written file holds, and the preview's "as migrated" layer
 //!   is the layer the written file holds;
+//! - under every migrate option, the verdict migrate reports on each material is the verdict
+//!   the preview of the same file labels and ranks its sheet by;
 //! - the data rules read any accessor layout over any bytes (every component type and type,
 //!   offsets, strides, sparse substitutions in and out of range) without a panic, and
 //!   `--no-data` leaves out their findings and nothing else.
@@ -539,9 +541,11 @@ proptest! {
                 }
             }
         }
+        // The plan as migrate's spine completes it: judged, with the plans the default takes
+        // for materials that would migrate visibly.
         let asset = velvet::asset::load(&input).asset.unwrap();
-        let plan = migrate::plan::plan_document(&asset, &options);
-        for m in velvet::preview::material::materials(&asset, &plan, options.roughness) {
+        let mut plan = migrate::plan::plan_document(&asset, &options);
+        for m in velvet::preview::verdict::judge(&asset, &mut plan, &options) {
             let extensions = &file["materials"][m.index]["extensions"];
             match m.kind {
                 velvet::preview::material::Kind::SheenToFuzz => {
@@ -566,6 +570,46 @@ proptest! {
                 velvet::preview::material::Kind::FuzzWithSheen => {}
             }
         }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(CASES))]
+
+    #[test]
+    fn migrate_reports_the_verdict_the_preview_labels_its_sheet_with(
+        doc in document(),
+        which in 0..5usize,
+    ) {
+        let options = migrate_options(which);
+        let (_dir, input) = written(&doc);
+        let report = migrating::run(&migrating::Request {
+            inputs: vec![input.clone()],
+            destination: Destination::None,
+            options: options.clone(),
+            dry_run: true,
+            progress: false,
+        })
+        .unwrap();
+        let result = report.files.into_iter().next().unwrap();
+        let preview = velvet::preview::plan(&[input], &options);
+        prop_assert!(preview.failures.is_empty(), "{:?}", preview.failures);
+        for entry in &preview.entries {
+            let planned = result
+                .detail
+                .materials
+                .iter()
+                .find(|m| m.index == entry.index)
+                .and_then(|m| m.verdict);
+            prop_assert_eq!(
+                planned,
+                Some(preview.sheets[entry.sheet].verdict),
+                "option set {}, material {}", which, entry.index
+            );
+        }
+        // Every material migrate measured is on a sheet.
+        let measured = result.detail.materials.iter().filter(|m| m.verdict.is_some()).count();
+        prop_assert_eq!(measured, preview.entries.len());
     }
 }
 

@@ -493,3 +493,211 @@ fn baked_by_part<'a>(
     };
     Ok(Some((bytes, changed, applied.outputs)))
 }
+
+/// The edits a dry run adds for the plan's bakes: the textures baked in memory (nothing is
+/// written) and applied to the document the plan's other edits give, then the difference as
+/// edits (`set` of each value the bake changes or adds, the new `images` and `textures`
+/// entries among them under the names they get, `remove` of what it drops). Applied after the
+/// materials' edits, the declarations and the URI rewrites, in that order, they give the
+/// document a run writes. A new image is named after a hash of its bytes, so only a bake can
+/// say its name. Empty when the plan bakes nothing.
+pub fn dry_run_bake_edits(plan: &FilePlan, claims: &Claims) -> Result<Vec<edit::Edit>, String> {
+    let bake_plan = textures::bake_plan(plan.document.materials.iter().flat_map(|m| &m.bakes))
+        .map_err(|e| format!("{}: {e}", plan.input.display()))?;
+    if bake_plan.is_empty() {
+        return Ok(Vec::new());
+    }
+    let options = BakeOptions {
+        kernel: KernelOptions {
+            exact: false,
+            measure: false,
+        },
+        max_image_pixels: crate::bake::engine::MaxImagePixels(plan.asset.options.max_image_pixels),
+        max_memory: crate::bake::engine::MaxMemory(plan.asset.options.max_memory),
+        ..BakeOptions::default()
+    };
+    let mut baked_images = Vec::with_capacity(bake_plan.recipes.len());
+    for (info, result) in
+        bake_plan
+            .outputs
+            .iter()
+            .zip(bake_into(&bake_plan.recipes, &plan.asset, &options, None))
+    {
+        baked_images.push(result.map_err(|e| {
+            format!(
+                "{}: cannot bake {} of image {}: {e}",
+                plan.input.display(),
+                info.labels.join(" + "),
+                info.image
+            )
+        })?);
+    }
+    let fail = |e: edit::EditError| format!("{}: {e}", plan.input.display());
+    // Named as the run names them: next to the output (the input itself without one).
+    let output = plan.output.as_deref().unwrap_or(&plan.input);
+    // Each way below names anew: a name one claimed is the same name with the same bytes for
+    // the run's claims, but taken for the names of one output.
+    let names_for =
+        || FileNames::next_to(claims, &plan.asset, &plan.input, output, &plan.relocation);
+    // New images that are files, as a run writes them: the bake applied to the part of the
+    // document it reads and changes, as the run applies it, so that a dry run of a large
+    // document does not build it whole.
+    if plan.asset.container == asset::Container::Gltf && !plan.embed {
+        if let Some(mut part) = BakePart::new(&plan.asset, &bake_plan, &plan.document) {
+            let mut json = std::mem::take(&mut part.json);
+            for e in plan.document.edits().chain(&plan.relocation.edits) {
+                if part.holds(e) {
+                    edit::apply(&mut json, std::slice::from_ref(e)).map_err(fail)?;
+                }
+            }
+            let before = json.clone();
+            let mut images = baked_images.clone();
+            let applied = bake_apply(
+                json,
+                None,
+                plan.asset.container,
+                &bake_plan,
+                &mut images,
+                ApplyOptions { embed: false },
+                &mut names_for(),
+            );
+            if applied.dropped == crate::bake::prune::Dropped::default() {
+                let mut edits = Vec::new();
+                for e in part.into_edits(&plan.asset, applied.json) {
+                    match &e {
+                        edit::Edit::Replace { pointer, value } => match before.pointer(pointer) {
+                            Some(old) => difference(pointer, old, value, &mut edits),
+                            None => edits.push(e),
+                        },
+                        _ => edits.push(e),
+                    }
+                }
+                return Ok(edits);
+            }
+        }
+    }
+    let edited = || -> Result<serde_json::Value, String> {
+        let mut before = plan.asset.root().to_value();
+        for edits in plan
+            .document
+            .materials
+            .iter()
+            .map(|m| m.edits.as_slice())
+            .chain([
+                plan.document.declarations.as_slice(),
+                plan.relocation.edits.as_slice(),
+            ])
+        {
+            edit::apply(&mut before, edits).map_err(fail)?;
+        }
+        Ok(before)
+    };
+    let before = edited()?;
+    // What the bake may change, kept to compare with: the members besides the materials, and
+    // the materials it bakes into (a whole copy of a large document would double the memory).
+    let baked: std::collections::BTreeSet<usize> = plan
+        .document
+        .materials
+        .iter()
+        .filter(|m| !m.bakes.is_empty())
+        .map(|m| m.index)
+        .collect();
+    let kept_members: serde_json::Map<String, serde_json::Value> = before
+        .as_object()
+        .into_iter()
+        .flatten()
+        .filter(|(key, _)| *key != "materials")
+        .map(|(key, value)| (key.clone(), value.clone()))
+        .collect();
+    let kept_materials: Vec<(usize, serde_json::Value)> = baked
+        .iter()
+        .filter_map(|&i| Some((i, before.get("materials")?.get(i)?.clone())))
+        .collect();
+    let materials_before = before
+        .get("materials")
+        .and_then(serde_json::Value::as_array)
+        .map_or(0, Vec::len);
+    let applied = bake_apply(
+        before,
+        plan.asset.bin.clone(),
+        plan.asset.container,
+        &bake_plan,
+        &mut baked_images,
+        ApplyOptions { embed: plan.embed },
+        &mut names_for(),
+    );
+    let mut edits = Vec::new();
+    let materials_after = applied.json.get("materials");
+    if applied.dropped != crate::bake::prune::Dropped::default()
+        || materials_after
+            .and_then(serde_json::Value::as_array)
+            .map_or(0, Vec::len)
+            != materials_before
+    {
+        // A bake that drops a texture renumbers references in any material: the whole
+        // document is compared.
+        difference("", &edited()?, &applied.json, &mut edits);
+        return Ok(edits);
+    }
+    for (i, material) in &kept_materials {
+        if let Some(after) = materials_after.and_then(|m| m.get(*i)) {
+            difference(&format!("/materials/{i}"), material, after, &mut edits);
+        }
+    }
+    let empty = serde_json::Map::new();
+    let after_members = applied.json.as_object().unwrap_or(&empty);
+    for (key, value) in &kept_members {
+        let at = crate::asset::pointer::join("", key);
+        match after_members.get(key) {
+            Some(new) => difference(&at, value, new, &mut edits),
+            None => edits.push(edit::Edit::remove(at)),
+        }
+    }
+    for (key, value) in after_members
+        .iter()
+        .filter(|(k, _)| *k != "materials" && !kept_members.contains_key(*k))
+    {
+        edits.push(edit::Edit::replace(
+            crate::asset::pointer::join("", key),
+            value.clone(),
+        ));
+    }
+    Ok(edits)
+}
+
+/// The edits that turn `from` into `to` (at `pointer`): members and elements compared one by
+/// one, so that each edit names the value it changes; an array that grows keeps its elements
+/// and gains the new ones at its end (`set` at its length appends).
+fn difference(
+    pointer: &str,
+    from: &serde_json::Value,
+    to: &serde_json::Value,
+    out: &mut Vec<edit::Edit>,
+) {
+    use serde_json::Value;
+    match (from, to) {
+        _ if from == to => {}
+        (Value::Object(a), Value::Object(b)) => {
+            for (key, value) in a {
+                let at = crate::asset::pointer::join(pointer, key);
+                match b.get(key) {
+                    Some(new) => difference(&at, value, new, out),
+                    None => out.push(edit::Edit::remove(at)),
+                }
+            }
+            for (key, value) in b.iter().filter(|(k, _)| !a.contains_key(*k)) {
+                let at = crate::asset::pointer::join(pointer, key);
+                out.push(edit::Edit::replace(at, value.clone()));
+            }
+        }
+        (Value::Array(a), Value::Array(b)) if a.len() <= b.len() => {
+            for (i, (old, new)) in a.iter().zip(b).enumerate() {
+                difference(&format!("{pointer}/{i}"), old, new, out);
+            }
+            for (i, new) in b.iter().enumerate().skip(a.len()) {
+                out.push(edit::Edit::replace(format!("{pointer}/{i}"), new.clone()));
+            }
+        }
+        _ => out.push(edit::Edit::replace(pointer.to_string(), to.clone())),
+    }
+}

@@ -31,6 +31,11 @@ pub struct MaterialPlan {
     pub bakes: Vec<TextureBake>,
     #[serde(serialize_with = "notes_json")]
     pub notes: Vec<Note>,
+    /// How the material as written looks beside the material as authored, measured right
+    /// after planning (see [`super::verdict`]); `None` when it was not measured (`--fast`,
+    /// `--roughness identity`, a material no sheet shows).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub verdict: Option<super::verdict::Verdict>,
 }
 
 pub(crate) fn notes_json<S: serde::Serializer>(notes: &[Note], s: S) -> Result<S::Ok, S::Error> {
@@ -57,6 +62,7 @@ impl MaterialPlan {
             edits: Vec::with_capacity(1),
             bakes: Vec::new(),
             notes: Vec::new(),
+            verdict: None,
         }
     }
 

@@ -22,6 +22,7 @@ pub mod plan;
 pub mod roughness;
 pub mod sheen_to_fuzz;
 pub mod textures;
+pub mod verdict;
 
 pub use note::{Conversion, Level, Note, Skip};
 pub use plan::{plan_document, DocumentPlan, MaterialPlan};
@@ -49,6 +50,13 @@ pub struct Options {
     pub rewrite_uris: bool,
     /// How close a shared mapped roughness texture must come to the exact one.
     pub budget: budget::Budget,
+    /// Leave out the perceptual verdict ([`verdict`]), which the spine otherwise measures for
+    /// every material right after planning: `--fast` and `--roughness identity` do, to stay
+    /// the speed paths, unless a view needs it (`--fail-on-visible`, `--preview`).
+    pub skip_verdict: bool,
+    /// How many bytes of new textures (uncompressed, per file) the default may add to bring
+    /// "visible" materials closer ([`verdict::CloserBudget`]).
+    pub closer_budget: verdict::CloserBudget,
     /// Limits and URI policy for reading inputs and their resources.
     pub load: crate::asset::LoadOptions,
 }

@@ -215,6 +215,27 @@ pub enum Note {
         /// `None`: the exact setting.
         budget: Option<f64>,
     },
+    /// The material as written looks visibly different from the material as authored (the
+    /// plan's verdict is "visible"); `remedy` is the run that would bring it to a better label,
+    /// when one would, and `tried` the flags measured.
+    VisibleDifference {
+        verdict: super::verdict::Verdict,
+        remedy: Option<super::verdict::Remedy>,
+        tried: Vec<String>,
+        /// The remedy was not taken by default: its new textures pass the size budget.
+        #[serde(skip_serializing_if = "Option::is_none")]
+        beyond_budget: Option<super::verdict::BeyondBudget>,
+    },
+    /// The default took a plan with more bakes (what `flags` would plan) because it brings a
+    /// "visible" material to a better verdict, within the size budget.
+    CloserPlanTaken {
+        flags: String,
+        /// The verdict of the plan it replaced.
+        before: super::verdict::Verdict,
+        after: super::verdict::Verdict,
+        /// The new textures' uncompressed size, in bytes.
+        bytes: u64,
+    },
     /// The best roughness lies below the floor renderers honour alike: the floor is written.
     RoughnessFloor {
         property: String,
@@ -261,6 +282,7 @@ impl Note {
             | Note::ExactBaked
             | Note::BakeError { .. }
             | Note::LegacyRoughnessBaked { .. }
+            | Note::CloserPlanTaken { .. }
             | Note::RoughnessFloor { .. } => Level::Info,
             Note::RoughnessPlan {
                 max_error, budget, ..
@@ -292,6 +314,7 @@ impl Note {
             | Note::LegacyTextureIntensity
             | Note::LegacyMixed { .. }
             | Note::TextureDropped { .. }
+            | Note::VisibleDifference { .. }
             | Note::ResourceMissing { .. } => Level::Warning,
         }
     }
@@ -422,6 +445,45 @@ impl Note {
                     "{property}: {}, {factor_key} {factor}; largest roughness difference from the exact mapping {max_error:.4}, {verdict}",
                     plan.describe()
                 )
+            }
+            Note::CloserPlanTaken { flags, before, after, bytes } => format!(
+                "the plan with more bakes that {flags} gives is taken, as it brings this material from {} to {}; its new textures take {} uncompressed, within the --closer-budget",
+                before.describe(),
+                after.describe(),
+                crate::output::summary::bytes(*bytes as usize)
+            ),
+            Note::VisibleDifference { verdict, remedy, tried, beyond_budget } => {
+                let mut m = format!(
+                    "the migrated material looks visibly different from the authored one: ꟻLIP {:.3} in the furnace (above {}), {:.3} under the light",
+                    verdict.furnace,
+                    super::verdict::CLOSE_FLIP,
+                    verdict.light
+                );
+                match (remedy, tried.is_empty()) {
+                    (Some(r), _) => {
+                        m += &format!("; {} would bring it to {}", r.flags, r.verdict.describe());
+                        if let Some(b) = beyond_budget {
+                            m += &format!(
+                                ", but its new textures ({} uncompressed) pass what is left of the --closer-budget ({}), so the default does not take it",
+                                crate::output::summary::bytes(b.bytes as usize),
+                                crate::output::summary::bytes(b.left as usize)
+                            );
+                        }
+                    }
+                    (None, true) => m += "; no other plan velvet offers changes this material (no texture to bake): look at the preview before trusting it",
+                    (None, false) => m += &format!(
+                        "; {} {}: look at the preview before trusting it",
+                        match tried.len() {
+                            1 => tried[0].clone(),
+                            _ => format!("neither {}", tried.join(" nor ")),
+                        },
+                        match tried.len() {
+                            1 => "would not bring it closer",
+                            _ => "would bring it closer",
+                        }
+                    ),
+                }
+                m
             }
             Note::RoughnessFloor { property, best, written } => format!(
                 "{property}: the best match, {best:.4}, lies below {written} (the floor renderers honour alike), so {written} is written: {:.4} rougher than the best match",

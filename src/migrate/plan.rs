@@ -75,6 +75,26 @@ pub fn plan_document(asset: &Asset, options: &Options) -> DocumentPlan {
     }
 }
 
+/// The plan of the materials at `indices` alone, each as [`plan_document`] plans it (roughness
+/// textures shared among these materials only), without declarations: what another set of
+/// options would do to them, for the verdict's remedies.
+pub fn plan_materials(asset: &Asset, indices: &[usize], options: &Options) -> DocumentPlan {
+    let primitives = Primitives::new(asset.root());
+    let mut materials: Vec<MaterialPlan> = indices
+        .iter()
+        .filter_map(|&i| plan_material(asset, i, options, &primitives))
+        .collect();
+    super::budget::plan(asset, &mut materials, options.budget);
+    materials.iter_mut().for_each(|m| {
+        m.settle_baked_factors();
+        m.shrink_to_fit();
+    });
+    DocumentPlan {
+        materials,
+        declarations: Vec::new(),
+    }
+}
+
 /// The plan of material `index`, or `None` when it has neither sheen nor fuzz.
 pub fn plan_material(
     asset: &Asset,

@@ -1,8 +1,10 @@
 //! The index pages of a preview run: static HTML (no scripts, no external resources), the
-//! sheets worst first by the plan's measure, [`PAGE`] to a page with links between the pages.
+//! sheets worst first by the plan's verdict, [`PAGE`] to a page with links between the pages.
 //! Each sheet is shown with its title, the materials that share it, the report's figures and
 //! the verdict as text; the first page also lists the sheets left undrawn (`--worst N`), the
-//! files without sheen or fuzz and the files that failed.
+//! files without sheen or fuzz and the files that failed. [`json`] writes the same run as
+//! `index.json` for tools, which a rerun reads ([`listed_sheets`]) to remove the sheets it no
+//! longer writes.
 
 use super::{Drawn, Plan};
 
@@ -100,9 +102,9 @@ fn html(plan: &Plan, sheets: &[Drawn], page: usize, total: usize, drawn: usize) 
         h += "<section>\n";
         h += &format!("<h2>{}. {}</h2>\n", d.sheet + 1, escape(&sum.title));
         h += &format!(
-            "<p>{} (plan measure {:.4})</p>\n",
+            "<p>{} (the plan's verdict: {})</p>\n",
             escape(sum.kind),
-            planned.metric
+            planned.verdict.describe()
         );
         h += &format!(
             "<a href=\"{0}\"><img src=\"{0}\" alt=\"{1}\"></a>\n",
@@ -136,11 +138,7 @@ fn html(plan: &Plan, sheets: &[Drawn], page: usize, total: usize, drawn: usize) 
                 plan.sheets.len() - drawn
             );
             for s in &plan.sheets[drawn..] {
-                h += &format!(
-                    "<li>{} (plan measure {:.4})</li>\n",
-                    escape(&s.title),
-                    s.metric
-                );
+                h += &format!("<li>{} ({})</li>\n", escape(&s.title), s.verdict.describe());
             }
             h += "</ul>\n";
         }
@@ -165,6 +163,82 @@ fn html(plan: &Plan, sheets: &[Drawn], page: usize, total: usize, drawn: usize) 
     }
     h += "</body>\n</html>\n";
     h
+}
+
+/// The machine-readable index of a run, `index.json`: one record per material, in the order
+/// of the pages (worst first by the plan's verdict, then the materials a sheet shows in input
+/// order), each with its sheet's file name (`file`, in the output folder), the asset
+/// (`asset`, as titles name it), the material's index and name, the plan's verdict (`label`,
+/// `flip`, `furnace`, `light`), whether its sheet was drawn in this run (`drawn`: `--worst`
+/// leaves sheets undrawn, a stop leaves the rest) and the layers as written at the factors
+/// (`written`: `sheen` `{color, roughness}` and `fuzz` `{weight, color, roughness}`, each
+/// present when the written file holds that layer).
+pub fn json(plan: &Plan, drawn: &[Drawn]) -> String {
+    use serde_json::{json, Map, Value};
+    let drawn_sheets: std::collections::HashSet<usize> = drawn.iter().map(|d| d.sheet).collect();
+    let mut records = Vec::new();
+    for (s, sheet) in plan.sheets.iter().enumerate() {
+        let factors = &sheet.material.factors;
+        let mut written = Map::new();
+        if let Some(sheen) = factors.written_sheen {
+            written.insert(
+                "sheen".into(),
+                json!({"color": sheen.color, "roughness": sheen.roughness}),
+            );
+        }
+        if let Some(fuzz) = factors.written_fuzz {
+            written.insert(
+                "fuzz".into(),
+                json!({"weight": fuzz.weight, "color": fuzz.color, "roughness": fuzz.roughness}),
+            );
+        }
+        for &e in &sheet.entries {
+            let entry = &plan.entries[e];
+            records.push(json!({
+                "file": sheet.name,
+                "asset": entry.label,
+                "material": entry.index,
+                "name": entry.name,
+                "label": sheet.verdict.label.as_str(),
+                "flip": sheet.verdict.flip,
+                "furnace": sheet.verdict.furnace,
+                "light": sheet.verdict.light,
+                "drawn": drawn_sheets.contains(&s),
+                "written": Value::Object(written.clone()),
+            }));
+        }
+    }
+    let mut out =
+        serde_json::to_string_pretty(&json!({ "sheets": records })).expect("an index serialises");
+    out.push('\n');
+    out
+}
+
+/// The sheet files an earlier run's `index.json` lists as drawn: plain names of PNG files in
+/// the output folder (anything else, or a file that does not read as an index, lists none, so
+/// that a rerun never removes a file it did not write).
+pub fn listed_sheets(index_json: &str) -> Vec<String> {
+    let Ok(value) = serde_json::from_str::<serde_json::Value>(index_json) else {
+        return Vec::new();
+    };
+    let mut names: Vec<String> = value
+        .get("sheets")
+        .and_then(serde_json::Value::as_array)
+        .into_iter()
+        .flatten()
+        .filter(|r| r.get("drawn").and_then(serde_json::Value::as_bool) == Some(true))
+        .filter_map(|r| r.get("file").and_then(serde_json::Value::as_str))
+        .filter(|name| {
+            name.ends_with(".png")
+                && !name.contains(['/', '\\'])
+                && !name.starts_with('.')
+                && *name != "overview.png"
+        })
+        .map(str::to_owned)
+        .collect();
+    names.sort();
+    names.dedup();
+    names
 }
 
 #[cfg(test)]

@@ -100,9 +100,15 @@ pub struct Material {
     pub notes: Vec<String>,
     /// fuzzRoughnessFactor was absent: the table default 0.5 is used.
     pub fuzz_roughness_assumed: bool,
+    /// `--fast` copied the roughness (a roughness texture it would have baked mapped): the
+    /// migrated column's roughness is copied, whatever the run's mapping.
+    pub roughness_copied_by_fast: bool,
     /// The roughness mapping of the run the plan was made for; the sheet's other column
     /// shows the other one.
     pub mapping: RoughnessMapping,
+    /// The plan's verdict on it (`preview::verdict`), once measured: the sheet's label and the
+    /// run's ranking.
+    pub verdict: Option<crate::migrate::verdict::Verdict>,
 }
 
 impl Material {
@@ -121,40 +127,10 @@ impl Material {
                 &self.swatches,
                 &self.notes,
                 self.fuzz_roughness_assumed,
+                self.roughness_copied_by_fast,
                 self.mapping
             )
         )
-    }
-
-    /// How far the migration moves the material's look, from the plan's numbers alone (nothing
-    /// rendered), to rank a library's materials before any sheet is drawn: the largest
-    /// |max3·E − w·R| between the authored layer and the one the migrated file adds or keeps
-    /// for loaders without fuzz (columns 0 and 1), at the factors, over views with μ ≥ 0.1 (the
-    /// report's "max_ordinary"). E and R come from their tables (a few ns each where
-    /// quadrature takes tens of µs, so a 20,000-material library is ranked in well under a
-    /// second); there the tables are within 6e-3 (E, r ≥ 0.25) and 1e-3 (R) of quadrature
-    /// (docs/shading.md), while at grazing views and small roughness the E table's error
-    /// reaches units, which is why grazing views are left out. 0 when the columns hold no
-    /// sheen–fuzz pair.
-    pub fn plan_metric(&self) -> f64 {
-        use crate::shading::layering::{FuzzReflectance, SheenAlbedo};
-        use crate::shading::{AlbedoMethod, ReflectanceMethod};
-        let cols = columns(self, &self.factors);
-        match cols
-            .get(1)
-            .and_then(|c| layer_pair(&cols[0].look.layer, &c.look.layer))
-        {
-            Some((sheen, fuzz)) => {
-                crate::shading::mapping::layer_match_with(
-                    sheen,
-                    fuzz,
-                    &SheenAlbedo(AlbedoMethod::Lut32),
-                    &FuzzReflectance(ReflectanceMethod::Table),
-                )
-                .max_ordinary
-            }
-            None => 0.0,
-        }
     }
 }
 
@@ -180,18 +156,27 @@ pub struct TextureStats {
 /// exclude both layers, so migrate leaves them), and a switched-off sheen or fuzz alone (to
 /// which migrate adds nothing), are left out.
 pub fn materials(asset: &Asset, plan: &DocumentPlan, mapping: RoughnessMapping) -> Vec<Material> {
-    let images = ImageCache::default();
-    // Each material's plan by index (the first, as a search in order would find it).
-    let mut planned: std::collections::HashMap<usize, &MaterialPlan> = Default::default();
-    for p in &plan.materials {
-        planned.entry(p.index).or_insert(p);
-    }
-    layers::materials(asset.json())
+    materials_with(asset, plan, mapping, &ImageCache::default())
+}
+
+/// [`materials`], the images' statistics read through `images` (shared by the reads of one
+/// document). Only the materials `plan` holds are read: the planner plans every material with
+/// a sheen or fuzz layer, and a plan of some materials alone gives those.
+pub(super) fn materials_with(
+    asset: &Asset,
+    plan: &DocumentPlan,
+    mapping: RoughnessMapping,
+    images: &ImageCache,
+) -> Vec<Material> {
+    // Each material is read from the document's index into a value of its own: the whole
+    // document is not built (for the 20,000-material library, that would double migrate's
+    // memory).
+    let all = asset.root().get("materials");
+    plan.materials
         .par_iter()
-        .enumerate()
-        .filter_map(|(index, m)| {
-            let planned = planned.get(&index).copied();
-            read(asset, index, m, planned, mapping, &images)
+        .filter_map(|p| {
+            let material = all?.get(p.index)?.to_value();
+            read(asset, p.index, &material, Some(p), mapping, images)
         })
         .collect()
 }
@@ -222,7 +207,7 @@ fn migrated(material: &Value, index: usize, plan: &MaterialPlan) -> Result<Value
 /// Each image's statistics per way of reading it, computed once however many materials (on
 /// however many threads) read it: the first to ask computes them, the others wait for them.
 #[derive(Default)]
-struct ImageCache {
+pub(super) struct ImageCache {
     stats: std::sync::Mutex<HashMap<(usize, Read, Transfer), StatsCell>>,
 }
 
@@ -416,7 +401,13 @@ fn read(
         swatches,
         notes,
         fuzz_roughness_assumed,
+        roughness_copied_by_fast: plan.is_some_and(|p| {
+            p.notes
+                .iter()
+                .any(|n| matches!(n, crate::migrate::Note::RoughnessTextureFast { .. }))
+        }),
         mapping,
+        verdict: None,
     })
 }
 
@@ -569,7 +560,7 @@ fn image_index(asset: &Asset, info: &Value) -> Result<usize, String> {
         .and_then(layers::as_index)
         .ok_or("no texture index")?;
     let source = asset
-        .json()
+        .root()
         .pointer(&format!("/textures/{texture}/source"))
         .and_then(layers::as_index)
         .ok_or_else(|| format!("texture {texture} has no source image"))?;
@@ -616,6 +607,8 @@ fn image_stats(
             .or_default(),
     );
     cell.get_or_init(|| {
+        // Nothing is decoded once the run is asked to stop.
+        crate::output::interrupt::check()?;
         asset
             .decode_image_with(image, 1, 4, |img| stats_by(&img.to_rgba8(), read, transfer))
             .map_err(|d| d.message)
@@ -640,7 +633,12 @@ fn stats_by(img: &image::RgbaImage, read: Read, transfer: Transfer) -> TextureSt
     // Per rank (the largest channel's code, or the channel's code): texel count and sums.
     let mut count = [0u64; 256];
     let mut sums = vec![[0.0f64; 3]; 256];
-    for p in img.pixels() {
+    for (i, p) in img.pixels().enumerate() {
+        // A stop (SIGINT, SIGTERM) ends a large image's pass early: the statistics are then
+        // partial, and the callers, which check for the stop next, use none of them.
+        if i % (1 << 16) == 0 && crate::output::interrupt::requested().is_some() {
+            break;
+        }
         let [r, g, b, a] = p.0;
         let (rank, values) = match read {
             Read::Rgb => (
@@ -767,7 +765,12 @@ pub fn columns(material: &Material, swatch: &Swatch) -> Vec<Column> {
                 },
                 Column {
                     title: "migrated: fuzz".into(),
-                    detail: format!("α {} {}", rough(migrated.roughness), mapping_word(mapping)),
+                    detail: match material.roughness_copied_by_fast {
+                        true => format!("α {} copied (--fast)", rough(migrated.roughness)),
+                        false => {
+                            format!("α {} {}", rough(migrated.roughness), mapping_word(mapping))
+                        }
+                    },
                     look: look(fuzz_layer(migrated)),
                 },
                 Column {
@@ -826,9 +829,17 @@ pub fn columns(material: &Material, swatch: &Swatch) -> Vec<Column> {
                     roughness: carried(f.roughness, Direction::FuzzToSheen, other(mapping)),
                     ..migrated
                 };
+                // A black fuzz gets no fallback: the column shows the base alone, and says so
+                // rather than describe a sheen the file does not hold.
+                let no_fallback = material.factors.written_sheen.is_none() && max3(color) <= 0.0;
                 cols.push(Column {
                     title: "no fuzz: sheen".into(),
-                    detail: format!("r {} {}", rough(migrated.roughness), mapping_word(mapping)),
+                    detail: match no_fallback {
+                        true => "none written: base alone".into(),
+                        false => {
+                            format!("r {} {}", rough(migrated.roughness), mapping_word(mapping))
+                        }
+                    },
                     look: look(sheen_layer(migrated)),
                 });
                 cols.push(Column {
@@ -928,7 +939,9 @@ mod tests {
             swatches: vec![],
             notes: vec![],
             fuzz_roughness_assumed: false,
+            roughness_copied_by_fast: false,
             mapping: RoughnessMapping::Fitted,
+            verdict: None,
         };
         let cols = columns(&m, &m.factors);
         assert_eq!(cols.len(), 3);

@@ -8,10 +8,11 @@
 //! reads a material's values and decides the columns (what migrate writes), [`shade`] shades a
 //! sphere exactly from `shading`'s formulas, [`sheet`] lays out and encodes a sheet with the
 //! built-in [`font`], [`overview`] draws the run's histogram of verdicts with its worst sheets,
-//! and [`index`] writes the HTML pages. A run is planned first ([`plan`]:
-//! every material read, materials with the same appearance sharing one sheet, the sheets
-//! ranked by the plan's own measure of how far the migration moves them), so `--worst N` picks
-//! its sheets before anything is drawn; [`write`] then draws the chosen sheets in parallel and
+//! [`index`] writes the HTML pages and `index.json`, and [`verdict`] measures the plan's
+//! perceptual verdict on each material and writes it into migrate's plan. A run is planned
+//! first ([`plan`]: every material read and judged, materials with the same appearance sharing
+//! one sheet, the sheets ranked by the plan's verdict), so `--worst N` picks its sheets before
+//! anything is drawn; [`write`] then draws the chosen sheets in parallel and
 //! writes each as soon as it is drawn (memory holds the sheets in flight, one per thread), every
 //! file through `edit::write::write_atomic`. A stop (SIGINT, SIGTERM) ends the run between
 //! sheets: those written stay, complete, and no partial file is left. The same inputs give the
@@ -24,6 +25,7 @@ pub mod material;
 pub mod overview;
 pub mod shade;
 pub mod sheet;
+pub mod verdict;
 
 use crate::asset::discover;
 use crate::edit::write::write_atomic;
@@ -68,8 +70,8 @@ pub struct SheetPlan {
     pub material: material::Material,
     /// The entries it shows, in input order.
     pub entries: Vec<usize>,
-    /// [`material::Material::plan_metric`].
-    pub metric: f64,
+    /// The plan's verdict on the material ([`verdict`]): the sheet's label and its rank.
+    pub verdict: crate::migrate::verdict::Verdict,
 }
 
 /// What a preview run draws, decided before anything is drawn.
@@ -102,6 +104,11 @@ pub struct Written {
     pub pages: Vec<PathBuf>,
     /// `overview.png`; none when the run was stopped.
     pub overview: Option<PathBuf>,
+    /// `index.json`, written by a finished run and by a stopped one (then listing the sheets
+    /// it finished as drawn).
+    pub index_json: Option<PathBuf>,
+    /// Sheets an earlier run's index.json listed that this run does not write, removed.
+    pub removed: Vec<PathBuf>,
     /// Stopped by SIGINT or SIGTERM before every chosen sheet was drawn.
     pub stopped: bool,
 }
@@ -184,8 +191,8 @@ pub fn plan(inputs: &[PathBuf], options: &crate::migrate::Options) -> Plan {
             let loaded = crate::asset::load_with(&file, &options.load);
             let materials = match loaded.asset {
                 Some(asset) => {
-                    let plan = crate::migrate::plan_document(&asset, options);
-                    Ok(material::materials(&asset, &plan, options.roughness))
+                    let mut plan = crate::migrate::plan_document(&asset, options);
+                    Ok(verdict::judge(&asset, &mut plan, options))
                 }
                 None => Err(loaded
                     .diagnostics
@@ -262,7 +269,9 @@ pub fn assemble(files: Vec<FileMaterials>, walk_errors: WalkErrors) -> Plan {
         .map(|&e| SheetPlan {
             name: sheet_name(&plan.entries[e]),
             title: plan.entries[e].title(),
-            metric: materials[e].plan_metric(),
+            verdict: materials[e]
+                .verdict
+                .unwrap_or_else(|| verdict::measure_pairs(&verdict::pairs(&materials[e]))),
             material: materials[e].clone(),
             entries: Vec::new(),
         })
@@ -279,14 +288,14 @@ pub fn assemble(files: Vec<FileMaterials>, walk_errors: WalkErrors) -> Plan {
             );
         }
     }
-    // Worst first; a NaN metric (none is expected) ranks as the worst.
+    // Worst first by the plan's verdict; a NaN (none is expected) ranks as the worst.
     let mut order: Vec<usize> = (0..sheets.len()).collect();
     order.sort_by(|&a, &b| {
         let key = |s: &SheetPlan| {
-            if s.metric.is_nan() {
+            if s.verdict.flip.is_nan() {
                 f64::INFINITY
             } else {
-                s.metric
+                s.verdict.flip
             }
         };
         key(&sheets[b]).total_cmp(&key(&sheets[a])).then(a.cmp(&b))
@@ -322,18 +331,43 @@ pub fn assemble(files: Vec<FileMaterials>, walk_errors: WalkErrors) -> Plan {
 
 /// Draws the first `count` sheets of `plan` (the worst; all of them when `count` is `None`)
 /// in parallel, writing each into `out_dir` (created if needed) as soon as it is drawn, then
-/// the index pages. `progress` draws a bar on a terminal. A stop (SIGINT, SIGTERM) ends the
-/// run between sheets: the sheets written stay and no index is written. Returns what was
-/// written, or the first write that failed.
+/// the overview, the index pages and `index.json`. The sheets an earlier run's index.json in
+/// `out_dir` lists and this run does not draw are removed (only those: a file velvet did not
+/// list is never touched). `progress` draws a bar on a terminal. A stop (SIGINT, SIGTERM) ends
+/// the run between sheets: the sheets written stay, and index.json lists them (index pages
+/// and overview are a finished run's). Returns what was written, or the first write that
+/// failed.
 pub fn write(
     plan: &Plan,
     out_dir: &Path,
     count: Option<usize>,
     progress: bool,
 ) -> Result<Written, String> {
+    // A run stopped before it draws (while its plan was made) writes nothing: its verdicts
+    // were left unmeasured.
+    if crate::output::interrupt::requested().is_some() {
+        return Ok(Written {
+            stopped: true,
+            ..Written::default()
+        });
+    }
     std::fs::create_dir_all(out_dir)
         .map_err(|e| format!("cannot create the folder {}: {e}", out_dir.display()))?;
     let chosen = count.map_or(plan.sheets.len(), |n| n.min(plan.sheets.len()));
+    let index_path = out_dir.join("index.json");
+    let listed = std::fs::read_to_string(&index_path)
+        .map(|text| index::listed_sheets(&text))
+        .unwrap_or_default();
+    let chosen_names: std::collections::HashSet<&str> = plan.sheets[..chosen]
+        .iter()
+        .map(|s| s.name.as_str())
+        .collect();
+    let mut written = Written::default();
+    // Sheets of the earlier run this one will not draw go first, so that a stop leaves no
+    // sheet the new index does not list.
+    for name in listed.iter().filter(|n| !chosen_names.contains(n.as_str())) {
+        written.removed.extend(remove_sheet(&out_dir.join(name))?);
+    }
     let bar = crate::output::progress_bar(progress, chosen, "sheets");
     let worst = overview::WorstSheets::default();
     let drawn: Vec<Result<Option<Drawn>, String>> = (0..chosen)
@@ -361,7 +395,6 @@ pub fn write(
     if let Some(bar) = bar {
         bar.finish_and_clear();
     }
-    let mut written = Written::default();
     for d in drawn {
         match d? {
             Some(d) => written.drawn.push(d),
@@ -369,15 +402,35 @@ pub fn write(
         }
     }
     if written.stopped {
+        // An earlier sheet under a name this run chose but did not reach is stale: removed, so
+        // that the folder holds what the new index lists.
+        let reached: std::collections::HashSet<&str> = written
+            .drawn
+            .iter()
+            .map(|d| plan.sheets[d.sheet].name.as_str())
+            .collect();
+        for name in listed
+            .iter()
+            .filter(|n| chosen_names.contains(n.as_str()) && !reached.contains(n.as_str()))
+        {
+            written.removed.extend(remove_sheet(&out_dir.join(name))?);
+        }
+        write_atomic(&index_path, index::json(plan, &written.drawn).as_bytes())
+            .map_err(|e| format!("cannot write {}: {e}", index_path.display()))?;
+        written.index_json = Some(index_path);
         return Ok(written);
     }
-    let flips: Vec<f64> = written.drawn.iter().map(|d| d.summary.flip[0]).collect();
+    let flips: Vec<f64> = written
+        .drawn
+        .iter()
+        .map(|d| d.summary.verdict.flip)
+        .collect();
     let path = out_dir.join("overview.png");
     let chosen_sheets: Vec<(f64, bool)> = plan
         .sheets
         .iter()
         .enumerate()
-        .map(|(s, sheet)| (sheet.metric, s < chosen))
+        .map(|(s, sheet)| (sheet.verdict.flip, s < chosen))
         .collect();
     write_atomic(
         &path,
@@ -391,7 +444,19 @@ pub fn write(
             .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
         written.pages.push(path);
     }
+    write_atomic(&index_path, index::json(plan, &written.drawn).as_bytes())
+        .map_err(|e| format!("cannot write {}: {e}", index_path.display()))?;
+    written.index_json = Some(index_path);
     Ok(written)
+}
+
+/// Removes an earlier run's sheet; `Some` its path when it was there.
+fn remove_sheet(path: &Path) -> Result<Option<PathBuf>, String> {
+    match std::fs::remove_file(path) {
+        Ok(()) => Ok(Some(path.to_path_buf())),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
+        Err(e) => Err(format!("cannot remove {}: {e}", path.display())),
+    }
 }
 
 #[cfg(test)]

@@ -1,13 +1,13 @@
-//! The overview of a preview run (`overview.png`): a histogram of the verdict's ꟻLIP over the
-//! sheets drawn, with the "same" and "close" thresholds marked and the bars coloured by
-//! verdict; under it a histogram of the plan's measure over every sheet of the run, drawn or
-//! not (the measure `--worst` ranks by, known before anything is drawn), the sheets drawn in
-//! colour and the others in grey; and beside them the sheets with the largest ꟻLIP, scaled
-//! down, worst first. It is the one picture of a library: how many materials a migration
+//! The overview of a preview run (`overview.png`): a histogram of the plan's verdict (its
+//! ꟻLIP in the furnace) over the sheets drawn, with the "same" and "close" thresholds marked
+//! and the bars coloured by verdict; under it a histogram of the same measure over every sheet
+//! of the run, drawn or not (what `--worst` ranks by, known before anything is drawn), the
+//! sheets drawn in colour and the others in grey; and beside them the sheets the plan's
+//! verdict ranks worst, scaled down, in the index's order. It is the one picture of a library: how many materials a migration
 //! moves, and which most.
 
 use super::font::{self, LINE_HEIGHT};
-use super::sheet::{self, Canvas, Verdict, CLOSE_FLIP, SAME_FLIP};
+use super::sheet::{self, Canvas, Label as Verdict, CLOSE_FLIP, SAME_FLIP};
 
 /// The sheets shown beside the histogram.
 pub const WORST_SHOWN: usize = 4;
@@ -33,15 +33,16 @@ pub struct Worst {
     pub height: usize,
 }
 
-/// Keeps the [`WORST_SHOWN`] sheets with the largest ꟻLIP (ties: the earlier sheet), whatever
-/// order they are offered in.
+/// Keeps the [`WORST_SHOWN`] sheets whose plan's verdict has the largest ꟻLIP (ties: the
+/// earlier sheet; the plan's ranking, so the index's order), whatever order they are offered
+/// in.
 #[derive(Default)]
 pub struct WorstSheets(std::sync::Mutex<Vec<Worst>>);
 
 impl WorstSheets {
     /// Offers a drawn sheet (the `sheet`-th of the plan).
     pub fn offer(&self, sheet_index: usize, drawn: &sheet::Sheet) {
-        let flip = drawn.summary.flip[0];
+        let flip = drawn.summary.verdict.flip;
         let mut worst = self.0.lock().unwrap_or_else(|e| e.into_inner());
         let ranks_after = |w: &Worst| (w.flip, std::cmp::Reverse(w.sheet));
         let full = worst.len() >= WORST_SHOWN;
@@ -156,7 +157,7 @@ pub fn png(flips: &[f64], metrics: &[(f64, bool)], worst: &[Worst]) -> Vec<u8> {
     c.text(
         MARGIN,
         MARGIN + LINE_HEIGHT,
-        "ꟻLIP in the furnace (99th percentile over the sphere), authored against migrated",
+        "the plan's ꟻLIP in the furnace, authored against migrated",
         DIM,
     );
     let colour = |v: Verdict| match v {
@@ -195,7 +196,7 @@ pub fn png(flips: &[f64], metrics: &[(f64, bool)], worst: &[Worst]) -> Vec<u8> {
         MARGIN,
         metric_top - 3 * LINE_HEIGHT,
         &format!(
-            "all {} sheets by the plan's measure: {drawn} drawn (colour), {} not drawn (grey)",
+            "all {} sheets by the plan's verdict: {drawn} drawn (colour), {} not drawn (grey)",
             metrics.len(),
             metrics.len() - drawn
         ),
@@ -204,7 +205,7 @@ pub fn png(flips: &[f64], metrics: &[(f64, bool)], worst: &[Worst]) -> Vec<u8> {
     c.text(
         MARGIN,
         metric_top - 2 * LINE_HEIGHT,
-        "largest |max3·E − w·R| over views with μ ≥ 0.1, authored against migrated",
+        "ꟻLIP in the furnace on the plan's small renders, authored against migrated",
         DIM,
     );
     for (i, &[d, u]) in metric_counts.iter().enumerate() {
@@ -291,7 +292,7 @@ mod tests {
                 figures: Vec::new(),
                 max_codes: [0; 2],
                 flip: [flip, 0.0],
-                verdict: Verdict::from_flip(flip),
+                verdict: crate::migrate::verdict::Verdict::new(flip, 0.0),
                 poor_match: false,
                 notes: Vec::new(),
             },

@@ -125,6 +125,89 @@ pub struct Look {
     pub layer: Layer,
 }
 
+/// How finely a look is sampled: as a sheet draws it, or as the plan's verdict measures it.
+///
+/// The verdict measures every material of a library, so its curves are cheaper: the layer's
+/// reflectance at [`VERDICT_CURVE_NODES`] view cosines, read from a grid over roughness
+/// ([`VERDICT_ROUGHNESS_STEPS`] + 1 columns, each computed once per process by the same
+/// quadrature as a sheet's nodes, on first use) by Catmull–Rom interpolation in roughness, and
+/// the base's furnace integrals on [`VERDICT_STEPS`]. Every value is a function of the look
+/// alone (a column is the same whichever task computes it first), so the verdict does not
+/// depend on the thread count or on which materials were measured before.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Quality {
+    /// The sheet's curves: [`CURVE_NODES`] nodes by quadrature, the furnace on [`Steps::default`].
+    Sheet,
+    /// The verdict's curves (see the type's comment).
+    Verdict,
+}
+
+/// View cosines sampled per look for the verdict.
+pub const VERDICT_CURVE_NODES: usize = 17;
+/// Roughness steps of the verdict's reflectance grid: columns at r = j / steps.
+pub const VERDICT_ROUGHNESS_STEPS: usize = 64;
+/// The base's furnace integrals for the verdict.
+pub const VERDICT_STEPS: Steps = Steps {
+    diffuse: 24,
+    specular: 24,
+    azimuth: 8,
+};
+
+impl Quality {
+    /// How many view cosines a look's curves are sampled at.
+    pub fn nodes(self) -> usize {
+        match self {
+            Quality::Sheet => CURVE_NODES,
+            Quality::Verdict => VERDICT_CURVE_NODES,
+        }
+    }
+
+    fn steps(self) -> Steps {
+        match self {
+            Quality::Sheet => Steps::default(),
+            Quality::Verdict => VERDICT_STEPS,
+        }
+    }
+}
+
+/// Which directional reflectance a grid column holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Reflectance {
+    Sheen,
+    Fuzz,
+}
+
+/// The verdict's reflectance curve at `roughness`: the grid's columns (each computed once per
+/// process, on first use) interpolated in roughness.
+fn grid_curve(kind: Reflectance, roughness: f64) -> Vec<f64> {
+    type Columns = Vec<OnceLock<Vec<f64>>>;
+    static GRID: OnceLock<[Columns; 2]> = OnceLock::new();
+    let grid = GRID.get_or_init(|| {
+        std::array::from_fn(|_| {
+            (0..=VERDICT_ROUGHNESS_STEPS)
+                .map(|_| OnceLock::new())
+                .collect()
+        })
+    });
+    let columns = &grid[kind as usize];
+    let nodes = VERDICT_CURVE_NODES;
+    let column = |j: usize| {
+        columns[j].get_or_init(|| {
+            let r = j as f64 / VERDICT_ROUGHNESS_STEPS as f64;
+            (0..nodes)
+                .map(|i| match kind {
+                    Reflectance::Sheen => sheen_node(node_mu(i, nodes), r, CURVE_TOL),
+                    Reflectance::Fuzz => fuzz_node(node_mu(i, nodes), r, CURVE_TOL),
+                })
+                .collect()
+        })
+    };
+    let r = clamp01(roughness);
+    (0..nodes)
+        .map(|i| catmull_rom(VERDICT_ROUGHNESS_STEPS + 1, |j| column(j)[i], r).max(0.0))
+        .collect()
+}
+
 /// The two lights of a contact sheet.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Light {
@@ -139,6 +222,7 @@ pub enum Light {
 #[derive(Clone, Debug)]
 pub struct Shaded {
     look: Look,
+    quality: Quality,
     /// The layer's directional reflectance at the curve nodes (E or R; 0 without a layer).
     reflectance: Vec<f64>,
     /// The base's furnace response at the curve nodes: ∫ A·a·μl dω and ∫ B·a·μl dω (the base
@@ -146,8 +230,8 @@ pub struct Shaded {
     base_furnace: Vec<[f64; 2]>,
 }
 
-fn node_mu(i: usize) -> f64 {
-    let t = i as f64 / (CURVE_NODES - 1) as f64;
+fn node_mu(i: usize, nodes: usize) -> f64 {
+    let t = i as f64 / (nodes - 1) as f64;
     t * t
 }
 
@@ -165,6 +249,11 @@ impl Shaded {
     /// Samples the look's curves (in parallel over the nodes; each node is computed alone, so
     /// the values do not depend on the thread count).
     pub fn new(look: Look) -> Shaded {
+        Shaded::with_quality(look, Quality::Sheet)
+    }
+
+    /// Samples the look's curves at `quality`.
+    pub fn with_quality(look: Look, quality: Quality) -> Shaded {
         // A switched-off layer is no layer (the specs: sheenColorFactor zero or fuzzFactor zero
         // disables the layer), so it shows the base exactly as a material without one.
         let layer = match look.layer {
@@ -179,39 +268,47 @@ impl Shaded {
             other => other,
         };
         let look = Look { layer, ..look };
-        let reflectance: Vec<f64> = match look.layer {
-            Layer::None => vec![0.0; CURVE_NODES],
-            Layer::Sheen { roughness, .. } => (0..CURVE_NODES)
+        let nodes = quality.nodes();
+        let reflectance: Vec<f64> = match (look.layer, quality) {
+            (Layer::None, _) => vec![0.0; nodes],
+            (Layer::Sheen { roughness, .. }, Quality::Verdict) => {
+                grid_curve(Reflectance::Sheen, roughness)
+            }
+            (Layer::Fuzz { roughness, .. }, Quality::Verdict) => {
+                grid_curve(Reflectance::Fuzz, roughness)
+            }
+            (Layer::Sheen { roughness, .. }, Quality::Sheet) => (0..nodes)
                 .into_par_iter()
-                .map(|i| sheen_node(node_mu(i), roughness, CURVE_TOL))
+                .map(|i| sheen_node(node_mu(i, nodes), roughness, CURVE_TOL))
                 .collect(),
-            Layer::Fuzz { roughness, .. } => (0..CURVE_NODES)
+            (Layer::Fuzz { roughness, .. }, Quality::Sheet) => (0..nodes)
                 .into_par_iter()
-                .map(|i| fuzz_node(node_mu(i), roughness, CURVE_TOL))
+                .map(|i| fuzz_node(node_mu(i, nodes), roughness, CURVE_TOL))
                 .collect(),
         };
         let mut shaded = Shaded {
             look,
+            quality,
             reflectance,
             base_furnace: Vec::new(),
         };
         let (metallic, alpha) = base_params(&look);
         shaded.base_furnace = match look.layer {
             // The attenuation depends on the view alone: it scales the base's albedo.
-            Layer::None | Layer::Fuzz { .. } => base_albedo_curve(metallic, alpha)
+            Layer::None | Layer::Fuzz { .. } => base_albedo_curve(metallic, alpha, quality)
                 .iter()
                 .enumerate()
                 .map(|(i, terms)| {
-                    let av = shaded.attenuation_at(node_mu(i));
+                    let av = shaded.attenuation_at(node_mu(i, nodes));
                     terms.map(|v| v * av)
                 })
                 .collect(),
             Layer::Sheen { .. } => {
-                let rules = base_rules(metallic, alpha);
-                (0..CURVE_NODES)
+                let rules = base_rules(metallic, alpha, quality);
+                (0..nodes)
                     .into_par_iter()
                     .map(|i| {
-                        let av = shaded.attenuation_at(node_mu(i));
+                        let av = shaded.attenuation_at(node_mu(i, nodes));
                         rules[i].integrate(&|mu_l| av.min(shaded.attenuation_at(mu_l)))
                     })
                     .collect()
@@ -227,7 +324,8 @@ impl Shaded {
 
     /// The layer's directional reflectance at view cosine μ (interpolated).
     pub fn reflectance_at(&self, mu: f64) -> f64 {
-        catmull_rom(CURVE_NODES, |k| self.reflectance[k], clamp01(mu).sqrt()).max(0.0)
+        let nodes = self.quality.nodes();
+        catmull_rom(nodes, |k| self.reflectance[k], clamp01(mu).sqrt()).max(0.0)
     }
 
     /// The base attenuation for one cosine: 1 − max3(sheenColor)·E(μ) or 1 − w·R(μ), clamped
@@ -257,8 +355,9 @@ impl Shaded {
     /// attenuation).
     pub fn base_furnace(&self, mu: f64) -> [f64; 3] {
         let x = clamp01(mu).sqrt();
-        let scale = catmull_rom(CURVE_NODES, |k| self.base_furnace[k][0], x).max(0.0);
-        let offset = catmull_rom(CURVE_NODES, |k| self.base_furnace[k][1], x).max(0.0);
+        let nodes = self.quality.nodes();
+        let scale = catmull_rom(nodes, |k| self.base_furnace[k][0], x).max(0.0);
+        let offset = catmull_rom(nodes, |k| self.base_furnace[k][1], x).max(0.0);
         self.look.base.map(|b| clamp01(b) * scale + offset)
     }
 
@@ -372,16 +471,16 @@ pub fn base_brdf(
 /// its [`base_rules`] integrated with no attenuation. They are a function of those two numbers
 /// alone, so they are computed once per process and shared by every look with that base
 /// (which task computes them first does not change them).
-fn base_albedo_curve(metallic: f64, alpha: f64) -> Arc<Vec<[f64; 2]>> {
-    type Curves = HashMap<(u64, u64), Arc<Vec<[f64; 2]>>>;
+fn base_albedo_curve(metallic: f64, alpha: f64, quality: Quality) -> Arc<Vec<[f64; 2]>> {
+    type Curves = HashMap<(u64, u64, Quality), Arc<Vec<[f64; 2]>>>;
     static KNOWN: OnceLock<Mutex<Curves>> = OnceLock::new();
     let known = KNOWN.get_or_init(|| Mutex::new(HashMap::new()));
-    let key = (metallic.to_bits(), alpha.to_bits());
+    let key = (metallic.to_bits(), alpha.to_bits(), quality);
     if let Some(curve) = known.lock().unwrap_or_else(|e| e.into_inner()).get(&key) {
         return Arc::clone(curve);
     }
     let curve: Arc<Vec<[f64; 2]>> = Arc::new(
-        base_rules(metallic, alpha)
+        base_rules(metallic, alpha, quality)
             .par_iter()
             .map(|rule| rule.integrate(&|_| 1.0))
             .collect(),
@@ -582,11 +681,11 @@ const KEPT_BASE_RULES: usize = 4;
 /// The rules at every curve node for (metallic, α): built once and shared while among the
 /// [`KEPT_BASE_RULES`] most recently used. A rule is a function of those two numbers alone, so
 /// which task builds it does not change a value.
-fn base_rules(metallic: f64, alpha: f64) -> Arc<Vec<BaseRule>> {
-    type Kept = Vec<((u64, u64), Arc<Vec<BaseRule>>)>;
+fn base_rules(metallic: f64, alpha: f64, quality: Quality) -> Arc<Vec<BaseRule>> {
+    type Kept = Vec<((u64, u64, Quality), Arc<Vec<BaseRule>>)>;
     static KEPT: OnceLock<Mutex<Kept>> = OnceLock::new();
     let kept = KEPT.get_or_init(|| Mutex::new(Vec::new()));
-    let key = (metallic.to_bits(), alpha.to_bits());
+    let key = (metallic.to_bits(), alpha.to_bits(), quality);
     {
         let mut kept = kept.lock().unwrap_or_else(|e| e.into_inner());
         if let Some(at) = kept.iter().position(|(k, _)| *k == key) {
@@ -597,9 +696,16 @@ fn base_rules(metallic: f64, alpha: f64) -> Arc<Vec<BaseRule>> {
         }
     }
     let rules: Arc<Vec<BaseRule>> = Arc::new(
-        (0..CURVE_NODES)
+        (0..quality.nodes())
             .into_par_iter()
-            .map(|i| BaseRule::new(node_mu(i), metallic, alpha, Steps::default()))
+            .map(|i| {
+                BaseRule::new(
+                    node_mu(i, quality.nodes()),
+                    metallic,
+                    alpha,
+                    quality.steps(),
+                )
+            })
             .collect(),
     );
     let mut kept = kept.lock().unwrap_or_else(|e| e.into_inner());
@@ -869,7 +975,7 @@ mod tests {
         let mut worst: [f64; 2] = [0.0; 2];
         for roughness in [0.0, 0.02, 0.07, 0.3, 0.7, 1.0] {
             for &i in &nodes {
-                let mu = node_mu(i);
+                let mu = node_mu(i, CURVE_NODES);
                 let e = sheen_node(mu, roughness, CURVE_TOL) - sheen_node(mu, roughness, 1e-9);
                 let r = fuzz_node(mu, roughness, CURVE_TOL) - fuzz_node(mu, roughness, 1e-9);
                 worst = [worst[0].max(e.abs()), worst[1].max(r.abs())];

@@ -11,9 +11,13 @@
 //! largest base-attenuation difference and its view cosine), with E and R by quadrature as the
 //! report has them.
 //!
-//! The verdict is NVIDIA's ꟻLIP (Andersson et al. 2020, an image-difference metric made for
-//! rendered images: per pixel an error in [0, 1] from colour and edge differences as a viewer
-//! sees them, here at ꟻLIP's default 67 pixels per degree), between the authored column and
+//! The label is the plan's verdict (`preview::verdict`, measured on small renders of the same
+//! columns, written into migrate's plan), so a sheet never says another word than migrate's
+//! report and the run's ranking; the sheet adds its own full-size ꟻLIP beside it, which may
+//! differ a little from the plan's. The verdict is NVIDIA's ꟻLIP (Andersson et al. 2020, an
+//! image-difference metric made for rendered images: per pixel an error in [0, 1] from colour
+//! and edge differences as a viewer sees them, at a sheet's size ꟻLIP's default 67 pixels per
+//! degree), between the authored column and
 //! column 1 in the white furnace, pooled as the 99th percentile over the sphere's pixels (the
 //! largest over the swatches): a change over at least 1 % of the sphere counts, a stray pixel
 //! does not. At most [`SAME_FLIP`] is "same to the eye", at most [`CLOSE_FLIP`] "close", above
@@ -114,45 +118,12 @@ pub const LABEL_W: usize = 72;
 pub const MARGIN: usize = 8;
 /// Gain of the difference image: a difference of one code shows as DIFF_GAIN codes.
 pub const DIFF_GAIN: u32 = 8;
-/// At most this ꟻLIP (99th percentile over the sphere in the furnace) between column 0 and
-/// column 1: "same to the eye".
-pub const SAME_FLIP: f64 = 0.10;
-/// At most this ꟻLIP: "close".
-pub const CLOSE_FLIP: f64 = 0.22;
+pub use crate::migrate::verdict::{Label, CLOSE_FLIP, SAME_FLIP};
 /// Background behind the spheres, linear.
 const BACKGROUND: f64 = 0.03;
 /// The colour of the text (sRGB codes), drawn over [`background_code`].
 pub const TEXT: [u8; 3] = [235, 235, 235];
 const DIM_TEXT: [u8; 3] = [170, 170, 170];
-
-/// What the picture says, in words.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Verdict {
-    Same,
-    Close,
-    Visible,
-}
-
-impl Verdict {
-    /// The verdict of a ꟻLIP value (see [`SAME_FLIP`], [`CLOSE_FLIP`]).
-    pub fn from_flip(flip: f64) -> Verdict {
-        if flip <= SAME_FLIP {
-            Verdict::Same
-        } else if flip <= CLOSE_FLIP {
-            Verdict::Close
-        } else {
-            Verdict::Visible
-        }
-    }
-
-    pub fn text(self) -> &'static str {
-        match self {
-            Verdict::Same => "same to the eye",
-            Verdict::Close => "close",
-            Verdict::Visible => "visible difference: look before trusting it",
-        }
-    }
-}
 
 /// The words of a sheet, for its index entry.
 #[derive(Clone, Debug, PartialEq)]
@@ -164,10 +135,11 @@ pub struct Summary {
     pub figures: Vec<String>,
     /// Largest difference between columns 0 and 1, in codes: furnace, directional light.
     pub max_codes: [u8; 2],
-    /// ꟻLIP between columns 0 and 1, the 99th percentile over the sphere (the largest over the
-    /// swatches): furnace (the verdict's), directional light.
+    /// ꟻLIP between columns 0 and 1 on this sheet's full-size spheres, the 99th percentile over
+    /// the sphere (the largest over the swatches): furnace, directional light.
     pub flip: [f64; 2],
-    pub verdict: Verdict,
+    /// The plan's verdict, which gives the sheet its label.
+    pub verdict: crate::migrate::verdict::Verdict,
     /// The sheen roughness lies below 0.1, where no fuzz roughness matches it.
     pub poor_match: bool,
     pub notes: Vec<String>,
@@ -179,11 +151,13 @@ impl Summary {
         let mut line = format!(
             "verdict: {} ({} vs {}: ꟻLIP {:.3} in the furnace, where at most {SAME_FLIP:.2} is \
              the same and at most {CLOSE_FLIP:.2} close; {:.3} under the light, where the lobes' \
-             shapes differ for every pair; at most {} codes apart in the furnace, {} under the \
-             light)",
-            self.verdict.text(),
+             shapes differ for every pair; on this sheet's full-size spheres ꟻLIP {:.3} and \
+             {:.3}, at most {} codes apart in the furnace, {} under the light)",
+            self.verdict.label.text(),
             self.columns[0],
             self.columns.get(1).map_or("", String::as_str),
+            self.verdict.furnace,
+            self.verdict.light,
             self.flip[0],
             self.flip[1],
             self.max_codes[0],
@@ -498,7 +472,9 @@ pub fn render(title: &str, material: &Material) -> Sheet {
         figures,
         max_codes,
         flip,
-        verdict: Verdict::from_flip(flip[0]),
+        verdict: material
+            .verdict
+            .unwrap_or_else(|| super::verdict::measure_pairs(&super::verdict::pairs(material))),
         poor_match,
         notes,
     };
@@ -586,6 +562,17 @@ pub fn render(title: &str, material: &Material) -> Sheet {
 /// The ꟻLIP error of `test` against `reference` (square sRGB images, row by row), the 99th
 /// percentile (nearest rank) over the pixels `on` marks; 0 for identical images.
 pub fn flip_p99(reference: &[[u8; 3]], test: &[[u8; 3]], on: &[bool]) -> f64 {
+    flip_p99_at(reference, test, on, nv_flip::DEFAULT_PIXELS_PER_DEGREE)
+}
+
+/// [`flip_p99`] at `pixels_per_degree` (the verdict's small spheres are seen at the angle a
+/// sheet's are, so at fewer pixels per degree).
+pub fn flip_p99_at(
+    reference: &[[u8; 3]],
+    test: &[[u8; 3]],
+    on: &[bool],
+    pixels_per_degree: f32,
+) -> f64 {
     if reference == test {
         return 0.0;
     }
@@ -594,11 +581,7 @@ pub fn flip_p99(reference: &[[u8; 3]], test: &[[u8; 3]], on: &[bool]) -> f64 {
         let flat: Vec<u8> = codes.iter().flatten().copied().collect();
         nv_flip::FlipImageRgb8::with_data(size, size, &flat)
     };
-    let error = nv_flip::flip(
-        image(reference),
-        image(test),
-        nv_flip::DEFAULT_PIXELS_PER_DEGREE,
-    );
+    let error = nv_flip::flip(image(reference), image(test), pixels_per_degree);
     let mut values: Vec<f32> = error
         .to_vec()
         .into_iter()

@@ -7,6 +7,7 @@ use crate::edit::Edit;
 use crate::migrate::apply::{execute, plan_file, Written};
 use crate::migrate::material::MaterialPlan;
 use crate::migrate::note::{Conversion, Level, Note, Skip};
+use crate::migrate::verdict::LabelCounts;
 use crate::migrate::Options;
 use crate::output::files::Claims;
 use crate::output::paths::{Destination, Job, ResourceCopy};
@@ -38,6 +39,12 @@ pub struct MigrateDetail {
     pub materials: Vec<MaterialPlan>,
     /// Edits outside the materials: declarations and URI rewrites.
     pub edits: Vec<Edit>,
+    /// A dry run's edits of the bakes, applied after the materials' edits and `edits`: the
+    /// new `images` and `textures` entries (under the names they will have) and the slots
+    /// that read them (see [`crate::migrate::apply::dry_run_bake_edits`]). Empty in a run
+    /// that writes: the bakes' outcome is in `textures_added` and the notes.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub bake_edits: Vec<Edit>,
     pub copies: Vec<ResourceCopy>,
     #[serde(serialize_with = "crate::migrate::material::notes_json")]
     pub notes: Vec<Note>,
@@ -74,6 +81,8 @@ pub struct Summary {
     pub materials_migrated: usize,
     pub conversions: BTreeMap<Conversion, usize>,
     pub skipped: BTreeMap<Skip, usize>,
+    /// The migrated materials by their plan's verdict (those measured).
+    pub verdicts: LabelCounts,
 }
 
 /// The outcome of a run: every file in input order, and the totals.
@@ -105,12 +114,25 @@ fn migrate_one(
         Ok(plan) => plan,
         Err(error) => return FileResult::failed(&job.input, job.output.as_deref(), error),
     };
-    let sheets = sheets.then(|| {
-        crate::preview::material::materials(&plan.asset, &plan.document, options.roughness)
-    });
+    // The plan's verdict, measured by the preview's renderer as soon as the plan is made; the
+    // materials it reads are the sheets' when `--preview` asks for them.
+    let judged = (sheets || !options.skip_verdict)
+        .then(|| crate::preview::verdict::judge(&plan.asset, &mut plan.document, options));
+    // A stop during the measuring leaves verdicts that are not to be reported.
+    if let Err(stopped) = crate::output::interrupt::check() {
+        return FileResult::failed(&job.input, job.output.as_deref(), stopped);
+    }
+    let sheets = judged.filter(|_| sheets);
+    let mut bake_edits = Vec::new();
     let outcome = if dry_run {
-        FileOutcome::Planned {
-            changes: plan.changes(),
+        match crate::migrate::apply::dry_run_bake_edits(&plan, claims) {
+            Ok(edits) => {
+                bake_edits = edits;
+                FileOutcome::Planned {
+                    changes: plan.changes(),
+                }
+            }
+            Err(error) => FileOutcome::Failed { error },
         }
     } else {
         match execute(&mut plan, claims) {
@@ -167,6 +189,7 @@ fn migrate_one(
                 .chain(&plan.relocation.edits)
                 .cloned()
                 .collect(),
+            bake_edits,
             materials: plan.document.materials,
             copies: plan.relocation.copies,
             notes,
@@ -232,6 +255,9 @@ fn summarise(files: &[FileResult]) -> Summary {
             }
             for c in &material.conversions {
                 *s.conversions.entry(*c).or_default() += 1;
+            }
+            if let (true, Some(v)) = (material.migrated(), material.verdict) {
+                s.verdicts.add(v.label);
             }
             if let Some(why) = material.skipped {
                 *s.skipped.entry(why).or_default() += 1;

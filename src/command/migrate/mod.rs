@@ -22,6 +22,10 @@ pub struct View {
     pub detail: Detail,
     /// `--check`: a file that would change fails the run (the request is a dry run).
     pub check: bool,
+    /// `--fail-on-visible` (with `--check`; also `fail-on-visible = true` in the velvet.toml
+    /// found for a file): the check judges appearance instead of change, and fails on a
+    /// material the plan's verdict calls "visible" (see [`visible_failures`]).
+    pub fail_on_visible: bool,
     /// `--preview DIR`: contact sheets of the inputs' materials, written there.
     pub preview: Option<PathBuf>,
 }
@@ -64,12 +68,75 @@ pub fn command(request: &Request, shard: Option<Shard>, view: &View) -> Status {
             None => {}
         }
     }
-    let failed =
-        report.failed() || preview_failed || (view.check && report.summary.totals.would_change > 0);
+    let check_failed = match view.check {
+        false => false,
+        true => match visible_failures(&report, view.fail_on_visible) {
+            Ok(None) => report.summary.totals.would_change > 0,
+            Ok(Some(lines)) => {
+                for line in &lines {
+                    super::note(format_args!("velvet: --check: {line}"));
+                }
+                !lines.is_empty()
+            }
+            Err(e) => return super::usage_error(e),
+        },
+    };
+    let failed = report.failed() || preview_failed || check_failed;
     // The command line exits after this: a library's report (a plan for every material) is
     // left to the exit rather than freed value by value.
     std::mem::forget(report);
     Status::failed_if(failed)
+}
+
+/// Under `--check`, the materials that fail an appearance gate, one line each (file, material,
+/// verdict), or `None` when no file is judged by appearance: the gate is on for a file when
+/// `--fail-on-visible` is given or the velvet.toml found for it sets `fail-on-visible`. A gated
+/// file fails on a material the migration would change visibly, and on one already migrated
+/// (fuzz with its fallback sheen in the file) whose fallback looks visibly different from its
+/// fuzz; a change alone does not fail it. Files not gated fail the check when they would change.
+pub fn visible_failures(
+    report: &RunReport,
+    flag: bool,
+) -> Result<Option<Vec<String>>, crate::config::ConfigError> {
+    let mut resolver = crate::config::Resolver::new(
+        None,
+        crate::config::Layer {
+            fail_on_visible: flag.then_some(true),
+            ..crate::config::Layer::default()
+        },
+    )?;
+    let mut gated_any = false;
+    let mut lines = Vec::new();
+    for file in &report.files {
+        let gated = resolver.for_path(&file.input)?.fail_on_visible.0;
+        if !gated {
+            if file.outcome == (FileOutcome::Planned { changes: true }) {
+                lines.push(format!("{}: would change", file.input.display()));
+            }
+            continue;
+        }
+        gated_any = true;
+        for m in &file.detail.materials {
+            let judged = m.migrated() || m.skipped == Some(crate::migrate::Skip::BothPresent);
+            match m.verdict {
+                Some(v) if judged && v.label == crate::migrate::verdict::Label::Visible => {
+                    let name = m
+                        .name
+                        .as_deref()
+                        .map(|n| format!(" \"{n}\""))
+                        .unwrap_or_default();
+                    lines.push(format!(
+                        "{}: material {}{name}: {}",
+                        file.input.display(),
+                        m.index,
+                        v.describe()
+                    ));
+                }
+                _ => {}
+            }
+        }
+    }
+    Ok(gated_any.then_some(lines))
 }
 
 /// The preview of a run: each file's materials as its plan (the one written) gave them, read

@@ -38,7 +38,11 @@ fn material_line(m: &MaterialPlan) -> String {
             .collect::<Vec<_>>()
             .join(", then ")
     };
-    format!("material {}{name}: {what}", m.index)
+    let verdict = match (m.migrated(), m.verdict) {
+        (true, Some(v)) => format!("; verdict {}", v.describe()),
+        _ => String::new(),
+    };
+    format!("material {}{name}: {what}{verdict}", m.index)
 }
 
 fn file_line(f: &FileResult, dry_run: bool) -> String {
@@ -108,7 +112,7 @@ pub fn file_text(f: &FileResult, plan: bool) -> String {
         );
     }
     if plan {
-        for edit in &f.detail.edits {
+        for edit in f.detail.edits.iter().chain(&f.detail.bake_edits) {
             push_line(&mut out, &format!("  {edit}"));
         }
         for copy in &f.detail.copies {
@@ -149,6 +153,14 @@ pub fn summary_text(summary: &Summary, dry_run: bool) -> String {
         let _ = write!(out, " ({})", counted(&s.skipped, |k| k.as_str()));
     }
     let _ = writeln!(out, "; {}", plural(t.warnings, "warning", "warnings"));
+    let v = &s.verdicts;
+    if v.total() > 0 {
+        let _ = writeln!(
+            out,
+            "verdicts: {} same, {} close, {} visible",
+            v.same, v.close, v.visible
+        );
+    }
     out
 }
 
