@@ -23,7 +23,9 @@ pub fn plan_document(asset: &Asset, options: &Options) -> DocumentPlan {
     // peaked at 108 MiB instead of 101). One arena for the whole process made the workers wait
     // on each other's allocations instead (see `asset::pages::limit_heaps`).
     let primitives = Primitives::new(asset.root());
+    crate::progress::stage("planning materials", count);
     let plan = |i: usize| {
+        crate::progress::advance(1);
         plan_material(asset, i, options, &primitives).map(|mut plan| {
             plan.shrink_to_fit();
             plan

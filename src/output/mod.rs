@@ -125,8 +125,7 @@ pub fn progress_bar(wanted: bool, count: usize, noun: &str) -> Option<indicatif:
 /// time so far, redrawn ten times a second, so that a large file's minutes on a terminal are
 /// visibly work and not a hang. The size is the file's length on disk (one `stat`), not read.
 pub fn show_one_file(bar: &indicatif::ProgressBar, file: &std::path::Path) {
-    if let Ok(style) = indicatif::ProgressStyle::with_template("{spinner} {msg} {stage}{elapsed}")
-    {
+    if let Ok(style) = indicatif::ProgressStyle::with_template("{spinner} {msg} {stage}{elapsed}") {
         // The stage with a space after it, or nothing before the first stage.
         bar.set_style(style.with_key(
             "stage",

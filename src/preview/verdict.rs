@@ -142,8 +142,10 @@ pub fn measure_all(materials: &[Material]) -> Vec<Verdict> {
         .collect();
     // A stop (SIGINT, SIGTERM) ends the measuring at once: what is left reads 0, and every
     // caller checks for the stop before it uses a verdict (see [`judge`]).
+    crate::progress::stage("judging appearance", distinct.len());
     let verdicts: Vec<Verdict> = distinct
         .par_iter()
+        .inspect(|_| crate::progress::advance(1))
         .map(|&i| match crate::output::interrupt::requested() {
             Some(_) => Verdict::new(0.0, 0.0),
             None => measure_pairs(&keys[i].1),
