@@ -900,7 +900,7 @@ fn a_library_larger_than_a_page_gets_pages_linked_from_the_first() {
     let first = std::fs::read_to_string(&written.pages[0]).unwrap();
     assert!(first.contains("<a href=\"index-2.html\">2</a>"));
     let second = std::fs::read_to_string(&written.pages[1]).unwrap();
-    assert_eq!(second.matches("<section>").count(), 5);
+    assert_eq!(second.matches("<section class=").count(), 5);
     // Worst first across the pages.
     let metrics: Vec<f64> = written
         .drawn
@@ -1569,4 +1569,53 @@ fn with_fast_a_copied_roughness_texture_is_labelled_copied_not_fitted() {
     assert!(columns(fitted, &fitted.factors)[1]
         .detail
         .ends_with(" fitted"));
+}
+
+#[test]
+fn the_index_page_shows_each_sheet_by_its_verdict_and_input_order_without_a_script() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let o = run_velvet(&["preview", "fixtures/migrate/", "-o", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert!(!html.contains("<script"));
+    let index: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("index.json")).unwrap()).unwrap();
+    // Each drawn sheet's label, from index.json (a record per material; a sheet once).
+    let mut labels: Vec<(String, String)> = Vec::new();
+    for s in index["sheets"].as_array().unwrap() {
+        let file = s["file"].as_str().unwrap().to_string();
+        if s["drawn"] == true && !labels.iter().any(|(f, _)| *f == file) {
+            labels.push((file, s["label"].as_str().unwrap().to_string()));
+        }
+    }
+    // The page's sections, in order: their class is the label, and each shows its sheet.
+    let sections: Vec<&str> = html.split("<section class=\"").skip(1).collect();
+    assert_eq!(sections.len(), labels.len().min(100));
+    for (section, (file, label)) in sections.iter().zip(&labels) {
+        assert!(
+            section.starts_with(&format!("{label}\" style=\"--input: ")),
+            "{section}"
+        );
+        assert!(
+            section.contains(&format!("<img src=\"{file}\"")),
+            "{file}: {section}"
+        );
+    }
+    for label in ["visible", "close", "same"] {
+        let n = labels.iter().filter(|(_, l)| l == label).count();
+        assert!(
+            html.contains(&format!(
+                "<label for=\"show-{label}\">{label} ({n})</label>"
+            )),
+            "{label}: {n}"
+        );
+        assert!(html.contains(&format!(
+            "<input type=\"radio\" name=\"show\" id=\"show-{label}\">"
+        )));
+        assert!(html.contains(&format!(
+            "#show-{label}:checked ~ .sheets section:not(.{label})"
+        )));
+    }
+    assert!(html.contains("#order-input:checked ~ .sheets section { order: var(--input); }"));
 }

@@ -1,5 +1,7 @@
 //! The index pages of a preview run: static HTML (no scripts, no external resources), the
-//! sheets worst first by the plan's verdict, [`PAGE`] to a page with links between the pages.
+//! sheets worst first by the plan's verdict, [`PAGE`] to a page with links between the pages;
+//! a page's sheets can be shown by verdict and in input order instead, through radio buttons
+//! and style rules alone (a section's class is its label, its `--input` its input order).
 //! Each sheet is shown with its title, the materials that share it, the report's figures and
 //! the verdict as text; the first page also lists the sheets left undrawn (`--worst N`), the
 //! files without sheen or fuzz and the files that failed. [`json`] writes the same run as
@@ -73,13 +75,24 @@ fn html(plan: &Plan, sheets: &[Drawn], page: usize, total: usize, drawn: usize) 
          <title>velvet preview</title>\n<style>\n\
          body { font-family: sans-serif; background: #111; color: #ddd; margin: 2em; }\n\
          section { margin-bottom: 3em; }\n img { max-width: 100%; }\n\
-         .verdict { font-weight: bold; }\n a { color: #9cf; }\n</style>\n</head>\n<body>\n\
-         <h1>velvet preview</h1>\n",
+         .verdict { font-weight: bold; }\n a { color: #9cf; }\n\
+         .sheets { display: flex; flex-direction: column; }\n\
+         #show-visible:checked ~ .sheets section:not(.visible),\n\
+         #show-close:checked ~ .sheets section:not(.close),\n\
+         #show-same:checked ~ .sheets section:not(.same) { display: none; }\n\
+         #order-input:checked ~ .sheets section { order: var(--input); }\n\
+         body > input { display: none; }\n label { cursor: pointer; text-decoration: underline; }\n\
+         #show-all:checked ~ p label[for=show-all], #show-visible:checked ~ p label[for=show-visible],\n\
+         #show-close:checked ~ p label[for=show-close], #show-same:checked ~ p label[for=show-same],\n\
+         #order-verdict:checked ~ p label[for=order-verdict],\n\
+         #order-input:checked ~ p label[for=order-input] { font-weight: bold; text-decoration: none; }\n\
+         </style>\n</head>\n<body>\n<h1>velvet preview</h1>\n",
     );
     h += &format!(
         "<p>{} material(s) on {} sheet(s) (materials with the same values share one), {drawn} \
-         drawn, worst first: ranked by the largest difference |max3&middot;E &minus; w&middot;R| \
-         between the layer as authored and as migrated, at views with &mu; &ge; 0.1. Each sheet \
+         drawn, worst first by the plan's verdict: the &#42791;LIP difference between the \
+         material as authored and as written, in the furnace (which gives the label) and under \
+         the light, as `velvet migrate` reports it. Each sheet \
          shows the material as authored, as migrated and as a loader without \
          KHR_materials_fuzz sees it, in a white furnace (top row of each pair) and under one \
          directional light with a dim ambient; the last column is the difference between the \
@@ -91,7 +104,34 @@ fn html(plan: &Plan, sheets: &[Drawn], page: usize, total: usize, drawn: usize) 
     if page == 0 && drawn > 0 {
         h += "<p><a href=\"overview.png\"><img src=\"overview.png\" alt=\"histogram of the verdicts and the worst sheets\"></a></p>\n";
     }
+    // Show by verdict, and in input order, with no script: radio buttons before the sheets,
+    // which the style rules read.
+    let count = |label: crate::migrate::verdict::Label| {
+        sheets
+            .iter()
+            .filter(|d| plan.sheets[d.sheet].verdict.label == label)
+            .count()
+    };
+    use crate::migrate::verdict::Label;
+    let shows = ["all", "visible", "close", "same"];
+    for (i, show) in shows.iter().enumerate() {
+        let checked = if i == 0 { " checked" } else { "" };
+        h += &format!("<input type=\"radio\" name=\"show\" id=\"show-{show}\"{checked}>\n");
+    }
+    h += "<input type=\"radio\" name=\"order\" id=\"order-verdict\" checked>\n\
+          <input type=\"radio\" name=\"order\" id=\"order-input\">\n";
+    h += "<p>show: <label for=\"show-all\">all</label>";
+    for label in [Label::Visible, Label::Close, Label::Same] {
+        h += &format!(
+            " &middot; <label for=\"show-{0}\">{0} ({1})</label>",
+            label.as_str(),
+            count(label)
+        );
+    }
+    h += "<br>order: <label for=\"order-verdict\">worst first</label> &middot; \
+          <label for=\"order-input\">input order</label></p>\n";
     h += &nav(page, total);
+    h += "<div class=\"sheets\">\n";
     for d in sheets {
         let planned = &plan.sheets[d.sheet];
         let sum = &d.summary;
@@ -99,7 +139,11 @@ fn html(plan: &Plan, sheets: &[Drawn], page: usize, total: usize, drawn: usize) 
             .path
             .file_name()
             .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
-        h += "<section>\n";
+        h += &format!(
+            "<section class=\"{}\" style=\"--input: {}\">\n",
+            planned.verdict.label.as_str(),
+            planned.entries.first().copied().unwrap_or(0)
+        );
         h += &format!("<h2>{}. {}</h2>\n", d.sheet + 1, escape(&sum.title));
         h += &format!(
             "<p>{} (the plan's verdict: {})</p>\n",
@@ -129,6 +173,7 @@ fn html(plan: &Plan, sheets: &[Drawn], page: usize, total: usize, drawn: usize) 
         }
         h += "</section>\n";
     }
+    h += "</div>\n";
     h += &nav(page, total);
     if page == 0 {
         if drawn < plan.sheets.len() {
