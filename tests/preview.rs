@@ -410,8 +410,16 @@ fn a_textured_layer_gives_three_swatches_and_a_missing_texture_leaves_the_factor
     }
     assert_eq!(m.base, [0.5; 3]);
     // The fuzz colour texture migrate carries from the sheen reads the same missing image.
-    assert_eq!(m.notes.len(), 3, "{:?}", m.notes);
+    assert_eq!(m.notes.len(), 4, "{:?}", m.notes);
     assert!(m.notes[2].starts_with("fuzzColorTexture not read"));
+    // Every texture slot of the written layers is named, with its image (a data: URI by its
+    // place) or the image it is baked from.
+    assert_eq!(
+        m.notes[3],
+        "textures as written: sheenColorTexture texture 1 (missing.png); sheenRoughnessTexture \
+         texture 0 (image 0); fuzzColorTexture texture 1 (missing.png); fuzzRoughnessTexture \
+         baked from texture 0 (image 0)"
+    );
     // The roughness texture is baked by the plan: at the codes the swatches read (p5 = 0,
     // p95 = 216), the migrated fuzz reads α(0.5 × texel) within the budget 0.01 (and the
     // four-decimal rounding of the factor).
@@ -437,14 +445,14 @@ fn a_textured_layer_gives_three_swatches_and_a_missing_texture_leaves_the_factor
             && n.ends_with("sheenColorFactor alone is used")));
     let sheet = sheet::render("textured.gltf", m);
     // The sheet says what the inputs lacked, and how its rows read the textures.
-    assert_eq!(sheet.summary.notes[..3], m.notes[..]);
+    assert_eq!(sheet.summary.notes[..4], m.notes[..]);
     assert!(
-        sheet.summary.notes[3].starts_with("the column headings give the values at the factors")
+        sheet.summary.notes[4].starts_with("the column headings give the values at the factors")
     );
     // The p5 row's sheen roughness is 0, whose E exceeds 1 at grazing views: the notes after
     // those say which columns have pixels above 1, marked.
-    assert!(sheet.summary.notes.len() > 4);
-    for n in &sheet.summary.notes[4..] {
+    assert!(sheet.summary.notes.len() > 5);
+    for n in &sheet.summary.notes[5..] {
         assert!(n.starts_with("column ") && n.contains("above 1"), "{n}");
     }
     // The headings and the verdict name the columns at the factors (r = 0.5).

@@ -331,6 +331,8 @@ fn read(
     let bakes: &[TextureBake] = plan.map_or(&[], |p| p.bakes.as_slice());
     let mut textured: Vec<(&'static Slot, TextureStats)> = Vec::new();
     let mut written_textured: Vec<(&'static Slot, TextureStats)> = Vec::new();
+    // Each texture slot of the written layers, with the image it reads or is baked from.
+    let mut written_slots: Vec<String> = Vec::new();
     for (json, extension, in_written, baked) in [
         (&sheen_json, layers::SHEEN, false, legacy),
         (&fuzz_json, layers::FUZZ, false, false),
@@ -345,6 +347,17 @@ fn read(
             let bake = bakes
                 .iter()
                 .find(|b| baked && b.extension == extension && b.texture_key == slot.texture);
+            if in_written {
+                let read = info.get("index").and_then(|i| i.as_u64());
+                written_slots.push(match bake {
+                    Some(bake) => format!(
+                        "{} baked from {}",
+                        slot.texture,
+                        image_of(asset, Some(bake.texture as u64))
+                    ),
+                    None => format!("{} {}", slot.texture, image_of(asset, read)),
+                });
+            }
             let stats = match bake {
                 Some(bake) => baked_stats(asset, bake, slot, images),
                 None => texture_stats(asset, info, slot.channels, slot.transfer, images),
@@ -363,6 +376,9 @@ fn read(
                 }
             }
         }
+    }
+    if !written_slots.is_empty() {
+        notes.push(format!("textures as written: {}", written_slots.join("; ")));
     }
     let views = Views {
         sheen: sheen.as_ref(),
@@ -409,6 +425,38 @@ fn read(
         mapping,
         verdict: None,
     })
+}
+
+/// How a sheet names the image texture `texture` reads: its URI (or name), or "image N" for
+/// one in a buffer view, or "texture N" when the texture names no image.
+fn image_of(asset: &Asset, texture: Option<u64>) -> String {
+    let root = asset.root();
+    let Some(t) = texture else {
+        return "(no texture index)".to_string();
+    };
+    let pointer = format!("/textures/{t}");
+    let Some(node) = root.pointer(&pointer) else {
+        return format!("texture {t}");
+    };
+    let image = crate::document::texture_sources(node, &pointer)
+        .into_iter()
+        .find_map(|(image, _)| image);
+    let Some(i) = image else {
+        return format!("texture {t}");
+    };
+    let image_node = root.pointer(&format!("/images/{i}"));
+    let named = |key: &str| {
+        image_node
+            .and_then(|n| n.get(key))
+            .and_then(|v| v.as_str().map(|s| s.into_owned()))
+    };
+    match named("uri")
+        .filter(|u| !u.starts_with("data:"))
+        .or_else(|| named("name"))
+    {
+        Some(name) => format!("texture {t} ({name})"),
+        None => format!("texture {t} (image {i})"),
+    }
 }
 
 /// The four layer views a swatch reads.
