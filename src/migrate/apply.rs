@@ -261,14 +261,7 @@ pub fn execute_by(
             )
         };
         for (info, result) in bake_plan.outputs.iter().zip(results) {
-            baked.push(result.map_err(|e| {
-                format!(
-                    "{}: cannot bake {} of image {}: {e}",
-                    plan.input.display(),
-                    info.labels.join(" + "),
-                    info.image
-                )
-            })?);
+            baked.push(result.map_err(|e| bake_failed(&plan.input, info, e))?);
         }
     }
     let mut names = names.into_inner().unwrap_or_else(|e| e.into_inner());
@@ -523,14 +516,7 @@ pub fn dry_run_bake_edits(plan: &FilePlan, claims: &Claims) -> Result<Vec<edit::
             .iter()
             .zip(bake_into(&bake_plan.recipes, &plan.asset, &options, None))
     {
-        baked_images.push(result.map_err(|e| {
-            format!(
-                "{}: cannot bake {} of image {}: {e}",
-                plan.input.display(),
-                info.labels.join(" + "),
-                info.image
-            )
-        })?);
+        baked_images.push(result.map_err(|e| bake_failed(&plan.input, info, e))?);
     }
     let fail = |e: edit::EditError| format!("{}: {e}", plan.input.display());
     // Named as the run names them: next to the output (the input itself without one).
@@ -700,4 +686,18 @@ fn difference(
         }
         _ => out.push(edit::Edit::replace(pointer.to_string(), to.clone())),
     }
+}
+
+/// The error of a bake that failed: the input, the slots and the image.
+fn bake_failed(
+    input: &std::path::Path,
+    info: &crate::bake::plan::OutputInfo,
+    e: impl std::fmt::Display,
+) -> String {
+    format!(
+        "{}: cannot bake {} of image {}: {e}",
+        input.display(),
+        info.labels.join(" + "),
+        info.image
+    )
 }
