@@ -61,8 +61,9 @@ pub struct Fix {
 /// that make the same edits are one fix repairing each of their findings.
 pub fn plan(asset: &Asset, findings: &[Finding]) -> Vec<Fix> {
     let mut fixes: Vec<Fix> = Vec::new();
-    // Each fix by its safety and edits, as text: a document may have a fix per material.
-    let mut by_edits: HashMap<String, usize> = HashMap::new();
+    // Each fix by the places its edits name (a document may have a fix per material); fixes
+    // that name the same places are compared whole.
+    let mut by_places: HashMap<String, Vec<usize>> = HashMap::new();
     for finding in findings {
         let d: &Diagnostic = &finding.diagnostic;
         let Some(fixer) = fixers::fixer_for(d.code) else {
@@ -78,14 +79,25 @@ pub fn plan(asset: &Asset, findings: &[Finding]) -> Vec<Fix> {
         };
         let drops_byte_order_mark = fixer.code.name == crate::diagnostics::codes::BOM_PRESENT.name;
         let rebuilds_container = container::CODES.contains(&fixer.code.name);
-        let key = format!(
-            "{:?} {:?} {drops_byte_order_mark} {rebuilds_container}",
-            fixer.safety, proposal.edits
-        );
-        match by_edits.get(&key) {
-            Some(&i) => fixes[i].repairs.push(repair),
+        let places = proposal
+            .edits
+            .iter()
+            .map(place_of)
+            .collect::<Vec<_>>()
+            .join("\0");
+        let same = by_places.get(&places).and_then(|candidates| {
+            candidates.iter().copied().find(|&i| {
+                let f = &fixes[i];
+                f.safety == fixer.safety
+                    && f.drops_byte_order_mark == drops_byte_order_mark
+                    && f.rebuilds_container == rebuilds_container
+                    && f.edits == proposal.edits
+            })
+        });
+        match same {
+            Some(i) => fixes[i].repairs.push(repair),
             None => {
-                by_edits.insert(key, fixes.len());
+                by_places.entry(places).or_default().push(fixes.len());
                 fixes.push(Fix {
                     repairs: vec![repair],
                     safety: fixer.safety,
@@ -99,6 +111,16 @@ pub fn plan(asset: &Asset, findings: &[Finding]) -> Vec<Fix> {
         }
     }
     separate(asset.root(), fixes)
+}
+
+/// The kind of an edit and the place it names, as a key.
+fn place_of(edit: &Edit) -> String {
+    match edit {
+        Edit::Set { pointer, .. } => format!("set {pointer}"),
+        Edit::Replace { pointer, .. } => format!("replace {pointer}"),
+        Edit::Remove { pointer } => format!("remove {pointer}"),
+        Edit::DeclareUsed { extension } => format!("declare {extension}"),
+    }
 }
 
 /// Where one edit acts: the value it targets, the value holding that one, and whether it
@@ -254,9 +276,13 @@ fn separate(root: Node, fixes: Vec<Fix>) -> Vec<Fix> {
 /// removed whole, unless another edit adds to it.
 pub fn combined(root: Node, fixes: &[&Fix]) -> Vec<Edit> {
     let mut edits: Vec<Edit> = Vec::new();
-    let mut seen: std::collections::HashSet<String> = std::collections::HashSet::new();
+    // The edits kept by the place they name; an edit at a place already named is compared
+    // with those before it there.
+    let mut at_place: HashMap<String, Vec<usize>> = HashMap::new();
     for edit in fixes.iter().flat_map(|f| &f.edits) {
-        if seen.insert(format!("{edit:?}")) {
+        let kept = at_place.entry(place_of(edit)).or_default();
+        if !kept.iter().any(|&k| edits[k] == *edit) {
+            kept.push(edits.len());
             edits.push(edit.clone());
         }
     }
