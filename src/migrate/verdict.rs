@@ -79,8 +79,14 @@ impl Verdict {
     pub fn new(furnace: f64, light: f64) -> Verdict {
         let round = |v: f64| (v * 1e4).round() / 1e4;
         let (furnace, light) = (round(furnace), round(light));
+        // The furnace decides; but "same to the eye" must hold under the light too: a material
+        // the light shows more than close apart is close at best.
+        let label = match Label::from_flip(furnace) {
+            Label::Same if light > CLOSE_FLIP => Label::Close,
+            label => label,
+        };
         Verdict {
-            label: Label::from_flip(furnace),
+            label,
             flip: furnace,
             furnace,
             light,
@@ -176,5 +182,11 @@ mod tests {
             v.describe(),
             "visible (ꟻLIP 0.307 in the furnace, 0.294 under the light)"
         );
+        // Same in the furnace but more than close under the light: close; the light never
+        // makes a verdict worse than close, and the ranking measure stays the furnace's.
+        assert_eq!(Verdict::new(0.08, 0.22).label, Label::Same);
+        let lit = Verdict::new(0.08, 0.284);
+        assert_eq!((lit.label, lit.flip), (Label::Close, 0.08));
+        assert_eq!(Verdict::new(0.15, 0.9).label, Label::Close);
     }
 }
