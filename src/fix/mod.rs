@@ -541,18 +541,23 @@ impl<'v> Fixing<'v> {
             .filter(|&i| fixes[i].deferred.is_none())
             .filter(|&i| !mode.changes() || mode.applies(fixes[i].safety))
             .collect();
-        let (accepted, mut refused, fixed) =
-            self.choose(path, &source, &before, &fixes, &wanted, &unlimited);
+        // The fixes' text edits (for the JSON and SARIF reports) do not depend on which are
+        // accepted: they are worked out on the other core while the fixes are tried.
+        let ((accepted, mut refused, fixed), edits) = rayon::join(
+            || self.choose(path, &source, &before, &fixes, &wanted, &unlimited),
+            || {
+                if mode.edits {
+                    all_text_edits(&source, &fixes)
+                } else {
+                    vec![Vec::new(); fixes.len()]
+                }
+            },
+        );
         for (i, fix) in fixes.iter().enumerate() {
             if let Some(reason) = &fix.deferred {
                 refused.push((i, reason.clone()));
             }
         }
-        let edits = if mode.edits {
-            all_text_edits(&source, &fixes)
-        } else {
-            vec![Vec::new(); fixes.len()]
-        };
         let changed = fixed
             .as_ref()
             .filter(|f| {
