@@ -335,16 +335,7 @@ fn write_rewritten(
     let fail = |e: edit::EditError| format!("{}: {e}", input.display());
     // The edits are applied where they lie in the plan (a large document's are not copied).
     let mut changed = false;
-    let groups = plan
-        .document
-        .materials
-        .iter()
-        .map(|m| m.edits.as_slice())
-        .chain([
-            plan.document.declarations.as_slice(),
-            plan.relocation.edits.as_slice(),
-        ]);
-    for edits in groups {
+    for edits in edit_groups(&plan.document, &plan.relocation.edits) {
         changed |= edit::apply(plan.asset.json_mut(), edits).map_err(fail)?;
     }
     if !changed && plan.in_place() {
@@ -564,16 +555,7 @@ pub fn dry_run_bake_edits(plan: &FilePlan, claims: &Claims) -> Result<Vec<edit::
     }
     let edited = || -> Result<serde_json::Value, String> {
         let mut before = plan.asset.root().to_value();
-        for edits in plan
-            .document
-            .materials
-            .iter()
-            .map(|m| m.edits.as_slice())
-            .chain([
-                plan.document.declarations.as_slice(),
-                plan.relocation.edits.as_slice(),
-            ])
-        {
+        for edits in edit_groups(&plan.document, &plan.relocation.edits) {
             edit::apply(&mut before, edits).map_err(fail)?;
         }
         Ok(before)
@@ -686,6 +668,19 @@ fn difference(
         }
         _ => out.push(edit::Edit::replace(pointer.to_string(), to.clone())),
     }
+}
+
+/// A file's plan's edits, group by group in the order they are applied: each material's, the
+/// extension declarations, the relocated URIs.
+fn edit_groups<'p>(
+    document: &'p DocumentPlan,
+    relocation: &'p [edit::Edit],
+) -> impl Iterator<Item = &'p [edit::Edit]> {
+    document
+        .materials
+        .iter()
+        .map(|m| m.edits.as_slice())
+        .chain([document.declarations.as_slice(), relocation])
 }
 
 /// The error of a bake that failed: the input, the slots and the image.
