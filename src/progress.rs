@@ -28,11 +28,15 @@ pub fn advance(n: usize) {
 /// nothing before the first stage.
 pub fn describe() -> String {
     let (what, total) = *STAGE.lock().unwrap_or_else(|e| e.into_inner());
-    let done = DONE.load(Ordering::Relaxed).min(total);
+    text(what, total, DONE.load(Ordering::Relaxed))
+}
+
+/// A stage's words: its name, and its count of `total` when it counts (`done` capped there).
+fn text(what: &str, total: usize, done: usize) -> String {
     match (what, total) {
         ("", _) => String::new(),
         (what, 0) => what.to_string(),
-        (what, total) => format!("{what} {done}/{total}"),
+        (what, total) => format!("{what} {}/{total}", done.min(total)),
     }
 }
 
@@ -40,14 +44,13 @@ pub fn describe() -> String {
 mod tests {
     use super::*;
 
+    // The stage itself is one process-wide value that every test validating a document
+    // changes: its words are tested apart from it.
     #[test]
     fn a_stage_is_described_with_its_count_capped_at_its_total() {
-        stage("checking rules", 3);
-        advance(2);
-        assert_eq!(describe(), "checking rules 2/3");
-        advance(5);
-        assert_eq!(describe(), "checking rules 3/3");
-        stage("trying fixes", 0);
-        assert_eq!(describe(), "trying fixes");
+        assert_eq!(text("checking rules", 3, 2), "checking rules 2/3");
+        assert_eq!(text("checking rules", 3, 7), "checking rules 3/3");
+        assert_eq!(text("trying fixes", 0, 4), "trying fixes");
+        assert_eq!(text("", 5, 1), "");
     }
 }

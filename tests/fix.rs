@@ -272,58 +272,10 @@ fn diff_prints_the_change_that_fix_writes_and_writes_nothing() {
     }
 }
 
-/// A replacement of bytes `start..end` by `text`, as a report gives it.
-#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord)]
-struct Replacement {
-    start: usize,
-    end: usize,
-    text: String,
-}
-
-impl Replacement {
-    /// One text edit of a JSON report's fix.
-    fn of_json_edit(edit: &Value) -> Replacement {
-        Replacement {
-            start: edit["location"]["offset"].as_u64().unwrap() as usize,
-            end: edit["endLocation"]["offset"].as_u64().unwrap() as usize,
-            text: edit["content"].as_str().unwrap().to_string(),
-        }
-    }
-}
-
-/// Every text edit of every fix in a JSON report.
-fn json_report_replacements(report: &Value) -> Vec<Replacement> {
-    report["issues"]["messages"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .flat_map(|m| m["fix"]["edits"].as_array().into_iter().flatten())
-        .map(Replacement::of_json_edit)
-        .collect()
-}
-
-/// `source` with `replacements` made in one pass, in order of place, as ruff's and eslint's
-/// consumers apply fixes: no two may overlap, nor insert at one place (their order would be
-/// a guess), and each is applied as given (an edit given twice is applied twice).
-fn apply_replacements(source: &[u8], mut replacements: Vec<Replacement>) -> Vec<u8> {
-    replacements.sort();
-    for pair in replacements.windows(2) {
-        let (a, b) = (&pair[0], &pair[1]);
-        assert!(
-            a.end <= b.start && !(a.start == a.end && a.start == b.start),
-            "overlapping edits: {a:?} and {b:?}"
-        );
-    }
-    let mut out = Vec::new();
-    let mut at = 0;
-    for r in replacements {
-        assert!(r.end >= r.start, "an edit ends before it starts: {r:?}");
-        out.extend_from_slice(&source[at..r.start]);
-        out.extend_from_slice(r.text.as_bytes());
-        at = r.end;
-    }
-    out.extend_from_slice(&source[at..]);
-    out
+/// `source` with `edits` made in one pass by the applier written apart from velvet
+/// (`support/one_pass.rs`), which refuses edits that overlap or insert at one place.
+fn apply_replacements(source: &[u8], edits: Vec<one_pass::Edit>) -> Vec<u8> {
+    one_pass::apply(source, edits).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// The byte offset of 1-based `line` and character `column` in `text`.
@@ -363,7 +315,7 @@ fn json_and_sarif_fixes_applied_apart_from_velvet_give_the_fixed_bytes() {
             }
             for edit in fix["edits"].as_array().unwrap() {
                 let (start, end) = (&edit["location"], &edit["endLocation"]);
-                let r = Replacement::of_json_edit(edit);
+                let r = one_pass::Edit::of_json_edit(edit);
                 // Rows and columns name the same places as the offsets.
                 let place = |l: &Value| {
                     offset_of(
@@ -431,7 +383,7 @@ fn json_and_sarif_fixes_applied_apart_from_velvet_give_the_fixed_bytes() {
                             "{}",
                             code.name
                         );
-                        replacements.push(Replacement {
+                        replacements.push(one_pass::Edit {
                             start,
                             end,
                             text: r["insertedContent"]["text"]
@@ -780,7 +732,7 @@ fn the_json_fixes_of_many_materials_applied_together_are_what_fix_writes() {
     let o = velvet_in(dir.path(), &["validate", "--format", "json", "m.gltf"]);
     let report: Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(report["fixes"]["fixable"], 41);
-    let replacements = json_report_replacements(&report);
+    let replacements = one_pass::json_edits(&report);
     let applied = apply_replacements(text.as_bytes(), replacements);
     let o = velvet_in(dir.path(), &["validate", "--fix", "m.gltf"]);
     assert_eq!(o.status.code(), Some(0), "{}", stdout(&o));
@@ -814,11 +766,11 @@ fn after_fix_the_fixes_left_are_given_against_the_text_written() {
     let written = std::fs::read(dir.path().join("m.gltf")).unwrap();
     let messages = report["issues"]["messages"].as_array().unwrap();
     assert_eq!(messages.len(), 1, "{messages:?}");
-    let replacements: Vec<Replacement> = messages[0]["fix"]["edits"]
+    let replacements: Vec<one_pass::Edit> = messages[0]["fix"]["edits"]
         .as_array()
         .unwrap()
         .iter()
-        .map(Replacement::of_json_edit)
+        .map(one_pass::Edit::of_json_edit)
         .collect();
     let applied = apply_replacements(&written, replacements);
     let o = velvet_in(
@@ -871,7 +823,7 @@ fn a_byte_order_mark_is_removed_by_its_fix_and_the_reports_edit_the_bytes_before
     );
     // The report's edits, the mark's and the declaration's (counted after the mark), give
     // the fixed file; so do the SARIF log's.
-    let replacements = json_report_replacements(&report);
+    let replacements = one_pass::json_edits(&report);
     assert_eq!(
         apply_replacements(&bytes, replacements),
         expected_fixed("UNDECLARED_EXTENSION")

@@ -23,18 +23,15 @@ impl Safety {
     }
 }
 
-/// One replacement in the JSON text as it was read: the bytes from `start` to `end` are
-/// replaced by `content` (an insertion when they are equal, a deletion when `content` is
-/// empty). Positions are 1-based lines and character columns, with byte offsets.
+/// One replacement in the file as it was read (of a .glb, in its JSON chunk): the bytes from
+/// `start` to `end` are replaced by `content` (an insertion when they are equal, a deletion
+/// when `content` is empty). Positions are 1-based lines and character columns of the JSON
+/// text, with byte offsets in the file (or chunk), a byte-order mark included.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct TextEdit {
     pub start: Position,
     pub end: Position,
     pub content: String,
-    /// The edit removes what precedes the JSON text in its file or chunk (a byte-order mark):
-    /// from the file's (or chunk's) first byte to the text's; `start` and `end` are the
-    /// text's first position.
-    pub lead: bool,
 }
 
 /// What became of a fix in this run.
@@ -97,9 +94,6 @@ pub struct FileFixes {
     pub diff: Option<String>,
     /// Why the fixed file could not be written, when it could not.
     pub write_error: Option<String>,
-    /// Where the JSON text starts in the text the edits are given against (the file of a
-    /// .gltf, the JSON chunk of a .glb): after a byte-order mark, and a .glb's header.
-    pub text_start: usize,
 }
 
 /// A finding's key: its code, pointer and message (findings of one code at one pointer differ

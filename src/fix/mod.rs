@@ -600,7 +600,6 @@ impl<'v> Fixing<'v> {
             .collect();
         let mut file_fixes = FileFixes::new(views);
         file_fixes.changed = changed;
-        file_fixes.text_start = edits_text_start(&source);
         let Some(fixed) = fixed.filter(|_| changed) else {
             let mut report = capped(before, settings);
             report.fixes = file_fixes;
@@ -676,10 +675,8 @@ impl<'v> Fixing<'v> {
             .cloned()
             .collect();
         all.extend(report.fixes.fixes().iter().cloned());
-        let text_start = report.fixes.text_start;
         report.fixes = FileFixes::new(all);
         report.fixes.changed = true;
-        report.fixes.text_start = text_start;
         report
     }
 
@@ -711,10 +708,12 @@ impl<'v> Fixing<'v> {
                 Err(Failed::Findings(offences)) => offences,
                 Err(Failed::Other(_)) => break,
             };
+            let blame = Blame::new(fixes, &trial);
             let mut laid: Vec<(usize, String)> = Vec::new();
+            let mut is_laid = vec![false; fixes.len()];
             for offence in &offences {
-                for i in culprits(offence, fixes, &trial) {
-                    if !laid.iter().any(|(j, _)| *j == i) {
+                for i in blame.culprits(offence) {
+                    if !std::mem::replace(&mut is_laid[i], true) {
                         laid.push((i, offence.reason()));
                     }
                 }
@@ -722,7 +721,7 @@ impl<'v> Fixing<'v> {
             if laid.is_empty() {
                 break;
             }
-            trial.retain(|i| !laid.iter().any(|(j, _)| j == i));
+            trial.retain(|&i| !is_laid[i]);
             refused.extend(laid);
         }
         let mut accepted = Vec::new();
@@ -949,35 +948,76 @@ fn verdict(before: &[Finding], after: &[Finding], fixes: &[&Fix]) -> Result<(), 
     }
 }
 
-/// Whether JSON pointer `a` names `b`, a value inside it, or one holding it.
-fn related(a: &str, b: &str) -> bool {
-    let (short, long) = if a.len() <= b.len() { (a, b) } else { (b, a) };
-    long.starts_with(short) && (long.len() == short.len() || long.as_bytes()[short.len()] == b'/')
+/// The fixes of a trial by what an offending finding can be laid to (see [`Blame::culprits`]),
+/// found once per trial: a document may have thousands of fixes and of offending findings.
+struct Blame<'f> {
+    /// By the finding each repairs (code and message).
+    repairing: HashMap<(&'f str, &'f str), Vec<usize>>,
+    /// By the pointer an edit targets.
+    at: HashMap<&'f str, Vec<usize>>,
+    /// By each pointer that holds a value an edit targets.
+    within: HashMap<&'f str, Vec<usize>>,
 }
 
-/// The fixes among `trial` (places in `fixes`) that `offence` is laid to: for a finding left,
-/// those meant to repair it; for a new one, those editing its value, a value in it or one
-/// holding it.
-fn culprits(offence: &Offence, fixes: &[Fix], trial: &[usize]) -> Vec<usize> {
-    trial
-        .iter()
-        .copied()
-        .filter(|&i| {
+impl<'f> Blame<'f> {
+    fn new(fixes: &'f [Fix], trial: &[usize]) -> Blame<'f> {
+        let mut blame = Blame {
+            repairing: HashMap::new(),
+            at: HashMap::new(),
+            within: HashMap::new(),
+        };
+        for &i in trial {
             let fix = &fixes[i];
-            if offence.left {
-                return fix
-                    .repairs
-                    .iter()
-                    .any(|r| r.code == offence.code && r.message == offence.message);
+            for r in &fix.repairs {
+                blame
+                    .repairing
+                    .entry((r.code, r.message.as_str()))
+                    .or_default()
+                    .push(i);
             }
-            fix.edits.iter().any(|e| match e {
-                Edit::Set { pointer, .. }
-                | Edit::Replace { pointer, .. }
-                | Edit::Remove { pointer } => related(pointer, &offence.pointer),
-                Edit::DeclareUsed { .. } => related("/extensionsUsed", &offence.pointer),
-            })
-        })
-        .collect()
+            for edit in &fix.edits {
+                let pointer = match edit {
+                    Edit::Set { pointer, .. }
+                    | Edit::Replace { pointer, .. }
+                    | Edit::Remove { pointer } => pointer.as_str(),
+                    Edit::DeclareUsed { .. } => "/extensionsUsed",
+                };
+                blame.at.entry(pointer).or_default().push(i);
+                let mut holder = fixers::parent(pointer);
+                while !holder.is_empty() {
+                    blame.within.entry(holder).or_default().push(i);
+                    holder = fixers::parent(holder);
+                }
+            }
+        }
+        blame
+    }
+
+    /// The fixes `offence` is laid to, each once: for a finding left, those meant to repair
+    /// it; for a new one, those editing its value, a value in it or one holding it.
+    fn culprits(&self, offence: &Offence) -> Vec<usize> {
+        let mut out: Vec<usize> = Vec::new();
+        if offence.left {
+            out.extend(
+                self.repairing
+                    .get(&(offence.code, offence.message.as_str()))
+                    .into_iter()
+                    .flatten(),
+            );
+        } else {
+            let pointer = offence.pointer.as_str();
+            out.extend(self.at.get(pointer).into_iter().flatten());
+            out.extend(self.within.get(pointer).into_iter().flatten());
+            let mut holder = pointer;
+            while !holder.is_empty() {
+                holder = fixers::parent(holder);
+                out.extend(self.at.get(holder).into_iter().flatten());
+            }
+        }
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
 }
 
 /// The edits of the JSON text each of `fixes` makes alone. Fixes that edit within one element
@@ -1047,7 +1087,7 @@ fn placed_together(
         return None;
     };
     let replacements = text::replacements(text, &spliced);
-    let text_edits = text::text_edits(text, &replacements);
+    let text_edits = text::text_edits(text, &replacements, edits_text_start(source));
     // The round's elements by where they start, with each one's place in the round.
     let mut by_start: Vec<(std::ops::Range<usize>, usize)> = round
         .iter()
@@ -1099,7 +1139,7 @@ fn element_of(root: Node, fix: &Fix) -> Option<(String, std::ops::Range<usize>)>
 /// before it, for the fix that removes one).
 fn fix_text_edits(source: &Asset, fix: &Fix) -> Vec<TextEdit> {
     if fix.drops_byte_order_mark {
-        let mut edits = vec![text::lead_removed()];
+        let mut edits = vec![text::lead_removed(edits_text_start(source))];
         if !fix.edits.is_empty() {
             edits.extend(fix_text_edits(
                 source,
@@ -1114,7 +1154,11 @@ fn fix_text_edits(source: &Asset, fix: &Fix) -> Vec<TextEdit> {
     let edits = combined(source.root(), &[fix]);
     let text = crate::edit::write::source(source);
     match crate::edit::splice::splice_edits(text, source.root(), &edits) {
-        Ok(Some((spliced, true))) => text::text_edits(text, &text::replacements(text, &spliced)),
+        Ok(Some((spliced, true))) => text::text_edits(
+            text,
+            &text::replacements(text, &spliced),
+            edits_text_start(source),
+        ),
         _ => Vec::new(),
     }
 }
@@ -1261,6 +1305,43 @@ mod tests {
             out[0].edits,
             [Edit::declare_used("A"), Edit::declare_used("B")]
         );
+    }
+
+    #[test]
+    fn an_offending_finding_is_laid_to_the_fixes_that_edit_its_value_or_were_to_repair_it() {
+        let mut a = fix(vec![Edit::set("/materials/0/a/b", serde_json::json!(1))]);
+        a.repairs.push(Repair {
+            code: "X",
+            pointer: "/materials/0".into(),
+            message: "m".into(),
+        });
+        let b = fix(vec![Edit::remove("/materials/1/x")]);
+        let c = fix(vec![Edit::declare_used("E")]);
+        let fixes = [a, b, c];
+        let blame = Blame::new(&fixes, &[0, 1, 2]);
+        let brought = |pointer: &str| Offence {
+            code: "Y",
+            message: String::new(),
+            pointer: pointer.into(),
+            left: false,
+        };
+        // The value itself, one holding it, one inside it; never a sibling.
+        assert_eq!(blame.culprits(&brought("/materials/0/a/b")), [0]);
+        assert_eq!(blame.culprits(&brought("/materials/0")), [0]);
+        assert_eq!(blame.culprits(&brought("/materials/0/a/b/c")), [0]);
+        assert_eq!(
+            blame.culprits(&brought("/materials/0/ab")),
+            Vec::<usize>::new()
+        );
+        assert_eq!(blame.culprits(&brought("/materials")), [0, 1]);
+        assert_eq!(blame.culprits(&brought("/extensionsUsed/0")), [2]);
+        let left = Offence {
+            code: "X",
+            message: "m".into(),
+            pointer: "/elsewhere".into(),
+            left: true,
+        };
+        assert_eq!(blame.culprits(&left), [0]);
     }
 
     #[test]

@@ -99,35 +99,39 @@ pub fn apply(source: &str, replacements: &[Replacement]) -> String {
     out
 }
 
-/// The replacements as the reports give them, placed at lines and columns of `source`.
-pub fn text_edits(source: &str, replacements: &[Replacement]) -> Vec<TextEdit> {
+/// The replacements as the reports give them, placed at lines and columns of `source`, their
+/// offsets counted from `text_start`, where the text starts in its file (or JSON chunk).
+pub fn text_edits(source: &str, replacements: &[Replacement], text_start: usize) -> Vec<TextEdit> {
     let offsets: Vec<usize> = replacements.iter().flat_map(|r| [r.start, r.end]).collect();
     let positions = positions_of(source, &offsets);
+    let shifted = |p: Position| Position {
+        offset: text_start + p.offset,
+        ..p
+    };
     replacements
         .iter()
         .zip(positions.chunks(2))
         .map(|(r, p)| TextEdit {
-            start: p[0],
-            end: p[1],
+            start: shifted(p[0]),
+            end: shifted(p[1]),
             content: r.text.clone(),
-            lead: false,
         })
         .collect()
 }
 
-/// The edit that removes a byte-order mark, which precedes the JSON text: the mark is the
-/// first character of the file's first line (U+FEFF), the text's first position ends it.
-pub fn lead_removed() -> TextEdit {
-    let at = |column| Position {
+/// The edit that removes what precedes the JSON text (a byte-order mark, `text_start` bytes):
+/// the mark is the first character of the file's first line (U+FEFF), the text's first
+/// position ends it.
+pub fn lead_removed(text_start: usize) -> TextEdit {
+    let at = |column, offset| Position {
         line: 1,
         column,
-        offset: 0,
+        offset,
     };
     TextEdit {
-        start: at(1),
-        end: at(2),
+        start: at(1, 0),
+        end: at(2, text_start),
         content: String::new(),
-        lead: true,
     }
 }
 

@@ -177,21 +177,12 @@ fn message_shape<'a>(
 }
 
 fn fix_shape<'a>(report: &FileReport, fix: &'a FixView) -> FixShape<'a> {
-    // Offsets in the file of a .gltf, in the JSON chunk of a .glb (after a byte-order mark);
-    // an edit of what precedes the text runs from the first byte to the text's.
+    // The edits' offsets are in the file of a .gltf and in the JSON chunk of a .glb.
     let glb = report.container == Some(crate::asset::Container::Glb);
-    let base = report.fixes.text_start;
     let at = |p: &crate::diagnostics::Position| LocationShape {
         row: p.line,
         column: p.column,
-        offset: base + p.offset,
-    };
-    let from = |e: &crate::diagnostics::fixes::TextEdit| {
-        let mut location = at(&e.start);
-        if e.lead {
-            location.offset = 0;
-        }
-        location
+        offset: p.offset,
     };
     FixShape {
         edits_with_message: None,
@@ -203,7 +194,7 @@ fn fix_shape<'a>(report: &FileReport, fix: &'a FixView) -> FixShape<'a> {
             .iter()
             .map(|e| EditShape {
                 content: &e.content,
-                location: from(e),
+                location: at(&e.start),
                 end_location: at(&e.end),
             })
             .collect(),
@@ -511,7 +502,6 @@ mod tests {
                 start: at(4),
                 end: at(4),
                 content: ",\n    \"X\"".into(),
-                lead: false,
             }],
             status: FixStatus::Available,
         }]);

@@ -362,7 +362,6 @@ fn result<'a>(
             .filter(|fix| !fix.edits.is_empty())
             .map(|fix| {
                 let glb = report.container == Some(Container::Glb);
-                let base = report.fixes.text_start;
                 vec![SarifFix {
                     description: Text { text: &fix.title },
                     properties: FixProperties {
@@ -391,14 +390,8 @@ fn result<'a>(
                                     start_column: e.start.column,
                                     end_line: e.end.line,
                                     end_column: e.end.column,
-                                    // An edit of what precedes the text (a byte-order
-                                    // mark) runs from the first byte to the text's.
-                                    byte_offset: if e.lead { 0 } else { base + e.start.offset },
-                                    byte_length: if e.lead {
-                                        base
-                                    } else {
-                                        e.end.offset - e.start.offset
-                                    },
+                                    byte_offset: e.start.offset,
+                                    byte_length: e.end.offset - e.start.offset,
                                 },
                                 inserted_content: (!e.content.is_empty())
                                     .then_some(Text { text: &e.content }),

@@ -46,23 +46,26 @@ fn velvet(dir: &Path, args: &[&str]) -> std::process::Output {
         .unwrap()
 }
 
+impl Edit {
+    /// One text edit of a JSON report's fix.
+    pub fn of_json_edit(e: &Value) -> Edit {
+        Edit {
+            start: e["location"]["offset"].as_u64().unwrap() as usize,
+            end: e["endLocation"]["offset"].as_u64().unwrap() as usize,
+            text: e["content"].as_str().unwrap().to_string(),
+        }
+    }
+}
+
 /// Every edit of every fix a JSON report gives with its messages.
 pub fn json_edits(report: &Value) -> Vec<Edit> {
-    let mut out = Vec::new();
-    for m in report["issues"]["messages"]
+    report["issues"]["messages"]
         .as_array()
         .into_iter()
         .flatten()
-    {
-        for e in m["fix"]["edits"].as_array().into_iter().flatten() {
-            out.push(Edit {
-                start: e["location"]["offset"].as_u64().unwrap() as usize,
-                end: e["endLocation"]["offset"].as_u64().unwrap() as usize,
-                text: e["content"].as_str().unwrap().to_string(),
-            });
-        }
-    }
-    out
+        .flat_map(|m| m["fix"]["edits"].as_array().into_iter().flatten())
+        .map(Edit::of_json_edit)
+        .collect()
 }
 
 /// Every replacement of every fix of a SARIF log's results.
