@@ -72,6 +72,35 @@ pub fn rounded(look: Look) -> Look {
     }
 }
 
+/// The pairs of looks as a key: every value's bits, each layer behind its kind. Two keys are
+/// equal exactly when the looks are (the values are rounded already, see [`rounded`]).
+fn key_of(pairs: &[(Look, Look)]) -> Vec<u64> {
+    use super::shade::Layer;
+    let mut key = Vec::with_capacity(pairs.len() * 2 * 10);
+    for look in pairs.iter().flat_map(|(a, b)| [a, b]) {
+        key.extend(look.base.map(f64::to_bits));
+        key.extend([look.base_metallic.to_bits(), look.base_roughness.to_bits()]);
+        match look.layer {
+            Layer::None => key.push(0),
+            Layer::Sheen { color, roughness } => {
+                key.push(1);
+                key.extend(color.map(f64::to_bits));
+                key.push(roughness.to_bits());
+            }
+            Layer::Fuzz {
+                color,
+                weight,
+                roughness,
+            } => {
+                key.push(2);
+                key.extend(color.map(f64::to_bits));
+                key.extend([weight.to_bits(), roughness.to_bits()]);
+            }
+        }
+    }
+    key
+}
+
 /// ꟻLIP's pixels per degree for the verdict's spheres: the default (a sheet's) scaled with the
 /// sphere, so that a small sphere subtends the angle a sheet's does and the metric's filters
 /// cover the same part of it.
@@ -121,20 +150,20 @@ pub fn measure_pairs(pairs: &[(Look, Look)]) -> Verdict {
 
 /// The verdict of each of `materials`, each distinct set of looks measured once (in parallel).
 pub fn measure_all(materials: &[Material]) -> Vec<Verdict> {
-    let keys: Vec<(String, Vec<(Look, Look)>)> = materials
+    let keys: Vec<(Vec<u64>, Vec<(Look, Look)>)> = materials
         .par_iter()
         .map(|m| {
             let pairs = pairs(m);
-            (format!("{pairs:?}"), pairs)
+            (key_of(&pairs), pairs)
         })
         .collect();
-    let mut first_of: HashMap<&str, usize> = HashMap::new();
+    let mut first_of: HashMap<&[u64], usize> = HashMap::new();
     let mut distinct: Vec<usize> = Vec::new();
     let slot: Vec<usize> = keys
         .iter()
         .enumerate()
         .map(|(i, (key, _))| {
-            *first_of.entry(key.as_str()).or_insert_with(|| {
+            *first_of.entry(key.as_slice()).or_insert_with(|| {
                 distinct.push(i);
                 distinct.len() - 1
             })
