@@ -85,9 +85,10 @@ impl FixView {
 pub struct FileFixes {
     /// The fixes; set with [`FileFixes::new`], which indexes them by the findings they repair.
     fixes: Vec<FixView>,
-    /// The fix of each finding (`code`, NUL, `pointer`): a report looks each finding up, and a
-    /// document may have a fix per material.
-    by_finding: std::collections::HashMap<String, usize>,
+    /// The fixes of each finding, by a hash of its key ([`finding_key`]): a report looks each
+    /// finding up, and a document may have a fix per material. The fixes under one hash are
+    /// told apart by their repairs.
+    by_finding: foldhash::HashMap<u64, Vec<usize>>,
     /// True when the fixes changed the file's bytes (written, or shown by `--diff`).
     pub changed: bool,
     /// With `--diff`: the change as a unified diff.
@@ -98,18 +99,22 @@ pub struct FileFixes {
 
 /// A finding's key: its code, pointer and message (findings of one code at one pointer differ
 /// by their message: a primitive's material may have several textures that read a missing set).
-fn finding_key(code: &str, pointer: &str, message: &str) -> String {
-    format!("{code}\0{pointer}\0{message}")
+fn finding_key(code: &str, pointer: &str, message: &str) -> u64 {
+    use std::hash::BuildHasher;
+    foldhash::fast::FixedState::with_seed(0).hash_one((code, pointer, message))
 }
 
 impl FileFixes {
     pub fn new(fixes: Vec<FixView>) -> FileFixes {
-        let mut by_finding = std::collections::HashMap::new();
+        let mut by_finding: foldhash::HashMap<u64, Vec<usize>> = Default::default();
         for (i, fix) in fixes.iter().enumerate() {
             for r in &fix.repairs {
-                by_finding
+                let at = by_finding
                     .entry(finding_key(r.code, &r.pointer, &r.message))
-                    .or_insert(i);
+                    .or_default();
+                if at.last() != Some(&i) {
+                    at.push(i);
+                }
             }
         }
         FileFixes {
@@ -158,9 +163,17 @@ impl FileFixes {
         if self.by_finding.is_empty() {
             return None;
         }
+        // The first fix that repairs it.
         self.by_finding
-            .get(&finding_key(d.code, &d.pointer, &d.message))
+            .get(&finding_key(d.code, &d.pointer, &d.message))?
+            .iter()
             .copied()
+            .find(|&i| {
+                self.fixes[i]
+                    .repairs
+                    .iter()
+                    .any(|r| r.code == d.code && r.pointer == d.pointer && r.message == d.message)
+            })
     }
 
     /// Findings repaired by applied fixes.

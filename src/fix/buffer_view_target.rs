@@ -4,8 +4,7 @@
 //! view also used the other way has BUFFER_VIEW_TARGET_OVERRIDE, and the check refuses a fix
 //! that would bring one).
 
-use super::fixers::{last_token, Fixer, Proposal};
-use crate::asset::Asset;
+use super::fixers::{last_token, Fixer, Planning, Proposal};
 use crate::diagnostics::{Diagnostic, Safety};
 use crate::edit::Edit;
 
@@ -17,7 +16,8 @@ pub const TARGET: Fixer = Fixer {
     code: &crate::rules::buffer_views::BUFFER_VIEW_TARGET_MISSING,
     safety: Safety::Safe,
     about: "sets the buffer view's target its first use implies (34962 for attributes, 34963 for indices)",
-    propose: |asset: &Asset, d: &Diagnostic| {
+    propose: |planning: &Planning, d: &Diagnostic| {
+        let asset = planning.asset;
         let root = asset.root();
         let accessor = root.pointer(&d.pointer)?.as_u64()?;
         let view = root

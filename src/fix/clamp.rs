@@ -5,8 +5,7 @@
 //! clamped (their factors); an index out of range names another object, and an exclusive bound
 //! has no nearest value, so neither is fixed.
 
-use super::fixers::{last_token, Fixer, Proposal};
-use crate::asset::Asset;
+use super::fixers::{last_token, Fixer, Planning, Proposal};
 use crate::diagnostics::{codes::VALUE_NOT_IN_RANGE, Diagnostic, Safety};
 use crate::edit::Edit;
 
@@ -30,7 +29,8 @@ pub const OUT_OF_RANGE: Fixer = Fixer {
     code: &VALUE_NOT_IN_RANGE,
     safety: Safety::Unsafe,
     about: "clamps a material's number into its range",
-    propose: |asset: &Asset, d: &Diagnostic| {
+    propose: |planning: &Planning, d: &Diagnostic| {
+        let asset = planning.asset;
         if !d.pointer.starts_with("/materials/") || last_token(&d.pointer)? == "index" {
             return None;
         }

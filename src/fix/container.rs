@@ -9,11 +9,12 @@
 //! unsafe for a header that declares more bytes than the file holds, since the file may have
 //! been cut at a chunk's end and the rebuilt header no longer says so.
 
-use super::fixers::{Fixer, Proposal};
-use crate::asset::{Asset, Container};
+use super::fixers::{Fixer, Planning, Proposal};
+use crate::asset::Container;
 use crate::diagnostics::{codes, Diagnostic, Safety};
 
-fn rebuild(asset: &Asset, _: &Diagnostic) -> Option<Proposal> {
+fn rebuild(planning: &Planning, _: &Diagnostic) -> Option<Proposal> {
+    let asset = planning.asset;
     (asset.container == Container::Glb).then(|| Proposal {
         title: "rebuild the GLB container (header length, chunk lengths and padding)".to_string(),
         edits: Vec::new(),

@@ -5,7 +5,7 @@
 //! read. A declaration that is also required is left alone (removing it would let loaders
 //! without the extension load the file, which they refuse today).
 
-use super::fixers::{last_token, string_at, Fixer, Proposal};
+use super::fixers::{last_token, string_at, Fixer, Planning, Proposal};
 use crate::asset::Asset;
 use crate::diagnostics::{Diagnostic, Safety};
 use crate::edit::Edit;
@@ -30,19 +30,27 @@ pub const UNDECLARED: Fixer = Fixer {
     code: &declaration::UNDECLARED_EXTENSION,
     safety: Safety::Safe,
     about: "adds the extension to extensionsUsed",
-    propose: |asset: &Asset, d: &Diagnostic| declare(asset, &last_token(&d.pointer)?),
+    propose: |planning: &Planning, d: &Diagnostic| {
+        declare(planning.asset, &last_token(&d.pointer)?)
+    },
 };
 
 pub const REQUIRED_NOT_USED: Fixer = Fixer {
     code: &declaration::UNUSED_EXTENSION_REQUIRED,
     safety: Safety::Safe,
     about: "adds the required extension to extensionsUsed",
-    propose: |asset: &Asset, d: &Diagnostic| declare(asset, &string_at(asset.root(), &d.pointer)?),
+    propose: |planning: &Planning, d: &Diagnostic| {
+        declare(
+            planning.asset,
+            &string_at(planning.asset.root(), &d.pointer)?,
+        )
+    },
 };
 
 /// Removes the unused declaration at `d.pointer` (`/extensionsUsed/K`), unless the extension
 /// is also required or used anywhere (the rule's own notion of used).
-fn remove_unused(asset: &Asset, d: &Diagnostic) -> Option<Proposal> {
+fn remove_unused(planning: &Planning, d: &Diagnostic) -> Option<Proposal> {
+    let asset = planning.asset;
     let root = asset.root();
     let name = string_at(root, &d.pointer)?;
     let required = crate::document::elements(root.get("extensionsRequired"))

@@ -7,6 +7,8 @@ use crate::asset::tape::Node;
 use crate::asset::Asset;
 use crate::diagnostics::{Code, Diagnostic, Safety};
 use crate::edit::Edit;
+use crate::migrate::plan::Primitives;
+use std::sync::OnceLock;
 
 /// What a fixer proposes: a title saying what it does, and the edits.
 #[derive(Debug, Clone, PartialEq)]
@@ -15,13 +17,36 @@ pub struct Proposal {
     pub edits: Vec<Edit>,
 }
 
+/// What fixers read while one document's fixes are planned: the document, and what the fixes
+/// of many findings would otherwise each work out again from the whole document (a document
+/// may have thousands of findings of one code). Each is worked out on first use, once per plan,
+/// whichever thread of the pool proposes first.
+pub struct Planning<'a> {
+    pub asset: &'a Asset,
+    /// The primitives that use each material (a draft sheen's upgrade is planned as migrate
+    /// plans it, which asks).
+    pub primitives: Primitives<'a>,
+    /// The document's prune: one proposal repairs every UNUSED_OBJECT finding.
+    pub(super) prune: OnceLock<Option<Proposal>>,
+}
+
+impl<'a> Planning<'a> {
+    pub fn new(asset: &'a Asset) -> Planning<'a> {
+        Planning {
+            asset,
+            primitives: Primitives::new(asset.root()),
+            prune: OnceLock::new(),
+        }
+    }
+}
+
 /// A fixer: the code it repairs, how safe its fix is, and the function that plans it.
 pub struct Fixer {
     pub code: &'static Code,
     pub safety: Safety,
     /// What its fix does, for the codes table and the docs.
     pub about: &'static str,
-    pub propose: fn(&Asset, &Diagnostic) -> Option<Proposal>,
+    pub propose: fn(&Planning, &Diagnostic) -> Option<Proposal>,
 }
 
 /// Every fixer, by code (each code once).

@@ -2,8 +2,7 @@
 //! gets the value velvet assumes (the draft's table, 0.5), so that every reader reads what
 //! velvet reads. Safe: velvet's own reading of the file, and its migration, do not change.
 
-use super::fixers::{Fixer, Proposal};
-use crate::asset::Asset;
+use super::fixers::{Fixer, Planning, Proposal};
 use crate::diagnostics::{Diagnostic, Safety};
 use crate::edit::Edit;
 use crate::layers;
@@ -13,7 +12,8 @@ pub const EXPLICIT_DEFAULT: Fixer = Fixer {
     code: &FUZZ_ROUGHNESS_DEFAULT_AMBIGUOUS,
     safety: Safety::Safe,
     about: "writes fuzzRoughnessFactor 0.5, the value velvet assumes",
-    propose: |asset: &Asset, d: &Diagnostic| {
+    propose: |planning: &Planning, d: &Diagnostic| {
+        let asset = planning.asset;
         let layer = asset.root().pointer(&d.pointer)?.as_object()?;
         if layer.get("fuzzRoughnessFactor").is_some() {
             return None;

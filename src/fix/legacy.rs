@@ -5,28 +5,23 @@
 //! the conversion to fuzz that a migration goes on to), and only where it needs no texture
 //! baked (a roughness read from a metallicRoughnessTexture is left to `velvet migrate`).
 
-use super::fixers::{Fixer, Proposal};
-use crate::asset::Asset;
+use super::fixers::{Fixer, Planning, Proposal};
 use crate::diagnostics::{Diagnostic, Safety};
 use crate::edit::Edit;
 use crate::layers;
-use crate::migrate::plan::{plan_material, Primitives};
+use crate::migrate::plan::plan_material;
 use crate::migrate::{Conversion, Options};
 use crate::rules::legacy_sheen::SHEEN_LEGACY_DRAFT;
 
-fn upgrade(asset: &Asset, d: &Diagnostic) -> Option<Proposal> {
+fn upgrade(planning: &Planning, d: &Diagnostic) -> Option<Proposal> {
+    let asset = planning.asset;
     let index = d
         .pointer
         .strip_prefix("/materials/")?
         .split('/')
         .next()
         .and_then(crate::asset::pointer::array_index)?;
-    let plan = plan_material(
-        asset,
-        index,
-        &Options::default(),
-        &Primitives::new(asset.root()),
-    )?;
+    let plan = plan_material(asset, index, &Options::default(), &planning.primitives)?;
     if !plan.conversions.contains(&Conversion::LegacyUpgrade) || !plan.bakes.is_empty() {
         return None;
     }

@@ -34,8 +34,11 @@ use crate::diagnostics::fixes::{FileFixes, FixStatus, FixView, Repair, TextEdit}
 use crate::diagnostics::{codes::IO_ERROR, Diagnostic, Safety, Settings};
 use crate::edit::Edit;
 use crate::validate::{FileReport, Finding, Validator};
+use fixers::{Fixer, Proposal};
 use rayon::prelude::*;
-use std::collections::HashMap;
+// foldhash's maps: a document's fixes are keyed by thousands of pointers, where std's SipHash
+// was a twentieth of a fix-heavy validation.
+use foldhash::{HashMap, HashMapExt, HashSet, HashSetExt};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
@@ -60,18 +63,27 @@ pub struct Fix {
 /// The fixes for `findings` of `asset`, in the order of the findings they first repair. Fixes
 /// that make the same edits are one fix repairing each of their findings.
 pub fn plan(asset: &Asset, findings: &[Finding]) -> Vec<Fix> {
+    let planning = fixers::Planning::new(asset);
+    // Each finding's fixer proposes on its own (side by side: a document may have a fix per
+    // material, and a draft sheen's upgrade plans the material as migrate does); the proposals
+    // are then merged in the findings' order.
+    let proposals: Vec<Option<(&Fixer, Proposal)>> = findings
+        .par_iter()
+        .with_min_len(PROPOSALS_PER_TASK)
+        .map(|finding| {
+            let fixer = fixers::fixer_for(finding.diagnostic.code)?;
+            Some((fixer, (fixer.propose)(&planning, &finding.diagnostic)?))
+        })
+        .collect();
     let mut fixes: Vec<Fix> = Vec::new();
-    // Each fix by the places its edits name (a document may have a fix per material); fixes
-    // that name the same places are compared whole.
-    let mut by_places: HashMap<String, Vec<usize>> = HashMap::new();
-    for finding in findings {
+    // Each fix by the places its edits name; fixes that name the same places are compared
+    // whole.
+    let mut by_places: HashMap<u64, Vec<usize>> = HashMap::new();
+    for (finding, proposed) in findings.iter().zip(proposals) {
+        let Some((fixer, proposal)) = proposed else {
+            continue;
+        };
         let d: &Diagnostic = &finding.diagnostic;
-        let Some(fixer) = fixers::fixer_for(d.code) else {
-            continue;
-        };
-        let Some(proposal) = (fixer.propose)(asset, d) else {
-            continue;
-        };
         let repair = Repair {
             code: fixer.code.name,
             pointer: d.pointer.clone(),
@@ -79,12 +91,7 @@ pub fn plan(asset: &Asset, findings: &[Finding]) -> Vec<Fix> {
         };
         let drops_byte_order_mark = fixer.code.name == crate::diagnostics::codes::BOM_PRESENT.name;
         let rebuilds_container = container::CODES.contains(&fixer.code.name);
-        let places = proposal
-            .edits
-            .iter()
-            .map(place_of)
-            .collect::<Vec<_>>()
-            .join("\0");
+        let places = places_key(&proposal.edits);
         let same = by_places.get(&places).and_then(|candidates| {
             candidates.iter().copied().find(|&i| {
                 let f = &fixes[i];
@@ -113,14 +120,26 @@ pub fn plan(asset: &Asset, findings: &[Finding]) -> Vec<Fix> {
     separate(asset.root(), fixes)
 }
 
-/// The kind of an edit and the place it names, as a key.
-fn place_of(edit: &Edit) -> String {
+/// How many findings' fixes one task of the thread pool proposes at least: a proposal takes a
+/// microsecond or two, a task's hand-over about as long.
+const PROPOSALS_PER_TASK: usize = 64;
+
+/// The kind of an edit and the place it names.
+fn place_of(edit: &Edit) -> (u8, &str) {
     match edit {
-        Edit::Set { pointer, .. } => format!("set {pointer}"),
-        Edit::Replace { pointer, .. } => format!("replace {pointer}"),
-        Edit::Remove { pointer } => format!("remove {pointer}"),
-        Edit::DeclareUsed { extension } => format!("declare {extension}"),
+        Edit::Set { pointer, .. } => (0, pointer),
+        Edit::Replace { pointer, .. } => (1, pointer),
+        Edit::Remove { pointer } => (2, pointer),
+        Edit::DeclareUsed { extension } => (3, extension),
     }
+}
+
+/// A key of the places `edits` name, in order: edits with equal keys are then compared whole,
+/// so two lists whose keys collide are still told apart.
+fn places_key(edits: &[Edit]) -> u64 {
+    use std::hash::BuildHasher;
+    foldhash::fast::FixedState::with_seed(0)
+        .hash_one(edits.iter().map(place_of).collect::<Vec<_>>())
 }
 
 /// Where one edit acts: the value it targets, the value holding that one, and whether it
@@ -278,7 +297,7 @@ pub fn combined(root: Node, fixes: &[&Fix]) -> Vec<Edit> {
     let mut edits: Vec<Edit> = Vec::new();
     // The edits kept by the place they name; an edit at a place already named is compared
     // with those before it there.
-    let mut at_place: HashMap<String, Vec<usize>> = HashMap::new();
+    let mut at_place: HashMap<(u8, &str), Vec<usize>> = HashMap::new();
     for edit in fixes.iter().flat_map(|f| &f.edits) {
         let kept = at_place.entry(place_of(edit)).or_default();
         if !kept.iter().any(|&k| edits[k] == *edit) {
@@ -600,11 +619,13 @@ impl<'v> Fixing<'v> {
             .collect();
         let mut file_fixes = FileFixes::new(views);
         file_fixes.changed = changed;
-        let Some(fixed) = fixed.filter(|_| changed) else {
+        let Some(mut fixed) = fixed.filter(|_| changed) else {
             let mut report = capped(before, settings);
             report.fixes = file_fixes;
             return report;
         };
+        self.validator
+            .place_findings(&fixed.asset, &mut fixed.report);
         if mode.diff {
             let name = crate::asset::discover::display_path(path);
             file_fixes.diff = Some(match source.container {
@@ -790,9 +811,10 @@ impl<'v> Fixing<'v> {
         let Some(after) = loaded.asset else {
             return Err(Failed::Other("the fixed file would not load".into()));
         };
-        let report = self
-            .validator
-            .validate_asset(path, &after, loaded.diagnostics, settings);
+        // Placed in the text (line and column) only if it becomes the file's report.
+        let report =
+            self.validator
+                .validate_asset_unplaced(path, &after, loaded.diagnostics, settings);
         verdict(&before.findings, &report.findings, fixes).map_err(Failed::Findings)?;
         Ok(Fixed {
             changed,
@@ -889,7 +911,7 @@ fn verdict(before: &[Finding], after: &[Finding], fixes: &[&Fix]) -> Result<(), 
             .entry((f.diagnostic.code, f.diagnostic.message.as_str()))
             .or_default() -= 1;
     }
-    let mut repaired: std::collections::HashSet<(&str, &str)> = std::collections::HashSet::new();
+    let mut repaired: HashSet<(&str, &str)> = HashSet::new();
     for r in fixes.iter().flat_map(|f| &f.repairs) {
         *excess.entry((r.code, r.message.as_str())).or_default() += 1;
         repaired.insert((r.code, r.message.as_str()));

@@ -5,7 +5,7 @@
 //! image or sampler that only removed textures refer to goes with them. Unsafe: an extension
 //! velvet does not know, or an application's `extras`, may name an element by its index.
 
-use super::fixers::{Fixer, Proposal};
+use super::fixers::{Fixer, Planning, Proposal};
 use crate::asset::tape::Node;
 use crate::asset::Asset;
 use crate::diagnostics::{Diagnostic, Safety};
@@ -62,7 +62,7 @@ fn removed(root: Node, sites: &[(String, &'static str, u64)]) -> Vec<Vec<bool>> 
     }
 }
 
-fn prune(asset: &Asset, d: &Diagnostic) -> Option<Proposal> {
+fn prune(planning: &Planning, d: &Diagnostic) -> Option<Proposal> {
     PRUNED
         .iter()
         .any(|a| {
@@ -71,6 +71,14 @@ fn prune(asset: &Asset, d: &Diagnostic) -> Option<Proposal> {
                 .is_some_and(|r| r.starts_with('/'))
         })
         .then_some(())?;
+    planning
+        .prune
+        .get_or_init(|| prune_document(planning.asset))
+        .clone()
+}
+
+/// The removals of every unused element of [`PRUNED`], and the renumbering they need.
+fn prune_document(asset: &Asset) -> Option<Proposal> {
     let root = asset.root();
     let sites = index_sites(root);
     let gone = removed(root, &sites);

@@ -4,8 +4,7 @@
 //! KHR_texture_transform overrides texCoord, the override is set. The fix is checked like every
 //! other: should another primitive of the material lack that set, it is refused.
 
-use super::fixers::{Fixer, Proposal};
-use crate::asset::Asset;
+use super::fixers::{Fixer, Planning, Proposal};
 use crate::diagnostics::{Diagnostic, Safety};
 use crate::edit::Edit;
 use crate::rules::texcoord::MESH_PRIMITIVE_TOO_FEW_TEXCOORDS;
@@ -18,7 +17,8 @@ fn texture_info(message: &str) -> Option<&str> {
     pointer.starts_with("/materials/").then_some(pointer)
 }
 
-fn retarget(asset: &Asset, d: &Diagnostic) -> Option<Proposal> {
+fn retarget(planning: &Planning, d: &Diagnostic) -> Option<Proposal> {
+    let asset = planning.asset;
     let root = asset.root();
     let info = texture_info(&d.message)?;
     root.pointer(info)?.as_object()?;

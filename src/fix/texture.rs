@@ -3,13 +3,13 @@
 //! textureInfo. Unsafe because it changes the asset's meaning: whoever turns the layer on later
 //! finds the texture gone (the texture and image objects stay in the document).
 
-use super::fixers::{last_token, Fixer, Proposal};
-use crate::asset::Asset;
+use super::fixers::{last_token, Fixer, Planning, Proposal};
 use crate::diagnostics::{Diagnostic, Safety};
 use crate::edit::Edit;
 use crate::rules::disabled_layer;
 
-fn drop_texture(asset: &Asset, d: &Diagnostic) -> Option<Proposal> {
+fn drop_texture(planning: &Planning, d: &Diagnostic) -> Option<Proposal> {
+    let asset = planning.asset;
     asset.root().pointer(&d.pointer)?.as_object()?;
     let slot = last_token(&d.pointer)?;
     Some(Proposal {

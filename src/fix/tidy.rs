@@ -11,8 +11,7 @@
 //!   others), and so does one the schema requires (the fixed file would lack it, an error, and
 //!   the check refuses the fix).
 
-use super::fixers::{last_token, parent, Fixer, Proposal};
-use crate::asset::Asset;
+use super::fixers::{last_token, parent, Fixer, Planning, Proposal};
 use crate::diagnostics::{Diagnostic, Safety};
 use crate::edit::Edit;
 
@@ -20,7 +19,8 @@ pub const ALPHA_CUTOFF_IGNORED: Fixer = Fixer {
     code: &crate::rules::materials::MATERIAL_ALPHA_CUTOFF_INVALID_MODE,
     safety: Safety::Safe,
     about: "removes the alphaCutoff that no alphaMode reads",
-    propose: |asset: &Asset, d: &Diagnostic| {
+    propose: |planning: &Planning, d: &Diagnostic| {
+        let asset = planning.asset;
         (last_token(&d.pointer)? == "alphaCutoff").then_some(())?;
         asset.root().pointer(&d.pointer)?.as_f64()?;
         Some(Proposal {
@@ -34,7 +34,8 @@ pub const DUPLICATE_DECLARATION: Fixer = Fixer {
     code: &crate::rules::core::DUPLICATE_ELEMENTS,
     safety: Safety::Safe,
     about: "removes the second of an element given twice in extensionsUsed, extensionsRequired, a scene's nodes or a node's children",
-    propose: |asset: &Asset, d: &Diagnostic| {
+    propose: |planning: &Planning, d: &Diagnostic| {
+        let asset = planning.asset;
         let list = parent(&d.pointer);
         let tokens: Vec<&str> = list.split('/').collect();
         let a_set = matches!(
@@ -63,7 +64,8 @@ pub const EMPTY: Fixer = Fixer {
     code: &crate::rules::core::EMPTY_ENTITY,
     safety: Safety::Safe,
     about: "removes an empty array or object held by a property",
-    propose: |asset: &Asset, d: &Diagnostic| {
+    propose: |planning: &Planning, d: &Diagnostic| {
+        let asset = planning.asset;
         let key = last_token(&d.pointer)?;
         if crate::asset::pointer::array_index(&key).is_some() {
             return None;
@@ -82,7 +84,8 @@ pub const DEFAULT_MATRIX: Fixer = Fixer {
     code: &crate::rules::nodes::NODE_MATRIX_DEFAULT,
     safety: Safety::Safe,
     about: "removes a node's identity matrix, the default",
-    propose: |asset: &Asset, d: &Diagnostic| {
+    propose: |planning: &Planning, d: &Diagnostic| {
+        let asset = planning.asset;
         (last_token(&d.pointer)? == "matrix").then_some(())?;
         asset.root().pointer(&d.pointer)?.as_array()?;
         Some(Proposal {

@@ -22,8 +22,8 @@ use crate::asset::json_text::push_quoted;
 use crate::diagnostics::fixes::{FileFixes, FixStatus, FixView};
 use crate::diagnostics::Safety;
 use crate::validate::{AssetInfo, FileReport};
+use foldhash::{HashMap, HashMapExt};
 use serde::Serialize;
-use std::collections::HashMap;
 
 #[derive(Serialize)]
 #[serde(rename_all = "camelCase")]

@@ -245,6 +245,17 @@ impl Validator {
         diagnostics: Vec<Diagnostic>,
         settings: &Settings,
     ) -> FileReport {
+        self.validate_asset_placed(path, asset, diagnostics, settings, true)
+    }
+
+    fn validate_asset_placed(
+        &self,
+        path: &Path,
+        asset: &asset::Asset,
+        diagnostics: Vec<Diagnostic>,
+        settings: &Settings,
+        placed: bool,
+    ) -> FileReport {
         let cx = Context::new(asset, self.schemas.get_or_init(Schemas::builtin))
             .reading_data(!settings.skip_data);
         // A large text, or (with the data checks) large buffers: a document whose weight is in
@@ -280,22 +291,44 @@ impl Validator {
             Some(info),
         );
         report.missing = missing;
-        if self.positions && !report.findings.is_empty() {
-            let positions = asset::position::locate(
-                &asset.json_text,
-                asset.root(),
-                report
-                    .findings
-                    .iter()
-                    .map(|f| f.diagnostic.pointer.as_str()),
-            );
-            for (f, position) in report.findings.iter_mut().zip(positions) {
-                if !f.diagnostic.pointer.is_empty() && f.position.is_none() {
-                    f.position = position;
-                }
-            }
+        if placed {
+            self.place_findings(asset, &mut report);
         }
         report
+    }
+
+    /// [`Validator::validate_asset`] without the findings' places in the text (line and
+    /// column), for a report that only decides something (a fixed text's, compared with the
+    /// file's); [`Validator::place_findings`] adds them if it is shown after all.
+    pub fn validate_asset_unplaced(
+        &self,
+        path: &Path,
+        asset: &asset::Asset,
+        diagnostics: Vec<Diagnostic>,
+        settings: &Settings,
+    ) -> FileReport {
+        self.validate_asset_placed(path, asset, diagnostics, settings, false)
+    }
+
+    /// Each finding's place in `asset`'s text (line and column), where the report shows them
+    /// and the finding has none yet.
+    pub fn place_findings(&self, asset: &asset::Asset, report: &mut FileReport) {
+        if !self.positions || report.findings.is_empty() {
+            return;
+        }
+        let positions = asset::position::locate(
+            &asset.json_text,
+            asset.root(),
+            report
+                .findings
+                .iter()
+                .map(|f| f.diagnostic.pointer.as_str()),
+        );
+        for (f, position) in report.findings.iter_mut().zip(positions) {
+            if !f.diagnostic.pointer.is_empty() && f.position.is_none() {
+                f.position = position;
+            }
+        }
     }
 
     /// The report of one file from its findings, in groups (the loader's, then each rule's):
