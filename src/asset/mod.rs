@@ -8,6 +8,7 @@
 
 pub mod discover;
 pub mod glb;
+pub mod image_features;
 pub mod json_text;
 mod key_table;
 pub mod limits;

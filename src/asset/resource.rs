@@ -8,6 +8,7 @@
 //! leaves the folder. Only regular files are read: a URI naming a device or a pipe (through a
 //! link) could otherwise stream without end.
 
+use super::image_features::{self, ImageFeatures};
 use crate::diagnostics::{codes, Diagnostic};
 use base64::Engine;
 use std::path::{Component, Path, PathBuf};
@@ -365,10 +366,13 @@ pub struct ImageHeader {
     pub has_alpha: Option<bool>,
     /// Bits per channel, where known.
     pub bits: Option<u8>,
+    /// What the header holds that glTF does not support (IMAGE_FEATURES_UNSUPPORTED).
+    pub features: ImageFeatures,
 }
 
 /// Reads the header of an image whose first bytes `reader` yields. Only the header is read
-/// from the reader (for PNG, up to the first image-data chunk).
+/// from the reader (for PNG, up to the first image-data chunk, walked twice: once for the
+/// chunks [`image_features::png`] reads, once by the decoder).
 pub fn read_header<R: std::io::BufRead + std::io::Seek>(
     mut reader: R,
     pointer: &str,
@@ -383,7 +387,8 @@ pub fn read_header<R: std::io::BufRead + std::io::Seek>(
             format!("{what}: {detail}"),
         )
     };
-    let mut magic = [0u8; 12];
+    // Every format's signature, and a WebP's first chunk header and VP8X flags.
+    let mut magic = [0u8; 21];
     let read = read_up_to(&mut reader, &mut magic).map_err(|e| unrecognized(e.to_string()))?;
     reader
         .seek(std::io::SeekFrom::Start(0))
@@ -395,6 +400,17 @@ pub fn read_header<R: std::io::BufRead + std::io::Seek>(
             format!("{what}: not a PNG, JPEG, WebP or KTX2 image"),
         )
     })?;
+    let features = match format {
+        ImageFormat::Png => {
+            let found = image_features::png(&mut reader);
+            reader
+                .seek(std::io::SeekFrom::Start(0))
+                .map_err(|e| unrecognized(e.to_string()))?;
+            found
+        }
+        ImageFormat::Webp => image_features::webp(&magic[..read]),
+        ImageFormat::Jpeg | ImageFormat::Ktx2 => ImageFeatures::default(),
+    };
     if format == ImageFormat::Ktx2 {
         let mut head = [0u8; 28];
         let n = read_up_to(&mut reader, &mut head).map_err(|e| unrecognized(e.to_string()))?;
@@ -414,6 +430,7 @@ pub fn read_header<R: std::io::BufRead + std::io::Seek>(
             channels: None,
             has_alpha: None,
             bits: None,
+            features,
         });
     }
     // A header cut short is IMAGE_UNEXPECTED_EOS, as the Khronos validator names it; any other
@@ -448,6 +465,7 @@ pub fn read_header<R: std::io::BufRead + std::io::Seek>(
         channels: Some(channels),
         has_alpha: Some(color.has_alpha()),
         bits: Some((color.bits_per_pixel() / u16::from(channels)) as u8),
+        features,
     })
 }
 

@@ -8,7 +8,8 @@
 //! leaves it too), and whether the file exists — a `stat`, not a read. A small file that is a
 //! Git LFS pointer (a clone without `git lfs pull`) is named as such. A buffer file shorter than
 //! its byteLength is found from its size. For every image the header is read (never the
-//! pixels): its format must match `mimeType`. Images stored in a bufferView are checked when
+//! pixels): its format must match `mimeType`, and what it holds that glTF does not support
+//! (colour information other than sRGB's, non-square pixels, animation) is named. Images stored in a bufferView are checked when
 //! the buffer is already in memory (the GLB BIN chunk or a `data:` URI); an external .bin is not
 //! opened for them.
 
@@ -47,6 +48,13 @@ pub const IMAGE_NPOT_DIMENSIONS: Code = Code::new(
     "IMAGE_NPOT_DIMENSIONS",
     Severity::Info,
     "An image's width or height is not a power of two; some loaders and texture formats need one.",
+);
+/// A warning, as the Khronos validator has it: loaders ignore what glTF does not support, so the
+/// image may look other than its author saw it.
+pub const IMAGE_FEATURES_UNSUPPORTED: Code = Code::new(
+    "IMAGE_FEATURES_UNSUPPORTED",
+    Severity::Warning,
+    "An image's header holds what glTF does not support: colour information other than sRGB's (an ICC profile, a gamma, primaries), non-square pixels, or animation.",
 );
 pub const DATA_URI_GLB: Code = Code::new(
     "DATA_URI_GLB",
@@ -96,6 +104,7 @@ impl Rule for Resources {
             &codes::BUFFER_BYTE_LENGTH_MISMATCH,
             &IMAGE_NON_ENABLED_MIME_TYPE,
             &IMAGE_NPOT_DIMENSIONS,
+            &IMAGE_FEATURES_UNSUPPORTED,
             &URI_GLB,
             &DATA_URI_GLB,
         ]
@@ -254,6 +263,16 @@ fn check_image(cx: &Context, index: usize, image: Node, out: &mut Vec<Diagnostic
                     format!(
                         "image {index} is {} × {}, not a power of two in each dimension",
                         header.width, header.height
+                    ),
+                ));
+            }
+            if header.features.any() {
+                out.push(Diagnostic::new(
+                    &IMAGE_FEATURES_UNSUPPORTED,
+                    format!("/images/{index}"),
+                    format!(
+                        "image {index} holds what glTF does not support: {}",
+                        header.features.describe().join(", ")
                     ),
                 ));
             }
