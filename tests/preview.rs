@@ -459,6 +459,23 @@ fn a_textured_layer_gives_three_swatches_and_a_missing_texture_leaves_the_factor
     assert_eq!(sheet.summary.columns[0], "authored: sheen r 0.500");
     // Two lights for each of the three swatches.
     assert!(sheet.height > 6 * sheet::CELL);
+
+    // The overview shows the sheet's comparison at full size: its two heading lines, then the
+    // mean swatch's furnace and light rows (the second of p5, mean and p95), byte for byte.
+    assert_eq!(sheet.swatches, 3);
+    let (strip, width, height) = sheet::comparison_strip(&sheet);
+    let row = 3 * sheet.width;
+    let headings = 2 * velvet::preview::font::LINE_HEIGHT;
+    assert_eq!((width, height), (sheet.width, headings + 2 * sheet::CELL));
+    assert_eq!(
+        strip[..row * headings],
+        sheet.rgb[row * sheet.headings_top..row * (sheet.headings_top + headings)]
+    );
+    let mean_rows = sheet.grid_top + 2 * sheet::CELL;
+    assert_eq!(
+        strip[row * headings..],
+        sheet.rgb[row * mean_rows..row * (mean_rows + 2 * sheet::CELL)]
+    );
 }
 
 fn library(dir: &Path) {

@@ -3,7 +3,9 @@
 //! and the bars coloured by verdict; under it a histogram of the same measure over every sheet
 //! of the run, drawn or not (what `--worst` ranks by, known before anything is drawn), the
 //! sheets drawn in colour and the others in grey; and beside them the sheets the plan's
-//! verdict ranks worst, scaled down, in the index's order. It is the one picture of a library: how many materials a migration
+//! verdict ranks worst, in the index's order, each as its comparison at full size (headings
+//! and the middle swatch's furnace and light rows, [`sheet::comparison_strip`]) under its
+//! verdict and title. It is the one picture of a library: how many materials a migration
 //! moves, and which most.
 
 use super::font::{self, LINE_HEIGHT};
@@ -11,8 +13,6 @@ use super::sheet::{self, Canvas, Label as Verdict, CLOSE_FLIP, SAME_FLIP};
 
 /// The sheets shown beside the histogram.
 pub const WORST_SHOWN: usize = 4;
-/// Each is shown at 1 / THUMB_SCALE of its size.
-pub const THUMB_SCALE: usize = 3;
 /// Histogram bins, each BIN wide, from 0; the last also holds everything above.
 const BINS: usize = 40;
 const BIN: f64 = 0.02;
@@ -22,11 +22,13 @@ const MARGIN: usize = 12;
 const TEXT: [u8; 3] = [235, 235, 235];
 const DIM: [u8; 3] = [150, 150, 150];
 
-/// One of the worst sheets: its ꟻLIP, its place in the plan, its title and its thumbnail.
+/// One of the worst sheets: its ꟻLIP, its place in the plan, its verdict and title, and its
+/// comparison strip.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Worst {
     pub flip: f64,
     pub sheet: usize,
+    pub verdict: crate::migrate::verdict::Verdict,
     pub title: String,
     pub rgb: Vec<u8>,
     pub width: usize,
@@ -53,10 +55,11 @@ impl WorstSheets {
         {
             return;
         }
-        let (rgb, width, height) = sheet::thumbnail(drawn, THUMB_SCALE);
+        let (rgb, width, height) = sheet::comparison_strip(drawn);
         worst.push(Worst {
             flip,
             sheet: sheet_index,
+            verdict: drawn.summary.verdict,
             title: drawn.summary.title.clone(),
             rgb,
             width,
@@ -134,7 +137,10 @@ pub fn png(flips: &[f64], metrics: &[(f64, bool)], worst: &[Worst]) -> Vec<u8> {
     let plot_w = BINS * BAR_W;
     let left = MARGIN + font::width("100000") + 8;
     let thumbs_w = worst.iter().map(|w| w.width).max().unwrap_or(0);
-    let thumbs_h: usize = worst.iter().map(|w| w.height + 2 * LINE_HEIGHT + 8).sum();
+    let thumbs_h: usize = worst
+        .iter()
+        .map(|w| w.height + (1 + title_lines(w, thumbs_w).len()) * LINE_HEIGHT + 2 * MARGIN)
+        .sum();
     let width = left + plot_w + 3 * MARGIN + thumbs_w + MARGIN;
     let plot_top = MARGIN + 4 * LINE_HEIGHT;
     let axis = plot_top + PLOT_H;
@@ -223,20 +229,40 @@ pub fn png(flips: &[f64], metrics: &[(f64, bool)], worst: &[Worst]) -> Vec<u8> {
     let x0 = left + plot_w + 3 * MARGIN;
     let mut y = MARGIN;
     for (k, w) in worst.iter().enumerate() {
-        let label = format!("{}. ꟻLIP {:.3}", k + 1, w.flip);
-        c.text(x0, y, &label, TEXT);
-        let title = font::wrap(&w.title, thumbs_w).remove(0);
-        c.text(x0, y + LINE_HEIGHT, &title, DIM);
-        y += 2 * LINE_HEIGHT + 4;
+        let label = format!(
+            "{}. {}: ꟻLIP {:.3} in the furnace, {:.3} under the light",
+            k + 1,
+            w.verdict.label.as_str(),
+            w.verdict.furnace,
+            w.verdict.light
+        );
+        c.text(x0, y, &label, colour(w.verdict.label));
+        y += LINE_HEIGHT;
+        for line in title_lines(w, thumbs_w) {
+            c.text(x0, y, &line, DIM);
+            y += LINE_HEIGHT;
+        }
+        y += MARGIN / 2;
         for row in 0..w.height {
             for col in 0..w.width {
                 let i = 3 * (row * w.width + col);
                 c.set(x0 + col, y + row, [w.rgb[i], w.rgb[i + 1], w.rgb[i + 2]]);
             }
         }
-        y += w.height + 4;
+        y += w.height + MARGIN + MARGIN / 2;
     }
     sheet::rgb_png(&c.rgb, c.width, c.height)
+}
+
+/// The lines of a worst sheet's title over a strip `width` wide: at most two, the second cut
+/// with "…" when the title goes on.
+fn title_lines(w: &Worst, width: usize) -> Vec<String> {
+    let mut lines = font::wrap(&w.title, width);
+    if lines.len() > 2 {
+        lines.truncate(2);
+        lines[1].push('…');
+    }
+    lines
 }
 
 /// A plot's two axes and its count labels (the tallest bar's count at the top, 0 at the foot).
@@ -285,6 +311,9 @@ mod tests {
             width: 6,
             height: 6,
             rgb: vec![128; 108],
+            headings_top: 0,
+            grid_top: 0,
+            swatches: 0,
             summary: sheet::Summary {
                 title: format!("flip {flip}"),
                 kind: "",

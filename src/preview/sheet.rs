@@ -179,6 +179,13 @@ pub struct Sheet {
     pub height: usize,
     pub rgb: Vec<u8>,
     pub summary: Summary,
+    /// Where the column headings start (two lines), on the sheet.
+    pub headings_top: usize,
+    /// Where the spheres' grid starts, on the sheet: per swatch a furnace row and a light row,
+    /// each [`CELL`] high.
+    pub grid_top: usize,
+    /// How many swatches the grid has rows for.
+    pub swatches: usize,
 }
 
 fn kind_text(kind: Kind) -> &'static str {
@@ -556,6 +563,9 @@ pub fn render(title: &str, material: &Material) -> Sheet {
         height,
         rgb: canvas.rgb,
         summary,
+        headings_top: header,
+        grid_top,
+        swatches: material.swatches.len(),
     }
 }
 
@@ -672,12 +682,19 @@ pub fn rgb_png(rgb: &[u8], width: usize, height: usize) -> Vec<u8> {
     out
 }
 
-/// `sheet` scaled down by `factor`, by `image`'s thumbnail filter (an area average).
-pub fn thumbnail(sheet: &Sheet, factor: usize) -> (Vec<u8>, usize, usize) {
-    let (w, h) = (sheet.width / factor, sheet.height / factor);
-    let image =
-        image::RgbImage::from_raw(sheet.width as u32, sheet.height as u32, sheet.rgb.clone())
-            .expect("a sheet holds width × height RGB pixels");
-    let small = image::imageops::thumbnail(&image, w as u32, h as u32);
-    (small.into_raw(), w, h)
+/// The part of `sheet` that shows its comparison at full size, for the overview: the column
+/// headings and the furnace and light rows of the middle swatch (the material's mean where its
+/// textures give p5, mean and p95; its factors where it has none), each with its row labels.
+/// Scaled down, a whole sheet's words and spheres were too small to read.
+pub fn comparison_strip(sheet: &Sheet) -> (Vec<u8>, usize, usize) {
+    let swatch = sheet.swatches.saturating_sub(1) / 2;
+    let rows_top = sheet.grid_top + 2 * CELL * swatch;
+    let row = 3 * sheet.width;
+    let mut rgb = Vec::with_capacity(row * (2 * LINE_HEIGHT + 2 * CELL));
+    for (top, height) in [(sheet.headings_top, 2 * LINE_HEIGHT), (rows_top, 2 * CELL)] {
+        let end = (top + height).min(sheet.height);
+        rgb.extend_from_slice(&sheet.rgb[row * top.min(end)..row * end]);
+    }
+    let height = rgb.len() / (3 * sheet.width);
+    (rgb, sheet.width, height)
 }
