@@ -446,6 +446,54 @@ fn check_bin_length(json: tape::Node, bin: Option<&[u8]>, out: &mut Vec<Diagnost
 }
 
 /// Checks that a buffer's data holds its declared byteLength.
+/// A buffer's bytes, for reading a part at a time: those already in memory (the GLB BIN
+/// chunk, a decoded `data:` URI), or its file, of which each part is read when it is asked
+/// for. The data rules read one accessor's bytes at a time, so that a document's buffers are
+/// never held whole: validating the 67 MB of the data library's buffer peaked at 80 MiB when
+/// it was read whole (docs/performance.md).
+pub enum BufferData<'a> {
+    Memory(Cow<'a, [u8]>),
+    /// The file (one reader at a time: a read is a seek and a read) and its length when it was
+    /// opened.
+    File {
+        file: std::sync::Mutex<std::fs::File>,
+        len: usize,
+    },
+}
+
+impl BufferData<'_> {
+    /// The buffer's length in bytes (a file's, when it was opened).
+    pub fn len(&self) -> usize {
+        match self {
+            BufferData::Memory(bytes) => bytes.len(),
+            BufferData::File { len, .. } => *len,
+        }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The bytes of `range`; `None` when the range goes past the buffer's end, or its file
+    /// no longer holds them (another program cut it short since it was opened).
+    pub fn read(&self, range: std::ops::Range<usize>) -> Option<Cow<'_, [u8]>> {
+        match self {
+            BufferData::Memory(bytes) => bytes.get(range).map(Cow::Borrowed),
+            BufferData::File { file, len } => {
+                if range.start > range.end || range.end > *len {
+                    return None;
+                }
+                use std::io::{Read, Seek, SeekFrom};
+                let mut bytes = vec![0u8; range.len()];
+                let mut file = file.lock().unwrap_or_else(|e| e.into_inner());
+                file.seek(SeekFrom::Start(range.start as u64)).ok()?;
+                file.read_exact(&mut bytes).ok()?;
+                Some(Cow::Owned(bytes))
+            }
+        }
+    }
+}
+
 fn check_buffer_length(
     buffer: tape::Node,
     index: usize,
@@ -587,6 +635,48 @@ impl Asset {
         }
     }
 
+    /// Buffer `index`, for reading a part at a time ([`BufferData`]); refused as
+    /// [`Asset::buffer_bytes`] refuses it (it does not exist, cannot be opened, or is shorter
+    /// than its byteLength).
+    pub fn buffer_data(&self, index: usize) -> Result<BufferData<'_>, Diagnostic> {
+        let pointer = format!("/buffers/{index}");
+        let buffer = self.root().pointer(&pointer).ok_or_else(|| {
+            Diagnostic::new(
+                &codes::UNRESOLVED_REFERENCE,
+                &pointer,
+                format!("buffer {index} does not exist"),
+            )
+        })?;
+        let uri_pointer = format!("{pointer}/uri");
+        match buffer.get("uri").and_then(|u| u.as_str()) {
+            Some(uri) => match self.resolve(&uri, &uri_pointer)? {
+                Location::File(path) => {
+                    let file = resource::open_file(&path, &uri, &uri_pointer)?;
+                    let len = file
+                        .metadata()
+                        .map(|m| usize::try_from(m.len()).unwrap_or(usize::MAX))
+                        .map_err(|e| {
+                            Diagnostic::new(
+                                &codes::IO_ERROR,
+                                &uri_pointer,
+                                format!("cannot read '{uri}' ({}): {e}", path.display()),
+                            )
+                        })?;
+                    check_buffer_length(buffer, index, len, &pointer)?;
+                    Ok(BufferData::File {
+                        file: std::sync::Mutex::new(file),
+                        len,
+                    })
+                }
+                Location::Data { bytes, .. } => {
+                    check_buffer_length(buffer, index, bytes.len(), &pointer)?;
+                    Ok(BufferData::Memory(Cow::Owned(bytes)))
+                }
+            },
+            None => self.buffer_bytes(index).map(BufferData::Memory),
+        }
+    }
+
     /// The encoded bytes of image `index`, from its URI or its bufferView.
     pub fn image_bytes(&self, index: usize) -> Result<Cow<'_, [u8]>, Diagnostic> {
         let pointer = format!("/images/{index}");
@@ -636,22 +726,42 @@ impl Asset {
             .unwrap_or(u64::MAX) as usize;
         let offset = view.get("byteOffset").and_then(|v| v.as_u64()).unwrap_or(0) as usize;
         let length = view.get("byteLength").and_then(|v| v.as_u64()).unwrap_or(0) as usize;
-        let bytes = self.buffer_bytes(buffer)?;
-        let end = offset.checked_add(length).filter(|end| *end <= bytes.len()).ok_or_else(|| {
+        let data = self.buffer_data(buffer)?;
+        let out_of_range = || {
             Diagnostic::new(
                 &codes::BUFFER_VIEW_OUT_OF_RANGE,
                 pointer,
                 format!(
                     "bufferView {view_index} spans bytes {offset}..{} of buffer {buffer}, which has {}",
                     offset.saturating_add(length),
-                    bytes.len()
+                    data.len()
                 ),
             )
-        })?;
-        Ok(match bytes {
-            Cow::Borrowed(b) => Cow::Borrowed(&b[offset..end]),
-            Cow::Owned(b) => Cow::Owned(b[offset..end].to_vec()),
-        })
+        };
+        let end = offset
+            .checked_add(length)
+            .filter(|end| *end <= data.len())
+            .ok_or_else(out_of_range)?;
+        match data {
+            BufferData::Memory(Cow::Borrowed(bin)) => Ok(Cow::Borrowed(&bin[offset..end])),
+            BufferData::Memory(Cow::Owned(mut bytes)) => {
+                bytes.truncate(end);
+                bytes.drain(..offset);
+                Ok(Cow::Owned(bytes))
+            }
+            file @ BufferData::File { .. } => file
+                .read(offset..end)
+                .map(|bytes| Cow::Owned(bytes.into_owned()))
+                .ok_or_else(|| {
+                    Diagnostic::new(
+                        &codes::IO_ERROR,
+                        pointer,
+                        format!(
+                            "bufferView {view_index}: the file of buffer {buffer} no longer holds bytes {offset}..{end}"
+                        ),
+                    )
+                }),
+        }
     }
 
     /// Where a resource URI leads under this asset's URI policy.

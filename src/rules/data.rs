@@ -1,7 +1,9 @@
 //! Accessor data, read for the rules that judge values rather than JSON (the Khronos
-//! glTF-Validator's DataError codes): each buffer is read once per document, on the first rule
-//! that asks for it ([`Buffers`]), and an accessor's elements are decoded from it where they lie,
-//! without a copy ([`Elements`]).
+//! glTF-Validator's DataError codes): each buffer is opened once per document, on the first
+//! rule that asks for it ([`Buffers`]), and each accessor's bytes are read from it when a rule
+//! asks for its elements ([`Elements`]): a buffer's file is never held whole, so that a
+//! document's memory is its text and the accessors being checked, whatever its buffers weigh.
+//! Bytes already in memory (a .glb's BIN chunk, a `data:` URI) are read where they lie.
 //!
 //! An accessor is decoded only when everything it names holds together: a valid component
 //! type and type, a buffer view inside its buffer, the elements inside the view, sparse indices
@@ -15,12 +17,13 @@
 use super::accessors::{component_size, components, element_layout};
 use super::{elements, Context};
 use crate::asset::tape::Node;
+use crate::asset::BufferData;
 use std::borrow::Cow;
 use std::sync::OnceLock;
 
-/// The document's buffers, each read on first use and kept for the other rules.
+/// The document's buffers, each opened on first use and kept for the other rules.
 pub struct Buffers<'a> {
-    slots: Vec<OnceLock<Option<Cow<'a, [u8]>>>>,
+    slots: Vec<OnceLock<Option<BufferData<'a>>>>,
 }
 
 impl<'a> Buffers<'a> {
@@ -30,13 +33,13 @@ impl<'a> Buffers<'a> {
         }
     }
 
-    /// Buffer `index`'s bytes; `None` when it cannot be read or is shorter than its
-    /// byteLength (the resource rules' findings).
-    pub fn get(&self, asset: &'a crate::asset::Asset, index: usize) -> Option<&[u8]> {
+    /// Buffer `index`; `None` when it cannot be read or is shorter than its byteLength (the
+    /// resource rules' findings).
+    pub fn get(&self, asset: &'a crate::asset::Asset, index: usize) -> Option<&BufferData<'a>> {
         self.slots
             .get(index)?
-            .get_or_init(|| asset.buffer_bytes(index).ok())
-            .as_deref()
+            .get_or_init(|| asset.buffer_data(index).ok())
+            .as_ref()
     }
 }
 
@@ -53,8 +56,8 @@ pub const MAX_COMPONENTS: usize = 16;
 
 /// Where an accessor's stored elements lie.
 struct Strided<'a> {
-    /// From the first element's first byte to the end of the buffer view.
-    bytes: &'a [u8],
+    /// From the first element's first byte to the last element's last.
+    bytes: Cow<'a, [u8]>,
     stride: usize,
     /// For matrices whose columns are padded to 4 bytes: (rows, bytes from column to column).
     columns: Option<(usize, usize)>,
@@ -64,7 +67,7 @@ struct Strided<'a> {
 /// element index.
 struct Sparse<'a> {
     substitutions: Vec<(usize, usize)>,
-    values: &'a [u8],
+    values: Cow<'a, [u8]>,
 }
 
 /// An accessor's elements, ready to be read.
@@ -84,10 +87,15 @@ pub fn index_of(node: Option<Node>) -> Option<usize> {
     usize::try_from(node?.as_u64()?).ok()
 }
 
-/// A buffer view's bytes, when the view lies inside its buffer and holds them: a view that a
-/// meshopt extension decompresses into holds them only once decoded (its buffer is a
-/// fallback, often zeros or absent), so its data is not judged.
-fn view_bytes<'c>(cx: &'c Context, view: usize) -> Option<&'c [u8]> {
+/// `length` bytes from `offset` in buffer view `view`, when the view lies inside its buffer
+/// and holds them: a view that a meshopt extension decompresses into holds them only once
+/// decoded (its buffer is a fallback, often zeros or absent), so its data is not judged.
+fn view_part<'c>(
+    cx: &'c Context,
+    view: usize,
+    offset: usize,
+    length: usize,
+) -> Option<Cow<'c, [u8]>> {
     let json = cx.json();
     let view = json.get("bufferViews")?.get(view)?;
     if let Some(extensions) = view.get("extensions") {
@@ -99,10 +107,17 @@ fn view_bytes<'c>(cx: &'c Context, view: usize) -> Option<&'c [u8]> {
         }
     }
     let buffer = index_of(view.get("buffer"))?;
-    let offset = byte_offset(view)?;
-    let length = index_of(view.get("byteLength"))?;
-    let bytes = cx.buffer(buffer)?;
-    bytes.get(offset..offset.checked_add(length)?)
+    let view_offset = byte_offset(view)?;
+    let view_length = index_of(view.get("byteLength"))?;
+    let data = cx.buffer(buffer)?;
+    let view_end = view_offset.checked_add(view_length)?;
+    if view_end > data.len() {
+        return None;
+    }
+    let end = offset
+        .checked_add(length)
+        .filter(|end| *end <= view_length)?;
+    data.read(view_offset + offset..view_offset + end)
 }
 
 impl<'a> Elements<'a> {
@@ -119,7 +134,6 @@ impl<'a> Elements<'a> {
             None => None,
             Some(view) => {
                 let view = index_of(Some(view))?;
-                let bytes = view_bytes(cx, view)?;
                 let offset = byte_offset(accessor)?;
                 let (element, packed) = element_layout(size as u64, &kind)?;
                 let (element, packed) = (
@@ -136,7 +150,7 @@ impl<'a> Elements<'a> {
                     Some(s) => index_of(Some(s)).filter(|s| *s >= element)?,
                 };
                 let needed = stride.checked_mul(count - 1)?.checked_add(element)?;
-                let bytes = bytes.get(offset..)?.get(..needed)?;
+                let bytes = view_part(cx, view, offset, needed)?;
                 let columns = (element != size * components).then(|| {
                     let rows = match components {
                         4 => 2,
@@ -178,7 +192,7 @@ impl<'a> Elements<'a> {
         let index_bytes = sparse_part(cx, indices, n.checked_mul(index_size)?)?;
         let values = sparse_part(cx, sparse.get("values")?, n.checked_mul(element)?)?;
         let mut substitutions = Vec::with_capacity(n);
-        for (k, index) in read_indices(index_bytes, index_size).enumerate() {
+        for (k, index) in read_indices(&index_bytes, index_size).enumerate() {
             let index = usize::try_from(index).ok().filter(|i| *i < count)?;
             substitutions.push((index, k * element));
         }
@@ -328,7 +342,7 @@ pub fn sparse_indices(cx: &Context, index: usize) -> Option<(Vec<u64>, u64)> {
     let indices = sparse.get("indices")?;
     let size = index_size(indices)?;
     let bytes = sparse_part(cx, indices, n.checked_mul(size)?)?;
-    Some((read_indices(bytes, size).collect(), count))
+    Some((read_indices(&bytes, size).collect(), count))
 }
 
 /// The `byteOffset` of a view, an accessor or a sparse part: 0 when absent, `None` when it is
@@ -350,10 +364,13 @@ fn index_size(indices: Node) -> Option<usize> {
 }
 
 /// The `length` bytes a sparse part (`indices` or `values`) names in its view.
-fn sparse_part<'c>(cx: &'c Context, holder: Node, length: usize) -> Option<&'c [u8]> {
-    let bytes = view_bytes(cx, index_of(holder.get("bufferView"))?)?;
-    let offset = byte_offset(holder)?;
-    bytes.get(offset..offset.checked_add(length)?)
+fn sparse_part<'c>(cx: &'c Context, holder: Node, length: usize) -> Option<Cow<'c, [u8]>> {
+    view_part(
+        cx,
+        index_of(holder.get("bufferView"))?,
+        byte_offset(holder)?,
+        length,
+    )
 }
 
 /// The number of accessors of the document.
@@ -369,16 +386,30 @@ mod tests {
 
     fn decoded(accessors: &str, views: &str, bytes: &[u8]) -> Vec<Vec<Vec<f64>>> {
         let data = base64::engine::general_purpose::STANDARD.encode(bytes);
-        let text = format!(
-            r#"{{"asset":{{"version":"2.0"}},"buffers":[{{"byteLength":{},"uri":"data:application/octet-stream;base64,{data}"}}],
-            "bufferViews":{views},"accessors":{accessors}}}"#,
-            bytes.len()
-        );
-        let loaded = load_bytes_with(
+        let uri = format!("data:application/octet-stream;base64,{data}");
+        decoded_from(
+            accessors,
+            views,
+            &uri,
+            bytes.len(),
             std::path::Path::new("t.gltf"),
-            text.as_bytes(),
-            &LoadOptions::default(),
+        )
+    }
+
+    /// The elements of every accessor of a document whose one buffer (`byte_length` long) is
+    /// at `uri`, the document read as the file `path`.
+    fn decoded_from(
+        accessors: &str,
+        views: &str,
+        uri: &str,
+        byte_length: usize,
+        path: &std::path::Path,
+    ) -> Vec<Vec<Vec<f64>>> {
+        let text = format!(
+            r#"{{"asset":{{"version":"2.0"}},"buffers":[{{"byteLength":{byte_length},"uri":"{uri}"}}],
+            "bufferViews":{views},"accessors":{accessors}}}"#
         );
+        let loaded = load_bytes_with(path, text.as_bytes(), &LoadOptions::default());
         let asset = loaded.asset.expect("the document parses");
         let schemas = super::super::schema::Schemas::builtin();
         let cx = Context::new(&asset, &schemas);
@@ -429,5 +460,51 @@ mod tests {
             &bytes,
         );
         assert!(found[0].is_empty());
+    }
+
+    #[test]
+    fn a_buffer_file_is_read_an_accessor_at_a_time_as_a_data_uri_is_read_whole() {
+        let mut bytes = Vec::new();
+        for v in [1.0f32, 2.0, 3.0, 4.0, 5.0, 6.0] {
+            bytes.extend_from_slice(&v.to_le_bytes());
+        }
+        let views = r#"[{"buffer":0,"byteLength":24},{"buffer":0,"byteOffset":8,"byteLength":16}]"#;
+        let accessors = r#"[
+            {"bufferView":0,"componentType":5126,"count":3,"type":"VEC2"},
+            {"bufferView":1,"byteOffset":4,"componentType":5126,"count":3,"type":"SCALAR"},
+            {"bufferView":1,"byteOffset":8,"componentType":5126,"count":3,"type":"SCALAR"}]"#;
+        let dir = tempfile::tempdir().expect("a temporary folder");
+        std::fs::write(dir.path().join("t.bin"), &bytes).expect("the buffer is written");
+        let path = dir.path().join("t.gltf");
+        let from_file = decoded_from(accessors, views, "t.bin", bytes.len(), &path);
+        assert_eq!(from_file, decoded(accessors, views, &bytes));
+        assert_eq!(
+            from_file[0],
+            [vec![1.0, 2.0], vec![3.0, 4.0], vec![5.0, 6.0]]
+        );
+        assert_eq!(from_file[1], [vec![4.0], vec![5.0], vec![6.0]]);
+        // Three floats from byte 8 of a 16-byte view run past it: not read.
+        assert!(from_file[2].is_empty());
+        // A file shorter than the buffer's byteLength is not read at all (BUFFER_BYTE_LENGTH_MISMATCH
+        // is the resource rules' finding).
+        std::fs::write(dir.path().join("t.bin"), &bytes[..20]).expect("the buffer is cut");
+        let cut = decoded_from(accessors, views, "t.bin", bytes.len(), &path);
+        assert!(cut.iter().all(|elements| elements.is_empty()));
+    }
+
+    #[test]
+    fn a_file_cut_short_after_it_was_opened_gives_no_bytes_past_its_new_end() {
+        let dir = tempfile::tempdir().expect("a temporary folder");
+        let path = dir.path().join("b.bin");
+        std::fs::write(&path, [7u8; 64]).expect("the buffer is written");
+        let data = BufferData::File {
+            file: std::sync::Mutex::new(std::fs::File::open(&path).expect("opened")),
+            len: 64,
+        };
+        assert_eq!(data.read(60..64).as_deref(), Some(&[7u8; 4][..]));
+        assert_eq!(data.read(60..65), None);
+        std::fs::write(&path, [7u8; 32]).expect("the buffer is cut");
+        assert_eq!(data.read(0..32).as_deref(), Some(&[7u8; 32][..]));
+        assert_eq!(data.read(30..40), None);
     }
 }

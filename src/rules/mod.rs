@@ -87,9 +87,9 @@ impl<'a> Context<'a> {
         self.read_data
     }
 
-    /// Buffer `index`'s bytes, read on first use and kept for every rule that reads data;
-    /// `None` when it cannot be read whole (the resource rules report why).
-    pub fn buffer(&self, index: usize) -> Option<&[u8]> {
+    /// Buffer `index`, opened on first use and kept for every rule that reads data (each reads
+    /// the parts it needs); `None` when it cannot be read (the resource rules report why).
+    pub fn buffer(&self, index: usize) -> Option<&crate::asset::BufferData<'a>> {
         self.buffers
             .get_or_init(|| data::Buffers::new(elements(self.json().get("buffers")).count()))
             .get(self.asset, index)
