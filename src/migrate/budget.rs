@@ -342,7 +342,7 @@ pub fn plan(asset: &Asset, materials: &mut [MaterialPlan], budget: Budget) {
                 .map(|(_, image)| codes_of(asset, *image, *channel))
                 .collect::<Result<_, _>>()
                 .ok()?;
-            Some(choose(slots, &sources, curve, budget))
+            choose(slots, &sources, curve, budget)
         })
         .collect();
     for (slots, choices) in groups.iter().zip(planned) {
@@ -382,13 +382,18 @@ fn codes_of(asset: &Asset, image: usize, channel: Channel) -> Result<Codes, Stri
     Ok(Codes::of(&pixels, channel))
 }
 
-/// The choice for each slot of one (texture, channel, mapping) group, in the slots' order.
-fn choose(slots: &[Slot], sources: &[Codes], curve: &Curve, budget: Budget) -> Vec<Choice> {
+/// The choice for each slot of one (texture, channel, mapping) group, in the slots' order;
+/// `None` once the run is asked to stop (the fitting of a library's groups takes most of a
+/// second, and what it would choose is thrown away: nothing is written after a stop).
+fn choose(slots: &[Slot], sources: &[Codes], curve: &Curve, budget: Budget) -> Option<Vec<Choice>> {
+    let stopped = crate::asset::limits::stop_requested;
     let Budget::Within(limit) = budget else {
-        return slots
-            .iter()
-            .map(|s| exact(sources, curve, s.factor))
-            .collect();
+        return Some(
+            slots
+                .iter()
+                .map(|s| exact(sources, curve, s.factor))
+                .collect(),
+        );
     };
     let mut out: Vec<Option<Choice>> = vec![None; slots.len()];
     // Shared: one texture for every factor, its curve fitted jointly to them (one source
@@ -402,6 +407,9 @@ fn choose(slots: &[Slot], sources: &[Codes], curve: &Curve, budget: Budget) -> V
     };
     let mut pending = Vec::new();
     for (i, slot) in slots.iter().enumerate() {
+        if stopped() {
+            return None;
+        }
         let pairs = over_sources(sources, &shared, curve, 1.0, slot.factor);
         let (written, error) = best_factor(&pairs);
         if error <= limit {
@@ -425,6 +433,9 @@ fn choose(slots: &[Slot], sources: &[Codes], curve: &Curve, budget: Budget) -> V
             .then(slots[a].material.cmp(&slots[b].material))
     });
     let group = |run: &[usize]| -> Option<Vec<Choice>> {
+        if stopped() {
+            return None;
+        }
         let mut factors: Vec<f64> = run.iter().map(|&i| slots[i].factor).collect();
         factors.dedup();
         let (texture, baked) = match sources {
@@ -447,6 +458,9 @@ fn choose(slots: &[Slot], sources: &[Codes], curve: &Curve, budget: Budget) -> V
     };
     let mut k = 0;
     while k < pending.len() {
+        if stopped() {
+            return None;
+        }
         let rest = &pending[k..];
         let (mut good, mut good_choices) = (1, None);
         let mut bad = None;
@@ -498,9 +512,11 @@ fn choose(slots: &[Slot], sources: &[Codes], curve: &Curve, budget: Budget) -> V
             }
         }
     }
-    out.into_iter()
-        .map(|c| c.expect("every slot gets a choice"))
-        .collect()
+    Some(
+        out.into_iter()
+            .map(|c| c.expect("every slot gets a choice"))
+            .collect(),
+    )
 }
 
 #[cfg(test)]
@@ -548,7 +564,8 @@ mod tests {
     fn nearby_factors_share_one_fitted_texture_within_the_default_budget() {
         let curve = roughness::curve(Direction::SheenToFuzz, RoughnessMapping::Fitted);
         let factors: Vec<f64> = (0..=30).map(|i| 0.3 + 0.01 * f64::from(i)).collect();
-        let choices = choose(&slots(&factors), &fabric_codes(), &curve, Budget::default());
+        let choices = choose(&slots(&factors), &fabric_codes(), &curve, Budget::default())
+            .expect("no stop was asked for");
         for (f, c) in factors.iter().zip(&choices) {
             assert_eq!(c.plan, TexturePlan::Shared, "factor {f}: {c:?}");
             assert!(c.error <= DEFAULT_BUDGET, "{c:?}");
@@ -568,7 +585,8 @@ mod tests {
     fn factors_too_far_apart_for_one_texture_are_grouped_or_baked() {
         let curve = roughness::curve(Direction::SheenToFuzz, RoughnessMapping::Fitted);
         let factors: Vec<f64> = (0..=85).map(|i| 0.12 + 0.01 * f64::from(i)).collect();
-        let choices = choose(&slots(&factors), &every_code(), &curve, Budget::default());
+        let choices = choose(&slots(&factors), &every_code(), &curve, Budget::default())
+            .expect("no stop was asked for");
         assert!(
             choices.iter().all(|c| c.error <= DEFAULT_BUDGET),
             "{choices:?}"
@@ -590,7 +608,8 @@ mod tests {
     #[test]
     fn the_exact_setting_bakes_each_factor_to_the_nearest_code() {
         let curve = roughness::curve(Direction::SheenToFuzz, RoughnessMapping::Fitted);
-        let choices = choose(&slots(&[0.4, 0.9]), &every_code(), &curve, Budget::Exact);
+        let choices = choose(&slots(&[0.4, 0.9]), &every_code(), &curve, Budget::Exact)
+            .expect("no stop was asked for");
         for (c, f) in choices.iter().zip([0.4, 0.9]) {
             assert_eq!((c.plan, c.baked, c.written), (TexturePlan::Exact, f, None));
             assert!(c.error <= 0.5 / 255.0 + 1e-12, "{c:?}");
@@ -605,7 +624,8 @@ mod tests {
             &every_code(),
             &curve,
             Budget::Within(0.0),
-        );
+        )
+        .expect("no stop was asked for");
         assert!(
             choices.iter().all(|c| c.plan == TexturePlan::Exact),
             "{choices:?}"

@@ -26,6 +26,11 @@ pub fn plan_document(asset: &Asset, options: &Options) -> DocumentPlan {
     let primitives = Primitives::new(asset.root());
     crate::progress::stage("planning materials", count);
     let plan = |i: usize| {
+        // A run asked to stop plans no more: what it planned is thrown away (nothing is
+        // written once a stop is asked for), so the stop comes within one material.
+        if crate::asset::limits::stop_requested() {
+            return None;
+        }
         crate::progress::advance(1);
         plan_material(asset, i, options, &primitives).map(|mut plan| {
             plan.shrink_to_fit();
