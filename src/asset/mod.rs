@@ -72,8 +72,41 @@ pub struct Asset {
     image_headers: Mutex<HashMap<usize, Result<ImageHeader, Diagnostic>>>,
     /// Whether each image asked about decodes, and why not (see [`Asset::image_decodes`]).
     image_decodes: Mutex<HashMap<usize, Result<(), String>>>,
+    /// What the file system said of its resources ([`ResourceLookups`]), shared with the
+    /// fixed texts tried for it.
+    lookups: std::sync::Arc<ResourceLookups>,
+}
+
+/// What the file system said of a document's resource files, asked once per file: every
+/// report of a file with fixable findings validates the fixed text too ([`crate::fix`]), whose
+/// resources are the file's, and on small files the second round of path checks, stats and
+/// header reads was a tenth of the run. Shared only by assets of one file, loaded under one
+/// policy, within one run ([`Asset::share_lookups`]).
+#[derive(Debug, Default)]
+struct ResourceLookups {
     /// The folder with its links resolved, found once on the first resource read.
     real_base: OnceLock<Option<PathBuf>>,
+    /// Where each URI that is not a `data:` URI led (a file, or why not), by URI and pointer.
+    resolved: Mutex<HashMap<(String, String), Result<PathBuf, Diagnostic>>>,
+    /// What each resource file is, by path.
+    files: Mutex<HashMap<PathBuf, Result<FileFacts, (std::io::ErrorKind, String)>>>,
+    /// The headers of images read from files, by image index and URI.
+    headers: Mutex<HashMap<(usize, String), Result<ImageHeader, Diagnostic>>>,
+}
+
+/// What a resource file is: a regular file or not, its length, and whether it is a Git LFS
+/// pointer file (for a file short enough to be one).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FileFacts {
+    pub is_file: bool,
+    pub len: u64,
+    pub lfs_pointer: bool,
+}
+
+/// `mutex`'s value, whatever a thread that panicked while holding it left there (a cache: at
+/// worst an entry is asked again).
+fn lock<T>(mutex: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    mutex.lock().unwrap_or_else(|e| e.into_inner())
 }
 
 /// The outcome of loading one file: the asset when its JSON could be read, and every fault
@@ -397,7 +430,7 @@ fn load_text(
             options: *options,
             image_headers: Mutex::new(HashMap::new()),
             image_decodes: Mutex::new(HashMap::new()),
-            real_base: OnceLock::new(),
+            lookups: Default::default(),
         }),
         diagnostics,
     }
@@ -768,6 +801,53 @@ impl Asset {
     /// Unless outside URIs are allowed, a path that stays in the folder by its text but leads
     /// out of it through a symbolic link is refused too.
     pub fn resolve(&self, uri: &str, pointer: &str) -> Result<Location, Diagnostic> {
+        // A data: URI is decoded from the text each time (nothing to ask the file system).
+        if uri.starts_with("data:") {
+            return self.resolve_asking(uri, pointer);
+        }
+        let key = (uri.to_string(), pointer.to_string());
+        if let Some(known) = lock(&self.lookups.resolved).get(&key) {
+            return known.clone().map(Location::File);
+        }
+        let location = self.resolve_asking(uri, pointer);
+        let known = match &location {
+            Ok(Location::File(path)) => Ok(path.clone()),
+            Ok(Location::Data { .. }) => return location,
+            Err(d) => Err(d.clone()),
+        };
+        lock(&self.lookups.resolved).insert(key, known);
+        location
+    }
+
+    /// Gives this asset the resource lookups of `other`, an asset of the same file loaded
+    /// under the same policy (the fixed text of a file, tried for its report): what the file
+    /// system said of their resources holds for both. Nothing is shared otherwise.
+    pub fn share_lookups(&mut self, other: &Asset) {
+        if self.path == other.path && self.options == other.options {
+            self.lookups = other.lookups.clone();
+        }
+    }
+
+    /// What the resource file `path` is ([`FileFacts`]), asked once per file; the error of its
+    /// stat otherwise.
+    pub fn file_facts(&self, path: &Path) -> Result<FileFacts, (std::io::ErrorKind, String)> {
+        if let Some(known) = lock(&self.lookups.files).get(path) {
+            return known.clone();
+        }
+        let facts = std::fs::metadata(path)
+            .map(|meta| FileFacts {
+                is_file: meta.is_file(),
+                len: meta.len(),
+                lfs_pointer: meta.is_file()
+                    && meta.len() <= resource::LFS_POINTER_MAX_LEN
+                    && resource::is_lfs_pointer(path),
+            })
+            .map_err(|e| (e.kind(), e.to_string()));
+        lock(&self.lookups.files).insert(path.to_path_buf(), facts.clone());
+        facts
+    }
+
+    fn resolve_asking(&self, uri: &str, pointer: &str) -> Result<Location, Diagnostic> {
         let location = resource::resolve_with(
             uri,
             self.base_dir(),
@@ -777,6 +857,7 @@ impl Asset {
         if let Location::File(path) = &location {
             if !self.options.allow_outside_uris {
                 let real_base = self
+                    .lookups
                     .real_base
                     .get_or_init(|| resource::real_folder(self.base_dir()));
                 resource::check_inside(path, self.base_dir(), real_base.as_deref(), uri, pointer)?;
@@ -950,11 +1031,60 @@ impl Asset {
         if let Some(uri) = uri {
             let uri_pointer = format!("{pointer}/uri");
             if let Location::File(path) = self.resolve(&uri, &uri_pointer)? {
-                let file = resource::open_file(&path, &uri, &uri_pointer)?;
-                return resource::read_header(BufReader::new(file), &pointer, &what);
+                let key = (index, uri.into_owned());
+                if let Some(known) = lock(&self.lookups.headers).get(&key) {
+                    return known.clone();
+                }
+                let header = resource::open_file(&path, &key.1, &uri_pointer)
+                    .and_then(|file| resource::read_header(BufReader::new(file), &pointer, &what));
+                lock(&self.lookups.headers).insert(key, header.clone());
+                return header;
             }
         }
         let bytes = self.image_bytes(index)?;
         resource::read_header(Cursor::new(bytes.as_ref()), &pointer, &what)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn what_the_file_system_said_is_shared_only_by_assets_of_one_file_and_policy() {
+        let dir = tempfile::tempdir().expect("a temporary folder");
+        let image = dir.path().join("a.png");
+        std::fs::write(&image, b"not yet a picture").expect("written");
+        let text = br#"{"asset":{"version":"2.0"}}"#;
+        let load = |name: &str, options: &LoadOptions| {
+            load_bytes_with(&dir.path().join(name), text, options)
+                .asset
+                .expect("the document parses")
+        };
+        let options = LoadOptions::default();
+        let file = load("a.gltf", &options);
+        let facts = file.file_facts(&image).expect("a file");
+        assert_eq!((facts.is_file, facts.len, facts.lfs_pointer), (true, 17, false));
+        std::fs::remove_file(&image).expect("removed");
+        // The fixed text of the same file shares the answer; the file itself keeps it.
+        let mut fixed = load("a.gltf", &options);
+        fixed.share_lookups(&file);
+        assert_eq!(fixed.file_facts(&image), Ok(facts));
+        // Another file, or the same one under another policy, asks again.
+        for (name, options) in [
+            ("b.gltf", options),
+            (
+                "a.gltf",
+                LoadOptions {
+                    allow_outside_uris: !options.allow_outside_uris,
+                    ..options
+                },
+            ),
+        ] {
+            let mut other = load(name, &options);
+            other.share_lookups(&file);
+            let asked = other.file_facts(&image);
+            assert_eq!(asked.map_err(|e| e.0), Err(std::io::ErrorKind::NotFound));
+        }
     }
 }

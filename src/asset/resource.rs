@@ -255,6 +255,19 @@ fn file_uri_path(uri: &str) -> Option<&str> {
     }
 }
 
+/// How a Git LFS pointer file begins (a clone without Git LFS has these in place of content).
+pub const LFS_POINTER_PREFIX: &[u8] = b"version https://git-lfs.github.com/spec/";
+/// Git LFS pointer files are about 130 bytes; anything larger is real content.
+pub const LFS_POINTER_MAX_LEN: u64 = 1024;
+
+/// Whether the file at `path` begins as a Git LFS pointer file does.
+pub fn is_lfs_pointer(path: &Path) -> bool {
+    let mut head = [0u8; LFS_POINTER_PREFIX.len()];
+    std::fs::File::open(path)
+        .and_then(|mut f| std::io::Read::read_exact(&mut f, &mut head))
+        .is_ok_and(|()| head == LFS_POINTER_PREFIX)
+}
+
 /// Opens a resource file that a URI led to, refusing anything but a regular file.
 pub fn open_file(path: &Path, uri: &str, pointer: &str) -> Result<std::fs::File, Diagnostic> {
     let fail = |detail: String| {

@@ -808,9 +808,11 @@ impl<'v> Fixing<'v> {
             bytes = file;
         }
         let loaded = asset::load_bytes_with(path, &bytes, &self.validator.load);
-        let Some(after) = loaded.asset else {
+        let Some(mut after) = loaded.asset else {
             return Err(Failed::Other("the fixed file would not load".into()));
         };
+        // Its resources are the file's: what the file system said of them holds.
+        after.share_lookups(source);
         // Placed in the text (line and column) only if it becomes the file's report.
         let report =
             self.validator

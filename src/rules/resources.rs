@@ -17,7 +17,6 @@ use super::{Context, Rule};
 use crate::asset::resource::{self, ImageFormat, Location};
 use crate::asset::tape::Node;
 use crate::diagnostics::{codes, Code, Diagnostic, Severity};
-use std::path::Path;
 
 pub const FILE_NOT_FOUND: Code = Code::new(
     "FILE_NOT_FOUND",
@@ -79,10 +78,6 @@ pub const DATA_URI_NOT_BASE64: Code = Code::new(
     Severity::Warning,
     "A data: URI is percent-encoded rather than base64: valid, but some loaders decode only base64.",
 );
-
-const LFS_POINTER_PREFIX: &[u8] = b"version https://git-lfs.github.com/spec/";
-/// Git LFS pointer files are about 130 bytes; anything larger is real content.
-const LFS_POINTER_MAX_LEN: u64 = 1024;
 
 pub struct Resources;
 
@@ -394,9 +389,10 @@ fn locate(cx: &Context, uri: &str, pointer: &str, out: &mut Vec<Diagnostic>) -> 
         }
     };
     let fault = |code: &Code, detail: String| Diagnostic::new(code, pointer, detail);
-    // Asset::resolve has refused links that lead out of the folder. A stat, not a read.
-    let meta = match std::fs::metadata(&path) {
-        Ok(meta) if meta.is_file() => meta,
+    // Asset::resolve has refused links that lead out of the folder. A stat, not a read (and
+    // the first bytes of a file short enough to be a Git LFS pointer).
+    let facts = match cx.asset.file_facts(&path) {
+        Ok(facts) if facts.is_file => facts,
         Ok(_) => {
             out.push(fault(
                 &codes::IO_ERROR,
@@ -404,8 +400,8 @@ fn locate(cx: &Context, uri: &str, pointer: &str, out: &mut Vec<Diagnostic>) -> 
             ));
             return None;
         }
-        Err(e) => {
-            out.push(if e.kind() == std::io::ErrorKind::NotFound {
+        Err((kind, e)) => {
+            out.push(if kind == std::io::ErrorKind::NotFound {
                 fault(
                     &FILE_NOT_FOUND,
                     format!("'{uri}' names {}, which does not exist", path.display()),
@@ -419,7 +415,7 @@ fn locate(cx: &Context, uri: &str, pointer: &str, out: &mut Vec<Diagnostic>) -> 
             return None;
         }
     };
-    if meta.len() <= LFS_POINTER_MAX_LEN && is_lfs_pointer(&path) {
+    if facts.lfs_pointer {
         out.push(fault(
             &GIT_LFS_POINTER,
             format!(
@@ -428,12 +424,5 @@ fn locate(cx: &Context, uri: &str, pointer: &str, out: &mut Vec<Diagnostic>) -> 
         ));
         return None;
     }
-    Some(Located::File { len: meta.len() })
-}
-
-fn is_lfs_pointer(path: &Path) -> bool {
-    let mut head = [0u8; LFS_POINTER_PREFIX.len()];
-    std::fs::File::open(path)
-        .and_then(|mut f| std::io::Read::read_exact(&mut f, &mut head))
-        .is_ok_and(|()| head == LFS_POINTER_PREFIX)
+    Some(Located::File { len: facts.len })
 }
