@@ -226,7 +226,7 @@ pub fn write_data_library(dir: &Path, meshes: usize) -> std::io::Result<()> {
         let mut accessor = accessor;
         accessor["bufferView"] = json!(views.len() - 1);
         accessors.push(accessor);
-        while bin.len() % 4 != 0 {
+        while !bin.len().is_multiple_of(4) {
             bin.push(0);
         }
         accessors.len() - 1

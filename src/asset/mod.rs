@@ -89,10 +89,13 @@ struct ResourceLookups {
     /// Where each URI that is not a `data:` URI led (a file, or why not), by URI and pointer.
     resolved: Mutex<HashMap<(String, String), Result<PathBuf, Diagnostic>>>,
     /// What each resource file is, by path.
-    files: Mutex<HashMap<PathBuf, Result<FileFacts, (std::io::ErrorKind, String)>>>,
+    files: Mutex<HashMap<PathBuf, Result<FileFacts, StatError>>>,
     /// The headers of images read from files, by image index and URI.
     headers: Mutex<HashMap<(usize, String), Result<ImageHeader, Diagnostic>>>,
 }
+
+/// Why a resource file could not be stat'ed: the error's kind and its words.
+pub type StatError = (std::io::ErrorKind, String);
 
 /// What a resource file is: a regular file or not, its length, and whether it is a Git LFS
 /// pointer file (for a file short enough to be one).
@@ -830,7 +833,7 @@ impl Asset {
 
     /// What the resource file `path` is ([`FileFacts`]), asked once per file; the error of its
     /// stat otherwise.
-    pub fn file_facts(&self, path: &Path) -> Result<FileFacts, (std::io::ErrorKind, String)> {
+    pub fn file_facts(&self, path: &Path) -> Result<FileFacts, StatError> {
         if let Some(known) = lock(&self.lookups.files).get(path) {
             return known.clone();
         }
@@ -1064,7 +1067,10 @@ mod tests {
         let options = LoadOptions::default();
         let file = load("a.gltf", &options);
         let facts = file.file_facts(&image).expect("a file");
-        assert_eq!((facts.is_file, facts.len, facts.lfs_pointer), (true, 17, false));
+        assert_eq!(
+            (facts.is_file, facts.len, facts.lfs_pointer),
+            (true, 17, false)
+        );
         std::fs::remove_file(&image).expect("removed");
         // The fixed text of the same file shares the answer; the file itself keeps it.
         let mut fixed = load("a.gltf", &options);

@@ -57,11 +57,11 @@ pub fn resolve_with(
             None => (header, false),
         };
         // RFC 2397: after the type, each parameter is `attribute=value`.
-        if media_type.split(';').skip(1).any(|parameter| {
-            !parameter
-                .split_once('=')
-                .is_some_and(|(a, _)| !a.is_empty())
-        }) {
+        if media_type
+            .split(';')
+            .skip(1)
+            .any(|parameter| parameter.split_once('=').is_none_or(|(a, _)| a.is_empty()))
+        {
             return Err(Diagnostic::new(
                 &codes::INVALID_URI,
                 pointer,

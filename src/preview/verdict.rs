@@ -148,9 +148,12 @@ pub fn measure_pairs(pairs: &[(Look, Look)]) -> Verdict {
     Verdict::new(flips[0], flips[1])
 }
 
+/// A material's looks to compare (authored, written), and the key of their values' bits.
+type KeyedPairs = (Vec<u64>, Vec<(Look, Look)>);
+
 /// The verdict of each of `materials`, each distinct set of looks measured once (in parallel).
 pub fn measure_all(materials: &[Material]) -> Vec<Verdict> {
-    let keys: Vec<(Vec<u64>, Vec<(Look, Look)>)> = materials
+    let keys: Vec<KeyedPairs> = materials
         .par_iter()
         .map(|m| {
             let pairs = pairs(m);

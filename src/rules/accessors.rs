@@ -251,7 +251,7 @@ fn laid_over(
     accessor: bool,
     out: &mut Vec<Diagnostic>,
 ) {
-    if offset % size != 0 {
+    if !offset.is_multiple_of(size) {
         out.push(Diagnostic::new(
             &ACCESSOR_OFFSET_ALIGNMENT,
             format!("{at}/byteOffset"),

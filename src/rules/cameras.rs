@@ -70,7 +70,7 @@ impl Rule for Cameras {
                 let at = format!("/cameras/{i}/orthographic");
                 for key in ["xmag", "ymag"] {
                     match number(&ortho, key) {
-                        Some(v) if v == 0.0 => out.push(Diagnostic::new(
+                        Some(0.0) => out.push(Diagnostic::new(
                             &CAMERA_XMAG_YMAG_ZERO,
                             format!("{at}/{key}"),
                             format!("{key} is 0: the projection matrix is singular"),

@@ -168,9 +168,9 @@ fn format_allowed(semantic: &str, accessor: &AccessorView) -> bool {
 fn fits_mode(mode: u64, count: u64) -> bool {
     match mode {
         0 => count >= 1,
-        1 => count >= 2 && count % 2 == 0,
+        1 => count >= 2 && count.is_multiple_of(2),
         2 | 3 => count >= 2,
-        4 => count >= 3 && count % 3 == 0,
+        4 => count >= 3 && count.is_multiple_of(3),
         5 | 6 => count >= 3,
         _ => true,
     }
@@ -230,7 +230,7 @@ impl Rule for Primitives {
             let Some(bv) = view.buffer_view.filter(|v| *v < strided.len()) else {
                 return;
             };
-            if view.byte_offset % 4 != 0 {
+            if !view.byte_offset.is_multiple_of(4) {
                 out.push(Diagnostic::new(
                     &MESH_PRIMITIVE_ACCESSOR_UNALIGNED,
                     at(),
