@@ -2282,8 +2282,9 @@ fn decodes_side_by_side_share_one_memory_budget() {
     );
 }
 
-/// A GLB whose bytes and BIN copy would exceed the memory budget is refused before it is read
-/// (here a sparse file of 200 MiB under a budget of 100 MiB): an IO_ERROR naming --max-memory.
+/// A GLB that would exceed the memory budget is refused before it is read (here a sparse file
+/// of 200 MiB): an IO_ERROR naming --max-memory. validate holds it once, migrate (which keeps
+/// the file's bytes beside its BIN chunk) twice.
 #[test]
 fn a_glb_larger_than_the_memory_budget_is_refused_before_it_is_read() {
     let dir = tempfile::tempdir().unwrap();
@@ -2306,15 +2307,36 @@ fn a_glb_larger_than_the_memory_budget_is_refused_before_it_is_read() {
         .unwrap()
         .set_len(200 << 20)
         .unwrap();
+    // validate holds the file once (its BIN chunk is carved out of its bytes in place)...
     let (status, out, err) = velvet(&["validate", s(&path), "--max-memory", "100M"]);
     assert_eq!(status, 1, "{out}{err}");
     assert!(
         out.contains(&format!(
-            "error IO_ERROR: reading {} (a GLB of 209715200 bytes) needs about 400.0 MiB, over \
+            "error IO_ERROR: reading {} (a GLB of 209715200 bytes) needs about 200.0 MiB, over \
              the memory budget of 100.0 MiB (raise it with --max-memory)",
             velvet::report::display_path(&path)
         )),
         "{out}"
+    );
+    // Within a budget of once its size, validate reads it.
+    let (_, out, err) = velvet(&["validate", s(&path), "--max-memory", "300M"]);
+    assert!(!out.contains("IO_ERROR"), "{out}{err}");
+    // ...and migrate, which keeps the file's bytes beside the chunk, twice.
+    let out_dir = dir.path().join("out");
+    let (status, out, err) = velvet(&[
+        "migrate",
+        s(&path),
+        "--out-dir",
+        s(&out_dir),
+        "--max-memory",
+        "300M",
+    ]);
+    assert_eq!(status, 1, "{out}{err}");
+    assert!(
+        format!("{out}{err}").contains(
+            "(a GLB of 209715200 bytes) needs about 400.0 MiB, over the memory budget of 300.0 MiB"
+        ),
+        "{out}{err}"
     );
 }
 

@@ -129,7 +129,8 @@ pub fn load(path: &Path) -> Loaded {
 /// Reads and parses one file under `options`. Never fails: faults become diagnostics.
 pub fn load_with(path: &Path, options: &LoadOptions) -> Loaded {
     crate::progress::stage("reading", 0);
-    match read(path, options) {
+    // The bytes are the asset's alone: a GLB's BIN chunk is carved out of them in place.
+    match read_held(path, options, 1) {
         Ok(bytes) => load_owned(path, bytes, options),
         Err(d) => Loaded {
             asset: None,
@@ -141,6 +142,13 @@ pub fn load_with(path: &Path, options: &LoadOptions) -> Loaded {
 /// Reads the bytes of an asset file (see [`limits::read_asset_file`]). A .gltf larger than
 /// the document limit is refused from its size alone, without being read.
 pub fn read(path: &Path, options: &LoadOptions) -> Result<FileBytes, Diagnostic> {
+    read_held(path, options, 2)
+}
+
+/// [`read`], a GLB asked of the memory budget `copies` times its size: 2 where the caller keeps
+/// the file's bytes while its BIN chunk is copied out of them, 1 where the chunk is carved out
+/// of them ([`load_with`]).
+fn read_held(path: &Path, options: &LoadOptions, copies: u64) -> Result<FileBytes, Diagnostic> {
     let io_error = |e: std::io::Error| {
         Diagnostic::new(
             &codes::IO_ERROR,
@@ -164,11 +172,10 @@ pub fn read(path: &Path, options: &LoadOptions) -> Result<FileBytes, Diagnostic>
                     options.document_too_large(meta.len()),
                 ));
             }
-            // A GLB's bytes are held while its BIN chunk is copied out of them: twice its
-            // size, asked for before it is read. (A .gltf over the document limit is refused
-            // above; one within it is far below any budget.)
+            // Asked for before it is read (see `copies`). (A .gltf over the document limit is
+            // refused above; one within it is far below any budget.)
             let what = format!("reading {} (a GLB of {} bytes)", path.display(), meta.len());
-            let needed = meta.len().saturating_mul(2);
+            let needed = meta.len().saturating_mul(copies);
             if let Some(message) = limits::over_memory_budget(&what, needed, options.max_memory) {
                 return Err(Diagnostic::new(&codes::IO_ERROR, "", message));
             }
@@ -205,7 +212,38 @@ pub fn load_bytes(path: &Path, bytes: &[u8]) -> Loaded {
 /// Parses bytes read from `path`, keeping them as the JSON text without a copy when the file is
 /// a .gltf in plain UTF-8 (a copy of a large document costs as much as indexing it).
 fn load_owned(path: &Path, bytes: FileBytes, options: &LoadOptions) -> Loaded {
+    if is_glb(path, &bytes) {
+        // The BIN chunk is made of the file's own bytes, moved to the front of their
+        // allocation, rather than copied out of them: the file is held once, not twice.
+        return load_from(path, Bytes::Owned(bytes.into_vec()), options);
+    }
     load_read(path, bytes, options).0
+}
+
+/// Whether bytes read from `path` are to be read as a GLB: they begin as one, or the file is
+/// named as one.
+fn is_glb(path: &Path, bytes: &[u8]) -> bool {
+    bytes.starts_with(b"glTF")
+        || path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("glb"))
+}
+
+/// A file's bytes for [`load_from`]: borrowed (the caller keeps them), or given (a GLB's BIN
+/// chunk is then carved out of them in place).
+enum Bytes<'a> {
+    Borrowed(&'a [u8]),
+    Owned(Vec<u8>),
+}
+
+impl std::ops::Deref for Bytes<'_> {
+    type Target = [u8];
+    fn deref(&self) -> &[u8] {
+        match self {
+            Bytes::Borrowed(bytes) => bytes,
+            Bytes::Owned(bytes) => bytes,
+        }
+    }
 }
 
 /// Parses bytes read from `path`, as [`load_with`] does, keeping them as the JSON text without
@@ -239,22 +277,23 @@ pub fn load_read(
 /// Parses the bytes of a file that lives (or would live) at `path`; `path` is used for the
 /// container kind (when the bytes do not tell) and to resolve relative URIs.
 pub fn load_bytes_with(path: &Path, bytes: &[u8], options: &LoadOptions) -> Loaded {
+    load_from(path, Bytes::Borrowed(bytes), options)
+}
+
+fn load_from(path: &Path, file: Bytes<'_>, options: &LoadOptions) -> Loaded {
+    let bytes: &[u8] = &file;
     let mut diagnostics = Vec::new();
-    let is_glb = bytes.starts_with(b"glTF")
-        || path
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("glb"));
     let mut other_chunks = Vec::new();
-    let (container, json_bytes, json_offset, bin) = if is_glb {
+    // Where the BIN chunk's data lies in the file.
+    let (container, json_bytes, json_offset, bin_range) = if is_glb(path, bytes) {
         match glb::split(bytes, &mut diagnostics) {
             Some(parts) => {
                 other_chunks = parts.other.iter().map(|c| c.to_vec()).collect();
-                (
-                    Container::Glb,
-                    parts.json,
-                    parts.json_offset,
-                    parts.bin.map(<[u8]>::to_vec),
-                )
+                let bin_range = parts.bin.map(|bin| {
+                    let start = bin.as_ptr() as usize - bytes.as_ptr() as usize;
+                    start..start + bin.len()
+                });
+                (Container::Glb, parts.json, parts.json_offset, bin_range)
             }
             None => {
                 return Loaded {
@@ -327,6 +366,14 @@ pub fn load_bytes_with(path: &Path, bytes: &[u8], options: &LoadOptions) -> Load
             };
         }
     };
+    let bin = bin_range.map(|range| match file {
+        Bytes::Borrowed(bytes) => bytes[range].to_vec(),
+        Bytes::Owned(mut bytes) => {
+            bytes.truncate(range.end);
+            bytes.drain(..range.start);
+            bytes
+        }
+    });
     let mut loaded = load_text(
         path,
         json_text,
@@ -1052,6 +1099,28 @@ impl Asset {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_glb_given_to_the_loader_has_its_bin_chunk_carved_out_in_place_as_a_copy_would_be() {
+        let json = br#"{"asset":{"version":"2.0"},"buffers":[{"byteLength":5}]}"#;
+        let bin = [1u8, 2, 3, 4, 5];
+        let mut file = glb::join(json, Some(&bin));
+        file.extend_from_slice(b"trailing bytes");
+        let path = Path::new("t.glb");
+        let options = LoadOptions::default();
+        let copied = load_bytes_with(path, &file, &options);
+        let carved = load_owned(path, FileBytes::from_vec(file), &options);
+        let (copied_asset, carved_asset) = (copied.asset.unwrap(), carved.asset.unwrap());
+        // The chunk padded to 4 bytes, as the container holds it.
+        assert_eq!(carved_asset.bin.as_deref(), Some(&[1u8, 2, 3, 4, 5, 0, 0, 0][..]));
+        assert_eq!(carved_asset.bin, copied_asset.bin);
+        assert_eq!(carved_asset.json_text.as_str(), copied_asset.json_text.as_str());
+        assert_eq!(carved.diagnostics, copied.diagnostics);
+        assert!(carved
+            .diagnostics
+            .iter()
+            .any(|d| d.code == codes::GLB_EXTRA_DATA.name));
+    }
 
     #[test]
     fn what_the_file_system_said_is_shared_only_by_assets_of_one_file_and_policy() {

@@ -26,6 +26,11 @@ impl FileBytes {
     pub fn from_vec(bytes: Vec<u8>) -> FileBytes {
         FileBytes(bytes)
     }
+
+    /// The bytes, given back.
+    pub fn into_vec(self) -> Vec<u8> {
+        self.0
+    }
 }
 
 impl Deref for FileBytes {
