@@ -1139,6 +1139,22 @@ fn error_findings(report: &velvet::validate::FileReport) -> Vec<(&str, &str)> {
 }
 
 #[test]
+fn fuzz_data_joints_shorter_than_their_weights_are_read_no_further_than_their_end() {
+    // The skinning check read the joints as far as the weights went, past the joints' bytes:
+    // a panic. Now both are read as far as the shorter goes, and the unequal counts are the
+    // primitive's finding.
+    let validator = Validator::new(Schemas::builtin(), Settings::default());
+    let report = validator.validate_file(&fixture("data-joints-shorter-than-weights.gltf"));
+    assert_eq!(
+        error_findings(&report),
+        [(
+            "MESH_PRIMITIVE_UNEQUAL_ACCESSOR_COUNT",
+            "/meshes/0/primitives/0/attributes/JOINTS_0"
+        )]
+    );
+}
+
+#[test]
 fn fuzz_validate_a_position_naming_no_accessor_is_a_dangling_reference() {
     // The gltf crate's core check looked the POSITION accessor up without checking the index.
     let validator = Validator::new(Schemas::builtin(), Settings::default());

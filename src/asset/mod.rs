@@ -1112,9 +1112,15 @@ mod tests {
         let carved = load_owned(path, FileBytes::from_vec(file), &options);
         let (copied_asset, carved_asset) = (copied.asset.unwrap(), carved.asset.unwrap());
         // The chunk padded to 4 bytes, as the container holds it.
-        assert_eq!(carved_asset.bin.as_deref(), Some(&[1u8, 2, 3, 4, 5, 0, 0, 0][..]));
+        assert_eq!(
+            carved_asset.bin.as_deref(),
+            Some(&[1u8, 2, 3, 4, 5, 0, 0, 0][..])
+        );
         assert_eq!(carved_asset.bin, copied_asset.bin);
-        assert_eq!(carved_asset.json_text.as_str(), copied_asset.json_text.as_str());
+        assert_eq!(
+            carved_asset.json_text.as_str(),
+            copied_asset.json_text.as_str()
+        );
         assert_eq!(carved.diagnostics, copied.diagnostics);
         assert!(carved
             .diagnostics

@@ -364,9 +364,14 @@ fn check_skinning(
     if sets.is_empty() {
         return;
     }
+    // Elements read side by side: as many as the shortest accessor holds (accessors of one
+    // primitive with unequal counts are MESH_PRIMITIVE_UNEQUAL_ACCESSOR_COUNT; a weights
+    // accessor longer than its joints must not be read past the joints' end).
     let count = sets
         .iter()
-        .filter_map(|(_, w, j)| w.as_ref().or(j.as_ref()).map(|e| e.count))
+        .flat_map(|(_, w, j)| [w.as_ref(), j.as_ref()])
+        .flatten()
+        .map(|e| e.count)
         .min()
         .unwrap_or(0);
     let components = sets.len() * 4;

@@ -1,0 +1,128 @@
+//! The data reader: a document made from the input's first bytes (accessors of any component
+//! type, type, count, offset and normalization, some sparse; buffer views of any offset,
+//! length and stride; meshes, an animation and a skin that use them) over a BIN chunk of the
+//! bytes that follow, validated with every data check: the accessors' elements decoded from
+//! wherever the views put them, in bounds or not.
+#![no_main]
+
+use libfuzzer_sys::fuzz_target;
+use std::path::Path;
+use std::sync::OnceLock;
+use velvet::asset::glb;
+use velvet::diagnostics::Settings;
+use velvet::rules::schema::Schemas;
+use velvet::validate::Validator;
+
+fn validator() -> &'static Validator {
+    static VALIDATOR: OnceLock<Validator> = OnceLock::new();
+    VALIDATOR.get_or_init(|| {
+        Validator::new(Schemas::builtin(), Settings::default())
+            .with_load_options(velvet_fuzz::options())
+    })
+}
+
+/// Reads numbers off the front of the input; zeros once it runs out.
+struct Cursor<'a>(&'a [u8]);
+
+impl Cursor<'_> {
+    fn byte(&mut self) -> u8 {
+        match self.0.split_first() {
+            Some((b, rest)) => {
+                self.0 = rest;
+                *b
+            }
+            None => 0,
+        }
+    }
+
+    fn small(&mut self, below: u32) -> u32 {
+        u32::from(self.byte()) % below.max(1)
+    }
+
+    fn number(&mut self) -> u32 {
+        u32::from_le_bytes([self.byte(), self.byte(), 0, 0])
+    }
+}
+
+const COMPONENT_TYPES: [u32; 7] = [5120, 5121, 5122, 5123, 5125, 5126, 5124];
+const TYPES: [&str; 7] = ["SCALAR", "VEC2", "VEC3", "VEC4", "MAT2", "MAT3", "MAT4"];
+
+fuzz_target!(|input: &[u8]| {
+    let mut at = Cursor(input);
+    let bin_len = at.number() as usize % 4096;
+    let views: Vec<String> = (0..1 + at.small(4))
+        .map(|_| {
+            let stride = match at.small(3) {
+                0 => String::new(),
+                _ => format!(r#","byteStride":{}"#, at.small(64)),
+            };
+            format!(
+                r#"{{"buffer":0,"byteOffset":{},"byteLength":{}{stride}}}"#,
+                at.number() % 4096,
+                at.number() % 4096
+            )
+        })
+        .collect();
+    let view_count = views.len() as u32;
+    let accessors: Vec<String> = (0..1 + at.small(6))
+        .map(|_| {
+            let mut fields = vec![
+                format!(r#""componentType":{}"#, COMPONENT_TYPES[at.small(7) as usize]),
+                format!(r#""type":"{}""#, TYPES[at.small(7) as usize]),
+                format!(r#""count":{}"#, at.number() % 512),
+            ];
+            if at.small(4) > 0 {
+                fields.push(format!(r#""bufferView":{}"#, at.small(view_count + 1)));
+                fields.push(format!(r#""byteOffset":{}"#, at.small(64)));
+            }
+            if at.small(4) == 0 {
+                fields.push(r#""normalized":true"#.to_string());
+            }
+            if at.small(3) == 0 {
+                fields.push(r#""min":[0,0,0],"max":[1,1,1]"#.to_string());
+            }
+            if at.small(4) == 0 {
+                fields.push(format!(
+                    r#""sparse":{{"count":{},"indices":{{"bufferView":{},"byteOffset":{},"componentType":{}}},"values":{{"bufferView":{},"byteOffset":{}}}}}"#,
+                    1 + at.small(16),
+                    at.small(view_count),
+                    at.small(32),
+                    [5121, 5123, 5125][at.small(3) as usize],
+                    at.small(view_count),
+                    at.small(32)
+                ));
+            }
+            format!("{{{}}}", fields.join(","))
+        })
+        .collect();
+    let n = accessors.len() as u32;
+    let mut pick = || at.small(n);
+    let json = format!(
+        r#"{{"asset":{{"version":"2.0"}},"buffers":[{{"byteLength":{bin_len}}}],
+        "bufferViews":[{}],"accessors":[{}],
+        "meshes":[{{"primitives":[{{"attributes":{{"POSITION":{},"NORMAL":{},"TANGENT":{},"TEXCOORD_0":{},"JOINTS_0":{},"WEIGHTS_0":{}}},"indices":{},"mode":{}}}]}}],
+        "nodes":[{{"mesh":0,"skin":0}},{{}}],
+        "skins":[{{"joints":[1],"inverseBindMatrices":{}}}],
+        "animations":[{{"channels":[{{"sampler":0,"target":{{"node":1,"path":"rotation"}}}}],
+            "samplers":[{{"input":{},"output":{},"interpolation":"LINEAR"}}]}}]}}"#,
+        views.join(","),
+        accessors.join(","),
+        pick(),
+        pick(),
+        pick(),
+        pick(),
+        pick(),
+        pick(),
+        pick(),
+        pick() % 7,
+        pick(),
+        pick(),
+        pick()
+    );
+    let rest = at.0;
+    let bin: Vec<u8> = rest.iter().copied().cycle().take(bin_len).collect();
+    let file = glb::join(json.as_bytes(), Some(&bin));
+    let path = Path::new("/nonexistent/fuzz.glb");
+    let loaded = velvet::asset::load_bytes_with(path, &file, &velvet_fuzz::options());
+    let _ = validator().validate_loaded(path, loaded);
+});
