@@ -1,8 +1,9 @@
 //! The data reader: a document made from the input's first bytes (accessors of any component
 //! type, type, count, offset and normalization, some sparse; buffer views of any offset,
-//! length and stride; meshes, an animation and a skin that use them) over a BIN chunk of the
-//! bytes that follow, validated with every data check: the accessors' elements decoded from
-//! wherever the views put them, in bounds or not.
+//! length and stride; meshes, an animation and a skin that use them) over a buffer of the
+//! bytes that follow — a .glb's BIN chunk, or (as the first byte says) a .bin file beside a
+//! .gltf, read a part at a time — validated with every data check: the accessors' elements
+//! decoded from wherever the views put them, in bounds or not.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
@@ -47,8 +48,19 @@ impl Cursor<'_> {
 const COMPONENT_TYPES: [u32; 7] = [5120, 5121, 5122, 5123, 5125, 5126, 5124];
 const TYPES: [&str; 7] = ["SCALAR", "VEC2", "VEC3", "VEC4", "MAT2", "MAT3", "MAT4"];
 
+/// A folder of this process's own for the .gltf inputs' buffer files.
+fn folder() -> &'static Path {
+    static FOLDER: OnceLock<std::path::PathBuf> = OnceLock::new();
+    FOLDER.get_or_init(|| {
+        let dir = std::env::temp_dir().join(format!("velvet-fuzz-data-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("a folder for the buffer files");
+        dir
+    })
+}
+
 fuzz_target!(|input: &[u8]| {
     let mut at = Cursor(input);
+    let as_file = at.small(2) == 1;
     let bin_len = at.number() as usize % 4096;
     let views: Vec<String> = (0..1 + at.small(4))
         .map(|_| {
@@ -97,8 +109,9 @@ fuzz_target!(|input: &[u8]| {
         .collect();
     let n = accessors.len() as u32;
     let mut pick = || at.small(n);
+    let uri = if as_file { r#","uri":"fuzz.bin""# } else { "" };
     let json = format!(
-        r#"{{"asset":{{"version":"2.0"}},"buffers":[{{"byteLength":{bin_len}}}],
+        r#"{{"asset":{{"version":"2.0"}},"buffers":[{{"byteLength":{bin_len}{uri}}}],
         "bufferViews":[{}],"accessors":[{}],
         "meshes":[{{"primitives":[{{"attributes":{{"POSITION":{},"NORMAL":{},"TANGENT":{},"TEXCOORD_0":{},"JOINTS_0":{},"WEIGHTS_0":{}}},"indices":{},"mode":{}}}]}}],
         "nodes":[{{"mesh":0,"skin":0}},{{}}],
@@ -121,8 +134,16 @@ fuzz_target!(|input: &[u8]| {
     );
     let rest = at.0;
     let bin: Vec<u8> = rest.iter().copied().cycle().take(bin_len).collect();
-    let file = glb::join(json.as_bytes(), Some(&bin));
-    let path = Path::new("/nonexistent/fuzz.glb");
-    let loaded = velvet::asset::load_bytes_with(path, &file, &velvet_fuzz::options());
-    let _ = validator().validate_loaded(path, loaded);
+    let (path, loaded) = if as_file {
+        let path = folder().join("fuzz.gltf");
+        std::fs::write(folder().join("fuzz.bin"), &bin).expect("the buffer file is written");
+        let loaded = velvet::asset::load_bytes_with(&path, json.as_bytes(), &velvet_fuzz::options());
+        (path, loaded)
+    } else {
+        let path = Path::new("/nonexistent/fuzz.glb").to_path_buf();
+        let file = glb::join(json.as_bytes(), Some(&bin));
+        let loaded = velvet::asset::load_bytes_with(&path, &file, &velvet_fuzz::options());
+        (path, loaded)
+    };
+    let _ = validator().validate_loaded(&path, loaded);
 });
