@@ -24,7 +24,16 @@ fuzz_target!(|data: &[u8]| {
     };
     let plan = plan_document(&asset, &options);
     let edits: Vec<_> = plan.edits().cloned().collect();
-    let spliced = write::spliced_bytes(&asset, &edits);
+    // The spliced bytes as an owned copy: the output borrows the asset, which is edited next.
+    let spliced = write::spliced_bytes(&asset, &edits).map(|spliced| {
+        spliced.map(|(output, changed)| {
+            let bytes: Vec<u8> = match output {
+                write::Output::Bytes(bytes) => bytes.into_owned(),
+                write::Output::Spliced(spliced) => spliced.to_text().into_bytes(),
+            };
+            (bytes, changed)
+        })
+    });
     let Ok(true) = velvet::edit::apply(asset.json_mut(), &edits) else {
         return;
     };

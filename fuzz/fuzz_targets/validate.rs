@@ -23,11 +23,13 @@ fuzz_target!(|data: &[u8]| {
     let loaded = velvet_fuzz::load("/nonexistent/fuzz.gltf", data);
     let report = validator().validate_loaded(path, loaded);
     let reports = [report];
-    for no_fold in [false, true] {
+    for (no_fold, diff, fix_only) in [(false, false, false), (true, true, true)] {
         let options = report::Options {
             color: false,
             quiet: false,
             no_fold,
+            diff,
+            fix_only,
         };
         for format in [Format::Text, Format::Json, Format::Sarif, Format::Github] {
             let _ = report::render(format, &reports, &options);
