@@ -10,17 +10,6 @@ use libfuzzer_sys::fuzz_target;
 use std::path::Path;
 use std::sync::OnceLock;
 use velvet::asset::glb;
-use velvet::diagnostics::Settings;
-use velvet::rules::schema::Schemas;
-use velvet::validate::Validator;
-
-fn validator() -> &'static Validator {
-    static VALIDATOR: OnceLock<Validator> = OnceLock::new();
-    VALIDATOR.get_or_init(|| {
-        Validator::new(Schemas::builtin(), Settings::default())
-            .with_load_options(velvet_fuzz::options())
-    })
-}
 
 /// Reads numbers off the front of the input; zeros once it runs out.
 struct Cursor<'a>(&'a [u8]);
@@ -145,5 +134,5 @@ fuzz_target!(|input: &[u8]| {
         let loaded = velvet::asset::load_bytes_with(&path, &file, &velvet_fuzz::options());
         (path, loaded)
     };
-    let _ = validator().validate_loaded(&path, loaded);
+    let _ = velvet_fuzz::validator().validate_loaded(&path, loaded);
 });

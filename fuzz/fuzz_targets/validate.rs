@@ -4,24 +4,12 @@
 
 use libfuzzer_sys::fuzz_target;
 use std::path::Path;
-use std::sync::OnceLock;
-use velvet::diagnostics::Settings;
 use velvet::report::{self, Format};
-use velvet::rules::schema::Schemas;
-use velvet::validate::Validator;
-
-fn validator() -> &'static Validator {
-    static VALIDATOR: OnceLock<Validator> = OnceLock::new();
-    VALIDATOR.get_or_init(|| {
-        Validator::new(Schemas::builtin(), Settings::default())
-            .with_load_options(velvet_fuzz::options())
-    })
-}
 
 fuzz_target!(|data: &[u8]| {
     let path = Path::new("/nonexistent/fuzz.gltf");
     let loaded = velvet_fuzz::load("/nonexistent/fuzz.gltf", data);
-    let report = validator().validate_loaded(path, loaded);
+    let report = velvet_fuzz::validator().validate_loaded(path, loaded);
     let reports = [report];
     for (no_fold, diff, fix_only) in [(false, false, false), (true, true, true)] {
         let options = report::Options {

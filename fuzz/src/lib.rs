@@ -2,7 +2,11 @@
 //! accessor the loader offers, under limits small enough that one input stays fast.
 
 use std::path::Path;
+use std::sync::OnceLock;
 use velvet::asset::{self, Asset, LoadOptions};
+use velvet::diagnostics::Settings;
+use velvet::rules::schema::Schemas;
+use velvet::validate::Validator;
 
 /// Limits for fuzzing: the defaults, but images of at most 64 × 64 pixels are decoded so that
 /// a forged header costs microseconds, not the decoder's time on a real texture.
@@ -11,6 +15,15 @@ pub fn options() -> LoadOptions {
         max_image_pixels: 64 * 64,
         ..LoadOptions::default()
     }
+}
+
+/// One validator for every input of a run (default settings, these limits): its schemas are
+/// compiled once.
+pub fn validator() -> &'static Validator {
+    static VALIDATOR: OnceLock<Validator> = OnceLock::new();
+    VALIDATOR.get_or_init(|| {
+        Validator::new(Schemas::builtin(), Settings::default()).with_load_options(options())
+    })
 }
 
 /// Loads `data` as a file at `path` (in a folder that does not exist: external URIs fail to

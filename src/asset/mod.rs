@@ -688,39 +688,28 @@ impl Asset {
         self.path.parent().unwrap_or(Path::new("."))
     }
 
-    /// The bytes of buffer `index`: the GLB BIN chunk, a `data:` URI or a file.
+    /// The bytes of buffer `index`, whole: the GLB BIN chunk, a `data:` URI or a file.
     pub fn buffer_bytes(&self, index: usize) -> Result<Cow<'_, [u8]>, Diagnostic> {
-        let pointer = format!("/buffers/{index}");
-        let buffer = self.root().pointer(&pointer).ok_or_else(|| {
-            Diagnostic::new(
-                &codes::UNRESOLVED_REFERENCE,
-                &pointer,
-                format!("buffer {index} does not exist"),
-            )
-        })?;
-        match buffer.get("uri").and_then(|u| u.as_str()) {
-            Some(uri) => {
-                let bytes = self.read_uri(&uri, &format!("{pointer}/uri"))?;
-                check_buffer_length(buffer, index, bytes.len(), &pointer)?;
-                Ok(Cow::Owned(bytes))
-            }
-            None => match (&self.bin, index) {
-                (Some(bin), 0) => {
-                    check_buffer_length(buffer, index, bin.len(), &pointer)?;
-                    Ok(Cow::Borrowed(bin.as_slice()))
-                }
-                _ => Err(Diagnostic::new(
-                    &codes::IO_ERROR,
-                    &pointer,
-                    format!("buffer {index} has no uri and is not the GLB's BIN chunk"),
-                )),
-            },
+        match self.buffer_data(index)? {
+            BufferData::Memory(bytes) => Ok(bytes),
+            file @ BufferData::File { .. } => file
+                .read(0..file.len())
+                .map(|bytes| Cow::Owned(bytes.into_owned()))
+                .ok_or_else(|| {
+                    Diagnostic::new(
+                        &codes::IO_ERROR,
+                        format!("/buffers/{index}/uri"),
+                        format!(
+                            "buffer {index}: its file no longer holds the bytes it had when opened"
+                        ),
+                    )
+                }),
         }
     }
 
-    /// Buffer `index`, for reading a part at a time ([`BufferData`]); refused as
-    /// [`Asset::buffer_bytes`] refuses it (it does not exist, cannot be opened, or is shorter
-    /// than its byteLength).
+    /// Buffer `index`, for reading a part at a time ([`BufferData`]): the GLB BIN chunk, a
+    /// `data:` URI or a file. Refused when it does not exist, cannot be opened, or is shorter
+    /// than its byteLength.
     pub fn buffer_data(&self, index: usize) -> Result<BufferData<'_>, Diagnostic> {
         let pointer = format!("/buffers/{index}");
         let buffer = self.root().pointer(&pointer).ok_or_else(|| {
@@ -731,7 +720,7 @@ impl Asset {
             )
         })?;
         let uri_pointer = format!("{pointer}/uri");
-        match buffer.get("uri").and_then(|u| u.as_str()) {
+        let data = match buffer.get("uri").and_then(|u| u.as_str()) {
             Some(uri) => match self.resolve(&uri, &uri_pointer)? {
                 Location::File(path) => {
                     let file = resource::open_file(&path, &uri, &uri_pointer)?;
@@ -745,19 +734,26 @@ impl Asset {
                                 format!("cannot read '{uri}' ({}): {e}", path.display()),
                             )
                         })?;
-                    check_buffer_length(buffer, index, len, &pointer)?;
-                    Ok(BufferData::File {
+                    BufferData::File {
                         file: std::sync::Mutex::new(file),
                         len,
-                    })
+                    }
                 }
-                Location::Data { bytes, .. } => {
-                    check_buffer_length(buffer, index, bytes.len(), &pointer)?;
-                    Ok(BufferData::Memory(Cow::Owned(bytes)))
+                Location::Data { bytes, .. } => BufferData::Memory(Cow::Owned(bytes)),
+            },
+            None => match (&self.bin, index) {
+                (Some(bin), 0) => BufferData::Memory(Cow::Borrowed(bin.as_slice())),
+                _ => {
+                    return Err(Diagnostic::new(
+                        &codes::IO_ERROR,
+                        &pointer,
+                        format!("buffer {index} has no uri and is not the GLB's BIN chunk"),
+                    ))
                 }
             },
-            None => self.buffer_bytes(index).map(BufferData::Memory),
-        }
+        };
+        check_buffer_length(buffer, index, data.len(), &pointer)?;
+        Ok(data)
     }
 
     /// The encoded bytes of image `index`, from its URI or its bufferView.

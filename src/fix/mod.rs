@@ -137,9 +137,12 @@ fn place_of(edit: &Edit) -> (u8, &str) {
 /// A key of the places `edits` name, in order: edits with equal keys are then compared whole,
 /// so two lists whose keys collide are still told apart.
 fn places_key(edits: &[Edit]) -> u64 {
-    use std::hash::BuildHasher;
-    foldhash::fast::FixedState::with_seed(0)
-        .hash_one(edits.iter().map(place_of).collect::<Vec<_>>())
+    use std::hash::{BuildHasher, Hash, Hasher};
+    let mut hasher = foldhash::fast::FixedState::with_seed(0).build_hasher();
+    for edit in edits {
+        place_of(edit).hash(&mut hasher);
+    }
+    hasher.finish()
 }
 
 /// Where one edit acts: the value it targets, the value holding that one, and whether it

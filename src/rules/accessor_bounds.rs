@@ -125,6 +125,18 @@ fn check_accessor(cx: &Context, i: usize, out: &mut Vec<Diagnostic>) {
         above: [0; MAX_COMPONENTS],
     };
     let mut invalid = 0;
+    // A value that is not finite: a finding (the first MAX_REPORTED of the accessor), and no
+    // part of the bounds.
+    let mut not_finite = |e: usize, c: usize, v: f64| {
+        if invalid < MAX_REPORTED {
+            out.push(Diagnostic::new(
+                &ACCESSOR_INVALID_FLOAT,
+                format!("/accessors/{i}"),
+                format!("the value at index {} is {}", e * n + c, name_of(v)),
+            ));
+        }
+        invalid += 1;
+    };
     if let Some((bytes, stride)) = elements.packed_floats() {
         // Floats as they lie, compared as single precision: a float converts to a double
         // exactly and in order, and the declared bounds are already single precision, so the
@@ -140,18 +152,7 @@ fn check_accessor(cx: &Context, i: usize, out: &mut Vec<Diagnostic>) {
             for (c, b) in element.chunks_exact(4).enumerate() {
                 let v = f32::from_le_bytes([b[0], b[1], b[2], b[3]]);
                 if !v.is_finite() {
-                    if invalid < MAX_REPORTED {
-                        out.push(Diagnostic::new(
-                            &ACCESSOR_INVALID_FLOAT,
-                            format!("/accessors/{i}"),
-                            format!(
-                                "the value at index {} is {}",
-                                e * n + c,
-                                name_of(f64::from(v))
-                            ),
-                        ));
-                    }
-                    invalid += 1;
+                    not_finite(e, c, f64::from(v));
                     continue;
                 }
                 low[c] = low[c].min(v);
@@ -168,14 +169,7 @@ fn check_accessor(cx: &Context, i: usize, out: &mut Vec<Diagnostic>) {
         elements.for_each(|e, values| {
             for (c, &v) in values.iter().enumerate() {
                 if !v.is_finite() {
-                    if invalid < MAX_REPORTED {
-                        out.push(Diagnostic::new(
-                            &ACCESSOR_INVALID_FLOAT,
-                            format!("/accessors/{i}"),
-                            format!("the value at index {} is {}", e * n + c, name_of(v)),
-                        ));
-                    }
-                    invalid += 1;
+                    not_finite(e, c, v);
                     continue;
                 }
                 tally.low[c] = tally.low[c].min(v);
@@ -373,6 +367,7 @@ mod tests {
             2.0,
             -0.25,
         ];
+        let mut codes_seen = std::collections::BTreeMap::new();
         let mut state = 12345u32;
         let mut next = || {
             state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
@@ -393,10 +388,27 @@ mod tests {
                         let fast = findings_read(&values, n, stride, &bounds, false);
                         let general = findings_read(&values, n, stride, &bounds, true);
                         assert_eq!(fast, general, "{n} components, {count} elements, {bounds}");
+                        for finding in &fast {
+                            let code = finding.split(' ').next().unwrap_or_default();
+                            *codes_seen.entry(code.to_string()).or_insert(0) += 1;
+                        }
                     }
                 }
             }
         }
+        // Every finding the rule makes was compared, not only clean accessors.
+        let codes: Vec<&str> = codes_seen.keys().map(String::as_str).collect();
+        assert_eq!(
+            codes,
+            [
+                "ACCESSOR_ELEMENT_OUT_OF_MAX_BOUND",
+                "ACCESSOR_ELEMENT_OUT_OF_MIN_BOUND",
+                "ACCESSOR_INVALID_FLOAT",
+                "ACCESSOR_MAX_MISMATCH",
+                "ACCESSOR_MIN_MISMATCH",
+            ],
+            "{codes_seen:?}"
+        );
     }
 
     #[test]

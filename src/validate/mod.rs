@@ -245,16 +245,20 @@ impl Validator {
         diagnostics: Vec<Diagnostic>,
         settings: &Settings,
     ) -> FileReport {
-        self.validate_asset_placed(path, asset, diagnostics, settings, true)
+        let mut report = self.validate_asset_unplaced(path, asset, diagnostics, settings);
+        self.place_findings(asset, &mut report);
+        report
     }
 
-    fn validate_asset_placed(
+    /// [`Validator::validate_asset`] without the findings' places in the text (line and
+    /// column), for a report that only decides something (a fixed text's, compared with the
+    /// file's); [`Validator::place_findings`] adds them if it is shown after all.
+    pub fn validate_asset_unplaced(
         &self,
         path: &Path,
         asset: &asset::Asset,
         diagnostics: Vec<Diagnostic>,
         settings: &Settings,
-        placed: bool,
     ) -> FileReport {
         let cx = Context::new(asset, self.schemas.get_or_init(Schemas::builtin))
             .reading_data(!settings.skip_data);
@@ -291,23 +295,7 @@ impl Validator {
             Some(info),
         );
         report.missing = missing;
-        if placed {
-            self.place_findings(asset, &mut report);
-        }
         report
-    }
-
-    /// [`Validator::validate_asset`] without the findings' places in the text (line and
-    /// column), for a report that only decides something (a fixed text's, compared with the
-    /// file's); [`Validator::place_findings`] adds them if it is shown after all.
-    pub fn validate_asset_unplaced(
-        &self,
-        path: &Path,
-        asset: &asset::Asset,
-        diagnostics: Vec<Diagnostic>,
-        settings: &Settings,
-    ) -> FileReport {
-        self.validate_asset_placed(path, asset, diagnostics, settings, false)
     }
 
     /// Each finding's place in `asset`'s text (line and column), where the report shows them
