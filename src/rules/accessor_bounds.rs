@@ -137,33 +137,41 @@ fn check_accessor(cx: &Context, i: usize, out: &mut Vec<Diagnostic>) {
         }
         invalid += 1;
     };
-    if let Some((bytes, stride)) = elements.packed_floats() {
+    let packed = elements
+        .packed_floats()
+        .filter(|_| PACKED_WIDTHS.contains(&n));
+    if let Some((bytes, stride)) = packed {
         // Floats as they lie, compared as single precision: a float converts to a double
         // exactly and in order, and the declared bounds are already single precision, so the
         // outcome is the general path's, at a fraction of its cost.
         let bound =
             |b: &Option<Vec<f64>>, c: usize, none: f32| b.as_ref().map_or(none, |b| b[c] as f32);
-        let floor: Vec<f32> = (0..n).map(|c| bound(&min, c, f32::NEG_INFINITY)).collect();
-        let ceiling: Vec<f32> = (0..n).map(|c| bound(&max, c, f32::INFINITY)).collect();
-        let mut low = [f32::INFINITY; MAX_COMPONENTS];
-        let mut high = [f32::NEG_INFINITY; MAX_COMPONENTS];
-        for e in 0..elements.count {
-            let element = &bytes[e * stride..e * stride + 4 * n];
-            for (c, b) in element.chunks_exact(4).enumerate() {
-                let v = f32::from_le_bytes([b[0], b[1], b[2], b[3]]);
-                if !v.is_finite() {
-                    not_finite(e, c, f64::from(v));
-                    continue;
-                }
-                low[c] = low[c].min(v);
-                high[c] = high[c].max(v);
-                tally.below[c] += usize::from(v < floor[c]);
-                tally.above[c] += usize::from(v > ceiling[c]);
-            }
+        let mut floats = FloatTally {
+            floor: [f32::NEG_INFINITY; MAX_COMPONENTS],
+            ceiling: [f32::INFINITY; MAX_COMPONENTS],
+            low: [f32::INFINITY; MAX_COMPONENTS],
+            high: [f32::NEG_INFINITY; MAX_COMPONENTS],
+            below: [0; MAX_COMPONENTS],
+            above: [0; MAX_COMPONENTS],
+        };
+        for c in 0..n {
+            floats.floor[c] = bound(&min, c, f32::NEG_INFINITY);
+            floats.ceiling[c] = bound(&max, c, f32::INFINITY);
+        }
+        let count = elements.count;
+        match n {
+            1 => floats.scan::<1>(bytes, stride, count, &mut not_finite),
+            2 => floats.scan::<2>(bytes, stride, count, &mut not_finite),
+            3 => floats.scan::<3>(bytes, stride, count, &mut not_finite),
+            4 => floats.scan::<4>(bytes, stride, count, &mut not_finite),
+            9 => floats.scan::<9>(bytes, stride, count, &mut not_finite),
+            _ => floats.scan::<16>(bytes, stride, count, &mut not_finite),
         }
         for c in 0..n {
-            tally.low[c] = f64::from(low[c]);
-            tally.high[c] = f64::from(high[c]);
+            tally.low[c] = f64::from(floats.low[c]);
+            tally.high[c] = f64::from(floats.high[c]);
+            tally.below[c] = floats.below[c];
+            tally.above[c] = floats.above[c];
         }
     } else {
         elements.for_each(|e, values| {
@@ -229,6 +237,58 @@ fn check_accessor(cx: &Context, i: usize, out: &mut Vec<Diagnostic>) {
                 ));
             }
         }
+    }
+}
+
+/// The numbers of components [`FloatTally::scan`] is made for: every type's (SCALAR, VEC2,
+/// VEC3, VEC4 and MAT2, MAT3, MAT4).
+const PACKED_WIDTHS: [usize; 6] = [1, 2, 3, 4, 9, 16];
+
+/// A float accessor's declared bounds, actual extremes and values beyond the bounds,
+/// component by component, in single precision.
+struct FloatTally {
+    floor: [f32; MAX_COMPONENTS],
+    ceiling: [f32; MAX_COMPONENTS],
+    low: [f32; MAX_COMPONENTS],
+    high: [f32; MAX_COMPONENTS],
+    below: [usize; MAX_COMPONENTS],
+    above: [usize; MAX_COMPONENTS],
+}
+
+impl FloatTally {
+    /// The walk over `count` packed float elements of `N` components, `stride` bytes apart:
+    /// the data checks' hottest loop, its width fixed when compiled so that the walk over an
+    /// element's components is unrolled and unchecked.
+    fn scan<const N: usize>(
+        &mut self,
+        bytes: &[u8],
+        stride: usize,
+        count: usize,
+        not_finite: &mut impl FnMut(usize, usize, f64),
+    ) {
+        let floor: [f32; N] = std::array::from_fn(|c| self.floor[c]);
+        let ceiling: [f32; N] = std::array::from_fn(|c| self.ceiling[c]);
+        let (mut low, mut high) = ([f32::INFINITY; N], [f32::NEG_INFINITY; N]);
+        let (mut below, mut above) = ([0usize; N], [0usize; N]);
+        for e in 0..count {
+            let element = &bytes[e * stride..e * stride + 4 * N];
+            for c in 0..N {
+                let b = &element[4 * c..4 * c + 4];
+                let v = f32::from_le_bytes([b[0], b[1], b[2], b[3]]);
+                if !v.is_finite() {
+                    not_finite(e, c, f64::from(v));
+                    continue;
+                }
+                low[c] = low[c].min(v);
+                high[c] = high[c].max(v);
+                below[c] += usize::from(v < floor[c]);
+                above[c] += usize::from(v > ceiling[c]);
+            }
+        }
+        self.low[..N].copy_from_slice(&low);
+        self.high[..N].copy_from_slice(&high);
+        self.below[..N].copy_from_slice(&below);
+        self.above[..N].copy_from_slice(&above);
     }
 }
 
@@ -313,7 +373,14 @@ mod tests {
         for v in &values[..n] {
             bytes.extend_from_slice(&v.to_le_bytes());
         }
-        let kind = ["SCALAR", "VEC2", "VEC3", "VEC4"][n - 1];
+        let kind = match n {
+            1 => "SCALAR",
+            2 => "VEC2",
+            3 => "VEC3",
+            4 => "VEC4",
+            9 => "MAT3",
+            _ => "MAT4",
+        };
         let sparse = if sparse {
             r#","sparse":{"count":1,"indices":{"bufferView":1,"componentType":5125},"values":{"bufferView":2}}"#
         } else {
@@ -373,7 +440,8 @@ mod tests {
             state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
             pool[(state >> 28) as usize]
         };
-        for n in 1..=4 {
+        // Every width the walk is made for: SCALAR, VEC2, VEC3, VEC4 (and MAT2), MAT3, MAT4.
+        for n in PACKED_WIDTHS {
             for count in [1, 2, 7] {
                 let values: Vec<f32> = (0..n * count).map(|_| next()).collect();
                 let finite: Vec<f32> = values.iter().copied().filter(|v| v.is_finite()).collect();

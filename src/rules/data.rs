@@ -267,34 +267,31 @@ impl<'a> Elements<'a> {
             return;
         }
         // Packed components: the type chosen once an element, not once a component (most of
-        // a data-heavy document's reading is float vectors).
+        // a data-heavy document's reading is float vectors and integer indices).
         let packed = &base.bytes[start..start + self.size * values.len()];
         match self.component_type {
-            5126 => {
-                for (slot, b) in values.iter_mut().zip(packed.chunks_exact(4)) {
-                    *slot = f64::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]]));
-                }
-            }
-            5125 => {
-                for (slot, b) in values.iter_mut().zip(packed.chunks_exact(4)) {
-                    *slot = f64::from(u32::from_le_bytes([b[0], b[1], b[2], b[3]]));
-                }
-            }
-            _ => {
-                for (slot, b) in values.iter_mut().zip(packed.chunks_exact(self.size)) {
-                    *slot = self.read(b);
-                }
-            }
+            5126 => decode(packed, values, |b: [u8; 4]| f32::from_le_bytes(b).into()),
+            5125 => decode(packed, values, |b: [u8; 4]| u32::from_le_bytes(b).into()),
+            5123 => decode(packed, values, |b: [u8; 2]| u16::from_le_bytes(b).into()),
+            5122 => decode(packed, values, |b: [u8; 2]| i16::from_le_bytes(b).into()),
+            5121 => decode(packed, values, |b: [u8; 1]| b[0].into()),
+            5120 => decode(packed, values, |b: [u8; 1]| (b[0] as i8).into()),
+            _ => values.fill(0.0),
         }
     }
 
-    /// The stored bytes of a float accessor with no sparse substitutions and no padded
-    /// columns, and the bytes from one element to the next: its values can be read as they
-    /// lie, without the general reader's steps (the data checks' hottest loop).
-    pub fn packed_floats(&self) -> Option<(&[u8], usize)> {
+    /// The stored bytes of an accessor with no sparse substitutions and no padded columns,
+    /// and the bytes from one element to the next: its values can be read as they lie,
+    /// without the general reader's steps (the data checks' hottest loops).
+    pub fn packed(&self) -> Option<(&[u8], usize)> {
         let base = self.base.as_ref()?;
-        (self.sparse.is_none() && base.columns.is_none() && self.component_type == 5126)
+        (self.sparse.is_none() && base.columns.is_none())
             .then(|| (base.bytes.as_ref(), base.stride))
+    }
+
+    /// [`Elements::packed`] for a float accessor.
+    pub fn packed_floats(&self) -> Option<(&[u8], usize)> {
+        self.packed().filter(|_| self.component_type == 5126)
     }
 
     /// Calls `visit` with each element's index and its stored components, in order, with the
@@ -329,6 +326,16 @@ impl<'a> Elements<'a> {
             }
             visit(i, values);
         }
+    }
+}
+
+/// Packed components of `N` bytes each into `values`, one `convert` each.
+#[inline(always)]
+fn decode<const N: usize>(packed: &[u8], values: &mut [f64], convert: impl Fn([u8; N]) -> f64) {
+    for (slot, b) in values.iter_mut().zip(packed.chunks_exact(N)) {
+        let mut bytes = [0; N];
+        bytes.copy_from_slice(b);
+        *slot = convert(bytes);
     }
 }
 

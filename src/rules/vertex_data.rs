@@ -84,7 +84,7 @@ pub const ACCESSOR_JOINTS_USED_ZERO_WEIGHT: Code = Code::new(
 pub struct VertexData;
 
 /// Findings of one kind at one place, counted so that each stops at [`MAX_REPORTED`]; the
-/// places are one primitive's, cleared before the next.
+/// places are one primitive's.
 struct Capped<'o> {
     out: &'o mut Vec<Diagnostic>,
     counts: Vec<(&'static str, String, usize)>,
@@ -133,6 +133,7 @@ impl Rule for VertexData {
     }
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
+        use rayon::prelude::*;
         if !cx.reads_data() {
             return;
         }
@@ -141,89 +142,121 @@ impl Rule for VertexData {
             return;
         };
         let joint_limits = joint_limits(cx);
-        let mut capped = Capped {
-            out,
-            counts: Vec::new(),
-        };
-        // An accessor's values are judged once for each kind of use, at its first use, as the
-        // Khronos validator does: a colour accessor shared by COLOR_0 and COLOR_1 is one finding.
+        // Which accessors each primitive judges is settled first, in document order: an
+        // accessor's values are judged once for each kind of use, at its first use, as the
+        // Khronos validator does (a colour accessor shared by COLOR_0 and COLOR_1 is one
+        // finding). The primitives are then read side by side (a document's weight is often in
+        // a few large meshes), their findings joined in document order.
         let mut judged: std::collections::HashSet<(&str, usize)> = std::collections::HashSet::new();
+        let mut uses = Vec::new();
         for (m, mesh) in elements(Some(meshes)).enumerate() {
             for (p, primitive) in elements(mesh.get("primitives")).enumerate() {
-                // Every place a count keeps is inside this primitive.
-                capped.counts.clear();
                 let Some(attributes) = primitive.get("attributes").and_then(|a| a.as_object())
                 else {
                     continue;
                 };
-                let at = format!("/meshes/{m}/primitives/{p}");
-                let mut read = |kind: &'static str, name: &str| {
-                    let index = index_of(attributes.get(name))?;
-                    judged
-                        .insert((kind, index))
-                        .then(|| Elements::of(cx, index))
-                        .flatten()
+                let mut first = |kind: &'static str, name: &str| {
+                    index_of(attributes.get(name)).filter(|&index| judged.insert((kind, index)))
                 };
-                let vertices = index_of(attributes.get("POSITION"))
-                    .and_then(|i| cx.json().get("accessors")?.get(i)?.get("count")?.as_u64());
-                if let (Some(indices), Some(vertices)) = (
-                    index_of(primitive.get("indices")).and_then(|i| Elements::of(cx, i)),
-                    vertices,
-                ) {
-                    let mode = primitive.get("mode").map_or(Some(4), |m| m.as_u64());
-                    check_indices(
-                        &indices,
-                        vertices,
-                        mode,
-                        &format!("{at}/indices"),
-                        &mut capped,
-                    );
-                }
-                if let Some(normals) = read("normal", "NORMAL").filter(|e| e.components == 3) {
-                    let at = format!("{at}/attributes/NORMAL");
-                    normals.for_each(|i, v| unit_length(&normals, i, v, 3, &at, &mut capped));
-                }
-                if let Some(tangents) = read("tangent", "TANGENT").filter(|e| e.components == 4) {
-                    let at = format!("{at}/attributes/TANGENT");
-                    tangents.for_each(|i, v| {
-                        let w = tangents.normalize(v[3]);
-                        if w != 1.0 && w != -1.0 {
-                            capped.push(&ACCESSOR_INVALID_SIGN, &at, || {
-                                format!(
-                                    "the tangent at indices {}..{} has w {w}; it must be 1 or -1",
-                                    i * 4,
-                                    i * 4 + 3
-                                )
-                            });
-                        }
-                        unit_length(&tangents, i, &v[..3], 4, &at, &mut capped);
-                    });
-                }
-                for (name, _) in attributes.iter().filter(|(n, _)| n.starts_with("COLOR_")) {
-                    let Some(colors) = read("color", &name).filter(|e| e.component_type == 5126)
-                    else {
-                        continue;
-                    };
-                    let at = format!("{at}/attributes/{}", pointer::escape(&name));
-                    let n = colors.components;
-                    colors.for_each(|i, v| {
-                        for (c, &value) in v.iter().enumerate() {
-                            if !(0.0..=1.0).contains(&value) {
-                                capped.push(&ACCESSOR_NON_CLAMPED, &at, || {
-                                    format!(
-                                        "the value at index {} is not within 0..1: {value}",
-                                        i * n + c
-                                    )
-                                });
-                            }
-                        }
-                    });
-                }
-                let limit = joint_limits.get(&m).copied();
-                check_skinning(cx, attributes, &at, limit, &mut capped);
+                let normal = first("normal", "NORMAL");
+                let tangent = first("tangent", "TANGENT");
+                let colors: Vec<(String, usize)> = attributes
+                    .iter()
+                    .filter(|(name, _)| name.starts_with("COLOR_"))
+                    .filter_map(|(name, _)| first("color", &name).map(|i| (name.into_owned(), i)))
+                    .collect();
+                uses.push(PrimitiveUses {
+                    mesh: m,
+                    at: format!("/meshes/{m}/primitives/{p}"),
+                    primitive,
+                    attributes,
+                    normal,
+                    tangent,
+                    colors,
+                });
             }
         }
+        let found: Vec<Vec<Diagnostic>> = uses
+            .par_iter()
+            .map(|uses| {
+                let mut out = Vec::new();
+                let limit = joint_limits.get(&uses.mesh).copied();
+                check_primitive(cx, uses, limit, &mut out);
+                out
+            })
+            .collect();
+        out.extend(found.into_iter().flatten());
     }
+}
+
+/// One primitive, with the accessors it is the first to use for each kind of check.
+struct PrimitiveUses<'a> {
+    mesh: usize,
+    /// The primitive's pointer.
+    at: String,
+    primitive: crate::asset::tape::Node<'a>,
+    attributes: crate::asset::tape::Object<'a>,
+    normal: Option<usize>,
+    tangent: Option<usize>,
+    /// Each COLOR_n attribute's name and accessor.
+    colors: Vec<(String, usize)>,
+}
+
+/// One primitive's data: its indices, the normals, tangents and colours it is the first to
+/// use, its weights and joints. `limit`: the fewest joints of a skin that draws its mesh.
+fn check_primitive(
+    cx: &Context,
+    uses: &PrimitiveUses,
+    limit: Option<(usize, usize)>,
+    out: &mut Vec<Diagnostic>,
+) {
+    let (primitive, attributes, at) = (uses.primitive, uses.attributes, uses.at.as_str());
+    let mut capped = Capped {
+        out,
+        counts: Vec::new(),
+    };
+    let vertices = index_of(attributes.get("POSITION"))
+        .and_then(|i| cx.json().get("accessors")?.get(i)?.get("count")?.as_u64());
+    if let (Some(indices), Some(vertices)) = (
+        index_of(primitive.get("indices")).and_then(|i| Elements::of(cx, i)),
+        vertices,
+    ) {
+        let mode = primitive.get("mode").map_or(Some(4), |m| m.as_u64());
+        check_indices(
+            &indices,
+            vertices,
+            mode,
+            &format!("{at}/indices"),
+            &mut capped,
+        );
+    }
+    let read = |index: Option<usize>| index.and_then(|i| Elements::of(cx, i));
+    if let Some(normals) = read(uses.normal).filter(|e| e.components == 3) {
+        check_directions(&normals, &format!("{at}/attributes/NORMAL"), &mut capped);
+    }
+    if let Some(tangents) = read(uses.tangent).filter(|e| e.components == 4) {
+        check_directions(&tangents, &format!("{at}/attributes/TANGENT"), &mut capped);
+    }
+    for (name, index) in &uses.colors {
+        let Some(colors) = read(Some(*index)).filter(|e| e.component_type == 5126) else {
+            continue;
+        };
+        let at = format!("{at}/attributes/{}", pointer::escape(name));
+        let n = colors.components;
+        colors.for_each(|i, v| {
+            for (c, &value) in v.iter().enumerate() {
+                if !(0.0..=1.0).contains(&value) {
+                    capped.push(&ACCESSOR_NON_CLAMPED, &at, || {
+                        format!(
+                            "the value at index {} is not within 0..1: {value}",
+                            i * n + c
+                        )
+                    });
+                }
+            }
+        });
+    }
+    check_skinning(cx, attributes, at, limit, &mut capped);
 }
 
 /// Indices against the primitive's vertices and the restart value of their type, and for
@@ -239,39 +272,42 @@ fn check_indices(
         return;
     }
     let restart = match indices.component_type {
-        5121 => f64::from(u8::MAX),
-        5123 => f64::from(u16::MAX),
-        5125 => f64::from(u32::MAX),
+        5121 => u64::from(u8::MAX),
+        5123 => u64::from(u16::MAX),
+        5125 => u64::from(u32::MAX),
         _ => return,
     };
-    let vertices = vertices as f64;
-    let triangles = mode == Some(4);
-    let (mut corner, mut degenerate) = ([0.0; 3], 0usize);
-    indices.for_each(|i, v| {
-        let index = v[0];
-        if triangles {
-            corner[i % 3] = index;
-            if i % 3 == 2
-                && (corner[0] == corner[1] || corner[1] == corner[2] || corner[0] == corner[2])
-            {
-                degenerate += 1;
+    let mut judge = IndexJudge {
+        vertices,
+        restart,
+        triangles: mode == Some(4),
+        corner: [0; 3],
+        degenerate: 0,
+        at,
+        capped,
+    };
+    match indices.packed() {
+        // Indices as they lie, read as integers (a document's indices are often most of its
+        // values).
+        Some((bytes, stride)) => {
+            let at = |i: usize| &bytes[i * stride..];
+            for i in 0..indices.count {
+                let index = match restart {
+                    255 => u64::from(at(i)[0]),
+                    65535 => u64::from(u16::from_le_bytes([at(i)[0], at(i)[1]])),
+                    _ => {
+                        let b = at(i);
+                        u64::from(u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+                    }
+                };
+                judge.index(i, index);
             }
         }
-        if index == restart {
-            capped.push(&ACCESSOR_INDEX_PRIMITIVE_RESTART, at, || {
-                format!("the index at {i} is {index}, the primitive restart value of its type")
-            });
-        } else if index >= vertices {
-            capped.push(&ACCESSOR_INDEX_OOB, at, || {
-                format!(
-                    "the index at {i} is {index}, past the primitive's last vertex ({})",
-                    vertices - 1.0
-                )
-            });
-        }
-    });
-    if degenerate > 0 {
-        let all = indices.count / 3;
+        // Unsigned integers of at most 32 bits: exact as doubles.
+        None => indices.for_each(|i, v| judge.index(i, v[0] as u64)),
+    }
+    if judge.degenerate > 0 {
+        let (degenerate, all) = (judge.degenerate, indices.count / 3);
         capped.push(&ACCESSOR_INDEX_TRIANGLE_DEGENERATE, at, || {
             format!(
                 "{degenerate} of the {all} triangles name a vertex twice and are drawn as nothing"
@@ -280,7 +316,85 @@ fn check_indices(
     }
 }
 
+/// The walk over a primitive's indices, one at a time.
+struct IndexJudge<'c, 'o> {
+    vertices: u64,
+    restart: u64,
+    triangles: bool,
+    /// The current triangle's corners.
+    corner: [u64; 3],
+    /// Triangles that name a vertex twice, so far.
+    degenerate: usize,
+    at: &'c str,
+    capped: &'c mut Capped<'o>,
+}
+
+impl IndexJudge<'_, '_> {
+    #[inline(always)]
+    fn index(&mut self, i: usize, index: u64) {
+        if self.triangles {
+            let corner = &mut self.corner;
+            corner[i % 3] = index;
+            if i % 3 == 2
+                && (corner[0] == corner[1] || corner[1] == corner[2] || corner[0] == corner[2])
+            {
+                self.degenerate += 1;
+            }
+        }
+        if index == self.restart {
+            self.capped
+                .push(&ACCESSOR_INDEX_PRIMITIVE_RESTART, self.at, || {
+                    format!("the index at {i} is {index}, the primitive restart value of its type")
+                });
+        } else if index >= self.vertices {
+            // The last vertex as the reference's message gives it (-1 for a primitive with no
+            // vertices).
+            let last = self.vertices as f64 - 1.0;
+            self.capped.push(&ACCESSOR_INDEX_OOB, self.at, || {
+                format!("the index at {i} is {index}, past the primitive's last vertex ({last})")
+            });
+        }
+    }
+}
+
+/// Normals (three components) or tangents (four, whose w is checked too) against unit length,
+/// read as they lie when they are plain floats.
+fn check_directions(elements: &Elements, at: &str, capped: &mut Capped) {
+    let n = elements.components;
+    match elements.packed_floats() {
+        Some((bytes, stride)) => {
+            let mut v = [0.0; 4];
+            for i in 0..elements.count {
+                let element = &bytes[i * stride..i * stride + 4 * n];
+                for (slot, b) in v.iter_mut().zip(element.chunks_exact(4)) {
+                    *slot = f64::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]]));
+                }
+                check_direction(elements, i, &v[..n], at, capped);
+            }
+        }
+        None => elements.for_each(|i, v| check_direction(elements, i, v, at, capped)),
+    }
+}
+
+#[inline(always)]
+fn check_direction(elements: &Elements, i: usize, v: &[f64], at: &str, capped: &mut Capped) {
+    if let [_, _, _, w] = *v {
+        let w = elements.normalize(w);
+        if w != 1.0 && w != -1.0 {
+            capped.push(&ACCESSOR_INVALID_SIGN, at, || {
+                format!(
+                    "the tangent at indices {}..{} has w {w}; it must be 1 or -1",
+                    i * 4,
+                    i * 4 + 3
+                )
+            });
+        }
+    }
+    unit_length(elements, i, &v[..3], v.len(), at, capped);
+}
+
 /// A vector's length (its first three components, as a loader reads them) against 1.
+#[inline(always)]
 fn unit_length(
     elements: &Elements,
     i: usize,
@@ -290,7 +404,11 @@ fn unit_length(
     capped: &mut Capped,
 ) {
     // Compared squared: the root is taken only for a finding's message.
-    let squared: f64 = v[..3].iter().map(|c| elements.normalize(*c).powi(2)).sum();
+    let squared: f64 = if elements.normalized {
+        v[..3].iter().map(|c| elements.normalize(*c).powi(2)).sum()
+    } else {
+        v[0] * v[0] + v[1] * v[1] + v[2] * v[2]
+    };
     let (low, high) = (
         (1.0 - UNIT_LENGTH_VEC3).powi(2),
         (1.0 + UNIT_LENGTH_VEC3).powi(2),
@@ -460,6 +578,18 @@ mod tests {
     use base64::Engine;
 
     fn document(values: &[(&str, u64, &str, Vec<f32>)], primitive: &str, extra: &str) -> String {
+        document_with_meshes(
+            values,
+            &format!(r#"[{{"primitives":[{primitive}]}}]"#),
+            extra,
+        )
+    }
+
+    fn document_with_meshes(
+        values: &[(&str, u64, &str, Vec<f32>)],
+        meshes: &str,
+        extra: &str,
+    ) -> String {
         let mut bytes = Vec::new();
         let mut views = Vec::new();
         let mut accessors = Vec::new();
@@ -497,7 +627,7 @@ mod tests {
         let data = base64::engine::general_purpose::STANDARD.encode(&bytes);
         format!(
             r#"{{"asset":{{"version":"2.0"}},"buffers":[{{"byteLength":{},"uri":"data:application/octet-stream;base64,{data}"}}],
-            "bufferViews":[{}],"accessors":[{}],"meshes":[{{"primitives":[{primitive}]}}]{extra}}}"#,
+            "bufferViews":[{}],"accessors":[{}],"meshes":{meshes}{extra}}}"#,
             bytes.len(),
             views.join(","),
             accessors.join(",")
@@ -575,6 +705,182 @@ mod tests {
                 "ACCESSOR_WEIGHTS_NEGATIVE /meshes/0/primitives/0/attributes/WEIGHTS_0",
                 "ACCESSOR_JOINTS_INDEX_DUPLICATE /meshes/0/primitives/0/attributes/JOINTS_0",
                 "ACCESSOR_WEIGHTS_NON_NORMALIZED /meshes/0/primitives/0/attributes/WEIGHTS_0",
+            ]
+        );
+    }
+
+    /// Every finding (code, pointer, message) of a primitive whose indices, normals and
+    /// tangents hold `indices`, `normals` and `tangents`: stored in buffer views (`sparse`
+    /// false: read as they lie), or as sparse substitutions of every element of accessors
+    /// without a view (read by the general reader).
+    fn findings_read(
+        index_type: u64,
+        indices: &[u32],
+        normals: &[f32],
+        tangents: &[f32],
+        sparse: bool,
+    ) -> Vec<String> {
+        let mut bytes: Vec<u8> = Vec::new();
+        let (mut views, mut accessors) = (Vec::new(), Vec::new());
+        let mut view = |bytes: &mut Vec<u8>, part: &[u8]| {
+            let start = bytes.len();
+            bytes.extend_from_slice(part);
+            bytes.resize(bytes.len().next_multiple_of(4), 0);
+            views.push(format!(
+                r#"{{"buffer":0,"byteOffset":{start},"byteLength":{}}}"#,
+                part.len()
+            ));
+            views.len() - 1
+        };
+        let index_bytes: Vec<u8> = indices
+            .iter()
+            .flat_map(|&i| match index_type {
+                5121 => vec![i as u8],
+                5123 => (i as u16).to_le_bytes().to_vec(),
+                _ => i.to_le_bytes().to_vec(),
+            })
+            .collect();
+        let floats =
+            |values: &[f32]| -> Vec<u8> { values.iter().flat_map(|v| v.to_le_bytes()).collect() };
+        let positions = view(&mut bytes, &floats(&[0.0; 12]));
+        accessors.push(format!(
+            r#"{{"bufferView":{positions},"componentType":5126,"count":4,"type":"VEC3","min":[0,0,0],"max":[0,0,0]}}"#
+        ));
+        for (component, kind, count, part) in [
+            (index_type, "SCALAR", indices.len(), index_bytes),
+            (5126, "VEC3", normals.len() / 3, floats(normals)),
+            (5126, "VEC4", tangents.len() / 4, floats(tangents)),
+        ] {
+            let data = view(&mut bytes, &part);
+            accessors.push(if sparse {
+                let every: Vec<u8> = (0..count as u32).flat_map(|i| i.to_le_bytes()).collect();
+                let at = view(&mut bytes, &every);
+                format!(
+                    r#"{{"componentType":{component},"count":{count},"type":"{kind}","sparse":{{"count":{count},
+                    "indices":{{"bufferView":{at},"componentType":5125}},"values":{{"bufferView":{data}}}}}}}"#
+                )
+            } else {
+                format!(
+                    r#"{{"bufferView":{data},"componentType":{component},"count":{count},"type":"{kind}"}}"#
+                )
+            });
+        }
+        let data = base64::engine::general_purpose::STANDARD.encode(&bytes);
+        let text = format!(
+            r#"{{"asset":{{"version":"2.0"}},"buffers":[{{"byteLength":{},"uri":"data:application/octet-stream;base64,{data}"}}],
+            "bufferViews":[{}],"accessors":[{}],"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0,"NORMAL":2,"TANGENT":3}},"indices":1}}]}}]}}"#,
+            bytes.len(),
+            views.join(","),
+            accessors.join(",")
+        );
+        let loaded = crate::asset::load_bytes_with(
+            std::path::Path::new("t.gltf"),
+            text.as_bytes(),
+            &crate::asset::LoadOptions::default(),
+        );
+        let asset = loaded.asset.expect("the document parses");
+        let schemas = crate::rules::schema::Schemas::builtin();
+        let cx = Context::new(&asset, &schemas);
+        let mut out = Vec::new();
+        VertexData.check(&cx, &mut out);
+        out.iter()
+            .map(|d| format!("{} {} {}", d.code, d.pointer, d.message))
+            .collect()
+    }
+
+    #[test]
+    fn indices_and_directions_read_as_they_lie_give_the_general_readers_findings() {
+        // Four vertices; indices in range, past it, degenerate and at each type's restart
+        // value; normals and tangents of unit length, short, long, NaN, and w of 1, -1, 0, 2.
+        let normals = [
+            0.0,
+            0.0,
+            1.0,
+            0.6,
+            0.8,
+            0.0,
+            0.5,
+            0.0,
+            0.0,
+            2.0,
+            0.0,
+            0.0,
+            f32::NAN,
+            0.0,
+            1.0,
+        ];
+        let tangents = [
+            1.0, 0.0, 0.0, 1.0, 0.0, 1.0, 0.0, -1.0, 0.0, 0.0, 1.0, 0.0, 0.3, 0.0, 0.0, 2.0,
+        ];
+        let mut codes = std::collections::BTreeSet::new();
+        for (index_type, restart) in [(5121, 255), (5123, 65_535), (5125, u32::MAX)] {
+            let indices = [0, 1, 2, 2, 2, 3, 0, 4, restart, 1, 3, 7];
+            let fast = findings_read(index_type, &indices, &normals, &tangents, false);
+            let general = findings_read(index_type, &indices, &normals, &tangents, true);
+            assert_eq!(fast, general, "indices of type {index_type}");
+            codes.extend(
+                fast.iter()
+                    .map(|f| f.split(' ').next().unwrap_or_default().to_string()),
+            );
+            assert!(
+                fast.iter().any(|f| f.ends_with(&format!(
+                    "the index at 8 is {restart}, the primitive restart value of its type"
+                ))),
+                "{fast:?}"
+            );
+        }
+        assert_eq!(
+            codes.into_iter().collect::<Vec<_>>(),
+            [
+                "ACCESSOR_INDEX_OOB",
+                "ACCESSOR_INDEX_PRIMITIVE_RESTART",
+                "ACCESSOR_INDEX_TRIANGLE_DEGENERATE",
+                "ACCESSOR_INVALID_SIGN",
+                "ACCESSOR_VECTOR3_NON_UNIT",
+            ]
+        );
+    }
+
+    #[test]
+    fn primitives_read_side_by_side_report_in_document_order_each_accessor_at_its_first_use() {
+        // Mesh 0 and mesh 1 each have a normal that is too long; they share a colour
+        // accessor with a value above 1, judged at its first use (mesh 0) only; mesh 1's
+        // index 5 is past its three vertices.
+        let values = [
+            ("VEC3", 5126, "POSITION", vec![0.0; 9]),
+            (
+                "VEC3",
+                5126,
+                "NORMAL",
+                vec![0.0, 0.0, 2.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0],
+            ),
+            (
+                "VEC3",
+                5126,
+                "NORMAL",
+                vec![0.0, 0.0, 1.0, 0.0, 3.0, 0.0, 0.0, 0.0, 1.0],
+            ),
+            (
+                "VEC4",
+                5126,
+                "COLOR_0",
+                vec![1.5, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
+            ),
+            ("SCALAR", 5121, "indices", vec![0.0, 1.0, 5.0]),
+        ];
+        let text = document_with_meshes(
+            &values,
+            r#"[{"primitives":[{"attributes":{"POSITION":0,"NORMAL":1,"COLOR_0":3}}]},
+                {"primitives":[{"attributes":{"POSITION":0,"NORMAL":2,"COLOR_0":3},"indices":4}]}]"#,
+            "",
+        );
+        assert_eq!(
+            crate::rules::findings_of(&VertexData, &text),
+            [
+                "ACCESSOR_VECTOR3_NON_UNIT /meshes/0/primitives/0/attributes/NORMAL",
+                "ACCESSOR_NON_CLAMPED /meshes/0/primitives/0/attributes/COLOR_0",
+                "ACCESSOR_INDEX_OOB /meshes/1/primitives/0/indices",
+                "ACCESSOR_VECTOR3_NON_UNIT /meshes/1/primitives/0/attributes/NORMAL",
             ]
         );
     }
