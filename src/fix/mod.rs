@@ -134,6 +134,16 @@ fn place_of(edit: &Edit) -> (u8, &str) {
     }
 }
 
+/// The JSON pointer of the value `edit` changes.
+fn edited_pointer(edit: &Edit) -> &str {
+    match edit {
+        Edit::Set { pointer, .. } | Edit::Replace { pointer, .. } | Edit::Remove { pointer } => {
+            pointer
+        }
+        Edit::DeclareUsed { .. } => "/extensionsUsed",
+    }
+}
+
 /// A key of the places `edits` name, in order: edits with equal keys are then compared whole,
 /// so two lists whose keys collide are still told apart.
 fn places_key(edits: &[Edit]) -> u64 {
@@ -471,6 +481,7 @@ impl<'v> Fixing<'v> {
             info: None,
             missing: Default::default(),
             fixes,
+            rule_spans: Vec::new(),
         }
     }
 
@@ -816,10 +827,33 @@ impl<'v> Fixing<'v> {
         };
         // Its resources are the file's: what the file system said of them holds.
         after.share_lookups(source);
-        // Placed in the text (line and column) only if it becomes the file's report.
-        let report =
+        // Placed in the text (line and column) only if it becomes the file's report. The
+        // rules that read nothing the edits touch (the data checks, for most fixes) give the
+        // file's findings again: they are taken from its report rather than read again. A
+        // fix of the byte-order mark or the container changes what lies outside the text.
+        let report = if drops_byte_order_mark || rebuilds_container {
             self.validator
-                .validate_asset_unplaced(path, &after, loaded.diagnostics, settings);
+                .validate_asset_unplaced(path, &after, loaded.diagnostics, settings)
+        } else {
+            let root = source.root();
+            let exists = |pointer: &str| root.pointer(pointer).is_some();
+            let touched = |reads: &crate::rules::Reads| {
+                edits
+                    .iter()
+                    .any(|edit| reads.touched_by(edited_pointer(edit), exists))
+            };
+            let reuse = crate::validate::Reuse {
+                report: before,
+                touched: &touched,
+            };
+            self.validator.validate_asset_reusing(
+                path,
+                &after,
+                loaded.diagnostics,
+                settings,
+                &reuse,
+            )
+        };
         verdict(&before.findings, &report.findings, fixes).map_err(Failed::Findings)?;
         Ok(Fixed {
             changed,
@@ -1468,5 +1502,140 @@ mod tests {
                 fixer.code.name
             );
         }
+    }
+
+    /// Every finding of a report as code, severity, pointer and message.
+    fn listed(findings: &[Finding]) -> Vec<String> {
+        findings
+            .iter()
+            .map(|f| {
+                let d = &f.diagnostic;
+                format!("{} {:?} {} {}", d.code, d.severity, d.pointer, d.message)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_trial_takes_from_the_files_report_only_findings_that_hold_for_the_fixed_text() {
+        // A document with data findings (a min that is not the data's) and a fix that touches
+        // no data (a view's missing target), then every fixture folder's documents: each fix
+        // tried alone and all together. The trial's report, which takes the findings of rules
+        // whose reads the edits leave alone from the file's report, must be the fixed text's
+        // report made whole.
+        use base64::Engine;
+        let floats: Vec<u8> = [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0]
+            .iter()
+            .flat_map(|v| v.to_le_bytes())
+            .collect();
+        let data = base64::engine::general_purpose::STANDARD.encode(&floats);
+        let with_data = format!(
+            r#"{{"asset":{{"version":"2.0"}},"buffers":[{{"byteLength":36,"uri":"data:application/octet-stream;base64,{data}"}}],
+            "bufferViews":[{{"buffer":0,"byteLength":36}}],
+            "accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0.5]}}],
+            "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}}}}]}}],
+            "nodes":[{{"mesh":0}}],"scenes":[{{"nodes":[0]}}],"scene":0}}"#
+        );
+        let dir = tempfile::tempdir().expect("a temporary folder");
+        let made = dir.path().join("data.gltf");
+        std::fs::write(&made, with_data).expect("the document is written");
+        let mut documents = vec![made];
+        let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/validate");
+        let mut folders: Vec<PathBuf> = std::fs::read_dir(&fixtures)
+            .expect("the fixtures are there")
+            .map(|e| e.expect("a fixture folder").path())
+            .collect();
+        folders.sort();
+        for folder in folders {
+            let mut files: Vec<PathBuf> = std::fs::read_dir(&folder)
+                .into_iter()
+                .flatten()
+                .map(|e| e.expect("a fixture").path())
+                .filter(|p| p.extension().is_some_and(|e| e == "gltf" || e == "glb"))
+                .collect();
+            files.sort();
+            documents.extend(files);
+        }
+        let validator = Validator::new(
+            crate::rules::schema::Schemas::builtin(),
+            Settings::default(),
+        );
+        let fixing = Fixing::new(
+            &validator,
+            Mode {
+                apply: false,
+                diff: false,
+                unsafe_fixes: true,
+                edits: false,
+            },
+        );
+        let settings = Settings::default();
+        let data_codes: Vec<&str> = crate::rules::REGISTRY
+            .iter()
+            .filter(|rule| matches!(rule.reads(), crate::rules::Reads::Properties { .. }))
+            .flat_map(|rule| rule.codes().iter().map(|c| c.name))
+            .collect();
+        let (mut trials, mut taken) = (0, 0);
+        for path in &documents {
+            let loaded = asset::load_with(path, &validator.load);
+            let Some(source) = loaded.asset else {
+                continue;
+            };
+            let before = validator.validate_asset(path, &source, loaded.diagnostics, &settings);
+            let fixes = plan(&source, &before.findings);
+            let all: Vec<&Fix> = fixes.iter().collect();
+            let tries = fixes.iter().map(|f| vec![f]).chain([all]);
+            for tried in tries.filter(|t| !t.is_empty()) {
+                let Ok(fixed) = fixing.attempt(path, &source, &before, &tried, &settings) else {
+                    continue;
+                };
+                let again = asset::load_bytes_with(path, &fixed.bytes, &validator.load);
+                let whole = validator.validate_asset_unplaced(
+                    path,
+                    again.asset.as_ref().expect("the fixed text loads"),
+                    again.diagnostics,
+                    &settings,
+                );
+                assert_eq!(
+                    listed(&fixed.report.findings),
+                    listed(&whole.findings),
+                    "{}: {:?}",
+                    path.display(),
+                    tried.iter().map(|f| &f.title).collect::<Vec<_>>()
+                );
+                trials += 1;
+                let edits = combined(source.root(), &tried);
+                let exists = |p: &str| source.root().pointer(p).is_some();
+                let data_untouched = !tried
+                    .iter()
+                    .any(|f| f.drops_byte_order_mark || f.rebuilds_container)
+                    && !edits.iter().any(|e| {
+                        crate::rules::data::DATA_READS.touched_by(edited_pointer(e), exists)
+                    });
+                let data_found = before
+                    .findings
+                    .iter()
+                    .any(|f| data_codes.contains(&f.diagnostic.code));
+                taken += usize::from(data_untouched && data_found);
+            }
+        }
+        // The comparison covered trials whose data findings were taken from the file's report.
+        assert!(trials > 100, "{trials} trials");
+        assert!(taken >= 1, "{taken} of {trials} trials took data findings");
+    }
+
+    #[test]
+    fn an_edit_touches_what_a_rule_reads_unless_it_is_elsewhere_or_an_excepted_member() {
+        let reads = crate::rules::data::DATA_READS;
+        let exists = |p: &str| p == "/bufferViews/0";
+        assert!(reads.touched_by("", exists));
+        assert!(reads.touched_by("/accessors/3/min/0", exists));
+        assert!(reads.touched_by("/bufferViews/0/byteStride", exists));
+        assert!(reads.touched_by("/bufferViews", exists));
+        assert!(!reads.touched_by("/materials/0/extensions", exists));
+        assert!(!reads.touched_by("/extensionsUsed", exists));
+        assert!(!reads.touched_by("/bufferViews/0/target", exists));
+        // Setting a member of a view that is not there creates the view.
+        assert!(reads.touched_by("/bufferViews/1/target", exists));
+        assert!(crate::rules::Reads::Document.touched_by("/materials/0", exists));
     }
 }

@@ -457,6 +457,7 @@ mod tests {
             }),
             missing: Default::default(),
             fixes: Default::default(),
+            rule_spans: Vec::new(),
         }
     }
 

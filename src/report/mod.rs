@@ -225,6 +225,7 @@ pub fn failed_run(format: Format, message: &str, json_array: bool) -> String {
         info: None,
         missing: MissingResources::default(),
         fixes: Default::default(),
+        rule_spans: Vec::new(),
     };
     match format {
         Format::Text => String::new(),

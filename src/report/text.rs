@@ -304,6 +304,7 @@ mod tests {
             info: None,
             missing: Default::default(),
             fixes: Default::default(),
+            rule_spans: Vec::new(),
         }
     }
 

@@ -72,6 +72,10 @@ impl Rule for AccessorBounds {
         4
     }
 
+    fn reads(&self) -> super::Reads {
+        super::data::DATA_READS
+    }
+
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
         use rayon::prelude::*;
         if !cx.reads_data() {

@@ -44,6 +44,10 @@ impl Rule for AnimationData {
         ]
     }
 
+    fn reads(&self) -> super::Reads {
+        super::data::DATA_READS
+    }
+
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
         if !cx.reads_data() {
             return;

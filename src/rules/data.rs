@@ -21,6 +21,22 @@ use crate::asset::BufferData;
 use std::borrow::Cow;
 use std::sync::OnceLock;
 
+/// What the data checks read: accessors, their views and buffers, and what draws, skins and
+/// animates them. A view's `target` is no part of it (BUFFER_VIEW_TARGET_MISSING's fix sets it),
+/// so a trial of that fix does not read a document's data again.
+pub const DATA_READS: super::Reads = super::Reads::Properties {
+    properties: &[
+        "accessors",
+        "bufferViews",
+        "buffers",
+        "meshes",
+        "nodes",
+        "skins",
+        "animations",
+    ],
+    except: &[("bufferViews", "target")],
+};
+
 /// The document's buffers, each opened on first use and kept for the other rules.
 pub struct Buffers<'a> {
     slots: Vec<OnceLock<Option<BufferData<'a>>>>,

@@ -237,6 +237,47 @@ pub struct MaterialLayers<'l> {
     pub sheen: Option<&'l SheenView>,
     pub fuzz: Option<&'l FuzzView>,
 }
+/// The parts of a document a rule's findings depend on. A fix's trial validates the fixed
+/// text again: a rule that reads nothing the fixes' edits touch gives the findings it gave the
+/// file, and the trial takes them from the file's report instead of reading the data again.
+#[derive(Debug, Clone, Copy)]
+pub enum Reads {
+    /// Anything in the document: the rule runs again after any edit.
+    Document,
+    /// Only the values of these top-level properties, less the `except` members of their
+    /// elements (`("bufferViews", "target")`: no data check reads a view's target).
+    Properties {
+        properties: &'static [&'static str],
+        except: &'static [(&'static str, &'static str)],
+    },
+}
+
+impl Reads {
+    /// Whether an edit at JSON pointer `pointer` may change what the rule reads; an edit of an
+    /// excepted member counts only where `element_exists` says the element it is in (the
+    /// pointer's first two tokens) is already there, since a set creates what it misses.
+    pub fn touched_by(&self, pointer: &str, element_exists: impl Fn(&str) -> bool) -> bool {
+        let Reads::Properties { properties, except } = self else {
+            return true;
+        };
+        let mut tokens = pointer.split('/').skip(1);
+        let Some(property) = tokens.next() else {
+            // The whole document.
+            return true;
+        };
+        if !properties.contains(&property) {
+            return false;
+        }
+        let (index, member) = (tokens.next(), tokens.next());
+        match (index, member) {
+            (Some(index), Some(member)) if except.contains(&(property, member)) => {
+                !element_exists(&format!("/{property}/{index}"))
+            }
+            _ => true,
+        }
+    }
+}
+
 /// A validation rule.
 pub trait Rule: Sync {
     /// The codes this rule may emit.
@@ -251,6 +292,11 @@ pub trait Rule: Sync {
     /// schema check, which does not read them, starts beside it.
     fn cost(&self) -> u32 {
         1
+    }
+    /// What the rule's findings depend on (see [`Reads`]); a rule that says nothing depends on
+    /// the whole document.
+    fn reads(&self) -> Reads {
+        Reads::Document
     }
 }
 

@@ -24,6 +24,10 @@ impl Rule for SkinData {
         &[&ACCESSOR_INVALID_IBM]
     }
 
+    fn reads(&self) -> super::Reads {
+        super::data::DATA_READS
+    }
+
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
         if !cx.reads_data() {
             return;

@@ -33,6 +33,10 @@ impl Rule for SparseData {
         ]
     }
 
+    fn reads(&self) -> super::Reads {
+        super::data::DATA_READS
+    }
+
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
         if !cx.reads_data() || cx.json().members_named("sparse").next().is_none() {
             return;

@@ -85,6 +85,38 @@ pub struct FileReport {
     pub missing: MissingResources,
     /// The fixes planned for the file (see `crate::fix`); empty when none were planned.
     pub fixes: crate::diagnostics::fixes::FileFixes,
+    /// Where each group of findings lies in `findings`: the loader's, then each registered
+    /// rule's in registry order; empty when a `--max-issues` cap reordered them. A trial of
+    /// the file's fixes takes from here the findings of the rules the fixes leave alone.
+    pub rule_spans: Vec<std::ops::Range<usize>>,
+}
+
+/// What a trial of a file's fixes may take from the file's report instead of running a rule
+/// again: the findings of each rule whose reads ([`rules::Reads`]) the fixes' edits do not
+/// touch. The file's report is of every finding (uncapped), under the trial's settings.
+pub struct Reuse<'r> {
+    pub report: &'r FileReport,
+    /// Whether the edits touch what a rule reads.
+    pub touched: &'r (dyn Fn(&rules::Reads) -> bool + Sync),
+}
+
+impl Reuse<'_> {
+    /// Rule `index`'s findings in the file's report, when they hold for the edited text too.
+    fn findings_of(&self, index: usize) -> Option<Vec<Diagnostic>> {
+        let spans = &self.report.rule_spans;
+        if spans.len() != rules::REGISTRY.len() + 1
+            || (self.touched)(&rules::REGISTRY[index].reads())
+        {
+            return None;
+        }
+        let span = spans[index + 1].clone();
+        Some(
+            self.report.findings[span]
+                .iter()
+                .map(|f| f.diagnostic.clone())
+                .collect(),
+        )
+    }
 }
 
 impl FileReport {
@@ -260,6 +292,30 @@ impl Validator {
         diagnostics: Vec<Diagnostic>,
         settings: &Settings,
     ) -> FileReport {
+        self.validate_unplaced(path, asset, diagnostics, settings, None)
+    }
+
+    /// [`Validator::validate_asset_unplaced`] of a file's fixed text, taking from the file's
+    /// report the findings of the rules its fixes leave alone (see [`Reuse`]).
+    pub fn validate_asset_reusing(
+        &self,
+        path: &Path,
+        asset: &asset::Asset,
+        diagnostics: Vec<Diagnostic>,
+        settings: &Settings,
+        reuse: &Reuse,
+    ) -> FileReport {
+        self.validate_unplaced(path, asset, diagnostics, settings, Some(reuse))
+    }
+
+    fn validate_unplaced(
+        &self,
+        path: &Path,
+        asset: &asset::Asset,
+        diagnostics: Vec<Diagnostic>,
+        settings: &Settings,
+        reuse: Option<&Reuse>,
+    ) -> FileReport {
         let cx = Context::new(asset, self.schemas.get_or_init(Schemas::builtin))
             .reading_data(!settings.skip_data);
         // A large text, or (with the data checks) large buffers: a document whose weight is in
@@ -277,9 +333,9 @@ impl Validator {
         let parallel = asset.json_text.len() >= PARALLEL_RULES_FROM
             || (!settings.skip_data && data_bytes() >= PARALLEL_RULES_FROM as u64);
         let (found, info) = if parallel {
-            rayon::join(|| run_rules(&cx, true), || asset_info(asset.root()))
+            rayon::join(|| run_rules(&cx, true, reuse), || asset_info(asset.root()))
         } else {
-            (run_rules(&cx, false), asset_info(asset.root()))
+            (run_rules(&cx, false, reuse), asset_info(asset.root()))
         };
         // The rules' shared reading of the document goes before the findings are listed.
         drop(cx);
@@ -334,7 +390,9 @@ impl Validator {
         let mut findings: Vec<Finding> = Vec::with_capacity(groups.iter().map(Vec::len).sum());
         asset::pages::advise_huge(&mut findings);
         let mut counts = Counts::default();
+        let mut rule_spans = Vec::with_capacity(groups.len());
         for group in groups {
+            let start = findings.len();
             for mut diagnostic in group {
                 if settings.ignore.contains(diagnostic.code) {
                     continue;
@@ -348,9 +406,11 @@ impl Validator {
                     diagnostic,
                 });
             }
+            rule_spans.push(start..findings.len());
         }
         let mut omitted = 0;
         if let Some(max) = settings.max_issues.filter(|max| findings.len() > *max) {
+            rule_spans.clear();
             // The listing keeps the most severe findings: errors before warnings before infos.
             findings.sort_by_key(|f| f.diagnostic.severity);
             omitted = findings.len() - max;
@@ -366,6 +426,7 @@ impl Validator {
             info,
             missing: MissingResources::default(),
             fixes: Default::default(),
+            rule_spans,
         }
     }
 }
@@ -398,10 +459,20 @@ fn missing_resources(
     }
 }
 
-/// Every registered rule's findings, in registry order, a list per rule. In parallel each
-/// rule keeps its own list, so the report does not depend on which rule finished first.
-fn run_rules(cx: &Context, parallel: bool) -> Vec<Vec<Diagnostic>> {
+/// Every registered rule's findings, in registry order, a list per rule (taken from `reuse`
+/// where it holds them). In parallel each rule keeps its own list, so the report does not
+/// depend on which rule finished first.
+fn run_rules(cx: &Context, parallel: bool, reuse: Option<&Reuse>) -> Vec<Vec<Diagnostic>> {
     crate::progress::stage("checking rules", rules::REGISTRY.len());
+    let run = |i: usize| {
+        let found = reuse.and_then(|r| r.findings_of(i)).unwrap_or_else(|| {
+            let mut out = Vec::new();
+            rules::REGISTRY[i].check(cx, &mut out);
+            out
+        });
+        crate::progress::advance(1);
+        found
+    };
     if parallel {
         // Each rule is a task of its own, taken dearest first by whichever thread is free
         // (split in registry order, three of the four dear rules fell to one core and the
@@ -417,10 +488,7 @@ fn run_rules(cx: &Context, parallel: bool) -> Vec<Vec<Diagnostic>> {
                     while let Some(&i) =
                         order.get(next.fetch_add(1, std::sync::atomic::Ordering::Relaxed))
                     {
-                        let mut out = Vec::new();
-                        rules::REGISTRY[i].check(cx, &mut out);
-                        let _ = found[i].set(out);
-                        crate::progress::advance(1);
+                        let _ = found[i].set(run(i));
                     }
                 });
             }
@@ -430,12 +498,7 @@ fn run_rules(cx: &Context, parallel: bool) -> Vec<Vec<Diagnostic>> {
             .map(|list| list.into_inner().unwrap_or_default())
             .collect()
     } else {
-        let mut out = Vec::new();
-        for rule in rules::REGISTRY {
-            rule.check(cx, &mut out);
-            crate::progress::advance(1);
-        }
-        vec![out]
+        (0..rules::REGISTRY.len()).map(run).collect()
     }
 }
 
@@ -535,10 +598,10 @@ mod tests {
         let asset = loaded.asset.expect("the document parses");
         let schemas = Schemas::builtin();
         let cx = Context::new(&asset, &schemas);
-        let sequential: Vec<Diagnostic> = run_rules(&cx, false).concat();
+        let sequential: Vec<Diagnostic> = run_rules(&cx, false, None).concat();
         assert!(sequential.len() > 500, "{} findings", sequential.len());
         for _ in 0..4 {
-            assert_eq!(run_rules(&cx, true).concat(), sequential);
+            assert_eq!(run_rules(&cx, true, None).concat(), sequential);
         }
     }
 }
