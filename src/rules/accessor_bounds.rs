@@ -12,6 +12,7 @@
 //! Float accessors are compared in single precision, as their values are stored: a declared
 //! 0.1 matches a stored 0.1f. Non-finite values take no part in the bounds.
 
+use super::accessor_declared_bounds::declared_bound;
 use super::data::{accessor_count, Elements, MAX_COMPONENTS};
 use super::{Context, Rule};
 use crate::diagnostics::{Code, Diagnostic, Severity};
@@ -101,27 +102,22 @@ fn check_accessor(cx: &Context, i: usize, out: &mut Vec<Diagnostic>) {
     let Some(accessor) = accessors.and_then(|a| a.get(i)) else {
         return;
     };
-    let bound = |key: &str| -> Option<Vec<f64>> {
-        let values = accessor.get(key)?.as_array()?;
-        values.iter().map(|v| v.as_f64()).collect()
-    };
-    let (min, max) = (bound("min"), bound("max"));
     let float = accessor.get("componentType").and_then(|c| c.as_u64()) == Some(5126);
-    if min.is_none() && max.is_none() && !float {
+    if accessor.get("min").is_none() && accessor.get("max").is_none() && !float {
         return;
     }
     let Some(elements) = Elements::of(cx, i) else {
         return;
     };
     let n = elements.components;
-    // Declared bounds as the data holds them: single precision for floats.
+    // Declared bounds as the data holds them: single precision for floats. A bound of the
+    // wrong length, or an integer one not whole or out of range, is the JSON's finding
+    // (`accessor_declared_bounds`), and no bound here, as in the reference.
     let stored = |v: f64| if float { f64::from(v as f32) } else { v };
-    let min = min
-        .filter(|m| m.len() == n)
-        .map(|m| m.into_iter().map(stored).collect::<Vec<_>>());
-    let max = max
-        .filter(|m| m.len() == n)
-        .map(|m| m.into_iter().map(stored).collect::<Vec<_>>());
+    let bound = |key: &str| {
+        declared_bound(accessor, key, n).map(|b| b.into_iter().map(stored).collect::<Vec<_>>())
+    };
+    let (min, max) = (bound("min"), bound("max"));
     let mut tally = Tally {
         low: [f64::INFINITY; MAX_COMPONENTS],
         high: [f64::NEG_INFINITY; MAX_COMPONENTS],

@@ -6,6 +6,7 @@
 //! Rules read the asset and push diagnostics; they never change anything.
 
 pub mod accessor_bounds;
+pub mod accessor_declared_bounds;
 pub mod accessors;
 pub mod animation_data;
 pub mod animations;
@@ -314,6 +315,7 @@ pub static REGISTRY: &[&dyn Rule] = &[
     &references::References,
     &attributes::Attributes,
     &accessors::Accessors,
+    &accessor_declared_bounds::AccessorDeclaredBounds,
     &accessor_bounds::AccessorBounds,
     &vertex_data::VertexData,
     &animation_data::AnimationData,
