@@ -7,6 +7,7 @@
 
 pub mod accessor_bounds;
 pub mod accessor_declared_bounds;
+pub mod accessor_usage;
 pub mod accessors;
 pub mod animation_data;
 pub mod animations;
@@ -316,6 +317,7 @@ pub static REGISTRY: &[&dyn Rule] = &[
     &attributes::Attributes,
     &accessors::Accessors,
     &accessor_declared_bounds::AccessorDeclaredBounds,
+    &accessor_usage::AccessorUsage,
     &accessor_bounds::AccessorBounds,
     &vertex_data::VertexData,
     &animation_data::AnimationData,
