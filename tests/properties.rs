@@ -718,6 +718,7 @@ proptest! {
                         | "ACCESSOR_TOTAL_OFFSET_ALIGNMENT"
                         | "ACCESSOR_TOO_LONG"
                         | "ACCESSOR_SPARSE_COUNT_OUT_OF_RANGE"
+                        | "ACCESSOR_USAGE_OVERRIDE"
                 )
         };
         let kept: Vec<String> = with
