@@ -45,6 +45,16 @@ pub fn replacements(source: &str, spliced: &Spliced) -> Vec<Replacement> {
         }
         i += 2;
     }
+    // Kept pieces of the source in order, from its first byte to its last, with the new texts
+    // between them: the replacements give the spliced text by construction, and the text is
+    // not joined to be compared (two copies of a large document for each round of fixes).
+    let end_of = |piece: &[u8]| offset_in_source(piece).map(|at| at + piece.len());
+    let covers_source = pieces.first().and_then(|p| offset_in_source(p)) == Some(0)
+        && pieces.last().and_then(|p| end_of(p)) == Some(source.len());
+    if laid_out && covers_source {
+        debug_assert_eq!(apply(source, &out), spliced.to_text());
+        return out;
+    }
     let joined = spliced.to_text();
     if laid_out && apply(source, &out) == joined {
         return out;
