@@ -536,10 +536,10 @@ fn check_bin_length(json: tape::Node, bin: Option<&[u8]>, out: &mut Vec<Diagnost
 /// it was read whole (docs/performance.md).
 pub enum BufferData<'a> {
     Memory(Cow<'a, [u8]>),
-    /// The file (one reader at a time: a read is a seek and a read) and its length when it was
-    /// opened.
+    /// The file and its length when it was opened. Reads are positional (no shared cursor):
+    /// the data checks read one buffer from several threads at once.
     File {
-        file: std::sync::Mutex<std::fs::File>,
+        file: std::fs::File,
         len: usize,
     },
 }
@@ -566,14 +566,35 @@ impl BufferData<'_> {
                 if range.start > range.end || range.end > *len {
                     return None;
                 }
-                use std::io::{Read, Seek, SeekFrom};
                 let mut bytes = vec![0u8; range.len()];
-                let mut file = file.lock().unwrap_or_else(|e| e.into_inner());
-                file.seek(SeekFrom::Start(range.start as u64)).ok()?;
-                file.read_exact(&mut bytes).ok()?;
+                read_exact_at(file, &mut bytes, range.start as u64).ok()?;
                 Some(Cow::Owned(bytes))
             }
         }
+    }
+}
+
+/// Fills `buf` from `file` at `offset`, leaving the file's cursor to no one: an error when the
+/// file ends first.
+fn read_exact_at(file: &std::fs::File, buf: &mut [u8], offset: u64) -> std::io::Result<()> {
+    #[cfg(unix)]
+    {
+        std::os::unix::fs::FileExt::read_exact_at(file, buf, offset)
+    }
+    #[cfg(windows)]
+    {
+        let mut done = 0;
+        while done < buf.len() {
+            match std::os::windows::fs::FileExt::seek_read(
+                file,
+                &mut buf[done..],
+                offset + done as u64,
+            )? {
+                0 => return Err(std::io::ErrorKind::UnexpectedEof.into()),
+                n => done += n,
+            }
+        }
+        Ok(())
     }
 }
 
@@ -734,10 +755,7 @@ impl Asset {
                                 format!("cannot read '{uri}' ({}): {e}", path.display()),
                             )
                         })?;
-                    BufferData::File {
-                        file: std::sync::Mutex::new(file),
-                        len,
-                    }
+                    BufferData::File { file, len }
                 }
                 Location::Data { bytes, .. } => BufferData::Memory(Cow::Owned(bytes)),
             },

@@ -831,29 +831,25 @@ impl<'v> Fixing<'v> {
         // rules that read nothing the edits touch (the data checks, for most fixes) give the
         // file's findings again: they are taken from its report rather than read again. A
         // fix of the byte-order mark or the container changes what lies outside the text.
-        let report = if drops_byte_order_mark || rebuilds_container {
-            self.validator
-                .validate_asset_unplaced(path, &after, loaded.diagnostics, settings)
-        } else {
-            let root = source.root();
-            let exists = |pointer: &str| root.pointer(pointer).is_some();
-            let touched = |reads: &crate::rules::Reads| {
-                edits
-                    .iter()
-                    .any(|edit| reads.touched_by(edited_pointer(edit), exists))
-            };
-            let reuse = crate::validate::Reuse {
-                report: before,
-                touched: &touched,
-            };
-            self.validator.validate_asset_reusing(
-                path,
-                &after,
-                loaded.diagnostics,
-                settings,
-                &reuse,
-            )
+        let root = source.root();
+        let exists = |pointer: &str| root.pointer(pointer).is_some();
+        let touched = |reads: &crate::rules::Reads| {
+            edits
+                .iter()
+                .any(|edit| reads.touched_by(edited_pointer(edit), exists))
         };
+        let reuse = crate::validate::Reuse {
+            report: before,
+            touched: &touched,
+        };
+        let outside_the_text = drops_byte_order_mark || rebuilds_container;
+        let report = self.validator.validate_asset_unplaced(
+            path,
+            &after,
+            loaded.diagnostics,
+            settings,
+            (!outside_the_text).then_some(&reuse),
+        );
         verdict(&before.findings, &report.findings, fixes).map_err(Failed::Findings)?;
         Ok(Fixed {
             changed,
@@ -1594,6 +1590,7 @@ mod tests {
                     again.asset.as_ref().expect("the fixed text loads"),
                     again.diagnostics,
                     &settings,
+                    None,
                 );
                 assert_eq!(
                     listed(&fixed.report.findings),

@@ -396,20 +396,7 @@ mod tests {
             base_len + 4,
             4 * n
         );
-        let schemas = crate::rules::schema::Schemas::builtin();
-        let asset = crate::asset::load_bytes_with(
-            std::path::Path::new("t.gltf"),
-            text.as_bytes(),
-            &crate::asset::LoadOptions::default(),
-        )
-        .asset
-        .expect("the document parses");
-        let cx = Context::new(&asset, &schemas);
-        let mut out = Vec::new();
-        AccessorBounds.check(&cx, &mut out);
-        out.iter()
-            .map(|d| format!("{} {} {}", d.code, d.pointer, d.message))
-            .collect()
+        crate::rules::findings_with_messages_of(&AccessorBounds, &text)
     }
 
     #[test]

@@ -37,29 +37,49 @@ fn integer_range(component_type: u64) -> Option<(&'static str, f64, f64)> {
     })
 }
 
-/// What is wrong with one of `accessor`'s bounds (`key`: "min" or "max"), as findings; none
-/// when it is absent, not an array of numbers (the schema's finding) or sound.
-fn faults(accessor: Node, key: &str, at: &str) -> Vec<Diagnostic> {
-    let mut found = Vec::new();
+/// What can be wrong with one value of an integer accessor's bound.
+enum IntegerFault {
+    /// Not a whole number: ARRAY_TYPE_MISMATCH.
+    NotWhole,
+    /// Outside the component type's range: INVALID_GL_VALUE.
+    OutOfRange,
+}
+
+/// What is wrong with `value` as a bound of an integer accessor whose component type holds
+/// `low..=high`, if anything.
+fn integer_fault(value: f64, low: f64, high: f64) -> Option<IntegerFault> {
+    if value.fract() != 0.0 || !value.is_finite() {
+        Some(IntegerFault::NotWhole)
+    } else if value < low || value > high {
+        Some(IntegerFault::OutOfRange)
+    } else {
+        None
+    }
+}
+
+/// What is wrong with one of `accessor`'s bounds (`key`: "min" or "max"), pushed to `out`;
+/// nothing when it is absent, not an array of numbers (the schema's finding) or sound.
+fn check_bound(accessor: Node, key: &str, at: &str, out: &mut Vec<Diagnostic>) {
     let Some(values) = accessor.get(key).and_then(|b| b.as_array()) else {
-        return found;
+        return;
     };
     let component_type = accessor.get("componentType").and_then(|c| c.as_u64());
     let kind = accessor.get("type").and_then(|t| t.as_str());
     let (Some(component_type), Some(kind)) = (component_type, kind) else {
-        return found;
+        return;
     };
     let Some(n) = components(&kind).and_then(|n| usize::try_from(n).ok()) else {
-        return found;
+        return;
     };
-    if component_type != 5126 && integer_range(component_type).is_none() {
-        return found;
+    let range = integer_range(component_type);
+    if component_type != 5126 && range.is_none() {
+        return;
     }
     let pointer = format!("{at}/{key}");
     let length = values.len();
     if length != n {
         if (1..=16).contains(&length) {
-            found.push(Diagnostic::new(
+            out.push(Diagnostic::new(
                 &ARRAY_LENGTH_NOT_IN_LIST,
                 pointer,
                 format!(
@@ -68,27 +88,25 @@ fn faults(accessor: Node, key: &str, at: &str) -> Vec<Diagnostic> {
                 ),
             ));
         }
-        return found;
+        return;
     }
-    let Some((name, low, high)) = integer_range(component_type) else {
-        return found;
+    let Some((name, low, high)) = range else {
+        return;
     };
     for value in values.iter().filter_map(|v| v.as_f64()) {
-        if value.fract() != 0.0 || !value.is_finite() {
-            found.push(Diagnostic::new(
+        let (code, message) = match integer_fault(value, low, high) {
+            None => continue,
+            Some(IntegerFault::NotWhole) => (
                 &super::core::ARRAY_TYPE_MISMATCH,
-                pointer.clone(),
                 format!("{key} holds {value}, not a whole number: the bounds of {name} accessor are integers"),
-            ));
-        } else if value < low || value > high {
-            found.push(Diagnostic::new(
+            ),
+            Some(IntegerFault::OutOfRange) => (
                 &INVALID_GL_VALUE,
-                pointer.clone(),
                 format!("{key} holds {value}, outside the range of {name}, {low}..{high}"),
-            ));
-        }
+            ),
+        };
+        out.push(Diagnostic::new(code, pointer.clone(), message));
     }
-    found
 }
 
 /// `accessor`'s `key` bound ("min" or "max") as the data checks read it: one number a
@@ -105,8 +123,10 @@ pub fn declared_bound(accessor: Node, key: &str, components: usize) -> Option<Ve
     }
     let component_type = accessor.get("componentType").and_then(|c| c.as_u64())?;
     if let Some((_, low, high)) = integer_range(component_type) {
-        let sound = |v: &f64| v.fract() == 0.0 && (low..=high).contains(v);
-        if !values.iter().all(sound) {
+        if values
+            .iter()
+            .any(|&v| integer_fault(v, low, high).is_some())
+        {
             return None;
         }
     }
@@ -125,8 +145,8 @@ impl Rule for AccessorDeclaredBounds {
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
         for (i, accessor) in elements(cx.json().get("accessors")).enumerate() {
             let at = format!("/accessors/{i}");
-            out.extend(faults(accessor, "min", &at));
-            out.extend(faults(accessor, "max", &at));
+            check_bound(accessor, "min", &at, out);
+            check_bound(accessor, "max", &at, out);
         }
     }
 }

@@ -52,15 +52,17 @@ struct Uses {
 
 impl Uses {
     fn set(&mut self, accessor: Option<usize>, usage: Usage, at: String) {
-        let Some(slot) = accessor.and_then(|a| self.first.get_mut(a)) else {
+        let Some(index) = accessor else {
+            return;
+        };
+        let Some(slot) = self.first.get_mut(index) else {
             return;
         };
         match slot {
             None => *slot = Some((usage, at)),
             Some((initial, first_at)) if *initial != usage => {
                 let message = format!(
-                    "accessor {} is used here as {}, and first as {} (at {first_at})",
-                    accessor.unwrap_or_default(),
+                    "accessor {index} is used here as {}, and first as {} (at {first_at})",
                     usage.words(),
                     initial.words()
                 );

@@ -305,6 +305,15 @@ impl<'a> Elements<'a> {
             .then(|| (base.bytes.as_ref(), base.stride))
     }
 
+    /// The values of a scalar accessor of unsigned integers (indices) as they lie, when it is
+    /// [`Elements::packed`].
+    pub fn packed_unsigned(&self) -> Option<impl Iterator<Item = u64> + '_> {
+        let (bytes, stride) = self.packed()?;
+        let size = self.size;
+        (self.components == 1 && matches!(self.component_type, 5121 | 5123 | 5125))
+            .then(|| (0..self.count).map(move |i| unsigned_at(&bytes[i * stride..], size)))
+    }
+
     /// [`Elements::packed`] for a float accessor.
     pub fn packed_floats(&self) -> Option<(&[u8], usize)> {
         self.packed().filter(|_| self.component_type == 5126)
@@ -357,11 +366,19 @@ fn decode<const N: usize>(packed: &[u8], values: &mut [f64], convert: impl Fn([u
 
 /// Unsigned little-endian integers of `size` bytes (1, 2 or 4), one after the other.
 fn read_indices(bytes: &[u8], size: usize) -> impl Iterator<Item = u64> + '_ {
-    bytes.chunks_exact(size).map(move |at| match size {
+    bytes
+        .chunks_exact(size)
+        .map(move |at| unsigned_at(at, size))
+}
+
+/// The unsigned little-endian integer of `size` bytes (1, 2 or 4) that `at` starts with.
+#[inline(always)]
+fn unsigned_at(at: &[u8], size: usize) -> u64 {
+    match size {
         1 => u64::from(at[0]),
         2 => u64::from(u16::from_le_bytes([at[0], at[1]])),
         _ => u64::from(u32::from_le_bytes([at[0], at[1], at[2], at[3]])),
-    })
+    }
 }
 
 /// Accessor `index`'s sparse indices as stored, with the accessor's count, when they can be
@@ -530,7 +547,7 @@ mod tests {
         let path = dir.path().join("b.bin");
         std::fs::write(&path, [7u8; 64]).expect("the buffer is written");
         let data = BufferData::File {
-            file: std::sync::Mutex::new(std::fs::File::open(&path).expect("opened")),
+            file: std::fs::File::open(&path).expect("opened"),
             len: 64,
         };
         assert_eq!(data.read(60..64).as_deref(), Some(&[7u8; 4][..]));

@@ -378,6 +378,24 @@ pub use crate::layers::{as_index, layer_objects, slot_pointer, slot_uses, LayerO
 /// unit tests read them.
 #[cfg(test)]
 pub(crate) fn findings_of(rule: &dyn Rule, text: &str) -> Vec<String> {
+    diagnostics_of(rule, text)
+        .into_iter()
+        .map(|d| format!("{} {}", d.code, d.pointer))
+        .collect()
+}
+
+/// [`findings_of`] with each finding's message: "CODE pointer message".
+#[cfg(test)]
+pub(crate) fn findings_with_messages_of(rule: &dyn Rule, text: &str) -> Vec<String> {
+    diagnostics_of(rule, text)
+        .into_iter()
+        .map(|d| format!("{} {} {}", d.code, d.pointer, d.message))
+        .collect()
+}
+
+/// What `rule` finds in the document `text` (read as `t.gltf`).
+#[cfg(test)]
+fn diagnostics_of(rule: &dyn Rule, text: &str) -> Vec<Diagnostic> {
     let loaded = crate::asset::load_bytes_with(
         std::path::Path::new("t.gltf"),
         text.as_bytes(),
@@ -388,9 +406,7 @@ pub(crate) fn findings_of(rule: &dyn Rule, text: &str) -> Vec<String> {
     let cx = Context::new(&asset, &schemas);
     let mut out = Vec::new();
     rule.check(&cx, &mut out);
-    out.into_iter()
-        .map(|d| format!("{} {}", d.code, d.pointer))
-        .collect()
+    out
 }
 
 #[cfg(test)]

@@ -277,38 +277,17 @@ impl Validator {
         diagnostics: Vec<Diagnostic>,
         settings: &Settings,
     ) -> FileReport {
-        let mut report = self.validate_asset_unplaced(path, asset, diagnostics, settings);
+        let mut report = self.validate_asset_unplaced(path, asset, diagnostics, settings, None);
         self.place_findings(asset, &mut report);
         report
     }
 
     /// [`Validator::validate_asset`] without the findings' places in the text (line and
     /// column), for a report that only decides something (a fixed text's, compared with the
-    /// file's); [`Validator::place_findings`] adds them if it is shown after all.
+    /// file's); [`Validator::place_findings`] adds them if it is shown after all. A fixed
+    /// text's trial takes from the file's report the findings of the rules its fixes leave
+    /// alone (`reuse`, see [`Reuse`]).
     pub fn validate_asset_unplaced(
-        &self,
-        path: &Path,
-        asset: &asset::Asset,
-        diagnostics: Vec<Diagnostic>,
-        settings: &Settings,
-    ) -> FileReport {
-        self.validate_unplaced(path, asset, diagnostics, settings, None)
-    }
-
-    /// [`Validator::validate_asset_unplaced`] of a file's fixed text, taking from the file's
-    /// report the findings of the rules its fixes leave alone (see [`Reuse`]).
-    pub fn validate_asset_reusing(
-        &self,
-        path: &Path,
-        asset: &asset::Asset,
-        diagnostics: Vec<Diagnostic>,
-        settings: &Settings,
-        reuse: &Reuse,
-    ) -> FileReport {
-        self.validate_unplaced(path, asset, diagnostics, settings, Some(reuse))
-    }
-
-    fn validate_unplaced(
         &self,
         path: &Path,
         asset: &asset::Asset,
