@@ -134,6 +134,10 @@ pub fn declared_bound(accessor: Node, key: &str, components: usize) -> Option<Ve
 }
 
 impl Rule for AccessorDeclaredBounds {
+    fn reads(&self) -> super::Reads {
+        super::Reads::properties(&["accessors", "extensionsUsed"])
+    }
+
     fn codes(&self) -> &'static [&'static Code] {
         &[
             &ARRAY_LENGTH_NOT_IN_LIST,

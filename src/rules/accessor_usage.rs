@@ -75,6 +75,10 @@ impl Uses {
 }
 
 impl Rule for AccessorUsage {
+    fn reads(&self) -> super::Reads {
+        super::Reads::properties(&["accessors", "meshes", "skins", "animations"])
+    }
+
     fn codes(&self) -> &'static [&'static Code] {
         &[&ACCESSOR_USAGE_OVERRIDE]
     }

@@ -99,6 +99,13 @@ pub fn element_layout(size: u64, kind: &str) -> Option<(u64, u64)> {
 pub struct Accessors;
 
 impl Rule for Accessors {
+    fn reads(&self) -> super::Reads {
+        super::Reads::Properties {
+            properties: &["accessors", "bufferViews"],
+            except: &[("bufferViews", "target")],
+        }
+    }
+
     fn codes(&self) -> &'static [&'static Code] {
         &[
             &ACCESSOR_NORMALIZED_INVALID,

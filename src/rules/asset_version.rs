@@ -35,6 +35,10 @@ fn parse(text: &str) -> Option<(u32, u32)> {
 }
 
 impl Rule for AssetVersion {
+    fn reads(&self) -> super::Reads {
+        super::Reads::properties(&["asset"])
+    }
+
     fn codes(&self) -> &'static [&'static Code] {
         &[
             &UNKNOWN_ASSET_MAJOR_VERSION,

@@ -78,6 +78,10 @@ fn invalid(at: &str, name: &str, out: &mut Vec<Diagnostic>) {
 pub struct Attributes;
 
 impl Rule for Attributes {
+    fn reads(&self) -> super::Reads {
+        super::Reads::properties(&["meshes"])
+    }
+
     fn codes(&self) -> &'static [&'static Code] {
         &[
             &MESH_PRIMITIVE_INVALID_ATTRIBUTE,

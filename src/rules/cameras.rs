@@ -39,6 +39,10 @@ pub const CAMERA_YFOV_GEQUAL_PI: Code = Code::new(
 pub struct Cameras;
 
 impl Rule for Cameras {
+    fn reads(&self) -> super::Reads {
+        super::Reads::properties(&["cameras"])
+    }
+
     fn codes(&self) -> &'static [&'static Code] {
         &[
             &codes::UNDEFINED_PROPERTY,

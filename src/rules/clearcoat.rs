@@ -21,6 +21,10 @@ pub const FUZZ_OVER_CLEARCOAT: Code = Code::new(
 pub struct Clearcoat;
 
 impl Rule for Clearcoat {
+    fn reads(&self) -> super::Reads {
+        super::Reads::properties(&["materials"])
+    }
+
     fn codes(&self) -> &'static [&'static Code] {
         &[&SHEEN_UNDER_CLEARCOAT, &FUZZ_OVER_CLEARCOAT]
     }

@@ -26,6 +26,10 @@ const ROUGHNESS_TEXTURE: &str = "sheenRoughnessTexture";
 pub struct DisabledLayer;
 
 impl Rule for DisabledLayer {
+    fn reads(&self) -> super::Reads {
+        super::Reads::properties(&["materials"])
+    }
+
     fn codes(&self) -> &'static [&'static Code] {
         &[&SHEEN_TEXTURE_WITHOUT_EFFECT, &FUZZ_TEXTURE_WITHOUT_EFFECT]
     }

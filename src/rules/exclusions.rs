@@ -21,6 +21,10 @@ pub const FUZZ_EXCLUDED: Code = Code::new(
 pub struct Exclusions;
 
 impl Rule for Exclusions {
+    fn reads(&self) -> super::Reads {
+        super::Reads::properties(&["materials"])
+    }
+
     fn codes(&self) -> &'static [&'static Code] {
         &[&SHEEN_EXCLUDED, &FUZZ_EXCLUDED]
     }

@@ -41,6 +41,10 @@ pub fn is_extension_name(name: &str) -> bool {
 pub struct ExtensionNames;
 
 impl Rule for ExtensionNames {
+    fn reads(&self) -> super::Reads {
+        super::Reads::properties(&["extensionsUsed", "extensionsRequired"])
+    }
+
     fn codes(&self) -> &'static [&'static Code] {
         &[&INVALID_EXTENSION_NAME_FORMAT, &NON_REQUIRED_EXTENSION]
     }

@@ -27,6 +27,10 @@ pub const FUZZ_FALLBACK_CONTRADICTS: Code = Code::new(
 pub struct Fallback;
 
 impl Rule for Fallback {
+    fn reads(&self) -> super::Reads {
+        super::Reads::properties(&["materials", "extensionsRequired"])
+    }
+
     fn codes(&self) -> &'static [&'static Code] {
         &[
             &FUZZ_WITHOUT_FALLBACK,

@@ -16,6 +16,10 @@ pub const FUZZ_ROUGHNESS_DEFAULT_AMBIGUOUS: Code = Code::new(
 pub struct FuzzRoughnessDefault;
 
 impl Rule for FuzzRoughnessDefault {
+    fn reads(&self) -> super::Reads {
+        super::Reads::properties(&["materials"])
+    }
+
     fn codes(&self) -> &'static [&'static Code] {
         &[&FUZZ_ROUGHNESS_DEFAULT_AMBIGUOUS]
     }

@@ -40,6 +40,10 @@ pub const THRESHOLD: f64 = 0.1;
 pub struct FuzzRoughnessMapping;
 
 impl Rule for FuzzRoughnessMapping {
+    fn reads(&self) -> super::Reads {
+        super::Reads::properties(&["materials"])
+    }
+
     fn codes(&self) -> &'static [&'static Code] {
         &[&FUZZ_ROUGHNESS_FAR_FROM_FALLBACK]
     }

@@ -12,6 +12,14 @@ use std::collections::BTreeSet;
 pub struct ImageSize;
 
 impl Rule for ImageSize {
+    /// An image's header is read from its file, data URI or buffer view.
+    fn reads(&self) -> super::Reads {
+        super::Reads::Properties {
+            properties: &["materials", "textures", "images", "bufferViews", "buffers", "extensionsUsed"],
+            except: &[("bufferViews", "target")],
+        }
+    }
+
     fn codes(&self) -> &'static [&'static Code] {
         &[&codes::IMAGE_TOO_LARGE]
     }

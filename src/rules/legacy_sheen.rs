@@ -19,6 +19,10 @@ pub use crate::layers::LEGACY_PROPERTIES;
 pub struct LegacySheen;
 
 impl Rule for LegacySheen {
+    fn reads(&self) -> super::Reads {
+        super::Reads::properties(&["materials"])
+    }
+
     fn codes(&self) -> &'static [&'static Code] {
         &[&SHEEN_LEGACY_DRAFT]
     }

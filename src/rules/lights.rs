@@ -19,6 +19,10 @@ const OUTER_CONE_ANGLE: f64 = std::f64::consts::FRAC_PI_4;
 pub struct Lights;
 
 impl Rule for Lights {
+    fn reads(&self) -> super::Reads {
+        super::Reads::properties(&["extensions"])
+    }
+
     fn codes(&self) -> &'static [&'static Code] {
         &[
             &codes::UNDEFINED_PROPERTY,

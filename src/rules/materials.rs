@@ -68,6 +68,10 @@ const WHOLE_MATERIAL: [&str; 2] = ["KHR_materials_unlit", "KHR_materials_pbrSpec
 pub struct Materials;
 
 impl Rule for Materials {
+    fn reads(&self) -> super::Reads {
+        super::Reads::properties(&["materials"])
+    }
+
     fn codes(&self) -> &'static [&'static Code] {
         &[
             &MATERIAL_ALPHA_CUTOFF_INVALID_MODE,

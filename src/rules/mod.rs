@@ -255,6 +255,14 @@ pub enum Reads {
 }
 
 impl Reads {
+    /// Every value of these top-level properties.
+    pub const fn properties(properties: &'static [&'static str]) -> Reads {
+        Reads::Properties {
+            properties,
+            except: &[],
+        }
+    }
+
     /// Whether an edit at JSON pointer `pointer` may change what the rule reads; an edit of an
     /// excepted member counts only where `element_exists` says the element it is in (the
     /// pointer's first two tokens) is already there, since a set creates what it misses.

@@ -30,6 +30,10 @@ pub const SCENE_NON_ROOT_NODE: Code = Code::new(
 pub struct NodeTree;
 
 impl Rule for NodeTree {
+    fn reads(&self) -> super::Reads {
+        super::Reads::properties(&["nodes", "scenes"])
+    }
+
     fn codes(&self) -> &'static [&'static Code] {
         &[&NODE_PARENT_OVERRIDE, &NODE_LOOP, &SCENE_NON_ROOT_NODE]
     }

@@ -97,6 +97,10 @@ fn numbers<const N: usize>(value: Option<Node>) -> Option<[f64; N]> {
 pub struct Nodes;
 
 impl Rule for Nodes {
+    fn reads(&self) -> super::Reads {
+        super::Reads::properties(&["nodes", "meshes"])
+    }
+
     fn codes(&self) -> &'static [&'static Code] {
         &[
             &ROTATION_NON_UNIT,

@@ -179,6 +179,13 @@ fn fits_mode(mode: u64, count: u64) -> bool {
 pub struct Primitives;
 
 impl Rule for Primitives {
+    fn reads(&self) -> super::Reads {
+        super::Reads::Properties {
+            properties: &["meshes", "accessors", "bufferViews", "extensionsUsed"],
+            except: &[("bufferViews", "target")],
+        }
+    }
+
     fn codes(&self) -> &'static [&'static Code] {
         &[
             &MESH_PRIMITIVE_NO_POSITION,

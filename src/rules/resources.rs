@@ -82,6 +82,13 @@ pub const DATA_URI_NOT_BASE64: Code = Code::new(
 pub struct Resources;
 
 impl Rule for Resources {
+    fn reads(&self) -> super::Reads {
+        super::Reads::Properties {
+            properties: &["buffers", "bufferViews", "images", "extensionsUsed"],
+            except: &[("bufferViews", "target")],
+        }
+    }
+
     fn codes(&self) -> &'static [&'static Code] {
         &[
             &FILE_NOT_FOUND,

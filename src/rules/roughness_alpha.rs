@@ -21,6 +21,14 @@ pub const FUZZ_ROUGHNESS_WITHOUT_ALPHA: Code = Code::new(
 pub struct RoughnessAlpha;
 
 impl Rule for RoughnessAlpha {
+    /// An image's header is read from its file, data URI or buffer view.
+    fn reads(&self) -> super::Reads {
+        super::Reads::Properties {
+            properties: &["materials", "textures", "images", "bufferViews", "buffers"],
+            except: &[("bufferViews", "target")],
+        }
+    }
+
     fn codes(&self) -> &'static [&'static Code] {
         &[
             &SHEEN_ROUGHNESS_WITHOUT_ALPHA,

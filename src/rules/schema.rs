@@ -260,6 +260,11 @@ fn code_for(kind: &ValidationErrorKind) -> &'static Code {
 pub struct SchemaCheck;
 
 impl Rule for SchemaCheck {
+    /// The layer objects, all in materials.
+    fn reads(&self) -> super::Reads {
+        super::Reads::properties(&["materials"])
+    }
+
     /// Among the dearest rules on a large document: every layer object against its schema.
     fn cost(&self) -> u32 {
         10

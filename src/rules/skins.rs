@@ -143,6 +143,10 @@ fn roots_of(parent: &[Option<usize>]) -> Vec<Option<usize>> {
 }
 
 impl Rule for Skins {
+    fn reads(&self) -> super::Reads {
+        super::Reads::properties(&["nodes", "skins", "scenes", "accessors", "meshes"])
+    }
+
     fn codes(&self) -> &'static [&'static Code] {
         &[
             &NODE_SKINNED_MESH_NON_ROOT,

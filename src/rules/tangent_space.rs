@@ -27,6 +27,10 @@ pub const MESH_PRIMITIVE_NO_TANGENT_SPACE: Code = Code::new(
 pub struct TangentSpace;
 
 impl Rule for TangentSpace {
+    fn reads(&self) -> super::Reads {
+        super::Reads::properties(&["materials", "meshes"])
+    }
+
     fn codes(&self) -> &'static [&'static Code] {
         &[
             &MESH_PRIMITIVE_GENERATED_TANGENT_SPACE,

@@ -18,6 +18,10 @@ pub const MESH_PRIMITIVE_TOO_FEW_TEXCOORDS: Code = Code::new(
 pub struct TexCoords;
 
 impl Rule for TexCoords {
+    fn reads(&self) -> super::Reads {
+        super::Reads::properties(&["materials", "meshes"])
+    }
+
     /// Among the dearest rules on a large document: every primitive of every mesh.
     fn cost(&self) -> u32 {
         2

@@ -35,6 +35,10 @@ fn media_type(image: Node) -> Option<String> {
 pub struct TextureSources;
 
 impl Rule for TextureSources {
+    fn reads(&self) -> super::Reads {
+        super::Reads::properties(&["textures", "images"])
+    }
+
     fn codes(&self) -> &'static [&'static Code] {
         &[&TEXTURE_INVALID_IMAGE_MIME_TYPE]
     }

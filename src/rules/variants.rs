@@ -14,6 +14,10 @@ pub const KHR_MATERIALS_VARIANTS_NON_UNIQUE_VARIANT: Code = Code::new(
 pub struct Variants;
 
 impl Rule for Variants {
+    fn reads(&self) -> super::Reads {
+        super::Reads::properties(&["meshes"])
+    }
+
     fn codes(&self) -> &'static [&'static Code] {
         &[&KHR_MATERIALS_VARIANTS_NON_UNIQUE_VARIANT]
     }

@@ -583,4 +583,119 @@ mod tests {
             assert_eq!(run_rules(&cx, true, None).concat(), sequential);
         }
     }
+
+    /// The findings of every rule that names what it reads (`Rule::reads`), per rule, in the
+    /// report of `text` read as the file `path` (whose folder holds its resources).
+    fn findings_by_rule(validator: &Validator, path: &Path, text: &str) -> Vec<Vec<String>> {
+        let loaded = asset::load_bytes_with(path, text.as_bytes(), &validator.load);
+        let asset = loaded.asset.expect("the document loads");
+        let report = validator.validate_asset_unplaced(
+            path,
+            &asset,
+            loaded.diagnostics,
+            &Settings::default(),
+            None,
+        );
+        report.rule_spans[1..]
+            .iter()
+            .map(|span| {
+                report.findings[span.clone()]
+                    .iter()
+                    .map(|f| {
+                        let d = &f.diagnostic;
+                        format!("{} {:?} {} {}", d.code, d.severity, d.pointer, d.message)
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_rule_finds_the_same_in_a_document_that_lacks_what_the_rule_does_not_read() {
+        // A fix's trial takes a rule's findings from the file's report when the fix edits
+        // nothing the rule says it reads. Each fixture document, less one top-level property at
+        // a time or less an excepted member of every element, must give every rule that does
+        // not read what went the findings it gave the whole document.
+        let validator = Validator::builtin(Settings::default());
+        let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/validate");
+        let mut documents: Vec<PathBuf> = std::fs::read_dir(&fixtures)
+            .expect("the fixtures are there")
+            .flat_map(|folder| std::fs::read_dir(folder.expect("a folder").path()))
+            .flatten()
+            .map(|e| e.expect("a fixture").path())
+            .filter(|p| p.extension().is_some_and(|e| e == "gltf"))
+            .collect();
+        documents.sort();
+        let excepted: Vec<(&str, &str)> = rules::REGISTRY
+            .iter()
+            .flat_map(|rule| match rule.reads() {
+                rules::Reads::Properties { except, .. } => except.to_vec(),
+                rules::Reads::Document => Vec::new(),
+            })
+            .collect();
+        let (mut compared, mut variants) = (0, 0);
+        for path in &documents {
+            let text = std::fs::read_to_string(path).expect("the fixture reads");
+            let Ok(serde_json::Value::Object(whole)) = serde_json::from_str(&text) else {
+                continue;
+            };
+            if asset::load_bytes_with(path, text.as_bytes(), &validator.load)
+                .asset
+                .is_none()
+            {
+                continue;
+            }
+            let found = findings_by_rule(&validator, path, &text);
+            // (what went, as the pointer an edit of it would have; the document without it)
+            let mut lesser: Vec<(String, serde_json::Map<String, serde_json::Value>)> = whole
+                .keys()
+                .map(|key| {
+                    let mut less = whole.clone();
+                    less.shift_remove(key);
+                    (format!("/{key}/0"), less)
+                })
+                .collect();
+            for (property, member) in &excepted {
+                let mut less = whole.clone();
+                let Some(serde_json::Value::Array(elements)) = less.get_mut(*property) else {
+                    continue;
+                };
+                let mut removed = false;
+                for element in elements.iter_mut().filter_map(|e| e.as_object_mut()) {
+                    removed |= element.shift_remove(*member).is_some();
+                }
+                if removed {
+                    lesser.push((format!("/{property}/0/{member}"), less));
+                }
+            }
+            for (gone, less) in lesser {
+                let less_text = serde_json::to_string(&less).expect("the document writes");
+                if asset::load_bytes_with(path, less_text.as_bytes(), &validator.load)
+                    .asset
+                    .is_none()
+                {
+                    continue;
+                }
+                let found_less = findings_by_rule(&validator, path, &less_text);
+                variants += 1;
+                for (i, rule) in rules::REGISTRY.iter().enumerate() {
+                    let reads = rule.reads();
+                    if matches!(reads, rules::Reads::Document) || reads.touched_by(&gone, |_| true)
+                    {
+                        continue;
+                    }
+                    assert_eq!(
+                        found[i],
+                        found_less[i],
+                        "{}: rule {i} ({:?}) without {gone}",
+                        path.display(),
+                        rule.codes().iter().map(|c| c.name).collect::<Vec<_>>()
+                    );
+                    compared += 1;
+                }
+            }
+        }
+        assert!(variants > 1000, "{variants} documents compared");
+        assert!(compared > 10_000, "{compared} rule findings compared");
+    }
 }
