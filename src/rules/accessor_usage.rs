@@ -12,6 +12,7 @@
 use super::data::index_of;
 use super::{elements, Context, Rule};
 use crate::asset::pointer;
+use crate::asset::tape::{KeyId, Node};
 use crate::diagnostics::{Code, Diagnostic, Severity};
 
 pub const ACCESSOR_USAGE_OVERRIDE: Code = Code::new(
@@ -51,7 +52,10 @@ struct Uses {
 }
 
 impl Uses {
-    fn set(&mut self, accessor: Option<usize>, usage: Usage, at: String) {
+    /// Records a use of `accessor` as `usage` at the place `at` makes: a place is written
+    /// only for a first use or a finding (a library's primitives are tens of thousands of uses
+    /// of a few accessors).
+    fn set(&mut self, accessor: Option<usize>, usage: Usage, at: impl FnOnce() -> String) {
         let Some(index) = accessor else {
             return;
         };
@@ -59,7 +63,7 @@ impl Uses {
             return;
         };
         match slot {
-            None => *slot = Some((usage, at)),
+            None => *slot = Some((usage, at())),
             Some((initial, first_at)) if *initial != usage => {
                 let message = format!(
                     "accessor {index} is used here as {}, and first as {} (at {first_at})",
@@ -67,7 +71,7 @@ impl Uses {
                     initial.words()
                 );
                 self.out
-                    .push(Diagnostic::new(&ACCESSOR_USAGE_OVERRIDE, at, message));
+                    .push(Diagnostic::new(&ACCESSOR_USAGE_OVERRIDE, at(), message));
             }
             Some(_) => {}
         }
@@ -92,35 +96,37 @@ impl Rule for AccessorUsage {
         if uses.first.is_empty() {
             return;
         }
+        // Keys numbered once: a lookup by number compares numbers.
+        let (attributes_key, indices_key, targets_key) = (
+            json.key_id("attributes"),
+            json.key_id("indices"),
+            json.key_id("targets"),
+        );
         for (m, mesh) in elements(json.get("meshes")).enumerate() {
             for (p, primitive) in elements(mesh.get("primitives")).enumerate() {
-                let at = format!("/meshes/{m}/primitives/{p}");
-                let attributes = |holder: Option<crate::asset::tape::Node>, at: &str| {
-                    let attributes = holder.and_then(|a| a.as_object());
-                    attributes
-                        .into_iter()
-                        .flat_map(|a| a.iter())
-                        .map(|(name, accessor)| {
-                            let place = format!("{at}/{}", pointer::escape(&name));
-                            (index_of(Some(accessor)), place)
-                        })
-                        .collect::<Vec<_>>()
-                };
-                for (accessor, place) in
-                    attributes(primitive.get("attributes"), &format!("{at}/attributes"))
-                {
-                    uses.set(accessor, Usage::VertexAttribute, place);
-                }
+                let at = || format!("/meshes/{m}/primitives/{p}");
+                let attributes =
+                    |uses: &mut Uses, holder: Option<Node>, within: &dyn Fn() -> String| {
+                        for (name, accessor) in holder
+                            .and_then(|a| a.as_object())
+                            .into_iter()
+                            .flat_map(|a| a.iter())
+                        {
+                            uses.set(index_of(Some(accessor)), Usage::VertexAttribute, || {
+                                format!("{}/{}", within(), pointer::escape(&name))
+                            });
+                        }
+                    };
+                attributes(&mut uses, member(primitive, attributes_key), &|| {
+                    format!("{}/attributes", at())
+                });
                 uses.set(
-                    index_of(primitive.get("indices")),
+                    index_of(member(primitive, indices_key)),
                     Usage::PrimitiveIndices,
-                    format!("{at}/indices"),
+                    || format!("{}/indices", at()),
                 );
-                for (t, target) in elements(primitive.get("targets")).enumerate() {
-                    for (accessor, place) in attributes(Some(target), &format!("{at}/targets/{t}"))
-                    {
-                        uses.set(accessor, Usage::VertexAttribute, place);
-                    }
+                for (t, target) in elements(member(primitive, targets_key)).enumerate() {
+                    attributes(&mut uses, Some(target), &|| format!("{}/targets/{t}", at()));
                 }
             }
         }
@@ -128,26 +134,31 @@ impl Rule for AccessorUsage {
             uses.set(
                 index_of(skin.get("inverseBindMatrices")),
                 Usage::InverseBindMatrices,
-                format!("/skins/{s}/inverseBindMatrices"),
+                || format!("/skins/{s}/inverseBindMatrices"),
             );
         }
         for (a, animation) in elements(json.get("animations")).enumerate() {
             for (s, sampler) in elements(animation.get("samplers")).enumerate() {
-                let at = format!("/animations/{a}/samplers/{s}");
+                let at = || format!("/animations/{a}/samplers/{s}");
                 uses.set(
                     index_of(sampler.get("input")),
                     Usage::AnimationInput,
-                    format!("{at}/input"),
+                    || format!("{}/input", at()),
                 );
                 uses.set(
                     index_of(sampler.get("output")),
                     Usage::AnimationOutput,
-                    format!("{at}/output"),
+                    || format!("{}/output", at()),
                 );
             }
         }
         out.append(&mut uses.out);
     }
+}
+
+/// `holder`'s member numbered `key`, when `holder` is an object.
+fn member(holder: Node<'_>, key: Option<KeyId>) -> Option<Node<'_>> {
+    holder.as_object()?.get_id(key?)
 }
 
 #[cfg(test)]

@@ -15,7 +15,14 @@ impl Rule for ImageSize {
     /// An image's header is read from its file, data URI or buffer view.
     fn reads(&self) -> super::Reads {
         super::Reads::Properties {
-            properties: &["materials", "textures", "images", "bufferViews", "buffers", "extensionsUsed"],
+            properties: &[
+                "materials",
+                "textures",
+                "images",
+                "bufferViews",
+                "buffers",
+                "extensionsUsed",
+            ],
             except: &[("bufferViews", "target")],
         }
     }

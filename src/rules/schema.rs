@@ -281,8 +281,9 @@ impl Rule for SchemaCheck {
         // random for each map: with SipHash the map's lookups took a fifth of this rule's
         // instructions on a document of 20,000 materials (29 million; 9 with foldhash), and a
         // random seed keeps a crafted document from choosing collisions.
+        // Sized for every object distinct: growing it rehashed each entry again and again.
         let mut checked: HashMap<(&str, &str), Vec<Diagnostic>, foldhash::quality::RandomState> =
-            HashMap::default();
+            HashMap::with_capacity_and_hasher(cx.layers().len(), Default::default());
         for layer in cx.layer_objects() {
             let found = checked
                 .entry((layer.extension, layer.value.raw()))
