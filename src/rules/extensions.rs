@@ -934,7 +934,7 @@ impl Rule for ExtensionObjects {
                 }
             }
         }
-        if !others && layer_keys == cx.layer_objects().count() {
+        if !others && layer_keys == cx.layer_object_count() {
             return;
         }
         let holders = found.iter().map(|e| e.span().start).collect();

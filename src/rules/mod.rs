@@ -171,6 +171,16 @@ impl<'a> Context<'a> {
         })
     }
 
+    /// How many layer objects the document has: from [`Context::layers`] once they are read,
+    /// else counted without reading their values (a fix's trial may run no rule that reads
+    /// them).
+    pub fn layer_object_count(&self) -> usize {
+        match self.layers.get() {
+            Some(layers) => layers.len(),
+            None => layer_objects(self.json()).count(),
+        }
+    }
+
     /// [`layer_objects`] of the document, from [`Context::layers`].
     pub fn layer_objects(&self) -> impl Iterator<Item = LayerObject<Node<'a>>> + '_ {
         self.layers().iter().map(|l| l.object)
