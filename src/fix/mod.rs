@@ -1621,7 +1621,7 @@ mod tests {
     }
 
     #[test]
-    fn an_edit_touches_what_a_rule_reads_unless_it_is_elsewhere_or_an_excepted_member() {
+    fn an_edit_touches_what_a_rule_reads_unless_it_is_elsewhere_or_an_excepted_member_or_beside_its_places() {
         let reads = crate::rules::data::DATA_READS;
         let exists = |p: &str| p == "/bufferViews/0";
         assert!(reads.touched_by("", exists));
@@ -1634,5 +1634,25 @@ mod tests {
         // Setting a member of a view that is not there creates the view.
         assert!(reads.touched_by("/bufferViews/1/target", exists));
         assert!(crate::rules::Reads::Document.touched_by("/materials/0", exists));
+        // The references rule reads the indices, and which elements the arrays they index hold.
+        let references = crate::rules::Reads::Places {
+            values: &["/nodes/*/mesh", "/materials/*/extensions/*/*Texture/index"],
+            elements: &["/meshes", "/extensions"],
+        };
+        let touched = |p: &str| references.touched_by(p, |_| true);
+        assert!(touched("/nodes/2/mesh"));
+        assert!(touched("/nodes/2"));
+        assert!(touched("/nodes"));
+        assert!(touched(""));
+        assert!(touched("/meshes/-"));
+        assert!(touched("/meshes/4"));
+        assert!(touched("/materials/0/extensions/KHR_materials_fuzz"));
+        assert!(touched("/materials/0/extensions/KHR_materials_fuzz/fuzzColorTexture"));
+        assert!(touched("/extensions/KHR_lights_punctual"));
+        assert!(!touched("/meshes/4/primitives/0/mode"));
+        assert!(!touched("/nodes/2/name"));
+        assert!(!touched("/materials/0/extensions/KHR_materials_fuzz/fuzzColorFactor/1"));
+        assert!(!touched("/bufferViews/1/target"));
+        assert!(!touched("/extensions/KHR_lights_punctual/lights/0/spot"));
     }
 }

@@ -262,6 +262,14 @@ pub enum Reads {
         properties: &'static [&'static str],
         except: &'static [(&'static str, &'static str)],
     },
+    /// Only the values at the pointers `values` match, and which elements the arrays
+    /// `elements` match hold (their number, not what is in them). In a pattern `*` stands for
+    /// any key or array index and `*Suffix` for any key that ends so, as in the references
+    /// rule's table (`/nodes/*/mesh`; `/animations/*/samplers`).
+    Places {
+        values: &'static [&'static str],
+        elements: &'static [&'static str],
+    },
 }
 
 impl Reads {
@@ -277,8 +285,12 @@ impl Reads {
     /// excepted member counts only where `element_exists` says the element it is in (the
     /// pointer's first two tokens) is already there, since a set creates what it misses.
     pub fn touched_by(&self, pointer: &str, element_exists: impl Fn(&str) -> bool) -> bool {
-        let Reads::Properties { properties, except } = self else {
-            return true;
+        let (properties, except) = match self {
+            Reads::Document => return true,
+            Reads::Places { values, elements } => {
+                return places_touched_by(values, elements, pointer);
+            }
+            Reads::Properties { properties, except } => (properties, except),
         };
         let mut tokens = pointer.split('/').skip(1);
         let Some(property) = tokens.next() else {
@@ -296,6 +308,33 @@ impl Reads {
             _ => true,
         }
     }
+}
+
+/// Whether an edit at `pointer` may change a value at a place `values` match (the edit is at
+/// or above such a place, which it may create, remove or replace, or inside one) or the
+/// elements an array `elements` matches holds (the edit is at or above one of its elements).
+fn places_touched_by(values: &[&str], elements: &[&str], pointer: &str) -> bool {
+    let tokens: Vec<std::borrow::Cow<str>> = pointer
+        .split('/')
+        .skip(1)
+        .map(crate::asset::pointer::unescape)
+        .collect();
+    // Whether the edit's path and the pattern's agree as far as both go.
+    let agrees = |pattern: &str| {
+        pattern
+            .split('/')
+            .skip(1)
+            .zip(&tokens)
+            .all(|(segment, token)| match segment.strip_prefix('*') {
+                Some("") => true,
+                Some(suffix) => token.ends_with(suffix),
+                None => segment == token,
+            })
+    };
+    values.iter().any(|pattern| agrees(pattern))
+        || elements.iter().any(|array| {
+            tokens.len() <= array.split('/').count() && agrees(array)
+        })
 }
 
 /// A validation rule.
