@@ -67,11 +67,7 @@ impl Rule for Declaration {
             .map(|(_, n)| n)
             .collect();
         undeclared(json, &declared, out);
-        let mut used = [false, false];
-        for layer in cx.layer_objects() {
-            used[usize::from(layer.extension == layers::FUZZ)] = true;
-        }
-        check_lists(json, &declared, used, out);
+        check_lists(json, &declared, cx.layer_extensions_present(), out);
     }
 }
 

@@ -181,6 +181,18 @@ impl<'a> Context<'a> {
         }
     }
 
+    /// Which of the two layers (sheen, fuzz) the document's materials hold, read as
+    /// [`Context::layer_object_count`] counts them.
+    pub fn layer_extensions_present(&self) -> [bool; 2] {
+        let mut present = [false, false];
+        let mut note = |extension: &str| present[usize::from(extension == layers::FUZZ)] = true;
+        match self.layers.get() {
+            Some(read) => read.iter().for_each(|l| note(l.object.extension)),
+            None => layer_objects(self.json()).for_each(|l| note(l.extension)),
+        }
+        present
+    }
+
     /// [`layer_objects`] of the document, from [`Context::layers`].
     pub fn layer_objects(&self) -> impl Iterator<Item = LayerObject<Node<'a>>> + '_ {
         self.layers().iter().map(|l| l.object)
