@@ -838,9 +838,18 @@ impl<'v> Fixing<'v> {
                 .iter()
                 .any(|edit| reads.touched_by(edited_pointer(edit), exists))
         };
+        let mut elements: Option<Vec<crate::rules::ElementPlace>> = edits
+            .iter()
+            .map(|edit| crate::rules::ElementPlace::of_edit(root, edited_pointer(edit)))
+            .collect();
+        if let Some(elements) = &mut elements {
+            elements.sort_by(|a, b| (&a.property, a.index).cmp(&(&b.property, b.index)));
+            elements.dedup();
+        }
         let reuse = crate::validate::Reuse {
             report: before,
             touched: &touched,
+            elements: elements.as_deref(),
         };
         let outside_the_text = drops_byte_order_mark || rebuilds_container;
         let report = self.validator.validate_asset_unplaced(
@@ -1621,7 +1630,8 @@ mod tests {
     }
 
     #[test]
-    fn an_edit_touches_what_a_rule_reads_unless_it_is_elsewhere_or_an_excepted_member_or_beside_its_places() {
+    fn an_edit_touches_what_a_rule_reads_unless_it_is_elsewhere_or_an_excepted_member_or_beside_its_places(
+    ) {
         let reads = crate::rules::data::DATA_READS;
         let exists = |p: &str| p == "/bufferViews/0";
         assert!(reads.touched_by("", exists));
@@ -1647,11 +1657,15 @@ mod tests {
         assert!(touched("/meshes/-"));
         assert!(touched("/meshes/4"));
         assert!(touched("/materials/0/extensions/KHR_materials_fuzz"));
-        assert!(touched("/materials/0/extensions/KHR_materials_fuzz/fuzzColorTexture"));
+        assert!(touched(
+            "/materials/0/extensions/KHR_materials_fuzz/fuzzColorTexture"
+        ));
         assert!(touched("/extensions/KHR_lights_punctual"));
         assert!(!touched("/meshes/4/primitives/0/mode"));
         assert!(!touched("/nodes/2/name"));
-        assert!(!touched("/materials/0/extensions/KHR_materials_fuzz/fuzzColorFactor/1"));
+        assert!(!touched(
+            "/materials/0/extensions/KHR_materials_fuzz/fuzzColorFactor/1"
+        ));
         assert!(!touched("/bufferViews/1/target"));
         assert!(!touched("/extensions/KHR_lights_punctual/lights/0/spot"));
     }

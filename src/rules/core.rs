@@ -190,6 +190,21 @@ impl CoreSchema {
         CoreSchema { validator }
     }
 
+    /// Whether `element`, an element of the root's array `property`, passes its schema: it is
+    /// judged as the one element of that array in an otherwise minimal document. False for an
+    /// array whose elements are not judged one by one.
+    pub fn element_passes(&self, property: &str, element: Node) -> bool {
+        if !ELEMENT_ARRAYS.contains(&property) {
+            return false;
+        }
+        let text = format!(
+            r#"{{"asset":{{"version":"2.0"}},"{property}":[{}]}}"#,
+            element.raw()
+        );
+        crate::asset::tape::Tape::build(&text)
+            .is_ok_and(|tape| self.validator.is_valid(tape.root(&text)))
+    }
+
     /// Validates `json`, pushing one diagnostic per schema error.
     pub fn check(&self, json: Node, out: &mut Vec<Diagnostic>) {
         // Most documents are valid, and the yes-or-no check is a quarter of the full walk.
@@ -657,6 +672,24 @@ fn one_of_names(at: &str) -> &'static str {
     }
 }
 
+/// The root's arrays whose elements the core schemas judge one by one (`items` of an object
+/// schema, no constraint across elements).
+const ELEMENT_ARRAYS: &[&str] = &[
+    "accessors",
+    "animations",
+    "buffers",
+    "bufferViews",
+    "cameras",
+    "images",
+    "materials",
+    "meshes",
+    "nodes",
+    "samplers",
+    "scenes",
+    "skins",
+    "textures",
+];
+
 pub struct CoreStructure;
 
 impl Rule for CoreStructure {
@@ -683,6 +716,24 @@ impl Rule for CoreStructure {
             &ARRAY_TYPE_MISMATCH,
             &INVALID_INDEX,
         ]
+    }
+
+    /// The core schemas judge each element of the root's arrays of objects by itself (their
+    /// only constraint across elements, `uniqueItems`, is on the lists of extension names): the
+    /// file's findings hold when it had none in the edited elements and the fixed elements
+    /// pass their schemas.
+    fn holds_inside(
+        &self,
+        cx: &Context,
+        elements: &[super::ElementPlace],
+        found_inside: &dyn Fn(&super::ElementPlace) -> bool,
+    ) -> bool {
+        elements.iter().all(|element| {
+            !found_inside(element)
+                && element
+                    .in_document(cx.json())
+                    .is_some_and(|value| cx.schemas.core.element_passes(&element.property, value))
+        })
     }
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {

@@ -344,9 +344,9 @@ fn places_touched_by(values: &[&str], elements: &[&str], pointer: &str) -> bool 
             })
     };
     values.iter().any(|pattern| agrees(pattern))
-        || elements.iter().any(|array| {
-            tokens.len() <= array.split('/').count() && agrees(array)
-        })
+        || elements
+            .iter()
+            .any(|array| tokens.len() <= array.split('/').count() && agrees(array))
 }
 
 /// A validation rule.
@@ -368,6 +368,60 @@ pub trait Rule: Sync {
     /// the whole document.
     fn reads(&self) -> Reads {
         Reads::Document
+    }
+    /// For a rule whose reads an edit touched: whether its findings on the file are its
+    /// findings on the fixed document `cx`, where every edit lies inside an element the file
+    /// has of a top-level array (`elements`, each edited element once; `found_inside`: whether
+    /// the file's findings of this rule hold one at or inside an element). A rule whose
+    /// judgment of such an element depends on that element alone, and whose findings elsewhere
+    /// do not depend on it, re-judges just those elements; by default a rule cannot say, and
+    /// runs again.
+    fn holds_inside(
+        &self,
+        cx: &Context,
+        elements: &[ElementPlace],
+        found_inside: &dyn Fn(&ElementPlace) -> bool,
+    ) -> bool {
+        let _ = (cx, elements, found_inside);
+        false
+    }
+}
+
+/// An element of a top-level array (`/bufferViews/1`) that a fix edits inside.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ElementPlace {
+    pub property: String,
+    pub index: usize,
+}
+
+impl ElementPlace {
+    /// The element an edit at `pointer` lies inside, when `pointer` goes below an element the
+    /// document `json` has of a top-level array (`/bufferViews/1/target`; not `/bufferViews/1`
+    /// itself, whose removal or replacement moves or reshapes the array).
+    pub fn of_edit(json: Node, pointer: &str) -> Option<ElementPlace> {
+        let mut tokens = pointer.split('/').skip(1);
+        let property = crate::asset::pointer::unescape(tokens.next()?);
+        let index: usize = tokens.next()?.parse().ok()?;
+        tokens.next()?;
+        (index < json.get(property.as_ref())?.as_array()?.len()).then(|| ElementPlace {
+            property: property.into_owned(),
+            index,
+        })
+    }
+
+    /// Whether `diagnostic` stands at this element or inside it.
+    pub fn holds(&self, diagnostic: &Diagnostic) -> bool {
+        let at = &diagnostic.pointer;
+        at.strip_prefix('/')
+            .and_then(|rest| rest.strip_prefix(&crate::asset::pointer::escape(&self.property)[..]))
+            .and_then(|rest| rest.strip_prefix('/'))
+            .and_then(|rest| rest.strip_prefix(&self.index.to_string()[..]))
+            .is_some_and(|rest| rest.is_empty() || rest.starts_with('/'))
+    }
+
+    /// The element in the document `json`.
+    pub fn in_document<'a>(&self, json: Node<'a>) -> Option<Node<'a>> {
+        json.get(&self.property)?.as_array()?.get(self.index)
     }
 }
 

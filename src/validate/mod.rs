@@ -98,24 +98,29 @@ pub struct Reuse<'r> {
     pub report: &'r FileReport,
     /// Whether the edits touch what a rule reads.
     pub touched: &'r (dyn Fn(&rules::Reads) -> bool + Sync),
+    /// The elements the edits lie inside, when every edit lies inside an element the file has
+    /// of a top-level array: a rule whose reads they touch may still find its findings hold
+    /// by judging those elements again ([`rules::Rule::holds_inside`]).
+    pub elements: Option<&'r [rules::ElementPlace]>,
 }
 
 impl Reuse<'_> {
-    /// Rule `index`'s findings in the file's report, when they hold for the edited text too.
-    fn findings_of(&self, index: usize) -> Option<Vec<Diagnostic>> {
+    /// Rule `index`'s findings in the file's report, when they hold for the edited text `cx`
+    /// too.
+    fn findings_of(&self, index: usize, cx: &Context) -> Option<Vec<Diagnostic>> {
         let spans = &self.report.rule_spans;
-        if spans.len() != rules::REGISTRY.len() + 1
-            || (self.touched)(&rules::REGISTRY[index].reads())
-        {
+        if spans.len() != rules::REGISTRY.len() + 1 {
             return None;
         }
-        let span = spans[index + 1].clone();
-        Some(
-            self.report.findings[span]
-                .iter()
-                .map(|f| f.diagnostic.clone())
-                .collect(),
-        )
+        let rule = rules::REGISTRY[index];
+        let found = &self.report.findings[spans[index + 1].clone()];
+        let found_inside =
+            |element: &rules::ElementPlace| found.iter().any(|f| element.holds(&f.diagnostic));
+        let holds = !(self.touched)(&rule.reads())
+            || self
+                .elements
+                .is_some_and(|elements| rule.holds_inside(cx, elements, &found_inside));
+        holds.then(|| found.iter().map(|f| f.diagnostic.clone()).collect())
     }
 }
 
@@ -444,7 +449,7 @@ fn missing_resources(
 fn run_rules(cx: &Context, parallel: bool, reuse: Option<&Reuse>) -> Vec<Vec<Diagnostic>> {
     crate::progress::stage("checking rules", rules::REGISTRY.len());
     let run = |i: usize| {
-        let found = reuse.and_then(|r| r.findings_of(i)).unwrap_or_else(|| {
+        let found = reuse.and_then(|r| r.findings_of(i, cx)).unwrap_or_else(|| {
             let mut out = Vec::new();
             rules::REGISTRY[i].check(cx, &mut out);
             out
@@ -704,5 +709,139 @@ mod tests {
         }
         assert!(variants > 1000, "{variants} documents compared");
         assert!(compared > 10_000, "{compared} rule findings compared");
+    }
+
+    #[test]
+    fn a_rule_that_rejudges_edited_elements_says_its_findings_hold_only_when_they_do() {
+        // Each member of each element of the root's arrays in every fixture document, removed
+        // or given a value of the wrong type: where a rule says its findings on the document
+        // hold for the edited one (`Rule::holds_inside`), they must be its findings there.
+        let validator = Validator::builtin(Settings::default());
+        let schemas = Schemas::builtin();
+        let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/validate");
+        let mut documents: Vec<PathBuf> = std::fs::read_dir(&fixtures)
+            .expect("the fixtures are there")
+            .flat_map(|folder| std::fs::read_dir(folder.expect("a folder").path()))
+            .flatten()
+            .map(|e| e.expect("a fixture").path())
+            .filter(|p| p.extension().is_some_and(|e| e == "gltf"))
+            .collect();
+        documents.sort();
+        // For each rule: how often it said its findings hold, and how often not.
+        let mut said = vec![(0usize, 0usize); rules::REGISTRY.len()];
+        for path in &documents {
+            let text = std::fs::read_to_string(path).expect("the fixture reads");
+            let Ok(serde_json::Value::Object(whole)) = serde_json::from_str(&text) else {
+                continue;
+            };
+            let loaded = asset::load_bytes_with(path, text.as_bytes(), &validator.load);
+            let Some(source) = loaded.asset else {
+                continue;
+            };
+            let found = validator.validate_asset_unplaced(
+                path,
+                &source,
+                loaded.diagnostics,
+                &Settings::default(),
+                None,
+            );
+            let by_rule = findings_by_rule(&validator, path, &text);
+            for (property, value) in &whole {
+                let Some(elements) = value.as_array() else {
+                    continue;
+                };
+                for (index, element) in elements.iter().enumerate().take(3) {
+                    let Some(members) = element.as_object() else {
+                        continue;
+                    };
+                    // Its members, and a member no kind defines.
+                    let unknown = "nmae".to_string();
+                    for member in members.keys().chain([&unknown]) {
+                        for wrong in [None, Some(serde_json::json!({"nmae": [true]}))] {
+                            let mut edited = whole.clone();
+                            let target =
+                                edited[property][index].as_object_mut().expect("an object");
+                            match &wrong {
+                                None => {
+                                    target.shift_remove(member);
+                                }
+                                Some(value) => {
+                                    target.insert(member.clone(), value.clone());
+                                }
+                            }
+                            let edited_text =
+                                serde_json::to_string(&edited).expect("the document writes");
+                            let loaded = asset::load_bytes_with(
+                                path,
+                                edited_text.as_bytes(),
+                                &validator.load,
+                            );
+                            let Some(after) = loaded.asset else {
+                                continue;
+                            };
+                            let place = rules::ElementPlace {
+                                property: property.clone(),
+                                index,
+                            };
+                            assert_eq!(
+                                rules::ElementPlace::of_edit(
+                                    source.root(),
+                                    &format!("/{property}/{index}/{member}")
+                                )
+                                .as_ref(),
+                                Some(&place)
+                            );
+                            let cx = Context::new(&after, &schemas);
+                            let mut found_after: Option<Vec<Vec<String>>> = None;
+                            for i in 0..rules::REGISTRY.len() {
+                                let span = found.rule_spans[i + 1].clone();
+                                let found_inside = |e: &rules::ElementPlace| {
+                                    found.findings[span.clone()]
+                                        .iter()
+                                        .any(|f| e.holds(&f.diagnostic))
+                                };
+                                let rule = rules::REGISTRY[i];
+                                if !rule.holds_inside(
+                                    &cx,
+                                    std::slice::from_ref(&place),
+                                    &found_inside,
+                                ) {
+                                    said[i].1 += 1;
+                                    continue;
+                                }
+                                said[i].0 += 1;
+                                let after_found = found_after.get_or_insert_with(|| {
+                                    findings_by_rule(&validator, path, &edited_text)
+                                });
+                                assert_eq!(
+                                    by_rule[i],
+                                    after_found[i],
+                                    "{}: rule {i} ({:?}) with /{property}/{index}/{member} {}",
+                                    path.display(),
+                                    rule.codes().iter().map(|c| c.name).collect::<Vec<_>>(),
+                                    if wrong.is_some() {
+                                        "of the wrong type"
+                                    } else {
+                                        "removed"
+                                    }
+                                );
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        // The rules that re-judge elements were asked both ways, many times.
+        for first_code in ["TYPE_MISMATCH", "UNEXPECTED_PROPERTY"] {
+            let i = rules::REGISTRY
+                .iter()
+                .position(|rule| rule.codes()[0].name == first_code)
+                .expect("the rule is registered");
+            let (held, refused) = said[i];
+            assert!(
+                held > 500 && refused > 500,
+                "{first_code}'s rule: held {held}, refused {refused}"
+            );
+        }
     }
 }
