@@ -256,6 +256,16 @@ pub fn load_read(
     options: &LoadOptions,
 ) -> (Loaded, Option<FileBytes>) {
     crate::progress::stage("indexing", 0);
+    load_given(path, bytes, options)
+}
+
+/// [`load_read`] without a word to the progress display: bytes a caller made and gives away
+/// (a fix's trial of the fixed text).
+pub fn load_given(
+    path: &Path,
+    bytes: FileBytes,
+    options: &LoadOptions,
+) -> (Loaded, Option<FileBytes>) {
     let plain = !bytes.starts_with(b"glTF")
         && !bytes.starts_with(b"\xEF\xBB\xBF")
         && !path

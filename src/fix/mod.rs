@@ -438,10 +438,22 @@ fn written_file(path: &Path) -> PathBuf {
 struct Fixed {
     /// Whether the edits changed the document (a GLB's bytes are repacked either way).
     changed: bool,
-    bytes: Vec<u8>,
+    /// The fixed file's bytes, unless they are the fixed document's text as it is (a .gltf
+    /// in plain UTF-8, whose text the loader took without a copy).
+    kept_bytes: Option<Vec<u8>>,
     /// The fixed document, loaded, and its report (of every finding).
     asset: Asset,
     report: FileReport,
+}
+
+impl Fixed {
+    /// The fixed file's bytes.
+    fn bytes(&self) -> &[u8] {
+        match &self.kept_bytes {
+            Some(bytes) => bytes,
+            None => self.asset.json_text.as_bytes(),
+        }
+    }
 }
 
 impl<'v> Fixing<'v> {
@@ -597,7 +609,7 @@ impl<'v> Fixing<'v> {
                 mode.changes()
                     && !accepted.is_empty()
                     && f.changed
-                    && !same_as_read(&source, &f.bytes)
+                    && !same_as_read(&source, f.bytes())
             })
             .is_some();
         if mode.changes() && !changed {
@@ -655,7 +667,7 @@ impl<'v> Fixing<'v> {
                         },
                         source.json_text.as_str()
                     ),
-                    &String::from_utf8_lossy(&fixed.bytes),
+                    &String::from_utf8_lossy(fixed.bytes()),
                 ),
                 Container::Glb => text::glb_not_diffed(&name),
             });
@@ -668,7 +680,7 @@ impl<'v> Fixing<'v> {
                 None => Err(format!("{} could not be read for writing", path.display())),
             }
             .and_then(|()| {
-                crate::edit::write::write_atomic(&written_file(path), &fixed.bytes)
+                crate::edit::write::write_atomic(&written_file(path), fixed.bytes())
                     .map_err(|e| format!("cannot write {}: {e}", path.display()))
             });
             if let Err(e) = written {
@@ -821,7 +833,21 @@ impl<'v> Fixing<'v> {
             file.append(&mut bytes);
             bytes = file;
         }
-        let loaded = asset::load_bytes_with(path, &bytes, &self.validator.load);
+        // A fixed .gltf's bytes become its text as they are: a copy of a large document costs
+        // about as much as indexing it.
+        let (loaded, kept_bytes) = if source.container == Container::Gltf {
+            let (loaded, back) = asset::load_given(
+                path,
+                asset::FileBytes::from_vec(bytes),
+                &self.validator.load,
+            );
+            (loaded, back.map(asset::FileBytes::into_vec))
+        } else {
+            (
+                asset::load_bytes_with(path, &bytes, &self.validator.load),
+                Some(bytes),
+            )
+        };
         let Some(mut after) = loaded.asset else {
             return Err(Failed::Other("the fixed file would not load".into()));
         };
@@ -862,7 +888,7 @@ impl<'v> Fixing<'v> {
         verdict(&before.findings, &report.findings, fixes).map_err(Failed::Findings)?;
         Ok(Fixed {
             changed,
-            bytes,
+            kept_bytes,
             asset: after,
             report,
         })
@@ -1593,7 +1619,7 @@ mod tests {
                 let Ok(fixed) = fixing.attempt(path, &source, &before, &tried, &settings) else {
                     continue;
                 };
-                let again = asset::load_bytes_with(path, &fixed.bytes, &validator.load);
+                let again = asset::load_bytes_with(path, fixed.bytes(), &validator.load);
                 let whole = validator.validate_asset_unplaced(
                     path,
                     again.asset.as_ref().expect("the fixed text loads"),
