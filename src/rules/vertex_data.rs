@@ -169,6 +169,19 @@ impl Rule for VertexData {
                     .filter(|(name, _)| name.starts_with("COLOR_"))
                     .filter_map(|(name, _)| first("color", &name).map(|i| (name.into_owned(), i)))
                     .collect();
+                // A primitive with no indices, no data it is the first to use and no skinning
+                // has nothing to judge here (a library's primitives mostly share a few
+                // accessors).
+                let skinned = attributes.contains_key("WEIGHTS_0")
+                    || attributes.contains_key("JOINTS_0");
+                if primitive.get("indices").is_none()
+                    && normal.is_none()
+                    && tangent.is_none()
+                    && colors.is_empty()
+                    && !skinned
+                {
+                    continue;
+                }
                 uses.push(PrimitiveUses {
                     mesh: m,
                     at: format!("/meshes/{m}/primitives/{p}"),
