@@ -800,6 +800,23 @@ impl Resolver {
         } else {
             abs.parent().map(Path::to_path_buf).unwrap_or(abs)
         };
+        self.for_folder(start)
+    }
+
+    /// The configuration for the file at the absolute path `file`, known not to be a folder
+    /// (a file a run found): searched from its folder, with no look at the file itself.
+    pub fn for_file(&mut self, file: &Path) -> Result<Arc<Config>, ConfigError> {
+        if let Some(fixed) = &self.fixed {
+            return Ok(fixed.clone());
+        }
+        match file.parent() {
+            Some(folder) => self.for_folder(folder.to_path_buf()),
+            None => self.for_path(file),
+        }
+    }
+
+    /// The configuration found from the absolute folder `start` upwards.
+    fn for_folder(&mut self, start: PathBuf) -> Result<Arc<Config>, ConfigError> {
         let mut visited = Vec::new();
         let mut found = None;
         for dir in start.ancestors() {

@@ -111,8 +111,11 @@ pub fn check_shard_each(
         // A file named as an input is found as itself; one found in a folder is below it.
         let named = inputs.get(found.input) == Some(&found.path);
         let file = found.path;
-        let config = resolver.for_path(&file)?;
-        if config.excludes(&crate::config::absolute(&file)) {
+        // Made absolute once: its configuration is searched from its folder, and its
+        // exclusion read, from the same path.
+        let absolute = crate::config::absolute(&file);
+        let config = resolver.for_file(&absolute)?;
+        if config.excludes(&absolute) {
             let by = match &config.file {
                 Some(file) => format!("the exclude patterns of {}", file.display()),
                 None => "the exclude patterns".to_string(),
