@@ -102,7 +102,7 @@ pub struct Tape {
 /// A key's number in the table of keys of one document ([`Node::key_id`]). A lookup by number
 /// ([`Object::get_id`]) compares numbers only; a rule that looks the same key up in thousands
 /// of objects finds its number once. Meaningful only for the document it came from.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct KeyId(u32);
 
 /// Why a text has no index: it is not JSON as serde_json reads it, or it is too large to index.
@@ -833,6 +833,13 @@ impl<'a> Object<'a> {
     pub fn keys(&self) -> impl Iterator<Item = Cow<'a, str>> + 'a {
         self.iter().map(|(k, _)| k)
     }
+
+    /// [`Object::iter`] with each key's number in the document ([`Node::key_id`]): a walk
+    /// that decides by key can remember its decision by number rather than compare names.
+    pub fn iter_keyed(&self) -> impl Iterator<Item = (KeyId, Cow<'a, str>, Node<'a>)> + 'a {
+        let mut members = self.iter();
+        std::iter::from_fn(move || members.next_keyed())
+    }
 }
 
 #[derive(Clone)]
@@ -863,18 +870,18 @@ pub struct Members<'a> {
     duplicates: bool,
 }
 
-impl<'a> Iterator for Members<'a> {
-    type Item = (Cow<'a, str>, Node<'a>);
-    fn next(&mut self) -> Option<Self::Item> {
+impl<'a> Members<'a> {
+    /// The next member with its key's number.
+    fn next_keyed(&mut self) -> Option<(KeyId, Cow<'a, str>, Node<'a>)> {
         loop {
             let (k, v) = self.raw.next()?;
             let node = self.object.node;
             let key = node.node(k).as_str().unwrap_or_default();
+            let id = node.node(k).entry().aux() as u32;
             if !self.duplicates {
-                return Some((key, node.node(v)));
+                return Some((KeyId(id), key, node.node(v)));
             }
             // A key seen before was given at its first place; a first one takes its last value.
-            let id = node.node(k).entry().aux() as u32;
             let mut earlier = RawMembers {
                 node,
                 at: node.at + 1,
@@ -884,8 +891,15 @@ impl<'a> Iterator for Members<'a> {
                 continue;
             }
             let value = self.object.get_key(id).unwrap_or(node.node(v));
-            return Some((key, value));
+            return Some((KeyId(id), key, value));
         }
+    }
+}
+
+impl<'a> Iterator for Members<'a> {
+    type Item = (Cow<'a, str>, Node<'a>);
+    fn next(&mut self) -> Option<Self::Item> {
+        self.next_keyed().map(|(_, key, value)| (key, value))
     }
 }
 

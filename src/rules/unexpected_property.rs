@@ -14,7 +14,8 @@
 use super::extensions::{shapes, Shapes};
 use super::{Context, Rule};
 use crate::asset::pointer;
-use crate::asset::tape::Node;
+use crate::asset::tape::{KeyId, Node};
+use std::collections::HashMap;
 use crate::diagnostics::{codes, Code, Diagnostic};
 
 pub struct UnexpectedProperty;
@@ -58,7 +59,7 @@ impl Rule for UnexpectedProperty {
                 Step::Index(element.index),
             ];
             let mut found = Vec::new();
-            walk(shapes, value, *kind, &mut path, &mut found);
+            Walk::new(shapes).walk(value, *kind, &mut path, &mut found);
             found.is_empty()
         })
     }
@@ -66,7 +67,7 @@ impl Rule for UnexpectedProperty {
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
         let shapes = shapes();
         let mut path = Vec::new();
-        walk(shapes, cx.json(), shapes.root(), &mut path, out);
+        Walk::new(shapes).walk(cx.json(), shapes.root(), &mut path, out);
     }
 }
 
@@ -89,55 +90,109 @@ fn pointer_of(path: &[Step]) -> String {
     at
 }
 
-fn walk<'a>(
-    shapes: &Shapes,
-    value: Node<'a>,
-    shape: usize,
-    path: &mut Vec<Step<'a>>,
-    out: &mut Vec<Diagnostic>,
-) {
-    let Some(object) = value.as_object() else {
-        return;
-    };
-    if path.len() > MAX_DEPTH {
-        return;
+/// What the walk does with a key on an object of one kind.
+#[derive(Clone, Copy)]
+enum Decision {
+    /// The kind's schemas do not define it: a finding.
+    Unexpected,
+    /// The object's extensions, each judged by its own kind where it has a schema.
+    Extensions,
+    /// An object (or an array of them, `array`) of kind `kind`.
+    Child { kind: usize, array: bool },
+    /// A value with no properties of its own to judge.
+    Leaf,
+}
+
+/// The walk of one document: each (kind, key) is decided once, by the key's number in the
+/// document, and not by comparing its name with the kind's property names at every object (a
+/// library's 20,000 materials ask the same few questions 20,000 times).
+struct Walk<'s> {
+    shapes: &'s Shapes,
+    decided: HashMap<(usize, KeyId), Decision, foldhash::quality::RandomState>,
+}
+
+impl<'s> Walk<'s> {
+    fn new(shapes: &'s Shapes) -> Walk<'s> {
+        Walk {
+            shapes,
+            decided: HashMap::default(),
+        }
     }
-    for (key, member) in object.iter() {
-        if !shapes.defines(shape, &key) {
-            let mut at = pointer_of(path);
-            at.push('/');
-            pointer::push_escaped(&mut at, &key);
-            out.push(Diagnostic::new(
-                &codes::UNEXPECTED_PROPERTY,
-                at,
-                format!("unexpected property '{key}'"),
-            ));
-        } else if key == "extensions" {
-            path.push(Step::Key(key));
-            for (name, extension) in member.as_object().into_iter().flat_map(|o| o.iter()) {
-                if let Some(kind) = shapes.extension_object(&name, shape) {
-                    path.push(Step::Key(name));
-                    walk(shapes, extension, kind, path, out);
-                    path.pop();
-                }
-            }
-            path.pop();
-        } else if let Some((_, child, array)) = shapes
-            .children(shape)
-            .iter()
-            .find(|(name, _, _)| *name == key)
-        {
-            path.push(Step::Key(key));
-            if *array {
-                for (i, element) in super::elements(Some(member)).enumerate() {
-                    path.push(Step::Index(i));
-                    walk(shapes, element, *child, path, out);
-                    path.pop();
+
+    fn decide(&mut self, shape: usize, id: KeyId, key: &str) -> Decision {
+        let shapes = self.shapes;
+        *self.decided.entry((shape, id)).or_insert_with(|| {
+            if !shapes.defines(shape, key) {
+                Decision::Unexpected
+            } else if key == "extensions" {
+                Decision::Extensions
+            } else if let Some((_, child, array)) = shapes
+                .children(shape)
+                .iter()
+                .find(|(name, _, _)| *name == key)
+            {
+                Decision::Child {
+                    kind: *child,
+                    array: *array,
                 }
             } else {
-                walk(shapes, member, *child, path, out);
+                Decision::Leaf
             }
-            path.pop();
+        })
+    }
+
+    fn walk<'a>(
+        &mut self,
+        value: Node<'a>,
+        shape: usize,
+        path: &mut Vec<Step<'a>>,
+        out: &mut Vec<Diagnostic>,
+    ) {
+        let Some(object) = value.as_object() else {
+            return;
+        };
+        if path.len() > MAX_DEPTH {
+            return;
+        }
+        for (id, key, member) in object.iter_keyed() {
+            match self.decide(shape, id, &key) {
+                Decision::Unexpected => {
+                    let mut at = pointer_of(path);
+                    at.push('/');
+                    pointer::push_escaped(&mut at, &key);
+                    out.push(Diagnostic::new(
+                        &codes::UNEXPECTED_PROPERTY,
+                        at,
+                        format!("unexpected property '{key}'"),
+                    ));
+                }
+                Decision::Extensions => {
+                    path.push(Step::Key(key));
+                    for (name, extension) in member.as_object().into_iter().flat_map(|o| o.iter())
+                    {
+                        if let Some(kind) = self.shapes.extension_object(&name, shape) {
+                            path.push(Step::Key(name));
+                            self.walk(extension, kind, path, out);
+                            path.pop();
+                        }
+                    }
+                    path.pop();
+                }
+                Decision::Child { kind, array } => {
+                    path.push(Step::Key(key));
+                    if array {
+                        for (i, element) in super::elements(Some(member)).enumerate() {
+                            path.push(Step::Index(i));
+                            self.walk(element, kind, path, out);
+                            path.pop();
+                        }
+                    } else {
+                        self.walk(member, kind, path, out);
+                    }
+                    path.pop();
+                }
+                Decision::Leaf => {}
+            }
         }
     }
 }
