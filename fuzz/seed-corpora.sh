@@ -25,7 +25,8 @@ glb=$(find "$root/fixtures" "$here/seeds" -name '*.glb' | sort)
     add migrate $gltf
     add bake $gltf $glb
     add tape $gltf
+    add fix $gltf
 }
-for target in load_gltf load_glb validate migrate bake tape; do
+for target in load_gltf load_glb validate migrate bake tape fix; do
     printf '%s: %s inputs\n' "$target" "$(ls "$here/corpus/$target" | wc -l)"
 done

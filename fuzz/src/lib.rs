@@ -49,3 +49,14 @@ pub fn touch_resources(asset: &Asset) {
         let _ = asset.decode_image(i);
     }
 }
+
+/// A folder of this process's own for the targets that write files (removed by nobody: it
+/// lives in the system's temporary folder, one small file per target).
+pub fn scratch_folder() -> &'static Path {
+    static FOLDER: OnceLock<std::path::PathBuf> = OnceLock::new();
+    FOLDER.get_or_init(|| {
+        let folder = std::env::temp_dir().join(format!("velvet-fuzz-{}", std::process::id()));
+        std::fs::create_dir_all(&folder).expect("the scratch folder is made");
+        folder
+    })
+}

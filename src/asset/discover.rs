@@ -505,7 +505,15 @@ pub fn absolute(path: &Path) -> PathBuf {
     } else {
         path
     };
-    let abs = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
+    let abs = if cfg!(unix) && path.is_relative() {
+        // The working folder asked once per run, not once per path: velvet never changes it.
+        match working_folder() {
+            Some(cwd) => cwd.join(path),
+            None => path.to_path_buf(),
+        }
+    } else {
+        std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf())
+    };
     // Drop `.` components and fold `..` where it is lexically safe.
     let mut out = PathBuf::new();
     for c in abs.components() {
@@ -522,12 +530,19 @@ pub fn absolute(path: &Path) -> PathBuf {
     out
 }
 
+/// The working folder, asked of the system once per run (velvet never changes it).
+pub fn working_folder() -> Option<&'static Path> {
+    static FOLDER: std::sync::OnceLock<Option<PathBuf>> = std::sync::OnceLock::new();
+    FOLDER
+        .get_or_init(|| std::env::current_dir().ok())
+        .as_deref()
+}
+
 /// A path as reports show it: relative to the working directory when it lies below it, with
 /// forward slashes.
 pub fn display_path(path: &Path) -> String {
-    let shown = std::env::current_dir()
-        .ok()
-        .and_then(|cwd| path.strip_prefix(&cwd).ok().map(Path::to_path_buf))
+    let shown = working_folder()
+        .and_then(|cwd| path.strip_prefix(cwd).ok().map(Path::to_path_buf))
         .unwrap_or_else(|| path.to_path_buf());
     shown.to_string_lossy().replace('\\', "/")
 }

@@ -754,7 +754,7 @@ impl Asset {
         let data = match buffer.get("uri").and_then(|u| u.as_str()) {
             Some(uri) => match self.resolve(&uri, &uri_pointer)? {
                 Location::File(path) => {
-                    let file = resource::open_file(&path, &uri, &uri_pointer)?;
+                    let file = self.open_resource(&path, &uri, &uri_pointer)?;
                     let len = file
                         .metadata()
                         .map(|m| usize::try_from(m.len()).unwrap_or(usize::MAX))
@@ -921,6 +921,29 @@ impl Asset {
         facts
     }
 
+    /// Opens the resource file `path` that `uri` (at `pointer`) led to, refusing anything but
+    /// a regular file as [`resource::open_file`] does, from the file's facts as the run first
+    /// asked them ([`Asset::file_facts`]): one stat of a file for every question of a run.
+    fn open_resource(
+        &self,
+        path: &Path,
+        uri: &str,
+        pointer: &str,
+    ) -> Result<std::fs::File, Diagnostic> {
+        let fail = |detail: &str| {
+            Diagnostic::new(
+                &codes::IO_ERROR,
+                pointer,
+                format!("cannot read '{uri}' ({}): {detail}", path.display()),
+            )
+        };
+        match self.file_facts(path) {
+            Err((_, message)) => Err(fail(&message)),
+            Ok(facts) if !facts.is_file => Err(fail("not a regular file")),
+            Ok(_) => std::fs::File::open(path).map_err(|e| fail(&e.to_string())),
+        }
+    }
+
     fn resolve_asking(&self, uri: &str, pointer: &str) -> Result<Location, Diagnostic> {
         let location = resource::resolve_with(
             uri,
@@ -930,11 +953,15 @@ impl Asset {
         )?;
         if let Location::File(path) = &location {
             if !self.options.allow_outside_uris {
-                let real_base = self
-                    .lookups
-                    .real_base
-                    .get_or_init(|| resource::real_folder(self.base_dir()));
-                resource::check_inside(path, self.base_dir(), real_base.as_deref(), uri, pointer)?;
+                // The folder's real path is resolved only for a path that is not plainly
+                // inside it (a link on the way, `..`): resolving it reads every folder above.
+                let real_base = || {
+                    self.lookups
+                        .real_base
+                        .get_or_init(|| resource::real_folder(self.base_dir()))
+                        .clone()
+                };
+                resource::check_inside(path, self.base_dir(), real_base, uri, pointer)?;
             }
         }
         Ok(location)
@@ -1109,7 +1136,8 @@ impl Asset {
                 if let Some(known) = lock(&self.lookups.headers).get(&key) {
                     return known.clone();
                 }
-                let header = resource::open_file(&path, &key.1, &uri_pointer)
+                let header = self
+                    .open_resource(&path, &key.1, &uri_pointer)
                     .and_then(|file| resource::read_header(BufReader::new(file), &pointer, &what));
                 lock(&self.lookups.headers).insert(key, header.clone());
                 return header;

@@ -175,8 +175,9 @@ pub fn is_remote(uri: &str) -> bool {
 }
 
 /// Refuses a path that lies in `base_dir` by its text but leads out of it through a symbolic
-/// link. A path that does not exist (yet) is left to whoever opens it. `real_base` is
-/// `base_dir` with every link resolved (see [`real_folder`]).
+/// link. A path that does not exist (yet) is left to whoever opens it. `real_base` gives
+/// `base_dir` with every link resolved (see [`real_folder`]), asked only when the path is not
+/// plainly inside.
 ///
 /// A path below the folder whose every component is a plain name and none a link is inside
 /// without resolving anything: one `lstat` per component, where resolving the whole path
@@ -184,7 +185,7 @@ pub fn is_remote(uri: &str) -> bool {
 pub fn check_inside(
     path: &Path,
     base_dir: &Path,
-    real_base: Option<&Path>,
+    real_base: impl FnOnce() -> Option<PathBuf>,
     uri: &str,
     pointer: &str,
 ) -> Result<(), Diagnostic> {
@@ -214,8 +215,8 @@ pub fn check_inside(
     let Ok(real) = std::fs::canonicalize(path) else {
         return Ok(());
     };
-    match real_base {
-        Some(base) if real.starts_with(base) => Ok(()),
+    match real_base() {
+        Some(base) if real.starts_with(&base) => Ok(()),
         _ => Err(Diagnostic::new(
             &codes::URI_NOT_FOLLOWED,
             pointer,

@@ -71,8 +71,8 @@ pub fn artifact_uri(path: &Path) -> (String, bool) {
     let abs = crate::asset::discover::absolute(path);
     let encode =
         |c: &std::ffi::OsStr| utf8_percent_encode(&c.to_string_lossy(), SEGMENT).to_string();
-    if let Some(rel) = std::env::current_dir().ok().and_then(|cwd| {
-        abs.strip_prefix(crate::asset::discover::absolute(&cwd))
+    if let Some(rel) = crate::asset::discover::working_folder().and_then(|cwd| {
+        abs.strip_prefix(crate::asset::discover::absolute(cwd))
             .ok()
             .map(Path::to_path_buf)
     }) {

@@ -15,8 +15,8 @@ use super::extensions::{shapes, Shapes};
 use super::{Context, Rule};
 use crate::asset::pointer;
 use crate::asset::tape::{KeyId, Node};
-use std::collections::HashMap;
 use crate::diagnostics::{codes, Code, Diagnostic};
+use std::collections::HashMap;
 
 pub struct UnexpectedProperty;
 
@@ -168,8 +168,7 @@ impl<'s> Walk<'s> {
                 }
                 Decision::Extensions => {
                     path.push(Step::Key(key));
-                    for (name, extension) in member.as_object().into_iter().flat_map(|o| o.iter())
-                    {
+                    for (name, extension) in member.as_object().into_iter().flat_map(|o| o.iter()) {
                         if let Some(kind) = self.shapes.extension_object(&name, shape) {
                             path.push(Step::Key(name));
                             self.walk(extension, kind, path, out);

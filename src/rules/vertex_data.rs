@@ -172,8 +172,8 @@ impl Rule for VertexData {
                 // A primitive with no indices, no data it is the first to use and no skinning
                 // has nothing to judge here (a library's primitives mostly share a few
                 // accessors).
-                let skinned = attributes.contains_key("WEIGHTS_0")
-                    || attributes.contains_key("JOINTS_0");
+                let skinned =
+                    attributes.contains_key("WEIGHTS_0") || attributes.contains_key("JOINTS_0");
                 if primitive.get("indices").is_none()
                     && normal.is_none()
                     && tangent.is_none()
