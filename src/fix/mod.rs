@@ -1656,6 +1656,43 @@ mod tests {
     }
 
     #[test]
+    fn an_edit_lies_inside_an_element_only_below_one_the_document_has() {
+        use crate::rules::ElementPlace;
+        let loaded = asset::load_bytes(
+            Path::new("t.gltf"),
+            br#"{"asset":{"version":"2.0"},"bufferViews":[{"buffer":0,"byteLength":4},{"buffer":0,"byteLength":4}],"extensionsUsed":["A"]}"#,
+        );
+        let asset = loaded.asset.expect("the document loads");
+        let at = |pointer: &str| ElementPlace::of_edit(asset.root(), pointer);
+        let view = |index| ElementPlace {
+            property: "bufferViews".to_string(),
+            index,
+        };
+        assert_eq!(at("/bufferViews/1/target"), Some(view(1)));
+        assert_eq!(at("/bufferViews/0/extensions/X/y"), Some(view(0)));
+        // The element itself, one the array does not have, an index as a pointer does not
+        // write it, and what is not an array of the root.
+        for outside in [
+            "/bufferViews/1",
+            "/bufferViews/2/target",
+            "/bufferViews/-/target",
+            "/bufferViews/01/target",
+            "/extensionsUsed",
+            "/asset/version",
+            "",
+        ] {
+            assert_eq!(at(outside), None, "{outside}");
+        }
+        let finding =
+            |pointer: &str| Diagnostic::new(&crate::diagnostics::codes::TYPE_MISMATCH, pointer, "");
+        assert!(view(1).holds(&finding("/bufferViews/1")));
+        assert!(view(1).holds(&finding("/bufferViews/1/target")));
+        assert!(!view(1).holds(&finding("/bufferViews/10/target")));
+        assert!(!view(1).holds(&finding("/bufferViews")));
+        assert!(!view(1).holds(&finding("/accessors/1")));
+    }
+
+    #[test]
     fn an_edit_touches_what_a_rule_reads_unless_it_is_elsewhere_or_an_excepted_member_or_beside_its_places(
     ) {
         let reads = crate::rules::data::DATA_READS;

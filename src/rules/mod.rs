@@ -401,7 +401,8 @@ impl ElementPlace {
     pub fn of_edit(json: Node, pointer: &str) -> Option<ElementPlace> {
         let mut tokens = pointer.split('/').skip(1);
         let property = crate::asset::pointer::unescape(tokens.next()?);
-        let index: usize = tokens.next()?.parse().ok()?;
+        // An array index as a pointer writes it (no sign, no leading zero).
+        let index = crate::asset::pointer::array_index(tokens.next()?)?;
         tokens.next()?;
         (index < json.get(property.as_ref())?.as_array()?.len()).then(|| ElementPlace {
             property: property.into_owned(),
