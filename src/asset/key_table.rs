@@ -18,7 +18,7 @@ use std::collections::HashMap;
 const SLOT_BITS: u32 = 10;
 
 /// The distinct keys of a text, numbered from 0 in the order they first appear.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub(crate) struct KeyTable {
     /// Each key's bytes (unescaped), one after another.
     bytes: Vec<u8>,

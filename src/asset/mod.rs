@@ -266,6 +266,32 @@ pub fn load_given(
     bytes: FileBytes,
     options: &LoadOptions,
 ) -> (Loaded, Option<FileBytes>) {
+    load_given_after(path, bytes, options, None)
+}
+
+/// [`load_given`] of bytes that are the text of `earlier` with edits spliced in, the first at
+/// byte `first_change` of that text: the text's index is resumed from `earlier`'s at the
+/// first edit ([`tape::Tape::build_resumed`]) rather than built from its first byte.
+pub fn load_given_resuming(
+    path: &Path,
+    bytes: FileBytes,
+    options: &LoadOptions,
+    earlier: &Asset,
+    first_change: usize,
+) -> (Loaded, Option<FileBytes>) {
+    debug_assert!(
+        bytes.get(..first_change) == earlier.json_text.as_bytes().get(..first_change),
+        "the text equals the earlier one before its first change"
+    );
+    load_given_after(path, bytes, options, Some((&earlier.tape, first_change)))
+}
+
+fn load_given_after(
+    path: &Path,
+    bytes: FileBytes,
+    options: &LoadOptions,
+    resume: Option<(&tape::Tape, usize)>,
+) -> (Loaded, Option<FileBytes>) {
     let plain = !bytes.starts_with(b"glTF")
         && !bytes.starts_with(b"\xEF\xBB\xBF")
         && !path
@@ -277,7 +303,16 @@ pub fn load_given(
     }
     match SourceText::from_bytes(bytes) {
         Ok(text) => (
-            load_text(path, text, Container::Gltf, 0, None, Vec::new(), options),
+            load_text(
+                path,
+                text,
+                Container::Gltf,
+                0,
+                None,
+                Vec::new(),
+                options,
+                resume,
+            ),
             None,
         ),
         Err((bytes, _)) => (load_bytes_with(path, &bytes, options), Some(bytes)),
@@ -392,6 +427,7 @@ fn load_from(path: &Path, file: Bytes<'_>, options: &LoadOptions) -> Loaded {
         bin,
         diagnostics,
         options,
+        None,
     );
     if let Some(asset) = &mut loaded.asset {
         asset.other_chunks = other_chunks;
@@ -401,6 +437,7 @@ fn load_from(path: &Path, file: Bytes<'_>, options: &LoadOptions) -> Loaded {
 }
 
 /// Indexes a document's JSON text and makes the asset.
+#[allow(clippy::too_many_arguments)]
 fn load_text(
     path: &Path,
     json_text: SourceText,
@@ -409,11 +446,17 @@ fn load_text(
     bin: Option<Vec<u8>>,
     mut diagnostics: Vec<Diagnostic>,
     options: &LoadOptions,
+    resume: Option<(&tape::Tape, usize)>,
 ) -> Loaded {
     // A GLB's JSON chunk may carry NUL padding (reported by glb::split); parse past it.
     let parse_text = json_text.trim_end_matches(['\0', ' ']);
     let max_depth = options.max_json_depth.min(limits::JSON_DEPTH_CEILING);
-    let built = tape::Tape::build_within(parse_text, max_depth);
+    let built = match resume {
+        Some((earlier, first_change)) => {
+            tape::Tape::build_resumed(parse_text, max_depth, earlier, first_change)
+        }
+        None => tape::Tape::build_within(parse_text, max_depth),
+    };
     // A text that nests too deep is refused for its depth, whatever else is wrong with it.
     let too_deep = match &built {
         Ok(_) => None,

@@ -125,6 +125,17 @@ struct Open {
     is_object: bool,
 }
 
+/// Where [`Tape::build_resumed`] takes over from an earlier index.
+struct ResumePoint {
+    /// The containers open there, outermost first, each with the value entries of its
+    /// children so far (the open child last).
+    open: Vec<(u32, Vec<u32>)>,
+    /// The first entry not taken from the earlier index.
+    after: u32,
+    /// The byte offset the parse resumes at: the end of the last value taken.
+    at: usize,
+}
+
 struct Builder<'t> {
     bytes: &'t [u8],
     at: usize,
@@ -171,6 +182,147 @@ impl Tape {
             elements: builder.elements,
             keys: builder.keys,
         })
+    }
+
+    /// Indexes `text` as [`Tape::build_within`] does, given `earlier`, the index of a text that
+    /// `text` equals up to byte `first_change` (a text with fixes spliced in: its first edit
+    /// is often near its end). The entries of the values that end before that byte are taken
+    /// from `earlier`, the containers open there are opened again, and only the rest is parsed.
+    /// A key only the earlier text had keeps its number (and finds no member); what any
+    /// reading of the index gives is what a fresh build gives.
+    pub fn build_resumed(
+        text: &str,
+        max_depth: usize,
+        earlier: &Tape,
+        first_change: usize,
+    ) -> Result<Tape, TapeError> {
+        if text.len() >= u32::MAX as usize {
+            return Err(TapeError::TooLarge);
+        }
+        let Some(point) = earlier.resume_point(first_change.min(text.len())) else {
+            return Tape::build_within(text, max_depth);
+        };
+        let mut entries = Vec::with_capacity((text.len() / 16).max(point.after as usize));
+        super::pages::advise_huge(&mut entries);
+        entries.extend_from_slice(&earlier.entries[..point.after as usize]);
+        // The runs of the arrays that closed before the resumed value's end, which come before
+        // the runs of every array that closes after it.
+        let closing_later = earlier.entries[point.after as usize..]
+            .iter()
+            .chain(
+                point
+                    .open
+                    .iter()
+                    .map(|(entry, _)| &earlier.entries[*entry as usize]),
+            )
+            .filter(|e| e.kind() == Kind::Array)
+            .map(Entry::aux)
+            .min();
+        let cut = closing_later.unwrap_or(earlier.elements.len());
+        let mut builder = Builder {
+            bytes: text.as_bytes(),
+            at: point.at,
+            max_depth,
+            entries,
+            elements: earlier.elements[..cut].to_vec(),
+            scratch: Vec::new(),
+            member_keys: Vec::new(),
+            keys: earlier.keys.clone(),
+        };
+        let mut stack = Vec::with_capacity(point.open.len());
+        for (entry, children) in &point.open {
+            let reopened = &mut builder.entries[*entry as usize];
+            let is_object = reopened.kind() == Kind::Object;
+            // What the close of the earlier text wrote (its end, count or run, duplicates) is
+            // written again by this one's.
+            reopened.meta = kind_bits(reopened.kind());
+            let scratch = builder.scratch.len();
+            if !is_object {
+                builder.scratch.extend_from_slice(children);
+            }
+            stack.push(Open {
+                entry: *entry,
+                count: children.len() as u32,
+                scratch,
+                is_object,
+            });
+        }
+        builder.after_value(&mut stack)?;
+        Ok(Tape {
+            entries: builder.entries,
+            elements: builder.elements,
+            keys: builder.keys,
+        })
+    }
+
+    /// Where a build of a text equal to this index's up to byte `first_change` can resume:
+    /// after the last value that ends by then inside the deepest container that holds the
+    /// change and such a value. `None` when no value of the root ends before the change.
+    fn resume_point(&self, first_change: usize) -> Option<ResumePoint> {
+        let entries = &self.entries;
+        let root = entries.first()?;
+        if !matches!(root.kind(), Kind::Object | Kind::Array) || root.end as usize <= first_change {
+            return None;
+        }
+        // The children of container `at`: (the entry it starts with, a key's or the value's;
+        // the value's entry).
+        let children = |at: u32| -> Vec<(u32, u32)> {
+            let e = &entries[at as usize];
+            if e.kind() == Kind::Object {
+                let mut out = Vec::new();
+                let mut key = at + 1;
+                while key < e.next {
+                    out.push((key, key + 1));
+                    key = entries[key as usize + 1].next;
+                }
+                out
+            } else {
+                let run = e.aux();
+                let count = self.elements[run] as usize;
+                self.elements[run + 1..run + 1 + count]
+                    .iter()
+                    .map(|&v| (v, v))
+                    .collect()
+            }
+        };
+        // Strictly before: the byte after the value is then the earlier text's too, so the
+        // value ends there in the new text as well (a number followed by a changed digit
+        // would not).
+        let ends_before = |value: u32| (entries[value as usize].end as usize) < first_change;
+        let mut open: Vec<(u32, Vec<u32>)> = Vec::new();
+        let mut container = 0u32;
+        loop {
+            let list = children(container);
+            let before = list.iter().take_while(|(_, v)| ends_before(*v)).count();
+            let values = |n: usize| list[..n].iter().map(|(_, v)| *v).collect::<Vec<u32>>();
+            // The child the change starts inside, when it is a container with a value of its
+            // own that ends before the change: the build resumes deeper.
+            let deeper = list.get(before).filter(|(first, value)| {
+                let child = &entries[*value as usize];
+                (entries[*first as usize].start as usize) < first_change
+                    && matches!(child.kind(), Kind::Object | Kind::Array)
+                    && children(*value)
+                        .first()
+                        .is_some_and(|(_, v)| ends_before(*v))
+            });
+            if let Some((_, value)) = deeper {
+                open.push((container, values(before + 1)));
+                container = *value;
+                continue;
+            }
+            if before == 0 {
+                // Only the root can hold no value that ends before the change: a deeper
+                // container is entered for one.
+                return None;
+            }
+            let last = &entries[list[before - 1].1 as usize];
+            open.push((container, values(before)));
+            return Some(ResumePoint {
+                open,
+                after: last.next,
+                at: last.end as usize,
+            });
+        }
     }
 
     /// The root value of `text`, which must be the text this index was built from.
@@ -230,9 +382,13 @@ impl Builder<'_> {
     fn document(&mut self) -> Result<(), TapeError> {
         let mut stack: Vec<Open> = Vec::new();
         self.skip_whitespace();
+        self.value_start(&mut stack)?;
+        self.after_value(&mut stack)
+    }
+
+    /// The rest of the text from the end of a value, with the containers `stack` still open.
+    fn after_value(&mut self, stack: &mut Vec<Open>) -> Result<(), TapeError> {
         loop {
-            // A value starts here.
-            self.value_start(&mut stack)?;
             // Close what ends here, then find where the next value starts.
             loop {
                 self.skip_whitespace();
@@ -265,6 +421,8 @@ impl Builder<'_> {
                     _ => return self.fail(),
                 }
             }
+            // A value starts here.
+            self.value_start(stack)?;
         }
     }
 
@@ -1287,7 +1445,156 @@ mod properties {
         })
     }
 
+    /// The index in a form two builds of one text must share: every entry (a key entry's
+    /// number replaced by what the key table says it spells), the arrays' runs, and each key
+    /// found by its spelling under the number its entries hold.
+    /// An entry as [`canonical`] gives it: span, next entry, kind and flags (and count or
+    /// run), and for a key what it spells in place of its number.
+    type CanonicalEntry = (u32, u32, u32, u32, Option<Vec<u8>>);
+
+    fn canonical(tape: &Tape, text: &str) -> (Vec<CanonicalEntry>, Vec<u32>) {
+        let entries = tape
+            .entries
+            .iter()
+            .map(|e| {
+                if e.meta & KEY != 0 {
+                    let raw = &text[e.start as usize..e.end as usize];
+                    let spelled: String = serde_json::from_str(raw).unwrap();
+                    assert_eq!(
+                        tape.keys.id(spelled.as_bytes()),
+                        Some(e.aux() as u32),
+                        "key {raw} found under its number"
+                    );
+                    let meta = e.meta & ((1 << COUNT_SHIFT) - 1);
+                    (e.start, e.end, e.next, meta, Some(spelled.into_bytes()))
+                } else {
+                    (e.start, e.end, e.next, e.meta, None)
+                }
+            })
+            .collect();
+        (entries, tape.elements.clone())
+    }
+
+    /// Every place of a few texts (nested objects and arrays, compact and pretty), each part of
+    /// up to three bytes replaced by each of a list of texts: the resumed index is the fresh
+    /// one, and most of the builds did resume.
+    #[test]
+    fn an_index_resumed_at_every_place_of_a_few_texts_is_the_fresh_index() {
+        let value: Value = serde_json::from_str(
+            r#"{"a":[1,[2,3],{"b":[4,{"c":5}]}],"d":{"e":{"f":[6,7],"g":"h"},"i":[]},"j":"k\u0061","a":0}"#,
+        )
+        .unwrap();
+        let replacements = [
+            "",
+            "1",
+            "\"a\"",
+            "{}",
+            "[]",
+            "[1,[2]]",
+            "{\"a\":{\"b\":1}}",
+            ",\"k\":0",
+            ",1",
+            "]",
+            "}",
+            ",",
+            " ",
+            "\"a\":",
+            "null,",
+            "\"\\u0061\":2,",
+            ",\"a\":[9]",
+        ];
+        let (mut resumed_builds, mut builds) = (0, 0);
+        for text in [
+            r#"{"a":[1,[2,3],{"b":[4,{"c":5}]}],"d":{"e":{"f":[6,7],"g":"h"},"i":[]},"j":"k\u0061","a":0}"#.to_string(),
+            serde_json::to_string_pretty(&value).unwrap(),
+        ] {
+            let earlier = Tape::build(&text).unwrap();
+            for start in (0..=text.len()).filter(|i| text.is_char_boundary(*i)) {
+                for length in 0..=3 {
+                    let end = (start + length).min(text.len());
+                    if !text.is_char_boundary(end) {
+                        continue;
+                    }
+                    for replacement in replacements {
+                        let changed = format!("{}{}{}", &text[..start], replacement, &text[end..]);
+                        let first_change = text
+                            .bytes()
+                            .zip(changed.bytes())
+                            .position(|(a, b)| a != b)
+                            .unwrap_or(text.len().min(changed.len()));
+                        let fresh = Tape::build_within(&changed, 5);
+                        let resumed = Tape::build_resumed(&changed, 5, &earlier, first_change);
+                        builds += 1;
+                        resumed_builds += usize::from(earlier.resume_point(first_change).is_some());
+                        match (&fresh, &resumed) {
+                            (Ok(fresh), Ok(resumed)) => assert_eq!(
+                                canonical(fresh, &changed),
+                                canonical(resumed, &changed),
+                                "{changed}"
+                            ),
+                            _ => assert_eq!(
+                                fresh.as_ref().err(),
+                                resumed.as_ref().err(),
+                                "{changed}"
+                            ),
+                        }
+                    }
+                }
+            }
+        }
+        assert!(
+            resumed_builds * 4 > builds * 3,
+            "{resumed_builds} of {builds} resumed"
+        );
+    }
+
     proptest! {
+        /// A text with a part replaced, indexed from the earlier text's index from the first
+        /// changed byte on, is indexed as a fresh build indexes it: the same entries, runs and
+        /// key lookups, or the same refusal.
+        #[test]
+        fn an_index_resumed_at_the_first_change_is_the_fresh_index(
+            value in json_value(),
+            pretty in any::<bool>(),
+            from in any::<prop::sample::Index>(),
+            length in 0usize..12,
+            replacement in prop::sample::select(vec![
+                "", "1", "\"a\"", "{}", "[]", "[1,[2]]", "{\"a\":{\"b\":1}}", ",\"k\":0",
+                ",1", "]", "}", ",", " ", "\"a\":", "null,", "\"\\u0061\":2,",
+            ]),
+        ) {
+            let text = if pretty {
+                serde_json::to_string_pretty(&value).unwrap()
+            } else {
+                serde_json::to_string(&value).unwrap()
+            };
+            let earlier = Tape::build(&text).unwrap();
+            let mut start = from.index(text.len() + 1);
+            while !text.is_char_boundary(start) {
+                start -= 1;
+            }
+            let mut end = (start + length).min(text.len());
+            while !text.is_char_boundary(end) {
+                end += 1;
+            }
+            let changed = format!("{}{}{}", &text[..start], replacement, &text[end..]);
+            let first_change = text
+                .bytes()
+                .zip(changed.bytes())
+                .position(|(a, b)| a != b)
+                .unwrap_or(text.len().min(changed.len()));
+            let fresh = Tape::build_within(&changed, 6);
+            let resumed = Tape::build_resumed(&changed, 6, &earlier, first_change);
+            match (&fresh, &resumed) {
+                (Ok(fresh), Ok(resumed)) => prop_assert_eq!(
+                    canonical(fresh, &changed),
+                    canonical(resumed, &changed),
+                    "{:?}", changed
+                ),
+                _ => prop_assert_eq!(fresh.as_ref().err(), resumed.as_ref().err(), "{:?}", changed),
+            }
+        }
+
         /// Any JSON text, and any cut or one-byte change of it, gets the same verdict from the
         /// index as from serde_json, and the same values when both read it.
         #[test]

@@ -817,9 +817,14 @@ impl<'v> Fixing<'v> {
             }
             Err(e) => return Err(Failed::Other(format!("its edits do not apply: {e}"))),
         };
+        // Where the fixed text first differs from the file's: its index is resumed there.
+        let mut first_change = None;
         let mut bytes: Vec<u8> = match output {
             crate::edit::write::Output::Bytes(bytes) => bytes.into_owned(),
-            crate::edit::write::Output::Spliced(spliced) => spliced.to_text().into_bytes(),
+            crate::edit::write::Output::Spliced(spliced) => {
+                first_change = spliced.first_change();
+                spliced.to_text().into_bytes()
+            }
         };
         let drops_byte_order_mark = fixes.iter().any(|f| f.drops_byte_order_mark);
         let rebuilds_container = fixes.iter().any(|f| f.rebuilds_container);
@@ -836,11 +841,19 @@ impl<'v> Fixing<'v> {
         // A fixed .gltf's bytes become its text as they are: a copy of a large document costs
         // about as much as indexing it.
         let (loaded, kept_bytes) = if source.container == Container::Gltf {
-            let (loaded, back) = asset::load_given(
-                path,
-                asset::FileBytes::from_vec(bytes),
-                &self.validator.load,
-            );
+            let bytes = asset::FileBytes::from_vec(bytes);
+            let (loaded, back) = match first_change {
+                // The text as spliced, nothing put before it: the file's index holds for what
+                // comes before the first edit.
+                Some(first_change) if source.json_offset == 0 => asset::load_given_resuming(
+                    path,
+                    bytes,
+                    &self.validator.load,
+                    source,
+                    first_change,
+                ),
+                _ => asset::load_given(path, bytes, &self.validator.load),
+            };
             (loaded, back.map(asset::FileBytes::into_vec))
         } else {
             (

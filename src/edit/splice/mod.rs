@@ -103,6 +103,12 @@ impl<'t> Spliced<'t> {
         self.runs().map(str::as_bytes)
     }
 
+    /// The byte of the source where the text first differs from it: the start of the first
+    /// splice (`None` without one).
+    pub fn first_change(&self) -> Option<usize> {
+        self.splices.first().map(|s| s.start)
+    }
+
     /// The text's length in bytes.
     pub fn len(&self) -> usize {
         let removed: usize = self.splices.iter().map(|s| s.end - s.start).sum();
