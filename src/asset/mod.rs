@@ -964,27 +964,20 @@ impl Asset {
         facts
     }
 
-    /// Opens the resource file `path` that `uri` (at `pointer`) led to, refusing anything but
-    /// a regular file as [`resource::open_file`] does, from the file's facts as the run first
-    /// asked them ([`Asset::file_facts`]): one stat of a file for every question of a run.
+    /// Opens the resource file `path` that `uri` (at `pointer`) led to
+    /// ([`resource::open_file`]), from the file's facts as the run first asked them
+    /// ([`Asset::file_facts`]): one stat of a file for every question of a run.
     fn open_resource(
         &self,
         path: &Path,
         uri: &str,
         pointer: &str,
     ) -> Result<std::fs::File, Diagnostic> {
-        let fail = |detail: &str| {
-            Diagnostic::new(
-                &codes::IO_ERROR,
-                pointer,
-                format!("cannot read '{uri}' ({}): {detail}", path.display()),
-            )
-        };
-        match self.file_facts(path) {
-            Err((_, message)) => Err(fail(&message)),
-            Ok(facts) if !facts.is_file => Err(fail("not a regular file")),
-            Ok(_) => std::fs::File::open(path).map_err(|e| fail(&e.to_string())),
-        }
+        let is_file = self
+            .file_facts(path)
+            .map(|facts| facts.is_file)
+            .map_err(|(_, why)| why);
+        resource::open_file(path, uri, pointer, is_file)
     }
 
     fn resolve_asking(&self, uri: &str, pointer: &str) -> Result<Location, Diagnostic> {
@@ -1013,7 +1006,10 @@ impl Asset {
     fn read_uri(&self, uri: &str, pointer: &str) -> Result<Vec<u8>, Diagnostic> {
         match self.resolve(uri, pointer)? {
             Location::Data { bytes, .. } => Ok(bytes),
-            Location::File(path) => resource::read_file(&path, uri, pointer),
+            Location::File(path) => {
+                let file = self.open_resource(&path, uri, pointer)?;
+                resource::read_whole(file, &path, uri, pointer)
+            }
         }
     }
 

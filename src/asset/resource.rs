@@ -269,26 +269,36 @@ pub fn is_lfs_pointer(path: &Path) -> bool {
         .is_ok_and(|()| head == LFS_POINTER_PREFIX)
 }
 
-/// Opens a resource file that a URI led to, refusing anything but a regular file.
-pub fn open_file(path: &Path, uri: &str, pointer: &str) -> Result<std::fs::File, Diagnostic> {
-    let fail = |detail: String| {
+/// Opens a resource file that a URI led to, refusing anything but a regular file. `is_file`
+/// is what the file system said of `path` when asked (whether it is a regular file, or why it
+/// could not say): asked before opening, since opening a pipe waits for a writer.
+pub fn open_file(
+    path: &Path,
+    uri: &str,
+    pointer: &str,
+    is_file: Result<bool, String>,
+) -> Result<std::fs::File, Diagnostic> {
+    let fail = |detail: &str| {
         Diagnostic::new(
             &codes::IO_ERROR,
             pointer,
             format!("cannot read '{uri}' ({}): {detail}", path.display()),
         )
     };
-    // Checked before opening: opening a pipe waits for a writer.
-    let meta = std::fs::metadata(path).map_err(|e| fail(e.to_string()))?;
-    if !meta.is_file() {
-        return Err(fail("not a regular file".to_string()));
+    match is_file {
+        Err(why) => Err(fail(&why)),
+        Ok(false) => Err(fail("not a regular file")),
+        Ok(true) => std::fs::File::open(path).map_err(|e| fail(&e.to_string())),
     }
-    std::fs::File::open(path).map_err(|e| fail(e.to_string()))
 }
 
-/// Reads a resource file that a URI led to (see [`open_file`]).
-pub fn read_file(path: &Path, uri: &str, pointer: &str) -> Result<Vec<u8>, Diagnostic> {
-    let mut file = open_file(path, uri, pointer)?;
+/// The whole of a resource file opened with [`open_file`].
+pub fn read_whole(
+    mut file: std::fs::File,
+    path: &Path,
+    uri: &str,
+    pointer: &str,
+) -> Result<Vec<u8>, Diagnostic> {
     let mut bytes = Vec::new();
     std::io::Read::read_to_end(&mut file, &mut bytes).map_err(|e| {
         Diagnostic::new(
@@ -569,7 +579,11 @@ mod tests {
 
     #[test]
     fn only_regular_files_are_read() {
-        let err = read_file(Path::new("/dev/zero"), "zero.bin", "/buffers/0/uri").unwrap_err();
+        let zero = Path::new("/dev/zero");
+        let is_file = std::fs::metadata(zero)
+            .map(|m| m.is_file())
+            .map_err(|e| e.to_string());
+        let err = open_file(zero, "zero.bin", "/buffers/0/uri", is_file).unwrap_err();
         assert_eq!(
             (err.code, err.pointer.as_str()),
             ("IO_ERROR", "/buffers/0/uri")

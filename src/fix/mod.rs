@@ -1583,22 +1583,7 @@ mod tests {
         let made = dir.path().join("data.gltf");
         std::fs::write(&made, with_data).expect("the document is written");
         let mut documents = vec![made];
-        let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/validate");
-        let mut folders: Vec<PathBuf> = std::fs::read_dir(&fixtures)
-            .expect("the fixtures are there")
-            .map(|e| e.expect("a fixture folder").path())
-            .collect();
-        folders.sort();
-        for folder in folders {
-            let mut files: Vec<PathBuf> = std::fs::read_dir(&folder)
-                .into_iter()
-                .flatten()
-                .map(|e| e.expect("a fixture").path())
-                .filter(|p| p.extension().is_some_and(|e| e == "gltf" || e == "glb"))
-                .collect();
-            files.sort();
-            documents.extend(files);
-        }
+        documents.extend(crate::rules::fixture_documents(&["gltf", "glb"]));
         let validator = Validator::new(
             crate::rules::schema::Schemas::builtin(),
             Settings::default(),

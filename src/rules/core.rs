@@ -719,21 +719,9 @@ impl Rule for CoreStructure {
     }
 
     /// The core schemas judge each element of the root's arrays of objects by itself (their
-    /// only constraint across elements, `uniqueItems`, is on the lists of extension names): the
-    /// file's findings hold when it had none in the edited elements and the fixed elements
-    /// pass their schemas.
-    fn holds_inside(
-        &self,
-        cx: &Context,
-        elements: &[super::ElementPlace],
-        found_inside: &dyn Fn(&super::ElementPlace) -> bool,
-    ) -> bool {
-        elements.iter().all(|element| {
-            !found_inside(element)
-                && element
-                    .in_document(cx.json())
-                    .is_some_and(|value| cx.schemas.core.element_passes(&element.property, value))
-        })
+    /// only constraint across elements, `uniqueItems`, is on the lists of extension names).
+    fn passes_alone(&self, cx: &Context, element: &super::ElementPlace, value: Node) -> bool {
+        cx.schemas.core.element_passes(&element.property, value)
     }
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {

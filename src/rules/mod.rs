@@ -369,22 +369,33 @@ pub trait Rule: Sync {
     fn reads(&self) -> Reads {
         Reads::Document
     }
-    /// For a rule whose reads an edit touched: whether its findings on the file are its
-    /// findings on the fixed document `cx`, where every edit lies inside an element the file
-    /// has of a top-level array (`elements`, each edited element once; `found_inside`: whether
-    /// the file's findings of this rule hold one at or inside an element). A rule whose
-    /// judgment of such an element depends on that element alone, and whose findings elsewhere
-    /// do not depend on it, re-judges just those elements; by default a rule cannot say, and
-    /// runs again.
-    fn holds_inside(
-        &self,
-        cx: &Context,
-        elements: &[ElementPlace],
-        found_inside: &dyn Fn(&ElementPlace) -> bool,
-    ) -> bool {
-        let _ = (cx, elements, found_inside);
+    /// For a rule that judges each element of the root's arrays by that element alone, and
+    /// whose findings elsewhere do not depend on it: whether the element `value` at `element`
+    /// of the document `cx` gives no finding, judged by itself. A rule that cannot judge an
+    /// element alone says no (the default), and runs again whenever its reads are touched.
+    fn passes_alone(&self, cx: &Context, element: &ElementPlace, value: Node) -> bool {
+        let _ = (cx, element, value);
         false
     }
+}
+
+/// For a rule whose reads a fix's edits touched, all inside the elements `elements` that the
+/// file has of the root's arrays: whether its findings on the file are its findings on the
+/// fixed document `cx`. They are when the file's findings of the rule held none at or inside
+/// those elements (`found_inside`) and each fixed element passes alone
+/// ([`Rule::passes_alone`]).
+pub fn findings_hold_inside(
+    rule: &dyn Rule,
+    cx: &Context,
+    elements: &[ElementPlace],
+    found_inside: &dyn Fn(&ElementPlace) -> bool,
+) -> bool {
+    elements.iter().all(|element| {
+        !found_inside(element)
+            && element
+                .in_document(cx.json())
+                .is_some_and(|value| rule.passes_alone(cx, element, value))
+    })
 }
 
 /// An element of a top-level array (`/bufferViews/1`) that a fix edits inside.
@@ -506,6 +517,26 @@ pub(crate) fn findings_of(rule: &dyn Rule, text: &str) -> Vec<String> {
         .into_iter()
         .map(|d| format!("{} {}", d.code, d.pointer))
         .collect()
+}
+
+/// The fixture documents of every code's folder (`fixtures/validate/<CODE>/`) whose file name
+/// ends in one of `extensions`, in path order: the tests that hold a mechanism to every
+/// fixture walk them.
+#[cfg(test)]
+pub(crate) fn fixture_documents(extensions: &[&str]) -> Vec<std::path::PathBuf> {
+    let fixtures = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/validate");
+    let mut documents: Vec<std::path::PathBuf> = std::fs::read_dir(&fixtures)
+        .expect("the fixtures are there")
+        .flat_map(|folder| std::fs::read_dir(folder.expect("a fixture folder").path()))
+        .flatten()
+        .map(|e| e.expect("a fixture").path())
+        .filter(|p| {
+            p.extension()
+                .is_some_and(|e| extensions.iter().any(|x| e == *x))
+        })
+        .collect();
+    documents.sort();
+    documents
 }
 
 /// [`findings_of`] with each finding's message: "CODE pointer message".

@@ -121,33 +121,31 @@ pub fn is_index(pointer: &str) -> bool {
 
 pub struct References;
 
-/// The places the rule reads: each index of [`LINKS`], the elements of the arrays they index
-/// and of [`PRUNED`], and which root extensions the document has (an index into a root
-/// extension's array that the document lacks is a missing dependency).
-fn places() -> &'static (Vec<&'static str>, Vec<String>) {
-    static PLACES: std::sync::OnceLock<(Vec<&'static str>, Vec<String>)> =
-        std::sync::OnceLock::new();
-    PLACES.get_or_init(|| {
-        let values = LINKS.iter().map(|(site, _)| *site).collect();
-        let mut arrays: Vec<String> = LINKS
-            .iter()
-            .map(|(_, target)| target.replace("{0}", "*"))
-            .chain(PRUNED.iter().map(|a| a.to_string()))
-            .chain(["/extensions".to_string()])
-            .collect();
-        arrays.sort();
-        arrays.dedup();
-        (values, arrays)
-    })
-}
-
 impl Rule for References {
+    /// The places the rule reads: each index of [`LINKS`], the elements of the arrays they
+    /// index and of [`PRUNED`], and which root extensions the document has (an index into a
+    /// root extension's array that the document lacks is a missing dependency).
     fn reads(&self) -> super::Reads {
-        static ELEMENTS: std::sync::OnceLock<Vec<&'static str>> = std::sync::OnceLock::new();
-        let (values, arrays) = places();
+        static ARRAYS: std::sync::OnceLock<Vec<&'static str>> = std::sync::OnceLock::new();
+        static SITES: std::sync::OnceLock<Vec<&'static str>> = std::sync::OnceLock::new();
+        let arrays = ARRAYS.get_or_init(|| {
+            let mut arrays: Vec<&'static str> = LINKS
+                .iter()
+                .map(|(_, target)| match target.contains("{0}") {
+                    // Made once per process, for as long as it runs.
+                    true => &*target.replace("{0}", "*").leak(),
+                    false => *target,
+                })
+                .chain(PRUNED)
+                .chain(["/extensions"])
+                .collect();
+            arrays.sort();
+            arrays.dedup();
+            arrays
+        });
         super::Reads::Places {
-            values,
-            elements: ELEMENTS.get_or_init(|| arrays.iter().map(String::as_str).collect()),
+            values: SITES.get_or_init(|| LINKS.iter().map(|(site, _)| *site).collect()),
+            elements: arrays,
         }
     }
 

@@ -35,33 +35,23 @@ impl Rule for UnexpectedProperty {
     }
 
     /// An element of one of the root's arrays is walked by itself, and nothing else depends on
-    /// what it holds: the file's findings hold when it had none in the edited elements and the
-    /// fixed elements have no key their kinds do not define.
-    fn holds_inside(
-        &self,
-        cx: &Context,
-        elements: &[super::ElementPlace],
-        found_inside: &dyn Fn(&super::ElementPlace) -> bool,
-    ) -> bool {
+    /// what it holds.
+    fn passes_alone(&self, _: &Context, element: &super::ElementPlace, value: Node) -> bool {
         let shapes = shapes();
-        elements.iter().all(|element| {
-            let kind = shapes
-                .children(shapes.root())
-                .iter()
-                .find(|(name, _, array)| *array && *name == element.property);
-            let (Some((_, kind, _)), Some(value), false) =
-                (kind, element.in_document(cx.json()), found_inside(element))
-            else {
-                return false;
-            };
-            let mut path = vec![
-                Step::Key(element.property.as_str().into()),
-                Step::Index(element.index),
-            ];
-            let mut found = Vec::new();
-            Walk::new(shapes).walk(value, *kind, &mut path, &mut found);
-            found.is_empty()
-        })
+        let Some((_, kind, _)) = shapes
+            .children(shapes.root())
+            .iter()
+            .find(|(name, _, array)| *array && *name == element.property)
+        else {
+            return false;
+        };
+        let mut path = vec![
+            Step::Key(element.property.as_str().into()),
+            Step::Index(element.index),
+        ];
+        let mut found = Vec::new();
+        Walk::new(shapes).walk(value, *kind, &mut path, &mut found);
+        found.is_empty()
     }
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {

@@ -100,7 +100,7 @@ pub struct Reuse<'r> {
     pub touched: &'r (dyn Fn(&rules::Reads) -> bool + Sync),
     /// The elements the edits lie inside, when every edit lies inside an element the file has
     /// of a top-level array: a rule whose reads they touch may still find its findings hold
-    /// by judging those elements again ([`rules::Rule::holds_inside`]).
+    /// by judging those elements again ([`rules::findings_hold_inside`]).
     pub elements: Option<&'r [rules::ElementPlace]>,
 }
 
@@ -117,9 +117,9 @@ impl Reuse<'_> {
         let found_inside =
             |element: &rules::ElementPlace| found.iter().any(|f| element.holds(&f.diagnostic));
         let holds = !(self.touched)(&rule.reads())
-            || self
-                .elements
-                .is_some_and(|elements| rule.holds_inside(cx, elements, &found_inside));
+            || self.elements.is_some_and(|elements| {
+                rules::findings_hold_inside(rule, cx, elements, &found_inside)
+            });
         holds.then(|| found.iter().map(|f| f.diagnostic.clone()).collect())
     }
 }
@@ -622,15 +622,7 @@ mod tests {
         // a time or less one member of every element of a top-level array, must give every rule
         // that does not read what went the findings it gave the whole document.
         let validator = Validator::builtin(Settings::default());
-        let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/validate");
-        let mut documents: Vec<PathBuf> = std::fs::read_dir(&fixtures)
-            .expect("the fixtures are there")
-            .flat_map(|folder| std::fs::read_dir(folder.expect("a folder").path()))
-            .flatten()
-            .map(|e| e.expect("a fixture").path())
-            .filter(|p| p.extension().is_some_and(|e| e == "gltf"))
-            .collect();
-        documents.sort();
+        let documents = rules::fixture_documents(&["gltf"]);
         let (mut compared, mut variants) = (0, 0);
         for path in &documents {
             let text = std::fs::read_to_string(path).expect("the fixture reads");
@@ -715,18 +707,10 @@ mod tests {
     fn a_rule_that_rejudges_edited_elements_says_its_findings_hold_only_when_they_do() {
         // Each member of each element of the root's arrays in every fixture document, removed
         // or given a value of the wrong type: where a rule says its findings on the document
-        // hold for the edited one (`Rule::holds_inside`), they must be its findings there.
+        // hold for the edited one (`rules::findings_hold_inside`), they must be its findings there.
         let validator = Validator::builtin(Settings::default());
         let schemas = Schemas::builtin();
-        let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/validate");
-        let mut documents: Vec<PathBuf> = std::fs::read_dir(&fixtures)
-            .expect("the fixtures are there")
-            .flat_map(|folder| std::fs::read_dir(folder.expect("a folder").path()))
-            .flatten()
-            .map(|e| e.expect("a fixture").path())
-            .filter(|p| p.extension().is_some_and(|e| e == "gltf"))
-            .collect();
-        documents.sort();
+        let documents = rules::fixture_documents(&["gltf"]);
         // For each rule: how often it said its findings hold, and how often not.
         let mut said = vec![(0usize, 0usize); rules::REGISTRY.len()];
         for path in &documents {
@@ -801,7 +785,8 @@ mod tests {
                                         .any(|f| e.holds(&f.diagnostic))
                                 };
                                 let rule = rules::REGISTRY[i];
-                                if !rule.holds_inside(
+                                if !rules::findings_hold_inside(
+                                    rule,
                                     &cx,
                                     std::slice::from_ref(&place),
                                     &found_inside,
