@@ -310,8 +310,17 @@ pub fn find_too_deep(text: &str, max_depth: usize) -> Option<TooDeep> {
 /// is read up to the length its header declares (at most 4 GiB), anything else up to the
 /// document limit; one byte more is read so that a longer stream is seen to be longer.
 pub fn read_asset_file(path: &Path, options: &LoadOptions) -> std::io::Result<FileBytes> {
-    let mut file = std::fs::File::open(path)?;
+    let file = std::fs::File::open(path)?;
     let metadata = file.metadata()?;
+    read_opened_asset(file, &metadata, options)
+}
+
+/// [`read_asset_file`] of a file opened, whose metadata is `metadata`.
+pub fn read_opened_asset(
+    mut file: std::fs::File,
+    metadata: &std::fs::Metadata,
+    options: &LoadOptions,
+) -> std::io::Result<FileBytes> {
     if metadata.is_file() {
         // Sized to the file (and one byte more, to see that it ends there) before it is read,
         // so that a large one can be advised huge pages (see super::pages).
@@ -320,7 +329,9 @@ pub fn read_asset_file(path: &Path, options: &LoadOptions) -> std::io::Result<Fi
         if bytes.try_reserve_exact(size.saturating_add(1)).is_ok() {
             super::pages::advise_huge(&mut bytes);
         }
-        file.read_to_end(&mut bytes)?;
+        // Through `take`: a `File`'s own `read_to_end` asks its length and position again
+        // (a stat and a seek), which the metadata above already told.
+        (&mut file).take(u64::MAX).read_to_end(&mut bytes)?;
         return Ok(FileBytes::from_vec(bytes));
     }
     let mut head = Vec::with_capacity(12);

@@ -27,7 +27,7 @@ use serde_json::Value;
 pub use source::{FileBytes, Snapshot, SourceText};
 use std::borrow::Cow;
 use std::collections::HashMap;
-use std::io::{BufReader, Cursor};
+use std::io::Cursor;
 use std::path::{Path, PathBuf};
 use std::sync::{Mutex, OnceLock};
 
@@ -92,6 +92,17 @@ struct ResourceLookups {
     files: Mutex<HashMap<PathBuf, Result<FileFacts, StatError>>>,
     /// The headers of images read from files, by image index and URI.
     headers: Mutex<HashMap<(usize, String), Result<ImageHeader, Diagnostic>>>,
+    /// The bytes of each regular file short enough to be a Git LFS pointer, by path: read
+    /// whole when its facts were asked (whether it is a pointer needs its first bytes), and
+    /// read from here by whatever reads the file afterwards.
+    short_files: Mutex<HashMap<PathBuf, std::sync::Arc<[u8]>>>,
+}
+
+/// A resource file as [`Asset::open_resource`] gives it: its bytes, when it is short and they
+/// were read with its facts, or the file opened.
+enum Opened {
+    Read(std::sync::Arc<[u8]>),
+    File(std::fs::File),
 }
 
 /// Why a resource file could not be stat'ed: the error's kind and its words.
@@ -156,32 +167,31 @@ fn read_held(path: &Path, options: &LoadOptions, copies: u64) -> Result<FileByte
             format!("cannot read {}: {e}", path.display()),
         )
     };
-    if let Ok(meta) = std::fs::metadata(path) {
-        // The document limit applies to the JSON, which is the whole file unless it is a GLB
-        // (whose BIN chunk may be large) or starts with a byte-order mark.
-        if meta.is_file() && meta.len() > options.max_document_bytes.saturating_add(3) {
-            let mut magic = [0u8; 4];
-            let is_glb = std::fs::File::open(path)
-                .and_then(|mut f| std::io::Read::read_exact(&mut f, &mut magic))
-                .is_ok()
-                && &magic == b"glTF";
-            if !is_glb {
-                return Err(Diagnostic::new(
-                    &codes::DOCUMENT_TOO_LARGE,
-                    "",
-                    options.document_too_large(meta.len()),
-                ));
-            }
-            // Asked for before it is read (see `copies`). (A .gltf over the document limit is
-            // refused above; one within it is far below any budget.)
-            let what = format!("reading {} (a GLB of {} bytes)", path.display(), meta.len());
-            let needed = meta.len().saturating_mul(copies);
-            if let Some(message) = limits::over_memory_budget(&what, needed, options.max_memory) {
-                return Err(Diagnostic::new(&codes::IO_ERROR, "", message));
-            }
+    // Opened once, and asked its metadata once: the checks and the reading share them.
+    let mut file = std::fs::File::open(path).map_err(io_error)?;
+    let meta = file.metadata().map_err(io_error)?;
+    // The document limit applies to the JSON, which is the whole file unless it is a GLB
+    // (whose BIN chunk may be large) or starts with a byte-order mark.
+    if meta.is_file() && meta.len() > options.max_document_bytes.saturating_add(3) {
+        let mut magic = [0u8; 4];
+        let is_glb = std::io::Read::read_exact(&mut file, &mut magic).is_ok() && &magic == b"glTF";
+        std::io::Seek::rewind(&mut file).map_err(io_error)?;
+        if !is_glb {
+            return Err(Diagnostic::new(
+                &codes::DOCUMENT_TOO_LARGE,
+                "",
+                options.document_too_large(meta.len()),
+            ));
+        }
+        // Asked for before it is read (see `copies`). (A .gltf over the document limit is
+        // refused above; one within it is far below any budget.)
+        let what = format!("reading {} (a GLB of {} bytes)", path.display(), meta.len());
+        let needed = meta.len().saturating_mul(copies);
+        if let Some(message) = limits::over_memory_budget(&what, needed, options.max_memory) {
+            return Err(Diagnostic::new(&codes::IO_ERROR, "", message));
         }
     }
-    limits::read_asset_file(path, options).map_err(io_error)
+    limits::read_opened_asset(file, &meta, options).map_err(io_error)
 }
 
 /// Reads an asset file as [`read`] does, for a command that will write something for it: with
@@ -796,20 +806,22 @@ impl Asset {
         let uri_pointer = format!("{pointer}/uri");
         let data = match buffer.get("uri").and_then(|u| u.as_str()) {
             Some(uri) => match self.resolve(&uri, &uri_pointer)? {
-                Location::File(path) => {
-                    let file = self.open_resource(&path, &uri, &uri_pointer)?;
-                    let len = file
-                        .metadata()
-                        .map(|m| usize::try_from(m.len()).unwrap_or(usize::MAX))
-                        .map_err(|e| {
-                            Diagnostic::new(
-                                &codes::IO_ERROR,
-                                &uri_pointer,
-                                format!("cannot read '{uri}' ({}): {e}", path.display()),
-                            )
-                        })?;
-                    BufferData::File { file, len }
-                }
+                Location::File(path) => match self.open_resource(&path, &uri, &uri_pointer)? {
+                    Opened::Read(bytes) => BufferData::Memory(Cow::Owned(bytes.to_vec())),
+                    Opened::File(file) => {
+                        let len = file
+                            .metadata()
+                            .map(|m| usize::try_from(m.len()).unwrap_or(usize::MAX))
+                            .map_err(|e| {
+                                Diagnostic::new(
+                                    &codes::IO_ERROR,
+                                    &uri_pointer,
+                                    format!("cannot read '{uri}' ({}): {e}", path.display()),
+                                )
+                            })?;
+                        BufferData::File { file, len }
+                    }
+                },
                 Location::Data { bytes, .. } => BufferData::Memory(Cow::Owned(bytes)),
             },
             None => match (&self.bin, index) {
@@ -951,13 +963,35 @@ impl Asset {
         if let Some(known) = lock(&self.lookups.files).get(path) {
             return known.clone();
         }
-        let facts = std::fs::metadata(path)
-            .map(|meta| FileFacts {
-                is_file: meta.is_file(),
-                len: meta.len(),
-                lfs_pointer: meta.is_file()
-                    && meta.len() <= resource::LFS_POINTER_MAX_LEN
-                    && resource::is_lfs_pointer(path),
+        self.file_facts_from(path, std::fs::metadata(path))
+    }
+
+    /// [`Asset::file_facts`] of `path` from its `stat`, kept for every later question (unless
+    /// some were kept already).
+    fn file_facts_from(
+        &self,
+        path: &Path,
+        stat: std::io::Result<std::fs::Metadata>,
+    ) -> Result<FileFacts, StatError> {
+        if let Some(known) = lock(&self.lookups.files).get(path) {
+            return known.clone();
+        }
+        let facts = stat
+            .map(|meta| {
+                let short = (meta.is_file() && meta.len() <= resource::LFS_POINTER_MAX_LEN)
+                    .then(|| resource::read_short(path, meta.len()))
+                    .flatten();
+                let lfs_pointer = short
+                    .as_ref()
+                    .is_some_and(|bytes| bytes.starts_with(resource::LFS_POINTER_PREFIX));
+                if let Some(bytes) = short {
+                    lock(&self.lookups.short_files).insert(path.to_path_buf(), bytes.into());
+                }
+                FileFacts {
+                    is_file: meta.is_file(),
+                    len: meta.len(),
+                    lfs_pointer,
+                }
             })
             .map_err(|e| (e.kind(), e.to_string()));
         lock(&self.lookups.files).insert(path.to_path_buf(), facts.clone());
@@ -967,17 +1001,16 @@ impl Asset {
     /// Opens the resource file `path` that `uri` (at `pointer`) led to
     /// ([`resource::open_file`]), from the file's facts as the run first asked them
     /// ([`Asset::file_facts`]): one stat of a file for every question of a run.
-    fn open_resource(
-        &self,
-        path: &Path,
-        uri: &str,
-        pointer: &str,
-    ) -> Result<std::fs::File, Diagnostic> {
+    /// A short file's bytes come from its facts, read once.
+    fn open_resource(&self, path: &Path, uri: &str, pointer: &str) -> Result<Opened, Diagnostic> {
         let is_file = self
             .file_facts(path)
             .map(|facts| facts.is_file)
             .map_err(|(_, why)| why);
-        resource::open_file(path, uri, pointer, is_file)
+        if let Some(bytes) = lock(&self.lookups.short_files).get(path) {
+            return Ok(Opened::Read(bytes.clone()));
+        }
+        resource::open_file(path, uri, pointer, is_file).map(Opened::File)
     }
 
     fn resolve_asking(&self, uri: &str, pointer: &str) -> Result<Location, Diagnostic> {
@@ -997,7 +1030,10 @@ impl Asset {
                         .get_or_init(|| resource::real_folder(self.base_dir()))
                         .clone()
                 };
-                resource::check_inside(path, self.base_dir(), real_base, uri, pointer)?;
+                let seen = resource::check_inside(path, self.base_dir(), real_base, uri, pointer)?;
+                if let Some(stat) = seen {
+                    let _ = self.file_facts_from(path, stat);
+                }
             }
         }
         Ok(location)
@@ -1006,10 +1042,10 @@ impl Asset {
     fn read_uri(&self, uri: &str, pointer: &str) -> Result<Vec<u8>, Diagnostic> {
         match self.resolve(uri, pointer)? {
             Location::Data { bytes, .. } => Ok(bytes),
-            Location::File(path) => {
-                let file = self.open_resource(&path, uri, pointer)?;
-                resource::read_whole(file, &path, uri, pointer)
-            }
+            Location::File(path) => match self.open_resource(&path, uri, pointer)? {
+                Opened::Read(bytes) => Ok(bytes.to_vec()),
+                Opened::File(file) => resource::read_whole(file, &path, uri, pointer),
+            },
         }
     }
 
@@ -1177,7 +1213,14 @@ impl Asset {
                 }
                 let header = self
                     .open_resource(&path, &key.1, &uri_pointer)
-                    .and_then(|file| resource::read_header(BufReader::new(file), &pointer, &what));
+                    .and_then(|opened| match opened {
+                        Opened::Read(bytes) => {
+                            resource::read_header(Cursor::new(&bytes[..]), &pointer, &what)
+                        }
+                        Opened::File(file) => {
+                            resource::read_header(resource::Rewinding::new(file), &pointer, &what)
+                        }
+                    });
                 lock(&self.lookups.headers).insert(key, header.clone());
                 return header;
             }
@@ -1258,5 +1301,38 @@ mod tests {
             let asked = other.file_facts(&image);
             assert_eq!(asked.map_err(|e| e.0), Err(std::io::ErrorKind::NotFound));
         }
+    }
+
+    #[test]
+    fn a_short_resource_is_read_once_with_its_facts_and_then_from_memory() {
+        let dir = tempfile::tempdir().expect("a temporary folder");
+        let mut png = Vec::new();
+        image::RgbaImage::new(2, 3)
+            .write_to(&mut Cursor::new(&mut png), image::ImageFormat::Png)
+            .expect("encoded");
+        assert!(png.len() as u64 <= resource::LFS_POINTER_MAX_LEN);
+        std::fs::write(dir.path().join("a.png"), &png).expect("written");
+        std::fs::write(dir.path().join("b.bin"), [7u8; 8]).expect("written");
+        let text = br#"{"asset":{"version":"2.0"},"images":[{"uri":"a.png"}],
+            "buffers":[{"uri":"b.bin","byteLength":8}]}"#;
+        let asset = load_bytes_with(&dir.path().join("a.gltf"), text, &LoadOptions::default())
+            .asset
+            .expect("the document parses");
+        let facts = asset.file_facts(&dir.path().join("a.png")).expect("a file");
+        assert_eq!((facts.len, facts.lfs_pointer), (png.len() as u64, false));
+        // Gone from the disk: what is read of them afterwards is what their facts read.
+        std::fs::remove_file(dir.path().join("a.png")).expect("removed");
+        let header = asset.image_header(0).expect("the header of the bytes kept");
+        assert_eq!((header.width, header.height), (2, 3));
+        // The buffer's facts are asked when it is resolved.
+        let _ = asset.resolve("b.bin", "/buffers/0/uri");
+        std::fs::remove_file(dir.path().join("b.bin")).expect("removed");
+        let data = asset.buffer_data(0).expect("the bytes kept");
+        assert_eq!(data.len(), 8);
+        // A short file that begins as a Git LFS pointer is one.
+        let pointer = [resource::LFS_POINTER_PREFIX, b"v1\noid sha256:0\nsize 9\n"].concat();
+        std::fs::write(dir.path().join("c.png"), pointer).expect("written");
+        let facts = asset.file_facts(&dir.path().join("c.png")).expect("a file");
+        assert!(facts.lfs_pointer);
     }
 }

@@ -182,41 +182,47 @@ pub fn is_remote(uri: &str) -> bool {
 /// A path below the folder whose every component is a plain name and none a link is inside
 /// without resolving anything: one `lstat` per component, where resolving the whole path
 /// would read every directory above the folder too. Anything else is resolved in full.
+///
+/// What the walk saw of the file itself, when it saw it: its last component's `lstat`, which
+/// for a path without links is its `stat`, or that a component is not there. The file's facts
+/// are then taken from it instead of being asked again.
 pub fn check_inside(
     path: &Path,
     base_dir: &Path,
     real_base: impl FnOnce() -> Option<PathBuf>,
     uri: &str,
     pointer: &str,
-) -> Result<(), Diagnostic> {
+) -> Result<Option<std::io::Result<std::fs::Metadata>>, Diagnostic> {
     if let Ok(below) = path.strip_prefix(base_dir) {
         if below
             .components()
             .all(|c| matches!(c, std::path::Component::Normal(_)))
         {
             let mut at = base_dir.to_path_buf();
-            let mut plain = true;
+            let mut last = None;
             for part in below.components() {
                 at.push(part);
                 match std::fs::symlink_metadata(&at) {
                     Ok(meta) if meta.file_type().is_symlink() => {
-                        plain = false;
+                        last = None;
                         break;
                     }
-                    Ok(_) => {}
-                    Err(_) => return Ok(()), // not there (yet): left to whoever opens it
+                    Ok(meta) => last = Some(Ok(meta)),
+                    // Not there (yet): left to whoever opens it, and so is any other error.
+                    Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Some(Err(e))),
+                    Err(_) => return Ok(None),
                 }
             }
-            if plain {
-                return Ok(());
+            if last.is_some() {
+                return Ok(last);
             }
         }
     }
     let Ok(real) = std::fs::canonicalize(path) else {
-        return Ok(());
+        return Ok(None);
     };
     match real_base() {
-        Some(base) if real.starts_with(&base) => Ok(()),
+        Some(base) if real.starts_with(&base) => Ok(None),
         _ => Err(Diagnostic::new(
             &codes::URI_NOT_FOLLOWED,
             pointer,
@@ -261,12 +267,17 @@ pub const LFS_POINTER_PREFIX: &[u8] = b"version https://git-lfs.github.com/spec/
 /// Git LFS pointer files are about 130 bytes; anything larger is real content.
 pub const LFS_POINTER_MAX_LEN: u64 = 1024;
 
-/// Whether the file at `path` begins as a Git LFS pointer file does.
-pub fn is_lfs_pointer(path: &Path) -> bool {
-    let mut head = [0u8; LFS_POINTER_PREFIX.len()];
-    std::fs::File::open(path)
-        .and_then(|mut f| std::io::Read::read_exact(&mut f, &mut head))
-        .is_ok_and(|()| head == LFS_POINTER_PREFIX)
+/// The bytes of the short file at `path`, whose stat said `len`; `None` when it cannot be
+/// read. Read through `take`: `std::fs::read` and a `File`'s own `read_to_end` ask the file's
+/// length and position again (a stat and a seek), which a run over hundreds of files would pay
+/// for each.
+pub fn read_short(path: &Path, len: u64) -> Option<Vec<u8>> {
+    use std::io::Read;
+    let mut file = std::fs::File::open(path).ok()?;
+    // One byte more than the stat said, to see that the file ends there.
+    let mut bytes = Vec::with_capacity(usize::try_from(len).ok()?.saturating_add(1));
+    (&mut file).take(u64::MAX).read_to_end(&mut bytes).ok()?;
+    Some(bytes)
 }
 
 /// Opens a resource file that a URI led to, refusing anything but a regular file. `is_file`
@@ -493,6 +504,98 @@ pub fn read_header<R: std::io::BufRead + std::io::Seek>(
     })
 }
 
+/// A reader that keeps every byte it has read, so that a seek back lands in what it kept: an
+/// image header is read from the file once, though [`read_header`] goes back to the start twice
+/// (after the signature, after the PNG chunks) and the decoder reads it again from there.
+/// `std::io::BufReader` forgets its buffer on every seek and reads the file again; no
+/// well-kept crate offers this for a `Read` alone, and it is a few lines.
+pub struct Rewinding<R> {
+    inner: R,
+    kept: Vec<u8>,
+    at: usize,
+}
+
+impl<R: std::io::Read> Rewinding<R> {
+    /// How much is read from `inner` at a time.
+    const CHUNK: usize = 8 << 10;
+
+    pub fn new(inner: R) -> Rewinding<R> {
+        Rewinding {
+            inner,
+            kept: Vec::new(),
+            at: 0,
+        }
+    }
+
+    /// Reads one more chunk from `inner` into what is kept; how many bytes came.
+    fn read_more(&mut self) -> std::io::Result<usize> {
+        let start = self.kept.len();
+        self.kept.resize(start + Self::CHUNK, 0);
+        let read = loop {
+            match self.inner.read(&mut self.kept[start..]) {
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+                other => break other,
+            }
+        };
+        self.kept.truncate(start + *read.as_ref().unwrap_or(&0));
+        read
+    }
+
+    /// Reads on until `len` bytes are kept or `inner` ends.
+    fn keep_up_to(&mut self, len: usize) -> std::io::Result<()> {
+        while self.kept.len() < len {
+            if self.read_more()? == 0 {
+                break;
+            }
+        }
+        Ok(())
+    }
+}
+
+impl<R: std::io::Read> std::io::Read for Rewinding<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let available = std::io::BufRead::fill_buf(self)?;
+        let n = available.len().min(buf.len());
+        buf[..n].copy_from_slice(&available[..n]);
+        self.at += n;
+        Ok(n)
+    }
+}
+
+impl<R: std::io::Read> std::io::BufRead for Rewinding<R> {
+    fn fill_buf(&mut self) -> std::io::Result<&[u8]> {
+        if self.at >= self.kept.len() {
+            self.keep_up_to(self.at + 1)?;
+        }
+        Ok(self.kept.get(self.at..).unwrap_or_default())
+    }
+
+    fn consume(&mut self, amount: usize) {
+        self.at += amount;
+    }
+}
+
+impl<R: std::io::Read> std::io::Seek for Rewinding<R> {
+    fn seek(&mut self, to: std::io::SeekFrom) -> std::io::Result<u64> {
+        let target = match to {
+            std::io::SeekFrom::Start(n) => Some(n),
+            std::io::SeekFrom::Current(d) => (self.at as u64).checked_add_signed(d),
+            std::io::SeekFrom::End(d) => {
+                // Only the end knows where the end is.
+                while self.read_more()? > 0 {}
+                (self.kept.len() as u64).checked_add_signed(d)
+            }
+        };
+        let target = target
+            .and_then(|t| usize::try_from(t).ok())
+            .ok_or_else(|| {
+                std::io::Error::new(std::io::ErrorKind::InvalidInput, "seek out of range")
+            })?;
+        self.at = target;
+        Ok(target as u64)
+    }
+}
+
 fn read_up_to<R: std::io::Read>(reader: &mut R, buf: &mut [u8]) -> std::io::Result<usize> {
     let mut filled = 0;
     while filled < buf.len() {
@@ -653,6 +756,57 @@ mod tests {
         )
         .unwrap();
         bytes
+    }
+
+    /// A reader that counts the bytes it hands out.
+    struct Counted<'c> {
+        bytes: &'c [u8],
+        handed: &'c std::cell::Cell<usize>,
+    }
+
+    impl std::io::Read for Counted<'_> {
+        fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+            let n = std::io::Read::read(&mut self.bytes, buf)?;
+            self.handed.set(self.handed.get() + n);
+            Ok(n)
+        }
+    }
+
+    #[test]
+    fn a_header_read_through_a_rewinding_reader_reads_each_byte_once_and_says_the_same() {
+        use image::ColorType;
+        for color in [ColorType::Rgba8, ColorType::L16] {
+            let bytes = png(color.into());
+            let handed = std::cell::Cell::new(0);
+            let rewinding = Rewinding::new(Counted {
+                bytes: &bytes,
+                handed: &handed,
+            });
+            let header = read_header(rewinding, "", "image 0").unwrap();
+            let expected = read_header(std::io::Cursor::new(&bytes), "", "image 0").unwrap();
+            assert_eq!(header, expected);
+            // The signature is read, then the chunks from the start, then the decoder reads
+            // from the start again: the file gives each byte once, and no more than it holds.
+            assert!(
+                handed.get() <= bytes.len(),
+                "{} of {}",
+                handed.get(),
+                bytes.len()
+            );
+        }
+        // Seeks from the end and from where it is, and past the end.
+        let mut r = Rewinding::new(&b"0123456789"[..]);
+        let mut two = [0u8; 2];
+        use std::io::{Read, Seek, SeekFrom};
+        assert_eq!(r.seek(SeekFrom::End(-3)).unwrap(), 7);
+        r.read_exact(&mut two).unwrap();
+        assert_eq!(&two, b"78");
+        assert_eq!(r.seek(SeekFrom::Current(-9)).unwrap(), 0);
+        r.read_exact(&mut two).unwrap();
+        assert_eq!(&two, b"01");
+        assert_eq!(r.seek(SeekFrom::Start(20)).unwrap(), 20);
+        assert_eq!(r.read(&mut two).unwrap(), 0);
+        assert!(r.seek(SeekFrom::Current(-30)).is_err());
     }
 
     #[test]

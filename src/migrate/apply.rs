@@ -270,10 +270,24 @@ pub fn execute_by(
         false => WriteStrategy::choose(&bake_plan, streamed, &baked),
     };
     let fail = |e: edit::EditError| format!("{}: {e}", plan.input.display());
+    // Without bakes no edit touches a URI that is copied (resources are copied or their URIs
+    // rewritten, never both), so the document as loaded names what the output uses: the
+    // copies are staged while the document is spliced. A document that turns out unchanged
+    // and stays in place drops them with the staging, unwritten.
+    let mut copied = None;
     let spliced: Option<PartWritten> = match strategy {
         WriteStrategy::Splice => {
             let edits = plan.document.edits().chain(&plan.relocation.edits);
-            write::spliced_bytes(&plan.asset, edits)
+            let (spliced, copies) = rayon::join(
+                || write::spliced_bytes(&plan.asset, edits),
+                || {
+                    bake_plan
+                        .is_empty()
+                        .then(|| copy_resources(&plan.relocation, plan.asset.root(), &staging))
+                },
+            );
+            copied = copies;
+            spliced
                 .map_err(fail)?
                 .map(|(out, changed)| (out, changed, Vec::new()))
         }
@@ -291,7 +305,7 @@ pub fn execute_by(
         WriteStrategy::Rewrite => None,
     };
     let Some((out, changed, outputs)) = spliced else {
-        let written = write_rewritten(plan, &output, &bake_plan, baked, names, staging)?;
+        let written = write_rewritten(plan, &output, &bake_plan, baked, names, staging, copied)?;
         return Ok((written, WriteStrategy::Rewrite));
     };
     // A spliced output is put in place (with, without bakes, the resource copies it needs).
@@ -300,9 +314,7 @@ pub fn execute_by(
     }
     create_parent(&output)?;
     let out = if bake_plan.is_empty() {
-        // Without bakes no edit touches a URI that is copied (resources are copied or their
-        // URIs rewritten, never both), so the document as loaded names what the output uses.
-        copy_resources(&plan.relocation, plan.asset.root(), &staging)?;
+        copied.unwrap_or_else(|| copy_resources(&plan.relocation, plan.asset.root(), &staging))?;
         match changed {
             true => out,
             false => Output::Bytes(input_bytes(plan)?),
@@ -322,7 +334,8 @@ pub fn execute_by(
     Ok((written, strategy))
 }
 
-/// Applies the plan (and its bakes) to the whole document and writes it anew.
+/// Applies the plan (and its bakes) to the whole document and writes it anew; `copied`: how
+/// staging the resource copies went, when they were staged already.
 fn write_rewritten(
     plan: &mut FilePlan,
     output: &std::path::Path,
@@ -330,6 +343,7 @@ fn write_rewritten(
     mut baked: Vec<Baked>,
     mut names: FileNames,
     staging: Staging,
+    copied: Option<Result<(), String>>,
 ) -> Result<Written, String> {
     let input = plan.input.clone();
     let fail = |e: edit::EditError| format!("{}: {e}", input.display());
@@ -347,7 +361,7 @@ fn write_rewritten(
     }
     create_parent(output)?;
     let bytes = if bake_plan.is_empty() {
-        copy_resources(&plan.relocation, plan.asset.root(), &staging)?;
+        copied.unwrap_or_else(|| copy_resources(&plan.relocation, plan.asset.root(), &staging))?;
         match changed {
             true => Cow::Owned(write::to_bytes(
                 &plan.asset,

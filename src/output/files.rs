@@ -172,6 +172,7 @@ pub(crate) fn copy_resources<'a>(
     staging: &Staging,
 ) -> Result<(), String> {
     let used = relative_uris(json);
+    let mut copies = Vec::new();
     for copy in relocation
         .copies
         .iter()
@@ -182,7 +183,7 @@ pub(crate) fn copy_resources<'a>(
             .canonicalize()
             .map_err(|e| format!("cannot read resource {}: {e}", copy.from.display()))?;
         create_parent(&copy.to)?;
-        staging.stage_copy(&from, &copy.to)?;
+        copies.push((from, copy.to.as_path()));
     }
-    Ok(())
+    staging.stage_copies(&copies)
 }
