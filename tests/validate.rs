@@ -269,7 +269,7 @@ fn json_output_has_the_khronos_report_shape_and_truncates() {
         "fixtures/validate/UNEXPECTED_PROPERTY/triggers.gltf"
     );
     assert_eq!(report["mimeType"], "model/gltf+json");
-    assert_eq!(report["issues"]["numWarnings"], 2);
+    assert_eq!(report["issues"]["numWarnings"], 3);
     assert_eq!(report["issues"]["truncated"], true);
     assert_eq!(
         report["issues"]["messages"],
@@ -279,7 +279,7 @@ fn json_output_has_the_khronos_report_shape_and_truncates() {
     assert_eq!(report["info"]["sheenMaterialCount"], 1);
     assert_eq!(
         report["info"]["extensionsUsed"],
-        json!(["KHR_materials_sheen"])
+        json!(["KHR_materials_pbrSpecularGlossiness", "KHR_materials_sheen"])
     );
 }
 
@@ -998,6 +998,12 @@ fn extension_cases() -> Vec<ExtensionCase> {
         ),
         material("KHR_materials_ior", json!({"ior": 1.4}), "ior", json!(0.5)),
         material("KHR_materials_iridescence", json!({"iridescenceFactor": 1, "iridescenceIor": 1.3}), "iridescenceIor", json!(0.9)),
+        material(
+            "KHR_materials_pbrSpecularGlossiness",
+            json!({"diffuseFactor": [0.5, 0.4, 0.3, 1], "diffuseTexture": {"index": 0}, "specularFactor": [0.04, 0.04, 0.04], "glossinessFactor": 0.3, "specularGlossinessTexture": {"index": 0}}),
+            "glossinessFactor",
+            json!(1.5),
+        ),
         material("KHR_materials_specular", json!({"specularFactor": 0.5, "specularColorFactor": [1, 1, 1]}), "specularFactor", json!(1.5)),
         material("KHR_materials_transmission", json!({"transmissionFactor": 0.5}), "transmissionFactor", json!(1.5)),
         case(

@@ -215,6 +215,15 @@ pub const EXTENSION_FILES: &[(&str, &[(&str, &str)])] = &[
             "material.KHR_materials_iridescence.schema.json"
         )],
     ),
+    // Archived, and not among the published schemas: velvet's own file, written from the
+    // archived spec's property table (schema/extensions/README.md).
+    (
+        "KHR_materials_pbrSpecularGlossiness",
+        &[ext_file!(
+            "KHR_materials_pbrSpecularGlossiness",
+            "material.KHR_materials_pbrSpecularGlossiness.schema.json"
+        )],
+    ),
     (
         "KHR_materials_specular",
         &[ext_file!(
@@ -485,6 +494,11 @@ pub const PLACEMENTS: &[Placement] = &[
         "KHR_materials_sheen",
         &["material"],
         "material.KHR_materials_sheen.schema.json",
+    ),
+    place(
+        "KHR_materials_pbrSpecularGlossiness",
+        &["material"],
+        "material.KHR_materials_pbrSpecularGlossiness.schema.json",
     ),
     place(
         "KHR_materials_specular",
