@@ -269,7 +269,7 @@ fn json_output_has_the_khronos_report_shape_and_truncates() {
         "fixtures/validate/UNEXPECTED_PROPERTY/triggers.gltf"
     );
     assert_eq!(report["mimeType"], "model/gltf+json");
-    assert_eq!(report["issues"]["numWarnings"], 3);
+    assert_eq!(report["issues"]["numWarnings"], 4);
     assert_eq!(report["issues"]["truncated"], true);
     assert_eq!(
         report["issues"]["messages"],
@@ -279,7 +279,11 @@ fn json_output_has_the_khronos_report_shape_and_truncates() {
     assert_eq!(report["info"]["sheenMaterialCount"], 1);
     assert_eq!(
         report["info"]["extensionsUsed"],
-        json!(["KHR_materials_pbrSpecularGlossiness", "KHR_materials_sheen"])
+        json!([
+            "KHR_materials_pbrSpecularGlossiness",
+            "KHR_materials_sheen",
+            "KHR_materials_variants"
+        ])
     );
 }
 

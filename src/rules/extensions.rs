@@ -681,6 +681,16 @@ struct ShapeBuilder {
     known: HashMap<(usize, String), usize>,
 }
 
+/// An object a property describes in place (`properties` of its own, as KHR_materials_variants'
+/// variants and mappings), and whether the property holds an array of them.
+fn object_in_place(property: &Value) -> Option<(&Value, bool)> {
+    if property.get("properties").is_some() {
+        return Some((property, false));
+    }
+    let items = property.get("items")?;
+    items.get("properties").is_some().then_some((items, true))
+}
+
 impl ShapeBuilder {
     /// The kind that file `name` describes, as seen from `folder`; `None` for a file that
     /// describes no object or is not there.
@@ -700,14 +710,28 @@ impl ShapeBuilder {
             return Some(at);
         }
         let schema: Value = serde_json::from_str(text).expect("compiled-in schemas are valid JSON");
+        Some(self.shape_of(folder, key, name.to_string(), &schema))
+    }
+
+    /// The kind `schema` describes, known by `key` (its file's, or for an object described in
+    /// place its file's and its place there) and called `name`: a file's name, or for an
+    /// object described in place its holder's kind and the property (`glTF.KHR_materials_
+    /// variants.variants`).
+    fn shape_of(
+        &mut self,
+        folder: &'static [(&'static str, &'static str)],
+        key: (usize, String),
+        name: String,
+        schema: &Value,
+    ) -> usize {
         let at = self.shapes.len();
         self.shapes.push(Shape {
-            is: vec![name.to_string()],
+            is: vec![name.clone()],
             children: Vec::new(),
             known: None,
         });
-        self.known.insert(key, at);
-        let mut is = vec![name.to_string()];
+        self.known.insert(key.clone(), at);
+        let mut is = vec![name.clone()];
         let mut children = Vec::new();
         let mut known: Option<Vec<String>> = match schema.get("additionalProperties") {
             None | Some(Value::Bool(false)) => Some(Vec::new()),
@@ -738,11 +762,22 @@ impl ShapeBuilder {
             if let Some(own) = &mut known {
                 own.push(property.clone());
             }
-            if let Some((target, array)) = object_ref(sub) {
-                if let Some(child) = self.shape(folder, target) {
-                    children.retain(|(name, _, _)| name != property);
-                    children.push((property.clone(), child, array));
-                }
+            let child = if let Some((target, array)) = object_ref(sub) {
+                self.shape(folder, target).map(|child| (child, array))
+            } else if let Some((object, array)) = object_in_place(sub) {
+                let holder = name.strip_suffix(".schema.json").unwrap_or(&name);
+                let place = (key.0, format!("{}#/properties/{property}", key.1));
+                let child = match self.known.get(&place) {
+                    Some(&child) => child,
+                    None => self.shape_of(folder, place, format!("{holder}.{property}"), object),
+                };
+                Some((child, array))
+            } else {
+                None
+            };
+            if let Some((child, array)) = child {
+                children.retain(|(name, _, _)| name != property);
+                children.push((property.clone(), child, array));
             }
         }
         if let Some(own) = &mut known {
@@ -754,7 +789,7 @@ impl ShapeBuilder {
             children,
             known,
         };
-        Some(at)
+        at
     }
 }
 
