@@ -102,7 +102,7 @@ pub const URI_NOT_FOLLOWED: Code = Code::new(
 pub const INVALID_URI: Code = Code::new(
     "INVALID_URI",
     Error,
-    "A resource URI that cannot be decoded (malformed data: URI, base64 or percent-encoding).",
+    "A resource URI that cannot be decoded (malformed data: URI, base64 or percent-encoding), or an image data: URI whose bytes are not of the media type it says.",
 );
 pub const BUFFER_VIEW_OUT_OF_RANGE: Code = Code::new(
     "BUFFER_VIEW_OUT_OF_RANGE",

@@ -190,7 +190,9 @@ fn check_buffer(cx: &Context, index: usize, buffer: Node, out: &mut Vec<Diagnost
     let Some(uri) = uri.as_str() else { return }; // TYPE_MISMATCH from the schema
     let pointer = format!("/buffers/{index}/uri");
     match locate(cx, &uri, &pointer, out) {
-        Some(Located::Data { media_type, len }) => {
+        Some(Located::Data {
+            media_type, len, ..
+        }) => {
             // Media types are case-insensitive (RFC 2045).
             if !matches!(
                 media_type.to_ascii_lowercase().as_str(),
@@ -226,8 +228,28 @@ fn check_image(cx: &Context, index: usize, image: Node, out: &mut Vec<Diagnostic
         let Some(uri) = uri.as_str() else { return };
         let pointer = format!("/images/{index}/uri");
         match locate(cx, &uri, &pointer, out) {
-            Some(Located::Data { media_type, .. }) => {
-                if declared.is_none() && KNOWN_MIME_TYPES.contains(&media_type.as_str()) {
+            Some(Located::Data {
+                media_type, holds, ..
+            }) => {
+                // The Khronos validator holds an image's data: URI to its own media type: bytes
+                // of another format, or bytes of no format it knows under a type it knows, make
+                // the URI invalid, and the image is not judged further. A type velvet does not
+                // read (DDS, AVIF) over bytes it does not recognize is left alone.
+                let known = KNOWN_MIME_TYPES.contains(&media_type.as_str());
+                let held = holds.map(mime_of);
+                if held != Some(media_type.as_str()) && (known || held.is_some()) {
+                    let bytes = match held {
+                        Some(held) => format!("its bytes are {held}"),
+                        None => "its bytes are no image format velvet recognizes".to_string(),
+                    };
+                    out.push(Diagnostic::new(
+                        &codes::INVALID_URI,
+                        &pointer,
+                        format!("image {index}'s data: URI says {media_type}, but {bytes}"),
+                    ));
+                    return;
+                }
+                if declared.is_none() && known {
                     declared = Some((media_type, pointer));
                 }
             }
@@ -356,8 +378,16 @@ fn view_in_memory(cx: &Context, image: Node) -> bool {
 
 /// What a URI that could be followed leads to.
 enum Located {
-    Data { media_type: String, len: u64 },
-    File { len: u64 },
+    /// A `data:` URI: its media type (parameters left out, lower case), how many bytes it
+    /// holds, and the image format those bytes begin as, if they begin as one.
+    Data {
+        media_type: String,
+        len: u64,
+        holds: Option<ImageFormat>,
+    },
+    File {
+        len: u64,
+    },
 }
 
 /// Resolves `uri` and checks what it leads to, pushing every fault; `None` when there is
@@ -384,9 +414,16 @@ fn locate(cx: &Context, uri: &str, pointer: &str, out: &mut Vec<Diagnostic>) -> 
                     "the data: URI is percent-encoded, not base64; it is valid, but some loaders decode only base64",
                 ));
             }
+            let media_type = media_type
+                .split(';')
+                .next()
+                .unwrap_or_default()
+                .trim()
+                .to_ascii_lowercase();
             return Some(Located::Data {
                 media_type,
                 len: bytes.len() as u64,
+                holds: ImageFormat::sniff(&bytes),
             });
         }
         Ok(Location::File(path)) => path,
