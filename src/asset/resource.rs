@@ -810,6 +810,29 @@ mod tests {
     }
 
     #[test]
+    fn every_cut_of_an_image_reads_through_a_rewinding_reader_as_from_memory() {
+        // PNG, JPEG and WebP headers cut at every length, and bytes no format begins with:
+        // the same header, or the same finding, whichever way the bytes come.
+        let mut images = vec![png(image::ExtendedColorType::Rgba8)];
+        for format in [image::ImageFormat::Jpeg, image::ImageFormat::WebP] {
+            let mut bytes = Vec::new();
+            image::DynamicImage::new_rgb8(3, 2)
+                .write_to(&mut std::io::Cursor::new(&mut bytes), format)
+                .unwrap();
+            images.push(bytes);
+        }
+        images.push(b"GIF89a not an image velvet reads".to_vec());
+        for image in &images {
+            for cut in 0..=image.len() {
+                let bytes = &image[..cut];
+                let rewinding = read_header(Rewinding::new(bytes), "/images/0", "image 0");
+                let memory = read_header(std::io::Cursor::new(bytes), "/images/0", "image 0");
+                assert_eq!(rewinding, memory, "{cut} of {} bytes", image.len());
+            }
+        }
+    }
+
+    #[test]
     fn png_headers_tell_alpha_and_depth() {
         use image::ExtendedColorType::*;
         for (color, channels, alpha, bits) in [
