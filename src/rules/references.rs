@@ -237,37 +237,86 @@ impl Rule for References {
         }
         // Reported link by link, in the table's order, each in document order.
         found.sort_by_key(|(link, _)| *link);
+        let mut found = found.into_iter().peekable();
         let mut dependent: Vec<String> = Vec::new();
-        for (link, d) in found {
-            // An index into a root extension's array where the document has no such root
-            // extension at all is a missing dependency, as the Khronos validator reports it: at
-            // the object that refers (the node's light, the mapping), once.
-            let target = LINKS[link].1;
-            if let Some(root) = target
+        for (link, (site, target)) in LINKS.iter().enumerate() {
+            let links_found = std::iter::from_fn(|| found.next_if(|(l, _)| *l == link));
+            // An object that holds an index into a root extension's array, in a document
+            // without that root extension, is a missing dependency, as the Khronos validator
+            // reports it: at the object (the node's light, the mapping), once, whether or not
+            // it holds the index yet (an empty light object is also UNDEFINED_PROPERTY).
+            let missing_root = target
                 .strip_prefix("/extensions/")
                 .and_then(|rest| rest.split('/').next())
-                .filter(|name| json.get("extensions").and_then(|e| e.get(*name)).is_none())
-            {
-                let mut holder = d.pointer.as_str();
-                while let Some((parent, _)) = holder.rsplit_once('/') {
-                    holder = parent;
-                    if json.pointer(holder).is_some_and(|n| n.is_object()) {
-                        break;
-                    }
-                }
-                if !dependent.iter().any(|h| h == holder) {
-                    dependent.push(holder.to_string());
+                .filter(|name| json.get("extensions").and_then(|e| e.get(*name)).is_none());
+            let Some(root) = missing_root else {
+                out.extend(links_found.map(|(_, d)| d));
+                continue;
+            };
+            links_found.for_each(drop);
+            for holder in holders(json, holder_pattern(site)) {
+                if !dependent.contains(&holder) {
                     out.push(Diagnostic::new(
                         &super::core::UNSATISFIED_DEPENDENCY,
-                        holder,
-                        format!("the document's root extensions must define {root}, which this refers to"),
+                        &holder,
+                        format!("the document's root extensions must define {root}, on which this object depends"),
                     ));
+                    dependent.push(holder);
                 }
-                continue;
             }
-            out.push(d);
         }
     }
+}
+
+/// The objects that hold the index at `site`: the pattern without its last name and the
+/// wildcards after it (`/nodes/*/extensions/KHR_lights_punctual/light` → the light objects,
+/// `…/mappings/*/variants/*` → the mappings).
+fn holder_pattern(site: &str) -> &str {
+    let mut holder = site;
+    while let Some((parent, last)) = holder.rsplit_once('/') {
+        holder = parent;
+        if last != "*" {
+            break;
+        }
+    }
+    holder
+}
+
+/// The pointers of the objects in `json` that `pattern` matches (`*` for any element or
+/// member), in document order.
+fn holders(json: Node, pattern: &str) -> Vec<String> {
+    fn walk(node: Node, segments: &[&str], at: &mut String, out: &mut Vec<String>) {
+        let Some((first, rest)) = segments.split_first() else {
+            if node.is_object() {
+                out.push(at.clone());
+            }
+            return;
+        };
+        let len = at.len();
+        let mut step = |at: &mut String, key: &str, child: Node| {
+            at.push('/');
+            pointer::push_escaped(at, key);
+            walk(child, rest, at, out);
+            at.truncate(len);
+        };
+        if *first == "*" {
+            if let Some(elements) = node.as_array() {
+                for (i, child) in elements.iter().enumerate() {
+                    step(at, &i.to_string(), child);
+                }
+            } else if let Some(members) = node.as_object() {
+                for (key, child) in members.iter() {
+                    step(at, &key, child);
+                }
+            }
+        } else if let Some(child) = node.get(*first) {
+            step(at, first, child);
+        }
+    }
+    let segments: Vec<&str> = pattern.split('/').skip(1).collect();
+    let mut out = Vec::new();
+    walk(json, &segments, &mut String::new(), &mut out);
+    out
 }
 
 /// Every index [`LINKS`] declares in the document: its pointer, the array it indexes and the
