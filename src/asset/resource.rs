@@ -504,18 +504,30 @@ pub fn read_header<R: std::io::BufRead + std::io::Seek>(
     })
 }
 
-/// A reader that keeps every byte it has read, so that a seek back lands in what it kept: an
-/// image header is read from the file once, though [`read_header`] goes back to the start twice
-/// (after the signature, after the PNG chunks) and the decoder reads it again from there.
-/// `std::io::BufReader` forgets its buffer on every seek and reads the file again; no
-/// well-kept crate offers this for a `Read` alone, and it is a few lines.
+/// A reader that keeps the first bytes it reads (up to [`Rewinding::KEEP`]), so that a seek
+/// back lands in what it kept: an image header is read from the file once, though
+/// [`read_header`] goes back to the start twice (after the signature, after the PNG chunks)
+/// and the decoder reads it again from there. `std::io::BufReader` forgets its buffer on
+/// every seek and reads the file again. Past what it keeps (a PNG whose chunks before its
+/// pixels run over a mebibyte) it reads as a `BufReader` would, so a hostile file costs no
+/// more memory than that. No well-kept crate offers this; it is a few lines.
 pub struct Rewinding<R> {
     inner: R,
+    /// The file's first bytes, as read.
     kept: Vec<u8>,
-    at: usize,
+    /// Whether the file ended within what is kept.
+    ended: bool,
+    /// Bytes past what is kept, from `window_start` on.
+    window: Vec<u8>,
+    window_start: u64,
+    /// Where the reader stands, and where `inner` does.
+    at: u64,
+    inner_at: u64,
 }
 
-impl<R: std::io::Read> Rewinding<R> {
+impl<R: std::io::Read + std::io::Seek> Rewinding<R> {
+    /// How much of the file's start is kept.
+    pub const KEEP: usize = 1 << 20;
     /// How much is read from `inner` at a time.
     const CHUNK: usize = 8 << 10;
 
@@ -523,76 +535,95 @@ impl<R: std::io::Read> Rewinding<R> {
         Rewinding {
             inner,
             kept: Vec::new(),
+            ended: false,
+            window: Vec::new(),
+            window_start: 0,
             at: 0,
+            inner_at: 0,
         }
     }
 
-    /// Reads one more chunk from `inner` into what is kept; how many bytes came.
-    fn read_more(&mut self) -> std::io::Result<usize> {
-        let start = self.kept.len();
-        self.kept.resize(start + Self::CHUNK, 0);
-        let read = loop {
-            match self.inner.read(&mut self.kept[start..]) {
+    /// Reads from `inner` at `from` into `into`; how many bytes came.
+    fn read_at(&mut self, from: u64, into: &mut [u8]) -> std::io::Result<usize> {
+        if self.inner_at != from {
+            self.inner.seek(std::io::SeekFrom::Start(from))?;
+            self.inner_at = from;
+        }
+        let n = loop {
+            match self.inner.read(into) {
                 Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
-                other => break other,
+                other => break other?,
             }
         };
-        self.kept.truncate(start + *read.as_ref().unwrap_or(&0));
-        read
-    }
-
-    /// Reads on until `len` bytes are kept or `inner` ends.
-    fn keep_up_to(&mut self, len: usize) -> std::io::Result<()> {
-        while self.kept.len() < len {
-            if self.read_more()? == 0 {
-                break;
-            }
-        }
-        Ok(())
-    }
-}
-
-impl<R: std::io::Read> std::io::Read for Rewinding<R> {
-    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
-        let available = std::io::BufRead::fill_buf(self)?;
-        let n = available.len().min(buf.len());
-        buf[..n].copy_from_slice(&available[..n]);
-        self.at += n;
+        self.inner_at += n as u64;
         Ok(n)
     }
 }
 
-impl<R: std::io::Read> std::io::BufRead for Rewinding<R> {
-    fn fill_buf(&mut self) -> std::io::Result<&[u8]> {
-        if self.at >= self.kept.len() {
-            self.keep_up_to(self.at + 1)?;
-        }
-        Ok(self.kept.get(self.at..).unwrap_or_default())
-    }
-
-    fn consume(&mut self, amount: usize) {
-        self.at += amount;
+impl<R: std::io::Read + std::io::Seek> std::io::Read for Rewinding<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let available = std::io::BufRead::fill_buf(self)?;
+        let n = available.len().min(buf.len());
+        buf[..n].copy_from_slice(&available[..n]);
+        self.at += n as u64;
+        Ok(n)
     }
 }
 
-impl<R: std::io::Read> std::io::Seek for Rewinding<R> {
+impl<R: std::io::Read + std::io::Seek> std::io::BufRead for Rewinding<R> {
+    fn fill_buf(&mut self) -> std::io::Result<&[u8]> {
+        // What is kept grows, a chunk at a time, until it holds the place asked for (a seek
+        // forward within the first mebibyte reads what it passes: the decoder reads it next).
+        while self.at >= self.kept.len() as u64 && self.at < Self::KEEP as u64 && !self.ended {
+            let start = self.kept.len();
+            let take = Self::CHUNK.min(Self::KEEP - start);
+            self.kept.resize(start + take, 0);
+            let mut chunk = std::mem::take(&mut self.kept);
+            let read = self.read_at(start as u64, &mut chunk[start..]);
+            chunk.truncate(start + *read.as_ref().unwrap_or(&0));
+            self.kept = chunk;
+            self.ended = read? == 0;
+        }
+        if self.at < self.kept.len() as u64 {
+            return Ok(&self.kept[self.at as usize..]);
+        }
+        if self.ended {
+            return Ok(&[]);
+        }
+        let in_window =
+            self.at >= self.window_start && self.at < self.window_start + self.window.len() as u64;
+        if !in_window {
+            let mut window = std::mem::take(&mut self.window);
+            window.resize(Self::CHUNK, 0);
+            let read = self.read_at(self.at, &mut window);
+            window.truncate(*read.as_ref().unwrap_or(&0));
+            self.window = window;
+            self.window_start = self.at;
+            read?;
+        }
+        Ok(&self.window[(self.at - self.window_start) as usize..])
+    }
+
+    fn consume(&mut self, amount: usize) {
+        self.at += amount as u64;
+    }
+}
+
+impl<R: std::io::Read + std::io::Seek> std::io::Seek for Rewinding<R> {
     fn seek(&mut self, to: std::io::SeekFrom) -> std::io::Result<u64> {
         let target = match to {
             std::io::SeekFrom::Start(n) => Some(n),
-            std::io::SeekFrom::Current(d) => (self.at as u64).checked_add_signed(d),
+            std::io::SeekFrom::Current(d) => self.at.checked_add_signed(d),
             std::io::SeekFrom::End(d) => {
-                // Only the end knows where the end is.
-                while self.read_more()? > 0 {}
-                (self.kept.len() as u64).checked_add_signed(d)
+                let end = self.inner.seek(std::io::SeekFrom::End(0))?;
+                self.inner_at = end;
+                end.checked_add_signed(d)
             }
         };
-        let target = target
-            .and_then(|t| usize::try_from(t).ok())
-            .ok_or_else(|| {
-                std::io::Error::new(std::io::ErrorKind::InvalidInput, "seek out of range")
-            })?;
-        self.at = target;
-        Ok(target as u64)
+        self.at = target.ok_or_else(|| {
+            std::io::Error::new(std::io::ErrorKind::InvalidInput, "seek out of range")
+        })?;
+        Ok(self.at)
     }
 }
 
@@ -760,15 +791,21 @@ mod tests {
 
     /// A reader that counts the bytes it hands out.
     struct Counted<'c> {
-        bytes: &'c [u8],
+        bytes: std::io::Cursor<&'c [u8]>,
         handed: &'c std::cell::Cell<usize>,
     }
 
     impl std::io::Read for Counted<'_> {
         fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
-            let n = std::io::Read::read(&mut self.bytes, buf)?;
+            let n = self.bytes.read(buf)?;
             self.handed.set(self.handed.get() + n);
             Ok(n)
+        }
+    }
+
+    impl std::io::Seek for Counted<'_> {
+        fn seek(&mut self, to: std::io::SeekFrom) -> std::io::Result<u64> {
+            self.bytes.seek(to)
         }
     }
 
@@ -779,7 +816,7 @@ mod tests {
             let bytes = png(color.into());
             let handed = std::cell::Cell::new(0);
             let rewinding = Rewinding::new(Counted {
-                bytes: &bytes,
+                bytes: std::io::Cursor::new(&bytes),
                 handed: &handed,
             });
             let header = read_header(rewinding, "", "image 0").unwrap();
@@ -795,7 +832,7 @@ mod tests {
             );
         }
         // Seeks from the end and from where it is, and past the end.
-        let mut r = Rewinding::new(&b"0123456789"[..]);
+        let mut r = Rewinding::new(std::io::Cursor::new(&b"0123456789"[..]));
         let mut two = [0u8; 2];
         use std::io::{Read, Seek, SeekFrom};
         assert_eq!(r.seek(SeekFrom::End(-3)).unwrap(), 7);
@@ -807,6 +844,39 @@ mod tests {
         assert_eq!(r.seek(SeekFrom::Start(20)).unwrap(), 20);
         assert_eq!(r.read(&mut two).unwrap(), 0);
         assert!(r.seek(SeekFrom::Current(-30)).is_err());
+    }
+
+    #[test]
+    fn a_png_whose_chunks_before_its_pixels_run_past_what_is_kept_reads_the_same() {
+        // A 3 MiB tEXt chunk after the header: the reader keeps its first mebibyte and reads
+        // on as a buffered reader does.
+        fn crc32(bytes: &[u8]) -> u32 {
+            let mut crc = !0u32;
+            for &b in bytes {
+                crc ^= u32::from(b);
+                for _ in 0..8 {
+                    crc = (crc >> 1) ^ (0xEDB8_8320 & (crc & 1).wrapping_neg());
+                }
+            }
+            !crc
+        }
+        let plain = png(image::ExtendedColorType::Rgba8);
+        let text = vec![b'a'; 3 << 20];
+        let mut chunk = (text.len() as u32).to_be_bytes().to_vec();
+        let typed = [&b"tEXt"[..], &text].concat();
+        chunk.extend_from_slice(&typed);
+        chunk.extend_from_slice(&crc32(&typed).to_be_bytes());
+        // After the signature (8 bytes) and the IHDR chunk (25).
+        let bytes = [&plain[..33], &chunk, &plain[33..]].concat();
+        let mut rewinding = Rewinding::new(std::io::Cursor::new(&bytes[..]));
+        let header = read_header(&mut rewinding, "", "image 0").unwrap();
+        let expected = read_header(std::io::Cursor::new(&bytes), "", "image 0").unwrap();
+        assert_eq!(header, expected);
+        assert_eq!((header.width, header.height), (2, 2));
+        assert_eq!(
+            rewinding.kept.len(),
+            Rewinding::<std::io::Cursor<&[u8]>>::KEEP
+        );
     }
 
     #[test]
@@ -825,7 +895,11 @@ mod tests {
         for image in &images {
             for cut in 0..=image.len() {
                 let bytes = &image[..cut];
-                let rewinding = read_header(Rewinding::new(bytes), "/images/0", "image 0");
+                let rewinding = read_header(
+                    Rewinding::new(std::io::Cursor::new(bytes)),
+                    "/images/0",
+                    "image 0",
+                );
                 let memory = read_header(std::io::Cursor::new(bytes), "/images/0", "image 0");
                 assert_eq!(rewinding, memory, "{cut} of {} bytes", image.len());
             }
