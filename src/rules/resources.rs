@@ -229,17 +229,24 @@ fn check_image(cx: &Context, index: usize, image: Node, out: &mut Vec<Diagnostic
         let pointer = format!("/images/{index}/uri");
         match locate(cx, &uri, &pointer, out) {
             Some(Located::Data {
-                media_type, holds, ..
+                media_type,
+                holds,
+                len,
             }) => {
                 // The Khronos validator holds an image's data: URI to its own media type: bytes
                 // of another format, or bytes of no format it knows under a type it knows, make
                 // the URI invalid, and the image is not judged further. A type velvet does not
-                // read (DDS, AVIF) over bytes it does not recognize is left alone.
+                // read (DDS, AVIF, from their extensions) over bytes it does not recognize is
+                // valid glTF, left alone as a `mimeType` of that type is.
                 let known = KNOWN_MIME_TYPES.contains(&media_type.as_str());
                 let held = holds.map(mime_of);
-                if held != Some(media_type.as_str()) && (known || held.is_some()) {
+                if held != Some(media_type.as_str()) {
+                    if !known && held.is_none() {
+                        return;
+                    }
                     let bytes = match held {
                         Some(held) => format!("its bytes are {held}"),
+                        None if len == 0 => "it holds no bytes".to_string(),
                         None => "its bytes are no image format velvet recognizes".to_string(),
                     };
                     out.push(Diagnostic::new(
@@ -249,7 +256,7 @@ fn check_image(cx: &Context, index: usize, image: Node, out: &mut Vec<Diagnostic
                     ));
                     return;
                 }
-                if declared.is_none() && known {
+                if declared.is_none() {
                     declared = Some((media_type, pointer));
                 }
             }
