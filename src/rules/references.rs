@@ -181,7 +181,25 @@ impl Rule for References {
         let mut found: Vec<(usize, Diagnostic)> = Vec::new();
         // Which elements of each of PRUNED something refers to.
         let mut used: Vec<Vec<bool>> = PRUNED.iter().map(|a| vec![false; array_len(a)]).collect();
-        let mut found_at = |link: usize, path: &[Token], value: Node| {
+        // For each link into a root extension the document lacks, that extension's name: the
+        // objects that hold such an index depend on it (see below).
+        let missing_root: Vec<Option<&str>> = LINKS
+            .iter()
+            .map(|(_, target)| {
+                target
+                    .strip_prefix("/extensions/")
+                    .and_then(|rest| rest.split('/').next())
+                    .filter(|name| json.get("extensions").and_then(|e| e.get(*name)).is_none())
+            })
+            .collect();
+        let mut holders: Vec<(usize, String)> = Vec::new();
+        let mut found_at = |reached: Reached, link: usize, path: &[Token], value: Node| {
+            if reached == Reached::Holder {
+                if missing_root[link].is_some() && value.is_object() {
+                    holders.push((link, pointer_of(path)));
+                }
+                return;
+            }
             let Some(index) = as_index(value) else {
                 return; // not an index: the schema check reports the type
             };
@@ -203,18 +221,7 @@ impl Rule for References {
                 }
             };
             if index >= len as u64 {
-                let mut at = String::with_capacity(64);
-                for token in path {
-                    at.push('/');
-                    match token {
-                        Token::Index(i) => {
-                            use std::fmt::Write;
-                            // Writing to a String cannot fail.
-                            let _ = write!(at, "{i}");
-                        }
-                        Token::Key(key) => pointer::push_escaped(&mut at, key),
-                    }
-                }
+                let at = pointer_of(path);
                 // An index beyond 64 bits is named as written, not as the u64::MAX it is read as.
                 let named = match index {
                     u64::MAX => value.raw().to_string(),
@@ -237,24 +244,23 @@ impl Rule for References {
         }
         // Reported link by link, in the table's order, each in document order.
         found.sort_by_key(|(link, _)| *link);
+        holders.sort_by_key(|(link, _)| *link);
         let mut found = found.into_iter().peekable();
+        let mut holders = holders.into_iter().peekable();
         let mut dependent: Vec<String> = Vec::new();
-        for (link, (site, target)) in LINKS.iter().enumerate() {
+        for (link, root) in missing_root.iter().enumerate() {
             let links_found = std::iter::from_fn(|| found.next_if(|(l, _)| *l == link));
+            let links_holders = std::iter::from_fn(|| holders.next_if(|(l, _)| *l == link));
             // An object that holds an index into a root extension's array, in a document
             // without that root extension, is a missing dependency, as the Khronos validator
             // reports it: at the object (the node's light, the mapping), once, whether or not
             // it holds the index yet (an empty light object is also UNDEFINED_PROPERTY).
-            let missing_root = target
-                .strip_prefix("/extensions/")
-                .and_then(|rest| rest.split('/').next())
-                .filter(|name| json.get("extensions").and_then(|e| e.get(*name)).is_none());
-            let Some(root) = missing_root else {
+            let Some(root) = root else {
                 out.extend(links_found.map(|(_, d)| d));
                 continue;
             };
             links_found.for_each(drop);
-            for holder in holders(json, holder_pattern(site)) {
+            for (_, holder) in links_holders {
                 if !dependent.contains(&holder) {
                     out.push(Diagnostic::new(
                         &super::core::UNSATISFIED_DEPENDENCY,
@@ -282,41 +288,21 @@ fn holder_pattern(site: &str) -> &str {
     holder
 }
 
-/// The pointers of the objects in `json` that `pattern` matches (`*` for any element or
-/// member), in document order.
-fn holders(json: Node, pattern: &str) -> Vec<String> {
-    fn walk(node: Node, segments: &[&str], at: &mut String, out: &mut Vec<String>) {
-        let Some((first, rest)) = segments.split_first() else {
-            if node.is_object() {
-                out.push(at.clone());
+/// The JSON pointer of a walked path.
+fn pointer_of(path: &[Token]) -> String {
+    let mut at = String::with_capacity(64);
+    for token in path {
+        at.push('/');
+        match token {
+            Token::Index(i) => {
+                use std::fmt::Write;
+                // Writing to a String cannot fail.
+                let _ = write!(at, "{i}");
             }
-            return;
-        };
-        let len = at.len();
-        let mut step = |at: &mut String, key: &str, child: Node| {
-            at.push('/');
-            pointer::push_escaped(at, key);
-            walk(child, rest, at, out);
-            at.truncate(len);
-        };
-        if *first == "*" {
-            if let Some(elements) = node.as_array() {
-                for (i, child) in elements.iter().enumerate() {
-                    step(at, &i.to_string(), child);
-                }
-            } else if let Some(members) = node.as_object() {
-                for (key, child) in members.iter() {
-                    step(at, &key, child);
-                }
-            }
-        } else if let Some(child) = node.get(*first) {
-            step(at, first, child);
+            Token::Key(key) => pointer::push_escaped(&mut at, key),
         }
     }
-    let segments: Vec<&str> = pattern.split('/').skip(1).collect();
-    let mut out = Vec::new();
-    walk(json, &segments, &mut String::new(), &mut out);
-    out
+    at
 }
 
 /// Every index [`LINKS`] declares in the document: its pointer, the array it indexes and the
@@ -325,16 +311,11 @@ pub fn index_sites(json: Node) -> Vec<(String, &'static str, u64)> {
     let steps = steps();
     let ids: Vec<Option<KeyId>> = steps.keys.iter().map(|key| json.key_id(key)).collect();
     let mut sites = Vec::new();
-    let mut found_at = |link: usize, path: &[Token], value: Node| {
-        let Some(index) = as_index(value) else {
+    let mut found_at = |reached: Reached, link: usize, path: &[Token], value: Node| {
+        let Some(index) = as_index(value).filter(|_| reached == Reached::Index) else {
             return;
         };
-        let mut at = String::new();
-        for token in path {
-            at.push('/');
-            pointer::push_escaped(&mut at, &token.text());
-        }
-        sites.push((at, LINKS[link].1, index));
+        sites.push((pointer_of(path), LINKS[link].1, index));
     };
     walk(json, &steps.root, &ids, &mut Vec::new(), &mut found_at);
     sites
@@ -399,7 +380,18 @@ struct Step {
     segment: Segment,
     /// The pattern that ends here, by its place in [`LINKS`].
     link: Option<usize>,
+    /// The patterns into a root extension's array whose indices the object here holds
+    /// ([`holder_pattern`]).
+    holds: Vec<usize>,
     next: Vec<Step>,
+}
+
+/// What a walk reached for a pattern of [`LINKS`]: the index itself, or the object that holds
+/// it (for a pattern into a root extension's array).
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Reached {
+    Index,
+    Holder,
 }
 
 /// [`LINKS`] as a tree, with the keys its segments name.
@@ -414,9 +406,12 @@ fn steps() -> &'static Steps {
     STEPS.get_or_init(|| {
         let mut root: Vec<Step> = Vec::new();
         let mut keys: Vec<&'static str> = Vec::new();
-        for (link, (pattern, _)) in LINKS.iter().enumerate() {
+        for (link, (pattern, target)) in LINKS.iter().enumerate() {
             let mut level = &mut root;
             let segments: Vec<&'static str> = pattern.split('/').skip(1).collect();
+            let holder_len = target
+                .starts_with("/extensions/")
+                .then(|| holder_pattern(pattern).split('/').skip(1).count());
             for (i, &text) in segments.iter().enumerate() {
                 let segment = match text.strip_prefix('*') {
                     Some("") => Segment::Any,
@@ -435,6 +430,7 @@ fn steps() -> &'static Steps {
                             text,
                             segment,
                             link: None,
+                            holds: Vec::new(),
                             next: Vec::new(),
                         });
                         level.len() - 1
@@ -443,6 +439,9 @@ fn steps() -> &'static Steps {
                 if i + 1 == segments.len() {
                     level[at].link = Some(link);
                 }
+                if Some(i + 1) == holder_len {
+                    level[at].holds.push(link);
+                }
                 level = &mut level[at].next;
             }
         }
@@ -450,7 +449,11 @@ fn steps() -> &'static Steps {
     })
 }
 
-/// Calls `found` with the pattern, path and value of every match of `steps` under `value`.
+/// What a walk calls at each match: what it reached, the pattern, the path and the value.
+type OnReached<'a> = dyn FnMut(Reached, usize, &[Token<'a>], Node<'a>) + 'a;
+
+/// Calls `found` with what was reached (an index, or an object that holds one), the pattern, path
+/// and value of every match of `steps` under `value`.
 /// `ids` holds the document's number for each of [`Steps::keys`]. The path is kept as tokens
 /// and turned into a pointer only for what is reported.
 fn walk<'a>(
@@ -458,13 +461,16 @@ fn walk<'a>(
     steps: &'static [Step],
     ids: &[Option<KeyId>],
     path: &mut Vec<Token<'a>>,
-    found: &mut dyn FnMut(usize, &[Token<'a>], Node<'a>),
+    found: &mut OnReached<'a>,
 ) {
     let mut visit =
         |step: &'static Step, token: Token<'a>, child: Node<'a>, path: &mut Vec<Token<'a>>| {
             path.push(token);
+            for &link in &step.holds {
+                found(Reached::Holder, link, path, child);
+            }
             if let Some(link) = step.link {
-                found(link, path, child);
+                found(Reached::Index, link, path, child);
             }
             if !step.next.is_empty() {
                 walk(child, &step.next, ids, path, found);

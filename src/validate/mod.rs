@@ -589,11 +589,15 @@ mod tests {
         }
     }
 
-    /// The findings of every rule that names what it reads (`Rule::reads`), per rule, in the
-    /// report of `text` read as the file `path` (whose folder holds its resources).
-    fn findings_by_rule(validator: &Validator, path: &Path, text: &str) -> Vec<Vec<String>> {
+    /// `text` read as the file `path` (whose folder holds its resources) and validated, its
+    /// findings not placed in the text; `None` when it does not load.
+    fn validated(
+        validator: &Validator,
+        path: &Path,
+        text: &str,
+    ) -> Option<(asset::Asset, FileReport)> {
         let loaded = asset::load_bytes_with(path, text.as_bytes(), &validator.load);
-        let asset = loaded.asset.expect("the document loads");
+        let asset = loaded.asset?;
         let report = validator.validate_asset_unplaced(
             path,
             &asset,
@@ -601,6 +605,11 @@ mod tests {
             &Settings::default(),
             None,
         );
+        Some((asset, report))
+    }
+
+    /// The findings of each rule in `report`, as text.
+    fn findings_by_rule(report: &FileReport) -> Vec<Vec<String>> {
         report.rule_spans[1..]
             .iter()
             .map(|span| {
@@ -629,13 +638,10 @@ mod tests {
             let Ok(serde_json::Value::Object(whole)) = serde_json::from_str(&text) else {
                 continue;
             };
-            if asset::load_bytes_with(path, text.as_bytes(), &validator.load)
-                .asset
-                .is_none()
-            {
+            let Some((_, report)) = validated(&validator, path, &text) else {
                 continue;
-            }
-            let found = findings_by_rule(&validator, path, &text);
+            };
+            let found = findings_by_rule(&report);
             // (what went, as the pointer an edit of it would have; the document without it)
             let mut lesser: Vec<(String, serde_json::Map<String, serde_json::Value>)> = whole
                 .keys()
@@ -674,13 +680,10 @@ mod tests {
             }
             for (gone, less) in lesser {
                 let less_text = serde_json::to_string(&less).expect("the document writes");
-                if asset::load_bytes_with(path, less_text.as_bytes(), &validator.load)
-                    .asset
-                    .is_none()
-                {
+                let Some((_, report_less)) = validated(&validator, path, &less_text) else {
                     continue;
-                }
-                let found_less = findings_by_rule(&validator, path, &less_text);
+                };
+                let found_less = findings_by_rule(&report_less);
                 variants += 1;
                 for (i, rule) in rules::REGISTRY.iter().enumerate() {
                     let reads = rule.reads();
@@ -718,18 +721,10 @@ mod tests {
             let Ok(serde_json::Value::Object(whole)) = serde_json::from_str(&text) else {
                 continue;
             };
-            let loaded = asset::load_bytes_with(path, text.as_bytes(), &validator.load);
-            let Some(source) = loaded.asset else {
+            let Some((source, found)) = validated(&validator, path, &text) else {
                 continue;
             };
-            let found = validator.validate_asset_unplaced(
-                path,
-                &source,
-                loaded.diagnostics,
-                &Settings::default(),
-                None,
-            );
-            let by_rule = findings_by_rule(&validator, path, &text);
+            let by_rule = findings_by_rule(&found);
             for (property, value) in &whole {
                 let Some(elements) = value.as_array() else {
                     continue;
@@ -796,7 +791,13 @@ mod tests {
                                 }
                                 said[i].0 += 1;
                                 let after_found = found_after.get_or_insert_with(|| {
-                                    findings_by_rule(&validator, path, &edited_text)
+                                    findings_by_rule(&validator.validate_asset_unplaced(
+                                        path,
+                                        &after,
+                                        loaded.diagnostics.clone(),
+                                        &Settings::default(),
+                                        None,
+                                    ))
                                 });
                                 assert_eq!(
                                     by_rule[i],
