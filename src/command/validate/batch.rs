@@ -5,15 +5,15 @@
 //! parallel, and decide whether the run failed. A configuration error stops the run before any
 //! file is read: a broken velvet.toml is a usage error, not a finding.
 //!
-//! Files are validated in parallel a batch at a time and each report is handed on in input
-//! order as soon as its batch is done, so that a run over ten thousand files holds one batch of
-//! reports, not ten thousand (see [`validate_each`]).
+//! Files are validated in parallel and each report is handed on in input order as soon as it
+//! and those before it are done, while the pool works on the files after it (see
+//! [`in_input_order`]): a run over ten thousand files holds a window of reports, not ten
+//! thousand, and writing a report never leaves a core idle.
 
 use crate::asset::discover::{self, Shard};
 use crate::config::{ConfigError, Resolver};
 use crate::diagnostics::Settings;
 use crate::validate::{FileReport, Validator};
-use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
 /// What a run produced.
@@ -59,9 +59,9 @@ pub struct Totals {
     pub failed: bool,
 }
 
-/// Files validated in parallel before their reports are handed on: enough to keep every core
-/// busy, few enough that the reports in hand stay small.
-const BATCH: usize = 256;
+/// How far the pool may work ahead of the report handed on last: enough to keep every core
+/// busy behind a slow file, few enough that the reports in hand stay small.
+const WINDOW: usize = 256;
 
 /// Validates like [`validate`], handing each report to `sink` in input order as soon as its
 /// batch is done instead of keeping them.
@@ -70,7 +70,7 @@ pub fn validate_each(
     inputs: &[PathBuf],
     resolver: &mut Resolver,
     progress: Option<&indicatif::ProgressBar>,
-    sink: &mut dyn FnMut(FileReport),
+    sink: &mut (dyn FnMut(FileReport) + Send),
 ) -> Result<Totals, ConfigError> {
     validate_shard_each(validator, inputs, None, resolver, progress, sink)
 }
@@ -83,7 +83,7 @@ pub fn validate_shard_each(
     shard: Option<Shard>,
     resolver: &mut Resolver,
     progress: Option<&indicatif::ProgressBar>,
-    sink: &mut dyn FnMut(FileReport),
+    sink: &mut (dyn FnMut(FileReport) + Send),
 ) -> Result<Totals, ConfigError> {
     let check = |file: &Path, settings: &Settings| validator.validate_file_with(file, settings);
     check_shard_each(validator, inputs, shard, resolver, progress, &check, sink)
@@ -99,7 +99,7 @@ pub fn check_shard_each(
     resolver: &mut Resolver,
     progress: Option<&indicatif::ProgressBar>,
     check: &(dyn Fn(&Path, &Settings) -> FileReport + Sync),
-    sink: &mut dyn FnMut(FileReport),
+    sink: &mut (dyn FnMut(FileReport) + Send),
 ) -> Result<Totals, ConfigError> {
     let (found, walk_errors) = discover::find(inputs, shard);
     let mut planned = Vec::with_capacity(found.len());
@@ -164,23 +164,19 @@ pub fn check_shard_each(
         }
         bar.set_length(planned.len() as u64);
     }
-    for batch in planned.chunks(BATCH) {
-        let checked: Vec<(FileReport, bool)> = batch
-            .par_iter()
-            .map(|(file, config)| {
-                let report = check(file, config.settings());
-                let fails = report.fails(config.settings());
-                if let Some(bar) = progress {
-                    bar.inc(1);
-                }
-                (report, fails)
-            })
-            .collect();
-        for (report, fails) in checked {
-            failed |= fails;
-            sink(report);
+    let check_one = |i: usize| {
+        let (file, config) = &planned[i];
+        let report = check(file, config.settings());
+        let fails = report.fails(config.settings());
+        if let Some(bar) = progress {
+            bar.inc(1);
         }
-    }
+        (report, fails)
+    };
+    in_input_order(planned.len(), &check_one, &mut |(report, fails)| {
+        failed |= fails;
+        sink(report);
+    });
     if let Some(bar) = progress {
         bar.finish_and_clear();
     }
@@ -189,4 +185,177 @@ pub fn check_shard_each(
         named_excluded,
         failed,
     })
+}
+
+/// Hands `work(0)`, `work(1)`, … `work(count - 1)` to `sink` in that order, each as soon as it
+/// and those before it are done. The pool's threads take the indices in order and never more
+/// than [`WINDOW`] past the first one not yet taken to be handed on (so at most twice that
+/// many are held); whichever thread finishes the next one due hands on every one ready from
+/// there, while the others work on. (Done a batch at a time, one
+/// thread wrote a batch's reports while the others stood idle: a twelfth of the run on 500
+/// small files.) Nothing waits but for the lock: a thread that finds the window full stops,
+/// and the thread that moves the window sets as many to work again.
+fn in_input_order<T: Send>(
+    count: usize,
+    work: &(dyn Fn(usize) -> T + Sync),
+    sink: &mut (dyn FnMut(T) + Send),
+) {
+    use std::collections::VecDeque;
+    use std::sync::{Mutex, PoisonError};
+    /// The window: `slots[k]` holds work `handed + k` once it is done.
+    struct Window<T> {
+        handed: usize,
+        /// The next index to take.
+        next: usize,
+        slots: VecDeque<Option<T>>,
+        /// A thread is handing on: the others leave what they finish in its slot.
+        handing: bool,
+        /// Threads that stopped at a full window.
+        stopped: usize,
+    }
+    let window = Mutex::new(Window {
+        handed: 0,
+        next: 0,
+        slots: (0..WINDOW.min(count)).map(|_| None).collect(),
+        handing: false,
+        stopped: 0,
+    });
+    let sink = Mutex::new(sink);
+    fn worker<'s, T: Send>(
+        scope: &rayon::Scope<'s>,
+        count: usize,
+        window: &'s Mutex<Window<T>>,
+        work: &'s (dyn Fn(usize) -> T + Sync),
+        sink: &'s Mutex<&mut (dyn FnMut(T) + Send)>,
+    ) {
+        let lock = || window.lock().unwrap_or_else(PoisonError::into_inner);
+        loop {
+            let i = {
+                let mut held = lock();
+                if held.next >= count {
+                    return;
+                }
+                if held.next >= held.handed + WINDOW {
+                    held.stopped += 1;
+                    return;
+                }
+                held.next += 1;
+                held.next - 1
+            };
+            let value = work(i);
+            let mut held = lock();
+            let k = i - held.handed;
+            held.slots[k] = Some(value);
+            if k != 0 || held.handing {
+                continue;
+            }
+            held.handing = true;
+            let mut handing = sink.lock().unwrap_or_else(PoisonError::into_inner);
+            loop {
+                let mut ready = Vec::new();
+                while let Some(Some(_)) = held.slots.front() {
+                    ready.extend(held.slots.pop_front().flatten());
+                    held.slots.push_back(None);
+                    held.handed += 1;
+                }
+                if ready.is_empty() {
+                    held.handing = false;
+                    break;
+                }
+                // The window moved: the threads stopped at it go back to work.
+                for _ in 0..std::mem::take(&mut held.stopped) {
+                    scope.spawn(move |scope| worker(scope, count, window, work, sink));
+                }
+                drop(held);
+                ready.into_iter().for_each(&mut **handing);
+                held = lock();
+            }
+        }
+    }
+    rayon::scope(|scope| {
+        for _ in 0..rayon::current_num_threads().min(count) {
+            scope.spawn(|scope| worker(scope, count, &window, work, &sink));
+        }
+    });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Work whose time varies from index to index (a slow one every so often), so that the
+    /// threads finish out of order and the window fills behind the slow ones.
+    fn uneven(i: usize) -> usize {
+        let spins = if i % 97 == 0 { 200_000 } else { (i * 7919) % 2_000 };
+        let mut x = i as u64;
+        for _ in 0..spins {
+            x = std::hint::black_box(x.wrapping_mul(6364136223846793005).wrapping_add(1));
+        }
+        i
+    }
+
+    fn handed_on(threads: usize, count: usize) -> Vec<usize> {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("a pool");
+        let mut handed = Vec::new();
+        pool.install(|| in_input_order(count, &uneven, &mut |i| handed.push(i)));
+        handed
+    }
+
+    #[test]
+    fn every_work_is_handed_on_once_in_input_order_whatever_the_thread_count() {
+        let count = 3 * WINDOW + 17;
+        let expected: Vec<usize> = (0..count).collect();
+        for threads in [1, 2, 4, 8] {
+            assert_eq!(handed_on(threads, count), expected, "{threads} threads");
+        }
+        assert_eq!(handed_on(4, 0), Vec::<usize>::new());
+        assert_eq!(handed_on(4, 1), vec![0]);
+    }
+
+    #[test]
+    fn the_pool_never_works_further_ahead_than_the_window_allows() {
+        // The first work is slow; without a window the other threads would finish every other
+        // work meanwhile. Each work records how far it starts past the last one handed on.
+        let handed = std::sync::atomic::AtomicUsize::new(0);
+        let furthest = std::sync::atomic::AtomicUsize::new(0);
+        let work = |i: usize| {
+            if i == 0 {
+                std::thread::sleep(std::time::Duration::from_millis(100));
+            }
+            let ahead = i - handed.load(std::sync::atomic::Ordering::SeqCst);
+            furthest.fetch_max(ahead, std::sync::atomic::Ordering::SeqCst);
+            i
+        };
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(4)
+            .build()
+            .expect("a pool");
+        pool.install(|| {
+            in_input_order(8 * WINDOW, &work, &mut |i| {
+                handed.store(i + 1, std::sync::atomic::Ordering::SeqCst);
+            })
+        });
+        assert_eq!(handed.into_inner(), 8 * WINDOW);
+        // Up to a window taken to be handed on, and a window past it.
+        let furthest = furthest.into_inner();
+        assert!(furthest < 2 * WINDOW, "a work started {furthest} past the last handed on");
+    }
+
+    #[test]
+    fn a_panic_in_a_work_reaches_the_caller_and_nothing_after_it_is_handed_on() {
+        let mut handed = Vec::new();
+        let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            in_input_order(
+                2 * WINDOW,
+                &|i| if i == 300 { panic!("work 300 fails") } else { uneven(i) },
+                &mut |i| handed.push(i),
+            )
+        }));
+        let message = outcome.expect_err("the panic is raised again");
+        assert_eq!(message.downcast_ref::<&str>(), Some(&"work 300 fails"));
+        assert_eq!(handed, (0..300).collect::<Vec<_>>());
+    }
 }
