@@ -286,7 +286,7 @@ mod tests {
     /// Work whose time varies from index to index (a slow one every so often), so that the
     /// threads finish out of order and the window fills behind the slow ones.
     fn uneven(i: usize) -> usize {
-        let spins = if i % 97 == 0 { 200_000 } else { (i * 7919) % 2_000 };
+        let spins = if i.is_multiple_of(97) { 200_000 } else { (i * 7919) % 2_000 };
         let mut x = i as u64;
         for _ in 0..spins {
             x = std::hint::black_box(x.wrapping_mul(6364136223846793005).wrapping_add(1));
