@@ -32,9 +32,11 @@ pub(crate) struct KeyTable {
 
 impl Default for KeyTable {
     fn default() -> KeyTable {
+        // Room for a small document's keys (a few dozen, some twenty bytes each) from the
+        // start: grown from nothing, the two lists were reallocated a dozen times a document.
         KeyTable {
-            bytes: Vec::new(),
-            ends: Vec::new(),
+            bytes: Vec::with_capacity(1024),
+            ends: Vec::with_capacity(64),
             slots: vec![0; 1 << SLOT_BITS],
             overflow: HashMap::new(),
         }

@@ -315,7 +315,8 @@ impl Reads {
         let (index, member) = (tokens.next(), tokens.next());
         match (index, member) {
             (Some(index), Some(member)) if except.contains(&(property, member)) => {
-                !element_exists(&format!("/{property}/{index}"))
+                // The element's pointer is where the edit's begins: `/{property}/{index}`.
+                !element_exists(&pointer[..property.len() + index.len() + 2])
             }
             _ => true,
         }
@@ -326,27 +327,31 @@ impl Reads {
 /// or above such a place, which it may create, remove or replace, or inside one) or the
 /// elements an array `elements` matches holds (the edit is at or above one of its elements).
 fn places_touched_by(values: &[&str], elements: &[&str], pointer: &str) -> bool {
-    let tokens: Vec<std::borrow::Cow<str>> = pointer
-        .split('/')
-        .skip(1)
-        .map(crate::asset::pointer::unescape)
-        .collect();
+    // Split again for each pattern rather than kept: most patterns part from the edit's path
+    // at their first segment, and the rules ask this for every edit of every fix tried.
+    let tokens = || {
+        pointer
+            .split('/')
+            .skip(1)
+            .map(crate::asset::pointer::unescape)
+    };
     // Whether the edit's path and the pattern's agree as far as both go.
     let agrees = |pattern: &str| {
         pattern
             .split('/')
             .skip(1)
-            .zip(&tokens)
+            .zip(tokens())
             .all(|(segment, token)| match segment.strip_prefix('*') {
                 Some("") => true,
                 Some(suffix) => token.ends_with(suffix),
                 None => segment == token,
             })
     };
+    let depth = tokens().count();
     values.iter().any(|pattern| agrees(pattern))
         || elements
             .iter()
-            .any(|array| tokens.len() <= array.split('/').count() && agrees(array))
+            .any(|array| depth <= array.split('/').count() && agrees(array))
 }
 
 /// A validation rule.
