@@ -1445,13 +1445,13 @@ mod properties {
         })
     }
 
-    /// The index in a form two builds of one text must share: every entry (a key entry's
-    /// number replaced by what the key table says it spells), the arrays' runs, and each key
-    /// found by its spelling under the number its entries hold.
     /// An entry as [`canonical`] gives it: span, next entry, kind and flags (and count or
     /// run), and for a key what it spells in place of its number.
     type CanonicalEntry = (u32, u32, u32, u32, Option<Vec<u8>>);
 
+    /// The index in a form two builds of one text must share: every entry (a key entry's
+    /// number replaced by what the key table says it spells), the arrays' runs, and each key
+    /// found by its spelling under the number its entries hold.
     fn canonical(tape: &Tape, text: &str) -> (Vec<CanonicalEntry>, Vec<u32>) {
         let entries = tape
             .entries

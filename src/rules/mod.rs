@@ -347,11 +347,12 @@ fn places_touched_by(values: &[&str], elements: &[&str], pointer: &str) -> bool 
                 None => segment == token,
             })
     };
-    let depth = tokens().count();
-    values.iter().any(|pattern| agrees(pattern))
-        || elements
+    values.iter().any(|pattern| agrees(pattern)) || {
+        let depth = tokens().count();
+        elements
             .iter()
             .any(|array| depth <= array.split('/').count() && agrees(array))
+    }
 }
 
 /// A validation rule.

@@ -193,9 +193,9 @@ fn check_buffer(cx: &Context, index: usize, buffer: Node, out: &mut Vec<Diagnost
         Some(Located::Data {
             media_type, len, ..
         }) => {
-            // Media types are case-insensitive (RFC 2045).
+            // Read in lower case (media types are case-insensitive, RFC 2045; see `locate`).
             if !matches!(
-                media_type.to_ascii_lowercase().as_str(),
+                media_type.as_str(),
                 "application/octet-stream" | "application/gltf-buffer"
             ) {
                 out.push(Diagnostic::new(

@@ -286,7 +286,11 @@ mod tests {
     /// Work whose time varies from index to index (a slow one every so often), so that the
     /// threads finish out of order and the window fills behind the slow ones.
     fn uneven(i: usize) -> usize {
-        let spins = if i.is_multiple_of(97) { 200_000 } else { (i * 7919) % 2_000 };
+        let spins = if i.is_multiple_of(97) {
+            200_000
+        } else {
+            (i * 7919) % 2_000
+        };
         let mut x = i as u64;
         for _ in 0..spins {
             x = std::hint::black_box(x.wrapping_mul(6364136223846793005).wrapping_add(1));
@@ -341,7 +345,10 @@ mod tests {
         assert_eq!(handed.into_inner(), 8 * WINDOW);
         // Up to a window taken to be handed on, and a window past it.
         let furthest = furthest.into_inner();
-        assert!(furthest < 2 * WINDOW, "a work started {furthest} past the last handed on");
+        assert!(
+            furthest < 2 * WINDOW,
+            "a work started {furthest} past the last handed on"
+        );
     }
 
     #[test]
@@ -350,7 +357,13 @@ mod tests {
         let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
             in_input_order(
                 2 * WINDOW,
-                &|i| if i == 300 { panic!("work 300 fails") } else { uneven(i) },
+                &|i| {
+                    if i == 300 {
+                        panic!("work 300 fails")
+                    } else {
+                        uneven(i)
+                    }
+                },
                 &mut |i| handed.push(i),
             )
         }));
