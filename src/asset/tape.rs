@@ -137,6 +137,7 @@ struct ResumePoint {
 }
 
 struct Builder<'t> {
+    text: &'t str,
     bytes: &'t [u8],
     at: usize,
     max_depth: usize,
@@ -162,6 +163,7 @@ impl Tape {
             return Err(TapeError::TooLarge);
         }
         let mut builder = Builder {
+            text,
             bytes: text.as_bytes(),
             at: 0,
             max_depth,
@@ -220,6 +222,7 @@ impl Tape {
             .min();
         let cut = closing_later.unwrap_or(earlier.elements.len());
         let mut builder = Builder {
+            text,
             bytes: text.as_bytes(),
             at: point.at,
             max_depth,
@@ -539,14 +542,13 @@ impl Builder<'_> {
         }
         let start = self.at;
         let escaped = self.string()?;
-        let key = &self.bytes[start + 1..self.at - 1];
         let id = if escaped {
             // Numbered by what it spells, as the same key written without escapes is.
-            let raw = std::str::from_utf8(&self.bytes[start..self.at]).unwrap_or_default();
-            let key: String = serde_json::from_str(raw).unwrap_or_default();
-            self.keys.intern(key.as_bytes())
+            let key: String = serde_json::from_str(&self.text[start..self.at]).unwrap_or_default();
+            self.keys.intern(&key)
         } else {
-            self.keys.intern(key)
+            // Between two quotes, which are character boundaries.
+            self.keys.intern(&self.text[start + 1..self.at - 1])
         };
         if id > MAX_AUX {
             return Err(TapeError::TooLarge);
@@ -755,6 +757,10 @@ impl<'a> Node<'a> {
         if e.kind() != Kind::String {
             return None;
         }
+        if e.meta & KEY != 0 {
+            // A key as the table holds it (unescaped), in cache where the text may not be.
+            return Some(Cow::Borrowed(self.tape.keys.key(e.aux() as u32)));
+        }
         let raw = self.raw();
         if e.meta & ESCAPED == 0 {
             Some(Cow::Borrowed(&raw[1..raw.len() - 1]))
@@ -832,7 +838,7 @@ impl<'a> Node<'a> {
 
     /// The number of `key` in this document, if any of its objects has that key.
     pub fn key_id(&self, key: &str) -> Option<KeyId> {
-        self.tape.keys.id(key.as_bytes()).map(KeyId)
+        self.tape.keys.id(key).map(KeyId)
     }
 
     /// The value of every object member named `key` anywhere inside this value, in text order,
@@ -846,7 +852,7 @@ impl<'a> Node<'a> {
         let entries = &self.tape.entries[self.at as usize + 1..self.entry().next as usize];
         let first = self.at + 1;
         // A key the text does not have is the key of no member: no scan.
-        let id = self.tape.keys.id(key.as_bytes());
+        let id = self.tape.keys.id(key);
         id.into_iter().flat_map(move |id| {
             entries
                 .iter()
@@ -918,7 +924,7 @@ impl<'a> Object<'a> {
     /// The value of `key`: the last one, if the key is written more than once.
     pub fn get(&self, key: &str) -> Option<Node<'a>> {
         // A key the text does not have is the key of no member.
-        self.get_key(self.node.tape.keys.id(key.as_bytes())?)
+        self.get_key(self.node.tape.keys.id(key)?)
     }
 
     /// The value of the key numbered `key` (from [`Node::key_id`] on the same document), as
@@ -954,7 +960,7 @@ impl<'a> Object<'a> {
     }
 
     pub fn contains_key(&self, key: &str) -> bool {
-        self.node.tape.keys.id(key.as_bytes()).is_some_and(|id| {
+        self.node.tape.keys.id(key).is_some_and(|id| {
             self.raw_members()
                 .any(|(k, _)| self.node.node(k).key_is(id))
         })
@@ -1034,8 +1040,9 @@ impl<'a> Members<'a> {
         loop {
             let (k, v) = self.raw.next()?;
             let node = self.object.node;
-            let key = node.node(k).as_str().unwrap_or_default();
             let id = node.node(k).entry().aux() as u32;
+            // The key as the table holds it (unescaped): it spells what the key entry does.
+            let key = Cow::Borrowed(node.tape.keys.key(id));
             if !self.duplicates {
                 return Some((KeyId(id), key, node.node(v)));
             }
@@ -1461,7 +1468,7 @@ mod properties {
                     let raw = &text[e.start as usize..e.end as usize];
                     let spelled: String = serde_json::from_str(raw).unwrap();
                     assert_eq!(
-                        tape.keys.id(spelled.as_bytes()),
+                        tape.keys.id(&spelled),
                         Some(e.aux() as u32),
                         "key {raw} found under its number"
                     );
