@@ -872,10 +872,12 @@ impl<'v> Fixing<'v> {
         // fix of the byte-order mark or the container changes what lies outside the text.
         let root = source.root();
         let exists = |pointer: &str| root.pointer(pointer).is_some();
+        let paths: Vec<crate::rules::EditPath> = edits
+            .iter()
+            .map(|edit| crate::rules::EditPath::of(edited_pointer(edit)))
+            .collect();
         let touched = |reads: &crate::rules::Reads| {
-            edits
-                .iter()
-                .any(|edit| reads.touched_by(edited_pointer(edit), exists))
+            paths.iter().any(|path| reads.touched_by_path(path, exists))
         };
         let mut elements: Option<Vec<crate::rules::ElementPlace>> = edits
             .iter()

@@ -297,14 +297,20 @@ impl Reads {
     /// excepted member counts only where `element_exists` says the element it is in (the
     /// pointer's first two tokens) is already there, since a set creates what it misses.
     pub fn touched_by(&self, pointer: &str, element_exists: impl Fn(&str) -> bool) -> bool {
+        self.touched_by_path(&EditPath::of(pointer), element_exists)
+    }
+
+    /// [`Reads::touched_by`] of an edit whose path is split already: a fix's trial asks it of
+    /// every rule for each edit.
+    pub fn touched_by_path(&self, edit: &EditPath, element_exists: impl Fn(&str) -> bool) -> bool {
         let (properties, except) = match self {
             Reads::Document => return true,
             Reads::Places { values, elements } => {
-                return places_touched_by(values, elements, pointer);
+                return places_touched_by(values, elements, &edit.tokens);
             }
             Reads::Properties { properties, except } => (properties, except),
         };
-        let mut tokens = pointer.split('/').skip(1);
+        let mut tokens = edit.pointer.split('/').skip(1);
         let Some(property) = tokens.next() else {
             // The whole document.
             return true;
@@ -316,43 +322,57 @@ impl Reads {
         match (index, member) {
             (Some(index), Some(member)) if except.contains(&(property, member)) => {
                 // The element's pointer is where the edit's begins: `/{property}/{index}`.
-                !element_exists(&pointer[..property.len() + index.len() + 2])
+                !element_exists(&edit.pointer[..property.len() + index.len() + 2])
             }
             _ => true,
         }
     }
 }
 
-/// Whether an edit at `pointer` may change a value at a place `values` match (the edit is at
-/// or above such a place, which it may create, remove or replace, or inside one) or the
-/// elements an array `elements` matches holds (the edit is at or above one of its elements).
-fn places_touched_by(values: &[&str], elements: &[&str], pointer: &str) -> bool {
-    // Split again for each pattern rather than kept: most patterns part from the edit's path
-    // at their first segment, and the rules ask this for every edit of every fix tried.
-    let tokens = || {
-        pointer
-            .split('/')
-            .skip(1)
-            .map(crate::asset::pointer::unescape)
-    };
-    // Whether the edit's path and the pattern's agree as far as both go.
+/// An edit's JSON pointer with its tokens unescaped, split once for all the rules asked
+/// whether it touches what they read.
+pub struct EditPath<'p> {
+    pointer: &'p str,
+    tokens: Vec<std::borrow::Cow<'p, str>>,
+}
+
+impl<'p> EditPath<'p> {
+    pub fn of(pointer: &'p str) -> EditPath<'p> {
+        EditPath {
+            pointer,
+            tokens: pointer
+                .split('/')
+                .skip(1)
+                .map(crate::asset::pointer::unescape)
+                .collect(),
+        }
+    }
+}
+
+/// Whether an edit at the path `tokens` may change a value at a place `values` match (the
+/// edit is at or above such a place, which it may create, remove or replace, or inside one)
+/// or the elements an array `elements` matches holds (the edit is at or above one of its
+/// elements).
+fn places_touched_by(values: &[&str], elements: &[&str], tokens: &[std::borrow::Cow<str>]) -> bool {
+    // Whether the edit's path and the pattern's agree as far as both go. A pattern is split
+    // on bytes: its segments are a few bytes long, shorter than a search for '/' is worth.
     let agrees = |pattern: &str| {
         pattern
-            .split('/')
+            .as_bytes()
+            .split(|b| *b == b'/')
             .skip(1)
-            .zip(tokens())
-            .all(|(segment, token)| match segment.strip_prefix('*') {
-                Some("") => true,
-                Some(suffix) => token.ends_with(suffix),
-                None => segment == token,
+            .zip(tokens)
+            .all(|(segment, token)| match segment.strip_prefix(b"*") {
+                Some(b"") => true,
+                Some(suffix) => token.as_bytes().ends_with(suffix),
+                None => segment == token.as_bytes(),
             })
     };
-    values.iter().any(|pattern| agrees(pattern)) || {
-        let depth = tokens().count();
-        elements
-            .iter()
-            .any(|array| depth <= array.split('/').count() && agrees(array))
-    }
+    values.iter().any(|pattern| agrees(pattern))
+        || elements.iter().any(|array| {
+            // At or above the array's elements: no deeper than one token past the array.
+            tokens.len() <= array.bytes().filter(|b| *b == b'/').count() + 1 && agrees(array)
+        })
 }
 
 /// A validation rule.
