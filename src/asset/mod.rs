@@ -80,8 +80,9 @@ pub struct Asset {
 /// What the file system said of a document's resource files, asked once per file: every
 /// report of a file with fixable findings validates the fixed text too ([`crate::fix`]), whose
 /// resources are the file's, and on small files the second round of path checks, stats and
-/// header reads was a tenth of the run. Shared only by assets of one file, loaded under one
-/// policy, within one run ([`Asset::share_lookups`]).
+/// header reads was a tenth of the run. Shared only by assets of one folder, loaded under one
+/// policy, within one run ([`Asset::share_lookups`], [`Asset::share_folder_lookups`]): every
+/// key is a path resolved from the folder, or a URI with the pointer that holds it.
 #[derive(Debug, Default)]
 struct ResourceLookups {
     /// The folder with its links resolved, found once on the first resource read.
@@ -97,6 +98,13 @@ struct ResourceLookups {
     /// read from here by whatever reads the file afterwards.
     short_files: Mutex<HashMap<PathBuf, std::sync::Arc<[u8]>>>,
 }
+
+/// The resource lookups of the documents of each folder, for one run under one set of load
+/// options ([`Asset::share_folder_lookups`]): a library's documents in one folder share their
+/// textures and buffers, and each document asked the file system about them again (on 500
+/// small files sharing an image and a buffer, a twentieth of the run's processor time).
+#[derive(Debug, Default)]
+pub struct FolderLookups(Mutex<HashMap<PathBuf, (LoadOptions, std::sync::Arc<ResourceLookups>)>>);
 
 /// A resource file as [`Asset::open_resource`] gives it: its bytes, when it is short and they
 /// were read with its facts, or the file opened.
@@ -954,6 +962,26 @@ impl Asset {
     pub fn share_lookups(&mut self, other: &Asset) {
         if self.path == other.path && self.options == other.options {
             self.lookups = other.lookups.clone();
+        }
+    }
+
+    /// Gives this asset, fresh from loading, the resource lookups of the documents of its
+    /// folder that `folders` holds, loaded under the same options (or makes its own theirs):
+    /// a resource path is resolved from the folder, and what the file system said of it holds
+    /// for every document there within one run.
+    pub fn share_folder_lookups(&mut self, folders: &FolderLookups) {
+        let mut folders = lock(&folders.0);
+        match folders.get(self.base_dir()) {
+            Some((options, lookups)) if *options == self.options => {
+                self.lookups = lookups.clone();
+            }
+            Some(_) => {}
+            None => {
+                folders.insert(
+                    self.base_dir().to_path_buf(),
+                    (self.options, self.lookups.clone()),
+                );
+            }
         }
     }
 

@@ -542,9 +542,10 @@ impl<'v> Fixing<'v> {
         settings: &Settings,
         mode: Mode,
     ) -> FileReport {
-        let Some(source) = loaded.asset else {
+        let Some(mut source) = loaded.asset else {
             return self.validator.validate_loaded_with(path, loaded, settings);
         };
+        self.validator.share_folder_lookups(&mut source);
         // Every finding is planned for and compared, also those a --max-issues cap leaves out
         // of the listing.
         let unlimited = Settings {

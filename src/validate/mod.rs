@@ -158,6 +158,8 @@ pub struct Validator {
     /// Whether findings are placed in the source text (line and column); a report format that
     /// does not show them skips the scan.
     pub positions: bool,
+    /// What the file system said of the resources of each folder's documents, this run.
+    folders: asset::FolderLookups,
 }
 
 impl Validator {
@@ -192,6 +194,7 @@ impl Validator {
             settings,
             load: asset::LoadOptions::default(),
             positions: true,
+            folders: Default::default(),
         }
     }
 
@@ -260,7 +263,7 @@ impl Validator {
         settings: &Settings,
     ) -> FileReport {
         let diagnostics = loaded.diagnostics;
-        let Some(asset) = loaded.asset else {
+        let Some(mut asset) = loaded.asset else {
             return self.finish(
                 settings,
                 path.to_path_buf(),
@@ -270,7 +273,14 @@ impl Validator {
                 None,
             );
         };
+        self.share_folder_lookups(&mut asset);
         self.validate_asset(path, &asset, diagnostics, settings)
+    }
+
+    /// Gives a document just loaded the resource lookups of the documents of its folder
+    /// validated before it in this run ([`asset::Asset::share_folder_lookups`]).
+    pub fn share_folder_lookups(&self, asset: &mut asset::Asset) {
+        asset.share_folder_lookups(&self.folders);
     }
 
     /// Validates a loaded document under `settings`; `diagnostics` are the loader's findings
@@ -569,6 +579,41 @@ mod tests {
             .expect("the validation in a pool of one thread finishes");
         assert!(codes.contains(&"TYPE_MISMATCH"), "{codes:?}");
         assert_eq!(codes, expected);
+    }
+
+    #[test]
+    fn the_documents_of_one_folder_share_what_the_file_system_said_of_their_resources_in_a_run() {
+        let dir = tempfile::tempdir().unwrap();
+        let sub = dir.path().join("sub");
+        std::fs::create_dir(&sub).unwrap();
+        let text = r#"{"asset":{"version":"2.0"},"buffers":[{"uri":"b.bin","byteLength":4}]}"#;
+        for file in [
+            dir.path().join("one.gltf"),
+            dir.path().join("two.gltf"),
+            sub.join("three.gltf"),
+        ] {
+            std::fs::write(file, text).unwrap();
+        }
+        std::fs::write(sub.join("b.bin"), [0u8; 4]).unwrap();
+        let missing = |validator: &Validator, file: &Path| -> Vec<(&'static str, String)> {
+            validator
+                .validate_file(file)
+                .findings
+                .iter()
+                .filter(|f| f.diagnostic.code == "FILE_NOT_FOUND")
+                .map(|f| (f.diagnostic.code, f.diagnostic.pointer.clone()))
+                .collect()
+        };
+        let validator = Validator::builtin(Settings::default());
+        let not_found = vec![("FILE_NOT_FOUND", "/buffers/0/uri".to_string())];
+        assert_eq!(missing(&validator, &dir.path().join("one.gltf")), not_found);
+        // Written after the run asked about it: the run's answer for the folder stands.
+        std::fs::write(dir.path().join("b.bin"), [0u8; 4]).unwrap();
+        assert_eq!(missing(&validator, &dir.path().join("two.gltf")), not_found);
+        // Another folder's document asks about its own file; another run asks again.
+        assert_eq!(missing(&validator, &sub.join("three.gltf")), vec![]);
+        let next_run = Validator::builtin(Settings::default());
+        assert_eq!(missing(&next_run, &dir.path().join("two.gltf")), vec![]);
     }
 
     #[test]
