@@ -289,6 +289,17 @@ pub fn report_pretty(report: &FileReport) -> String {
     serde_json::to_string_pretty(&shape(report)).expect("a report serialises")
 }
 
+/// [`report_pretty`] as an element of a pretty-printed array: every line indented one level.
+/// Written as a one-element array, less its brackets, rather than indented line by line
+/// afterwards (a second pass over the text).
+pub fn report_pretty_element(report: &FileReport) -> String {
+    let mut text = serde_json::to_string_pretty(&[shape(report)]).expect("a report serialises");
+    // "[\n" and "\n]" around the element.
+    text.truncate(text.len() - 2);
+    text.drain(..2);
+    text
+}
+
 /// How many messages one task of [`write_pretty`] writes.
 const MESSAGES_PER_TASK: usize = 1024;
 /// How many tasks' text [`write_pretty`] holds at once.

@@ -234,7 +234,7 @@ pub fn failed_run(format: Format, message: &str, json_array: bool) -> String {
             github::escape_data(&escape::terminal(message))
         ),
         // As the stream writes an array of one report.
-        Format::Json if json_array => format!("[\n{}\n]\n", json_element(&report())),
+        Format::Json if json_array => format!("[\n{}\n]\n", json::report_pretty_element(&report())),
         Format::Json => json::render(&[report()]),
         Format::Jsonl => json::render_lines(&[report()]),
         Format::Sarif => sarif::render_failed(message),
@@ -259,20 +259,6 @@ pub struct Stream<W: std::io::Write> {
     deferred: String,
     /// The run's fixes, counted for the text summary.
     fixes: text::FixTotals,
-}
-
-/// A JSON report as an element of the pretty-printed array of several: every line indented.
-fn json_element(report: &FileReport) -> String {
-    let text = json::report_pretty(report);
-    let mut out = String::with_capacity(text.len() + 64);
-    for (i, line) in text.lines().enumerate() {
-        if i > 0 {
-            out.push('\n');
-        }
-        out.push_str("  ");
-        out.push_str(line);
-    }
-    out
 }
 
 impl<W: std::io::Write> Stream<W> {
@@ -329,8 +315,10 @@ impl<W: std::io::Write> Stream<W> {
                 self.kept.push(report);
                 return;
             }
-            Format::Json if self.files == 1 => format!("[\n{}", json_element(&report)),
-            Format::Json => format!(",\n{}", json_element(&report)),
+            Format::Json if self.files == 1 => {
+                format!("[\n{}", json::report_pretty_element(&report))
+            }
+            Format::Json => format!(",\n{}", json::report_pretty_element(&report)),
             Format::Sarif => {
                 self.kept.push(report);
                 return;

@@ -144,11 +144,18 @@ impl BufferViews {
     fn uses(&self, json: Node, out: &mut Vec<Diagnostic>) {
         let accessors = json.get("accessors");
         let views = json.get("bufferViews");
+        // Each accessor's view, read once: a library's meshes use a few accessors thousands
+        // of times over.
+        let accessor_views: Vec<Option<usize>> = elements(accessors)
+            .map(|accessor| {
+                let view = accessor.as_object()?.get("bufferView")?;
+                super::element_at(views, Some(view))?;
+                usize::try_from(view.as_u64()?).ok()
+            })
+            .collect();
         let view_index = |accessor: Option<Node>| -> Option<usize> {
-            let accessor = super::element_at(accessors, accessor)?;
-            let view = accessor.get("bufferView")?;
-            super::element_at(views, Some(view))?;
-            usize::try_from(view.as_u64()?).ok()
+            let index = usize::try_from(accessor?.as_u64()?).ok()?;
+            *accessor_views.get(index)?
         };
         let strided = |view: usize| {
             views
