@@ -310,19 +310,17 @@ impl Reads {
             }
             Reads::Properties { properties, except } => (properties, except),
         };
-        let mut tokens = edit.pointer.split('/').skip(1);
-        let Some(property) = tokens.next() else {
+        let Some(property) = edit.tokens.first() else {
             // The whole document.
             return true;
         };
-        if !properties.contains(&property) {
+        if !properties.contains(&property.as_ref()) {
             return false;
         }
-        let (index, member) = (tokens.next(), tokens.next());
-        match (index, member) {
-            (Some(index), Some(member)) if except.contains(&(property, member)) => {
+        match (edit.tokens.get(2), edit.element_end) {
+            (Some(member), Some(end)) if except.contains(&(property.as_ref(), member.as_ref())) => {
                 // The element's pointer is where the edit's begins: `/{property}/{index}`.
-                !element_exists(&edit.pointer[..property.len() + index.len() + 2])
+                !element_exists(&edit.pointer[..end])
             }
             _ => true,
         }
@@ -334,17 +332,20 @@ impl Reads {
 pub struct EditPath<'p> {
     pointer: &'p str,
     tokens: Vec<std::borrow::Cow<'p, str>>,
+    /// Where `/{property}/{index}` ends in the pointer, when the edit lies below it.
+    element_end: Option<usize>,
 }
 
 impl<'p> EditPath<'p> {
     pub fn of(pointer: &'p str) -> EditPath<'p> {
+        let raw: Vec<&str> = pointer.split('/').skip(1).collect();
         EditPath {
             pointer,
-            tokens: pointer
-                .split('/')
-                .skip(1)
-                .map(crate::asset::pointer::unescape)
+            tokens: raw
+                .iter()
+                .map(|token| crate::asset::pointer::unescape(token))
                 .collect(),
+            element_end: (raw.len() >= 3).then(|| raw[0].len() + raw[1].len() + 2),
         }
     }
 }
