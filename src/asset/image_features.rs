@@ -198,50 +198,47 @@ pub fn webp(head: &[u8]) -> ImageFeatures {
     }
 }
 
+/// A PNG chunk of `kind` holding `data`, its CRC-32 (ISO 3309) computed bit by bit: for tests
+/// that build PNGs with chunks an encoder does not write.
+#[cfg(test)]
+pub(crate) fn png_chunk(kind: &[u8; 4], data: &[u8]) -> Vec<u8> {
+    let mut typed = kind.to_vec();
+    typed.extend_from_slice(data);
+    let mut crc = !0u32;
+    for &byte in &typed {
+        crc ^= u32::from(byte);
+        for _ in 0..8 {
+            crc = if crc & 1 == 1 {
+                (crc >> 1) ^ 0xEDB8_8320
+            } else {
+                crc >> 1
+            };
+        }
+    }
+    let mut out = (data.len() as u32).to_be_bytes().to_vec();
+    out.extend_from_slice(&typed);
+    out.extend_from_slice(&(!crc).to_be_bytes());
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use std::io::Cursor;
 
-    /// The CRC-32 of PNG chunks (ISO 3309), bit by bit.
-    fn crc32(bytes: &[u8]) -> u32 {
-        let mut crc = !0u32;
-        for &byte in bytes {
-            crc ^= u32::from(byte);
-            for _ in 0..8 {
-                crc = if crc & 1 == 1 {
-                    (crc >> 1) ^ 0xEDB8_8320
-                } else {
-                    crc >> 1
-                };
-            }
-        }
-        !crc
-    }
-
-    fn chunk(kind: &[u8; 4], data: &[u8]) -> Vec<u8> {
-        let mut out = (data.len() as u32).to_be_bytes().to_vec();
-        out.extend_from_slice(kind);
-        out.extend_from_slice(data);
-        let mut typed = kind.to_vec();
-        typed.extend_from_slice(data);
-        out.extend_from_slice(&crc32(&typed).to_be_bytes());
-        out
-    }
-
     /// A 1 × 1 RGBA PNG with `chunks` between its IHDR and its IDAT, and `after` between its
     /// IDAT and its IEND.
     fn png_around(chunks: &[Vec<u8>], after: &[Vec<u8>]) -> Vec<u8> {
         let mut out = b"\x89PNG\r\n\x1a\n".to_vec();
-        out.extend(chunk(b"IHDR", &[0, 0, 0, 1, 0, 0, 0, 1, 8, 6, 0, 0, 0]));
+        out.extend(png_chunk(b"IHDR", &[0, 0, 0, 1, 0, 0, 0, 1, 8, 6, 0, 0, 0]));
         out.extend(chunks.concat());
         // One filter byte and a black, opaque pixel, deflated.
         let idat = [
             0x78, 0x9c, 0x63, 0x60, 0x60, 0x60, 0xf8, 0x0f, 0x00, 0x01, 0x04, 0x01, 0x00,
         ];
-        out.extend(chunk(b"IDAT", &idat));
+        out.extend(png_chunk(b"IDAT", &idat));
         out.extend(after.concat());
-        out.extend(chunk(b"IEND", &[]));
+        out.extend(png_chunk(b"IEND", &[]));
         out
     }
 
@@ -254,25 +251,25 @@ mod tests {
     }
 
     fn gama(value: u32) -> Vec<u8> {
-        chunk(b"gAMA", &value.to_be_bytes())
+        png_chunk(b"gAMA", &value.to_be_bytes())
     }
 
     fn chrm(values: [u32; 8]) -> Vec<u8> {
-        chunk(b"cHRM", &values.map(u32::to_be_bytes).concat())
+        png_chunk(b"cHRM", &values.map(u32::to_be_bytes).concat())
     }
 
     fn phys(x: u32, y: u32, unit: u8) -> Vec<u8> {
         let mut data = [x.to_be_bytes(), y.to_be_bytes()].concat();
         data.push(unit);
-        chunk(b"pHYs", &data)
+        png_chunk(b"pHYs", &data)
     }
 
     fn srgb() -> Vec<u8> {
-        chunk(b"sRGB", &[0])
+        png_chunk(b"sRGB", &[0])
     }
 
     fn iccp() -> Vec<u8> {
-        chunk(b"iCCP", b"profile\0\0\x78\x9c\x03\x00\x00\x00\x00\x01")
+        png_chunk(b"iCCP", b"profile\0\0\x78\x9c\x03\x00\x00\x00\x00\x01")
     }
 
     const CUSTOM_PRIMARIES: [u32; 8] = [
@@ -394,14 +391,14 @@ mod tests {
     #[test]
     fn chunks_of_another_length_than_their_own_are_passed_over() {
         let found = features(&png_with(&[
-            chunk(b"sRGB", &[0, 0]),
-            chunk(b"gAMA", &[0, 0, 0xC3, 0x50, 0]),
-            chunk(b"cHRM", &[0; 31]),
-            chunk(b"pHYs", &[0, 0, 0, 1, 0, 0, 0, 2]),
+            png_chunk(b"sRGB", &[0, 0]),
+            png_chunk(b"gAMA", &[0, 0, 0xC3, 0x50, 0]),
+            png_chunk(b"cHRM", &[0; 31]),
+            png_chunk(b"pHYs", &[0, 0, 0, 1, 0, 0, 0, 2]),
         ]));
         assert!(!found.any(), "{found:?}");
         // The malformed sRGB chunk set nothing: a well-formed gAMA after it is read.
-        let found = features(&png_with(&[chunk(b"sRGB", &[]), gama(50_000)]));
+        let found = features(&png_with(&[png_chunk(b"sRGB", &[]), gama(50_000)]));
         assert_eq!(found.gamma, Some(50_000));
     }
 

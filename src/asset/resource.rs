@@ -16,8 +16,9 @@ use std::path::{Component, Path, PathBuf};
 /// Where a URI leads.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Location {
-    /// The decoded bytes of a `data:` URI, with its media type (its parameters, such as
-    /// `;charset=…`, included) and whether it was base64 (or else percent-encoded).
+    /// The decoded bytes of a `data:` URI, with its media type (without its parameters, such
+    /// as `;charset=…`, and in lower case: media types are case-insensitive, RFC 2045) and
+    /// whether it was base64 (or else percent-encoded).
     Data {
         media_type: String,
         bytes: Vec<u8>,
@@ -88,7 +89,12 @@ pub fn resolve_with(
             })?
         };
         return Ok(Location::Data {
-            media_type: media_type.to_string(),
+            media_type: media_type
+                .split(';')
+                .next()
+                .unwrap_or_default()
+                .trim()
+                .to_ascii_lowercase(),
             bytes,
             base64,
         });
@@ -759,6 +765,20 @@ mod tests {
                 base64: true,
             }
         );
+        // The media type without its parameters, in lower case.
+        assert_eq!(
+            resolve(
+                "data:Application/Octet-Stream;charset=x;base64,AAEC",
+                base(),
+                ""
+            )
+            .unwrap(),
+            Location::Data {
+                media_type: "application/octet-stream".into(),
+                bytes: vec![0, 1, 2],
+                base64: true,
+            }
+        );
         for uri in [
             "data:;base64,@@@",
             "data:nocomma",
@@ -850,22 +870,8 @@ mod tests {
     fn a_png_whose_chunks_before_its_pixels_run_past_what_is_kept_reads_the_same() {
         // A 3 MiB tEXt chunk after the header: the reader keeps its first mebibyte and reads
         // on as a buffered reader does.
-        fn crc32(bytes: &[u8]) -> u32 {
-            let mut crc = !0u32;
-            for &b in bytes {
-                crc ^= u32::from(b);
-                for _ in 0..8 {
-                    crc = (crc >> 1) ^ (0xEDB8_8320 & (crc & 1).wrapping_neg());
-                }
-            }
-            !crc
-        }
         let plain = png(image::ExtendedColorType::Rgba8);
-        let text = vec![b'a'; 3 << 20];
-        let mut chunk = (text.len() as u32).to_be_bytes().to_vec();
-        let typed = [&b"tEXt"[..], &text].concat();
-        chunk.extend_from_slice(&typed);
-        chunk.extend_from_slice(&crc32(&typed).to_be_bytes());
+        let chunk = crate::asset::image_features::png_chunk(b"tEXt", &vec![b'a'; 3 << 20]);
         // After the signature (8 bytes) and the IHDR chunk (25).
         let bytes = [&plain[..33], &chunk, &plain[33..]].concat();
         let mut rewinding = Rewinding::new(std::io::Cursor::new(&bytes[..]));

@@ -1041,7 +1041,8 @@ impl<'a> Members<'a> {
             let (k, v) = self.raw.next()?;
             let node = self.object.node;
             let id = node.node(k).entry().aux() as u32;
-            // The key as the table holds it (unescaped): it spells what the key entry does.
+            // The key as the table holds it (unescaped), as `as_str` reads a key entry, without
+            // asking the entry's kind again: this is the walk of every member by every rule.
             let key = Cow::Borrowed(node.tape.keys.key(id));
             if !self.duplicates {
                 return Some((KeyId(id), key, node.node(v)));

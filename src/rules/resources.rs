@@ -193,7 +193,7 @@ fn check_buffer(cx: &Context, index: usize, buffer: Node, out: &mut Vec<Diagnost
         Some(Located::Data {
             media_type, len, ..
         }) => {
-            // Read in lower case (media types are case-insensitive, RFC 2045; see `locate`).
+            // In lower case, without parameters, as `resolve` gives it.
             if !matches!(
                 media_type.as_str(),
                 "application/octet-stream" | "application/gltf-buffer"
@@ -421,12 +421,6 @@ fn locate(cx: &Context, uri: &str, pointer: &str, out: &mut Vec<Diagnostic>) -> 
                     "the data: URI is percent-encoded, not base64; it is valid, but some loaders decode only base64",
                 ));
             }
-            let media_type = media_type
-                .split(';')
-                .next()
-                .unwrap_or_default()
-                .trim()
-                .to_ascii_lowercase();
             return Some(Located::Data {
                 media_type,
                 len: bytes.len() as u64,

@@ -63,8 +63,8 @@ pub struct Totals {
 /// busy behind a slow file, few enough that the reports in hand stay small.
 const WINDOW: usize = 256;
 
-/// Validates like [`validate`], handing each report to `sink` in input order as soon as its
-/// batch is done instead of keeping them.
+/// Validates like [`validate`], handing each report to `sink` in input order as soon as it and
+/// those before it are done ([`in_input_order`]) instead of keeping them.
 pub fn validate_each(
     validator: &Validator,
     inputs: &[PathBuf],
