@@ -7,9 +7,7 @@
 //! fault per 2 MiB. The advice changes no byte and is ignored where it cannot be taken; on
 //! other systems this does nothing.
 //!
-//! The process's threads also share at most two heaps ([`limit_heaps`]).
-//!
-//! `libc` is the crate for the calls: std has no binding for `madvise` or `mallopt`.
+//! `libc` is the crate for the call: std has no binding for `madvise`.
 
 /// Buffers from this size (bytes) are advised: below it a huge page would mostly back other
 /// allocations.
@@ -40,23 +38,6 @@ pub fn advise_huge<T>(buffer: &mut Vec<T>) {
                 libc::madvise(first as *mut libc::c_void, end - first, libc::MADV_HUGEPAGE);
             }
         }
-    }
-}
-
-/// Caps the process's heaps (glibc's malloc arenas) at two, where glibc makes one per thread
-/// up to eight per core. What a thread pool's workers free stays in their own arena, unused by
-/// the other threads: a migration's workers make and drop thousands of small values in turn
-/// (the units they splice, the values they read back), and with an arena each, the default
-/// migration of the 20,000-material library peaked at 116 MiB. Measured at 2 threads on that
-/// library: two arenas, 103 MiB in 2.7 s (`--fast` 73 MiB, 0.29 s); one arena, 98 MiB but
-/// 3.0 s (`--fast` 0.35 s), the workers waiting on each other's allocations. Call it first
-/// thing, before any other thread starts. Elsewhere than glibc this does nothing.
-pub fn limit_heaps() {
-    #[cfg(all(target_os = "linux", target_env = "gnu"))]
-    // SAFETY: mallopt sets a tunable of the allocator; called before any thread exists, it
-    // changes how later allocations are placed and nothing already allocated.
-    unsafe {
-        libc::mallopt(libc::M_ARENA_MAX, 2);
     }
 }
 

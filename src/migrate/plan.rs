@@ -18,11 +18,10 @@ pub fn plan_document(asset: &Asset, options: &Options) -> DocumentPlan {
         .map_or(0, |m| m.len());
     // On the speed paths (--fast, and --roughness identity without --exact: nothing baked to
     // map roughness) materials are planned side by side on the thread pool (the 20,000 of the
-    // library in 52 ms instead of 85). Otherwise one after another: the plans then come from
-    // the workers' own allocator arenas, and the bakes that follow a default migration found
-    // less of the memory freed in one arena free in the other (the library's default migration
-    // peaked at 108 MiB instead of 101). One arena for the whole process made the workers wait
-    // on each other's allocations instead (see `asset::pages::limit_heaps`).
+    // library in 52 ms instead of 85). Otherwise one after another: planned on both workers,
+    // the plans came from both workers' heaps, and the bakes that follow a default migration
+    // found less of the memory freed in one heap free in the other (the library's default
+    // migration peaked at 108 MiB instead of 101, measured with glibc's allocator).
     let primitives = Primitives::new(asset.root());
     crate::progress::stage("planning materials", count);
     let plan = |i: usize| {
