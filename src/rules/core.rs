@@ -170,6 +170,17 @@ pub(crate) static CORE_FILES: std::sync::LazyLock<HashMap<String, Value>> =
             .collect()
     });
 
+/// Builds jsonschema's validator of the core schemas' meta-schema (draft 2020-12), which it
+/// builds once per process, the first time a schema of that draft compiles.
+pub(crate) fn prepare_meta_schema() {
+    let schema = serde_json::json!({
+        "$schema": "https://json-schema.org/draft/2020-12/schema",
+        "type": "object"
+    });
+    let valid = jsonschema::meta::is_valid(&schema);
+    debug_assert!(valid);
+}
+
 /// The core schema compiled for one run.
 pub struct CoreSchema {
     validator: jsonschema::Validator<TapeJson>,
@@ -721,13 +732,13 @@ impl Rule for CoreStructure {
     /// The core schemas judge each element of the root's arrays of objects by itself (their
     /// only constraint across elements, `uniqueItems`, is on the lists of extension names).
     fn passes_alone(&self, cx: &Context, element: &super::ElementPlace, value: Node) -> bool {
-        cx.schemas.core.element_passes(&element.property, value)
+        cx.schemas.core().element_passes(&element.property, value)
     }
 
     fn check(&self, cx: &Context, out: &mut Vec<Diagnostic>) {
         let json = cx.json();
         let first = out.len();
-        cx.schemas.core.check(json, out);
+        cx.schemas.core().check(json, out);
         // Values an extension adds to a core enumeration are in the list once the extension
         // is declared, as the Khronos validator reads them.
         let declared = |name: &str| super::declares(json, name);

@@ -14,7 +14,7 @@ use jsonschema::error::ValidationErrorKind;
 use serde_json::Value;
 use std::collections::{BTreeSet, HashMap};
 use std::path::Path;
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 /// Our schema files, by file name, as compiled into the binary.
 pub const BUILTIN: &[(&str, &str)] = &[
@@ -81,8 +81,9 @@ struct LayerSchema {
 pub struct Schemas {
     sheen: LayerSchema,
     fuzz: LayerSchema,
-    /// The official glTF 2.0 schemas (always the built-in files).
-    pub core: super::core::CoreSchema,
+    /// The official glTF 2.0 schemas (always the built-in files), compiled on first use
+    /// ([`Schemas::core`]) or by a job of the run ([`Schemas::with_core`]).
+    core: Arc<OnceLock<super::core::CoreSchema>>,
     /// The published extension schemas (always the built-in files), compiled on first use.
     pub extensions: super::extensions::ExtensionSchemas,
 }
@@ -106,6 +107,19 @@ impl jsonschema::Retrieve for FileRetriever {
 impl Schemas {
     /// The schemas compiled into velvet.
     pub fn builtin() -> Schemas {
+        Schemas::with_core(Arc::new(OnceLock::new()))
+    }
+
+    /// The schemas compiled into velvet, the core schema taken from `core` once something
+    /// compiles it there: a run compiles it on one worker while another compiles the rest
+    /// (the core schema is three quarters of the work, some 3 ms).
+    pub fn with_core(core: Arc<OnceLock<super::core::CoreSchema>>) -> Schemas {
+        if core.get().is_none() {
+            // While the core schema's job parses its files, the validator of their
+            // meta-schema, which jsonschema builds once per process before it compiles them,
+            // is built here (1.3 of the core schema's 3.3 ms).
+            super::core::prepare_meta_schema();
+        }
         let files = BUILTIN
             .iter()
             .map(|(name, text)| {
@@ -115,7 +129,7 @@ impl Schemas {
                 )
             })
             .collect();
-        Schemas::compile(files).expect("built-in schemas compile")
+        Schemas::compile(files, core).expect("built-in schemas compile")
     }
 
     /// The built-in schemas with every file present in `dir` (same file names) replacing its
@@ -146,10 +160,18 @@ impl Schemas {
                 value,
             );
         }
-        Schemas::compile(files)
+        Schemas::compile(files, Arc::new(OnceLock::new()))
     }
 
-    fn compile(files: HashMap<String, Value>) -> Result<Schemas, SchemaError> {
+    /// The core schema, compiled here if nothing has compiled it yet.
+    pub fn core(&self) -> &super::core::CoreSchema {
+        self.core.get_or_init(super::core::CoreSchema::builtin)
+    }
+
+    fn compile(
+        files: HashMap<String, Value>,
+        core: Arc<OnceLock<super::core::CoreSchema>>,
+    ) -> Result<Schemas, SchemaError> {
         let files = Arc::new(files);
         let layer = |name: &str| -> Result<LayerSchema, SchemaError> {
             let schema = &files[name];
@@ -169,7 +191,7 @@ impl Schemas {
         Ok(Schemas {
             sheen: layer("material.KHR_materials_sheen.schema.json")?,
             fuzz: layer("material.KHR_materials_fuzz.schema.json")?,
-            core: super::core::CoreSchema::builtin(),
+            core,
             extensions: super::extensions::ExtensionSchemas::default(),
         })
     }
@@ -356,6 +378,19 @@ fn check_layer(schemas: &Schemas, layer: &LayerObject<Node>) -> Vec<Diagnostic> 
 mod tests {
     use super::*;
     use crate::asset::{load_bytes_with, LoadOptions};
+
+    #[test]
+    fn the_core_schema_compiles_once_into_the_slot_the_schemas_share() {
+        let core = Arc::new(OnceLock::new());
+        let schemas = Schemas::with_core(Arc::clone(&core));
+        // Compiled on first use, not with the layers' schemas.
+        assert!(core.get().is_none());
+        let compiled: *const super::super::core::CoreSchema = schemas.core();
+        assert!(std::ptr::eq(compiled, core.get().unwrap()));
+        // A second set of schemas sharing the slot takes the same compiled schema.
+        let again = Schemas::with_core(Arc::clone(&core));
+        assert!(std::ptr::eq(again.core(), compiled));
+    }
 
     fn schema_findings(text: &str) -> Vec<(String, String, String)> {
         let loaded = load_bytes_with(

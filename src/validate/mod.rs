@@ -148,11 +148,14 @@ impl FileReport {
 /// A validator for one run: schemas compiled once, settings applied to every file, every file
 /// loaded under the same limits.
 pub struct Validator {
-    /// The schemas of a run: given, or compiling on a worker of the thread pool while the
+    /// The schemas of a run: given, or compiling on the workers of the thread pool while the
     /// first file is read (compiling the core schemas takes about as long as reading a large
     /// file). Filled by that worker, or by whoever needs them before the worker has started on
     /// them (a pool of one thread, busy with the file): no one waits on work that cannot run.
     schemas: Arc<OnceLock<Schemas>>,
+    /// Where the built-in schemas' core schema compiles (on a worker of its own), for
+    /// whoever fills `schemas` (unused when the schemas were given).
+    core: Arc<OnceLock<crate::rules::core::CoreSchema>>,
     pub settings: Settings,
     pub load: asset::LoadOptions,
     /// Whether findings are placed in the source text (line and column); a report format that
@@ -164,33 +167,55 @@ pub struct Validator {
 
 impl Validator {
     pub fn new(schemas: Schemas, settings: Settings) -> Validator {
-        Validator::with_compiled(Arc::new(OnceLock::from(schemas)), settings)
+        Validator::with_compiled(
+            Arc::new(OnceLock::from(schemas)),
+            Arc::new(OnceLock::new()),
+            settings,
+        )
     }
 
     /// A validator with the built-in schemas, which compile in the background until the first
-    /// file's rules need them. They compile on a worker of the pool rather than on a thread of
-    /// their own: while one worker reads the first file another is idle, and a thread beside
-    /// the pool's workers (one per core) would share the cores with them.
+    /// file's rules need them, in two jobs: the core schema (some 3 ms) on one worker, the
+    /// layers' schemas and the kinds of objects the rules walk (some 1.5 ms) on the other,
+    /// which then takes the first file. They compile on workers of the pool rather than on
+    /// threads of their own: a thread beside the pool's workers (one per core) would share the
+    /// cores with them. A file that needs a schema before its job has started compiles it
+    /// itself (a pool of one thread, busy with the file): no one waits on work that cannot
+    /// run.
     pub fn builtin(settings: Settings) -> Validator {
+        // The built-in schemas are tested to compile; should a job panic, its OnceLock stays
+        // empty and the panic is raised again where the schema is first needed, rather than
+        // ending the process from the pool.
+        let in_background = |job: Box<dyn FnOnce() + Send>| {
+            rayon::spawn(move || {
+                let _ = std::panic::catch_unwind(std::panic::AssertUnwindSafe(job));
+            })
+        };
+        let core = Arc::new(OnceLock::new());
+        let core_job: Arc<OnceLock<crate::rules::core::CoreSchema>> = Arc::clone(&core);
+        in_background(Box::new(move || {
+            core_job.get_or_init(crate::rules::core::CoreSchema::builtin);
+        }));
         let schemas = Arc::new(OnceLock::new());
         let job = Arc::clone(&schemas);
-        rayon::spawn(move || {
-            // The built-in schemas are tested to compile; should they panic here, the OnceLock
-            // stays empty and the panic is raised again where the schemas are first needed,
-            // rather than ending the process from the pool.
-            let _ = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                job.get_or_init(Schemas::builtin);
-                // The kinds of objects the extension and texture rules walk, read from the
-                // schemas once per process: here, rather than in the first file's rules.
-                crate::rules::extensions::prepare();
-            }));
-        });
-        Validator::with_compiled(schemas, settings)
+        let job_core = Arc::clone(&core);
+        in_background(Box::new(move || {
+            job.get_or_init(|| Schemas::with_core(job_core));
+            // The kinds of objects the extension and texture rules walk, read from the
+            // schemas once per process: here, rather than in the first file's rules.
+            crate::rules::extensions::prepare();
+        }));
+        Validator::with_compiled(schemas, core, settings)
     }
 
-    fn with_compiled(schemas: Arc<OnceLock<Schemas>>, settings: Settings) -> Validator {
+    fn with_compiled(
+        schemas: Arc<OnceLock<Schemas>>,
+        core: Arc<OnceLock<crate::rules::core::CoreSchema>>,
+        settings: Settings,
+    ) -> Validator {
         Validator {
             schemas,
+            core,
             settings,
             load: asset::LoadOptions::default(),
             positions: true,
@@ -310,7 +335,10 @@ impl Validator {
         settings: &Settings,
         reuse: Option<&Reuse>,
     ) -> FileReport {
-        let cx = Context::new(asset, self.schemas.get_or_init(Schemas::builtin))
+        let schemas = self
+            .schemas
+            .get_or_init(|| Schemas::with_core(Arc::clone(&self.core)));
+        let cx = Context::new(asset, schemas)
             .reading_data(!settings.skip_data);
         // A large text, or (with the data checks) large buffers: a document whose weight is in
         // its data has a small text and megabytes of accessors to read.
