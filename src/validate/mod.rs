@@ -338,8 +338,7 @@ impl Validator {
         let schemas = self
             .schemas
             .get_or_init(|| Schemas::with_core(Arc::clone(&self.core)));
-        let cx = Context::new(asset, schemas)
-            .reading_data(!settings.skip_data);
+        let cx = Context::new(asset, schemas).reading_data(!settings.skip_data);
         // A large text, or (with the data checks) large buffers: a document whose weight is in
         // its data has a small text and megabytes of accessors to read.
         let data_bytes = || {
