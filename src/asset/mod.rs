@@ -287,36 +287,54 @@ pub fn load_given(
     load_given_after(path, bytes, options, None)
 }
 
-/// [`load_given`] of bytes that are the text of `earlier` with edits spliced in, the first at
-/// byte `first_change` of that text: the text's index is resumed from `earlier`'s at the
-/// first edit ([`tape::Tape::build_resumed`]) rather than built from its first byte.
-pub fn load_given_resuming(
+/// [`load_given`] of a text velvet joined itself (UTF-8 as made, so not checked again): the
+/// text of an earlier asset with edits spliced in, whose index takes what `resumption` copied
+/// of the earlier one ([`tape::Tape::resumption`]) and is built only from the first edit on.
+pub fn load_joined_resuming(
     path: &Path,
-    bytes: FileBytes,
+    text: String,
     options: &LoadOptions,
-    earlier: &Asset,
-    first_change: usize,
+    resumption: Option<tape::Resumption>,
 ) -> (Loaded, Option<FileBytes>) {
-    debug_assert!(
-        bytes.get(..first_change) == earlier.json_text.as_bytes().get(..first_change),
-        "the text equals the earlier one before its first change"
+    if !is_plain_text(path, text.as_bytes(), options) {
+        return load_given_after(
+            path,
+            FileBytes::from_vec(text.into_bytes()),
+            options,
+            resumption,
+        );
+    }
+    let loaded = load_text(
+        path,
+        SourceText::from(text),
+        Container::Gltf,
+        0,
+        None,
+        Vec::new(),
+        options,
+        resumption,
     );
-    load_given_after(path, bytes, options, Some((&earlier.tape, first_change)))
+    (loaded, None)
+}
+
+/// Whether `bytes`, of a file at `path`, are read as a plain glTF JSON text: not a GLB (by
+/// their magic or the path's extension), no byte-order mark, within the document size limit.
+fn is_plain_text(path: &Path, bytes: &[u8], options: &LoadOptions) -> bool {
+    !bytes.starts_with(b"glTF")
+        && !bytes.starts_with(b"\xEF\xBB\xBF")
+        && !path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("glb"))
+        && bytes.len() as u64 <= options.max_document_bytes
 }
 
 fn load_given_after(
     path: &Path,
     bytes: FileBytes,
     options: &LoadOptions,
-    resume: Option<(&tape::Tape, usize)>,
+    resumption: Option<tape::Resumption>,
 ) -> (Loaded, Option<FileBytes>) {
-    let plain = !bytes.starts_with(b"glTF")
-        && !bytes.starts_with(b"\xEF\xBB\xBF")
-        && !path
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("glb"))
-        && bytes.len() as u64 <= options.max_document_bytes;
-    if !plain {
+    if !is_plain_text(path, &bytes, options) {
         return (load_bytes_with(path, &bytes, options), Some(bytes));
     }
     match SourceText::from_bytes(bytes) {
@@ -329,7 +347,7 @@ fn load_given_after(
                 None,
                 Vec::new(),
                 options,
-                resume,
+                resumption,
             ),
             None,
         ),
@@ -464,15 +482,14 @@ fn load_text(
     bin: Option<Vec<u8>>,
     mut diagnostics: Vec<Diagnostic>,
     options: &LoadOptions,
-    resume: Option<(&tape::Tape, usize)>,
+    resumption: Option<tape::Resumption>,
 ) -> Loaded {
     // A GLB's JSON chunk may carry NUL padding (reported by glb::split); parse past it.
     let parse_text = json_text.trim_end_matches(['\0', ' ']);
     let max_depth = options.max_json_depth.min(limits::JSON_DEPTH_CEILING);
-    let built = match resume {
-        Some((earlier, first_change)) => {
-            tape::Tape::build_resumed(parse_text, max_depth, earlier, first_change)
-        }
+    // With what an earlier index holds of the text (a fixed text's), the rest is indexed.
+    let built = match resumption {
+        Some(resumption) => resumption.build(parse_text, max_depth),
         None => tape::Tape::build_within(parse_text, max_depth),
     };
     // A text that nests too deep is refused for its depth, whatever else is wrong with it.

@@ -59,13 +59,13 @@ pub fn locate<'p>(
 }
 
 /// A place in a text that only moves forward, knowing its line and column.
-struct Cursor<'a> {
+pub(crate) struct Cursor<'a> {
     bytes: &'a [u8],
     at: Position,
 }
 
 impl<'a> Cursor<'a> {
-    fn new(text: &'a str) -> Cursor<'a> {
+    pub(crate) fn new(text: &'a str) -> Cursor<'a> {
         Cursor {
             bytes: text.as_bytes(),
             at: Position {
@@ -77,26 +77,29 @@ impl<'a> Cursor<'a> {
     }
 
     /// The position of byte `offset` (at or after the cursor's, on a character boundary),
-    /// where the cursor then stands.
-    fn advance_to(&mut self, offset: usize) -> Position {
+    /// where the cursor then stands. The lines passed are counted, and the column is counted
+    /// from the last newline passed (or carried on from the cursor's): a one-line (minified)
+    /// document's places are each counted from the one before, not from the line's start.
+    pub(crate) fn advance_to(&mut self, offset: usize) -> Position {
         debug_assert!(offset >= self.at.offset, "the cursor only moves forward");
-        for &b in &self.bytes[self.at.offset..offset] {
-            if b == b'\n' {
-                self.at.line += 1;
-                self.at.column = 1;
-            } else if !is_continuation(b) {
-                // A character is counted at its first byte.
-                self.at.column += 1;
+        let passed = &self.bytes[self.at.offset..offset];
+        match memchr::memrchr(b'\n', passed) {
+            Some(last) => {
+                self.at.line += bytecount::count(passed, b'\n');
+                // A character is counted at its first byte (bytecount counts UTF-8 characters
+                // so).
+                self.at.column = bytecount::num_chars(&passed[last + 1..]) + 1;
             }
+            None => self.at.column += bytecount::num_chars(passed),
         }
         self.at.offset = offset;
         self.at
     }
-}
 
-/// True for the second to fourth byte of a UTF-8 character (0b10xx_xxxx).
-fn is_continuation(b: u8) -> bool {
-    b & 0xC0 == 0x80
+    /// The byte the cursor stands at.
+    pub(crate) fn offset(&self) -> usize {
+        self.at.offset
+    }
 }
 
 #[cfg(test)]
@@ -237,6 +240,49 @@ mod tests {
                     "{pointer}"
                 );
             }
+        }
+    }
+
+    /// Places far apart (the counts then run over whole vector registers) in a long line and
+    /// in a text with newlines, CR LF line ends and characters of one to four bytes, ends of
+    /// lines and the text's last byte among them: each as counted alone.
+    #[test]
+    fn places_far_apart_are_counted_as_each_alone() {
+        let piece = "ab日\r\nü€ 😀x\n\n";
+        // A long line first, then many lines.
+        let mut text = "ü€😀a".repeat(600);
+        for i in 0..3000 {
+            text.push_str(
+                &piece[..piece
+                    .char_indices()
+                    .nth(i % 9)
+                    .map_or(piece.len(), |(b, _)| b)],
+            );
+            text.push_str(if i % 97 == 0 {
+                ""
+            } else {
+                "long line of plain text "
+            });
+        }
+        let offsets: Vec<usize> = (0..text.len())
+            .step_by(997)
+            .chain([text.len()])
+            .map(|mut at| {
+                while !text.is_char_boundary(at) {
+                    at += 1;
+                }
+                at
+            })
+            .collect();
+        let mut cursor = Cursor::new(&text);
+        for offset in offsets {
+            let found = cursor.advance_to(offset);
+            assert_eq!(found.offset, offset);
+            assert_eq!(
+                (found.line, found.column),
+                counted_alone(&text, offset),
+                "{offset}"
+            );
         }
     }
 

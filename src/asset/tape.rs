@@ -201,36 +201,75 @@ impl Tape {
         if text.len() >= u32::MAX as usize {
             return Err(TapeError::TooLarge);
         }
-        let Some(point) = earlier.resume_point(first_change.min(text.len())) else {
-            return Tape::build_within(text, max_depth);
-        };
-        let mut entries = Vec::with_capacity((text.len() / 16).max(point.after as usize));
+        match earlier.resumption(first_change, text.len()) {
+            Some(resumption) => resumption.build(text, max_depth),
+            None => Tape::build_within(text, max_depth),
+        }
+    }
+
+    /// What [`Tape::build_resumed`] takes from this index for a text of `text_len` bytes that
+    /// equals this index's up to byte `first_change`, copied before that text exists: a fix's
+    /// trial copies it while the fixed text is joined. `None` when nothing is taken.
+    pub fn resumption(&self, first_change: usize, text_len: usize) -> Option<Resumption> {
+        if text_len >= u32::MAX as usize {
+            return None;
+        }
+        let point = self.resume_point(first_change.min(text_len))?;
+        let mut entries = Vec::with_capacity((text_len / 16).max(point.after as usize));
         super::pages::advise_huge(&mut entries);
-        entries.extend_from_slice(&earlier.entries[..point.after as usize]);
+        entries.extend_from_slice(&self.entries[..point.after as usize]);
         // The runs of the arrays that closed before the resumed value's end, which come before
         // the runs of every array that closes after it.
-        let closing_later = earlier.entries[point.after as usize..]
+        let closing_later = self.entries[point.after as usize..]
             .iter()
             .chain(
                 point
                     .open
                     .iter()
-                    .map(|(entry, _)| &earlier.entries[*entry as usize]),
+                    .map(|(entry, _)| &self.entries[*entry as usize]),
             )
             .filter(|e| e.kind() == Kind::Array)
             .map(Entry::aux)
             .min();
-        let cut = closing_later.unwrap_or(earlier.elements.len());
+        let cut = closing_later.unwrap_or(self.elements.len());
+        Some(Resumption {
+            text_len,
+            entries,
+            elements: self.elements[..cut].to_vec(),
+            keys: self.keys.clone(),
+            point,
+        })
+    }
+}
+
+/// The part of an earlier index a build of a changed text takes over ([`Tape::resumption`]).
+pub struct Resumption {
+    /// The length of the text it was taken for.
+    text_len: usize,
+    entries: Vec<Entry>,
+    elements: Vec<u32>,
+    keys: KeyTable,
+    point: ResumePoint,
+}
+
+impl Resumption {
+    /// Indexes `text`, the changed text of the length it was taken for, from where the
+    /// earlier index stops holding; a text of another length is indexed from its first byte.
+    pub fn build(self, text: &str, max_depth: usize) -> Result<Tape, TapeError> {
+        if text.len() != self.text_len {
+            return Tape::build_within(text, max_depth);
+        }
+        let point = self.point;
         let mut builder = Builder {
             text,
             bytes: text.as_bytes(),
             at: point.at,
             max_depth,
-            entries,
-            elements: earlier.elements[..cut].to_vec(),
+            entries: self.entries,
+            elements: self.elements,
             scratch: Vec::new(),
             member_keys: Vec::new(),
-            keys: earlier.keys.clone(),
+            keys: self.keys,
         };
         let mut stack = Vec::with_capacity(point.open.len());
         for (entry, children) in &point.open {
@@ -257,7 +296,9 @@ impl Tape {
             keys: builder.keys,
         })
     }
+}
 
+impl Tape {
     /// Where a build of a text equal to this index's up to byte `first_change` can resume:
     /// after the last value that ends by then inside the deepest container that holds the
     /// change and such a value. `None` when no value of the root ends before the change.
@@ -1562,6 +1603,36 @@ mod properties {
         assert!(
             resumed_builds * 4 > builds * 3,
             "{resumed_builds} of {builds} resumed"
+        );
+    }
+
+    /// What a resumption copied ahead of the text indexes the text it was taken for as a fresh
+    /// build does; given a text of another length (a caller's mistake, or padding trimmed
+    /// after), it indexes that text from its first byte, still as a fresh build does.
+    #[test]
+    fn a_resumption_taken_ahead_indexes_its_text_and_only_its_text_from_the_earlier_index() {
+        let text = r#"{"a":[1,2,{"b":3}],"c":{"d":[4,5]},"e":6}"#;
+        let earlier = Tape::build(text).unwrap();
+        let changed = r#"{"a":[1,2,{"b":3}],"c":{"d":[4,50]},"e":6}"#;
+        let first_change = text.find("5]").unwrap();
+        let fresh = canonical(&Tape::build(changed).unwrap(), changed);
+        let resumption = earlier.resumption(first_change, changed.len()).unwrap();
+        assert!(
+            resumption.point.after > 1,
+            "the build resumes past the root"
+        );
+        let resumed = resumption.build(changed, 64).unwrap();
+        assert_eq!(canonical(&resumed, changed), fresh);
+        // Another text, which differs from the earlier one before the resumption's place.
+        let longer = r#"{"a":[100,2,{"b":3}],"c":{"d":[4,5]},"e":6}"#;
+        let from_start = earlier
+            .resumption(first_change, changed.len())
+            .unwrap()
+            .build(longer, 64)
+            .unwrap();
+        assert_eq!(
+            canonical(&from_start, longer),
+            canonical(&Tape::build(longer).unwrap(), longer)
         );
     }
 
