@@ -17,7 +17,8 @@ use velvet::report::{self, ColorChoice, Format};
 
 /// On Linux with glibc, the process allocates from mimalloc: validating makes and drops many
 /// small values, and glibc's malloc and free were a sixth of the processor time of a
-/// validation with fixes (500 small files: 97 → 82 ms of processor time; docs/performance.md).
+/// validation with fixes (500 small files: 49.6 → 42.8 ms, 89.5 → 76.7 ms of processor time;
+/// docs/performance.md).
 /// Elsewhere the system's allocator, where it was not measured.
 #[cfg(all(target_os = "linux", target_env = "gnu"))]
 #[global_allocator]
@@ -30,11 +31,12 @@ static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 const MI_OPTION_ARENA_EAGER_COMMIT: libmimalloc_sys::mi_option_t = 4;
 
 /// mimalloc commits the memory it reserves as it is used, not all at once: committed at once
-/// (its default on Linux), each run peaked 12–45 MiB higher than with glibc's allocator (the
-/// 500 small files 32 MiB instead of 18, the library 100 instead of 57), for no speed on the
-/// small files and the data library, 10 % on the library. Returning freed memory at once
-/// instead (`purge_delay` 0) kept the library's speed and half the extra memory, but the data
-/// rules, which free and take again each accessor's bytes, went from 37 to 58 ms.
+/// (its default on Linux), each run peaked 13–85 MiB higher than with glibc's allocator (the
+/// 500 small files 31–33 MiB instead of 18, the library 87–103 instead of 57–58), for no
+/// speed on the small files and the data library and some 10 % less processor time on the
+/// library. Returning freed memory at once instead (`purge_delay` 0) kept the library's speed
+/// and half the extra memory, but the data rules, which free and take again each accessor's
+/// bytes, went from 37 to 58 ms.
 ///
 /// The option is read when mimalloc first reserves memory, which the Rust runtime's start
 /// already asks for, before `main`: it is set by a constructor of the executable, which the
