@@ -838,6 +838,10 @@ impl<'v> Fixing<'v> {
                             .and_then(|at| source.tape.resumption(at, spliced.len()))
                     },
                 );
+                // The resumption holds for a text equal to the file's up to its first edit.
+                debug_assert!(spliced.first_change().is_none_or(|at| {
+                    text.as_bytes().get(..at) == source.json_text.as_bytes().get(..at)
+                }));
                 let (loaded, back) =
                     asset::load_joined_resuming(path, text, &self.validator.load, resumption);
                 (loaded, back.map(asset::FileBytes::into_vec))

@@ -175,13 +175,13 @@ impl Validator {
     }
 
     /// A validator with the built-in schemas, which compile in the background until the first
-    /// file's rules need them, in two jobs: the core schema (some 3 ms) on one worker, the
-    /// layers' schemas and the kinds of objects the rules walk (some 1.5 ms) on the other,
-    /// which then takes the first file. They compile on workers of the pool rather than on
-    /// threads of their own: a thread beside the pool's workers (one per core) would share the
-    /// cores with them. A file that needs a schema before its job has started compiles it
-    /// itself (a pool of one thread, busy with the file): no one waits on work that cannot
-    /// run.
+    /// file's rules need them, in two jobs: the core schema (some 3 ms), and the layers'
+    /// schemas with the kinds of objects the rules walk (some 1.5 ms), which the first file's
+    /// worker often compiles itself, having needed them first. They compile on workers of the
+    /// pool rather than on threads of their own: a thread beside the pool's workers (one per
+    /// core) would share the cores with them. A file that needs a schema before its job has
+    /// started compiles it itself (a pool of one thread, busy with the file): no one waits on
+    /// work that cannot run.
     pub fn builtin(settings: Settings) -> Validator {
         // The built-in schemas are tested to compile; should a job panic, its OnceLock stays
         // empty and the panic is raised again where the schema is first needed, rather than
