@@ -125,7 +125,7 @@ struct Open {
     is_object: bool,
 }
 
-/// Where [`Tape::build_resumed`] takes over from an earlier index.
+/// Where a [`Resumption`] takes over from an earlier index.
 struct ResumePoint {
     /// The containers open there, outermost first, each with the value entries of its
     /// children so far (the open child last).
@@ -186,30 +186,14 @@ impl Tape {
         })
     }
 
-    /// Indexes `text` as [`Tape::build_within`] does, given `earlier`, the index of a text that
-    /// `text` equals up to byte `first_change` (a text with fixes spliced in: its first edit
-    /// is often near its end). The entries of the values that end before that byte are taken
-    /// from `earlier`, the containers open there are opened again, and only the rest is parsed.
+    /// What a build of a text of `text_len` bytes that equals this index's text up to byte
+    /// `first_change` (a text with fixes spliced in: its first edit is often near its end)
+    /// takes from this index: the entries of the values that end before that byte, and the
+    /// containers open there, to be opened again; [`Resumption::build`] parses only the rest.
     /// A key only the earlier text had keeps its number (and finds no member); what any
-    /// reading of the index gives is what a fresh build gives.
-    pub fn build_resumed(
-        text: &str,
-        max_depth: usize,
-        earlier: &Tape,
-        first_change: usize,
-    ) -> Result<Tape, TapeError> {
-        if text.len() >= u32::MAX as usize {
-            return Err(TapeError::TooLarge);
-        }
-        match earlier.resumption(first_change, text.len()) {
-            Some(resumption) => resumption.build(text, max_depth),
-            None => Tape::build_within(text, max_depth),
-        }
-    }
-
-    /// What [`Tape::build_resumed`] takes from this index for a text of `text_len` bytes that
-    /// equals this index's up to byte `first_change`, copied before that text exists: a fix's
-    /// trial copies it while the fixed text is joined. `None` when nothing is taken.
+    /// reading of the index gives is what a fresh build ([`Tape::build_within`]) gives. Taken
+    /// before the text exists: a fix's trial copies it while the fixed text is joined. `None`
+    /// when nothing is taken.
     pub fn resumption(&self, first_change: usize, text_len: usize) -> Option<Resumption> {
         if text_len >= u32::MAX as usize {
             return None;
@@ -1524,8 +1508,23 @@ mod properties {
         (entries, tape.elements.clone())
     }
 
+    /// `text`, which equals the text `earlier` indexes up to byte `first_change`, indexed from
+    /// what a resumption takes of `earlier` (from its first byte when it takes nothing), as a
+    /// fix's trial indexes a fixed text.
+    fn build_resumed(
+        text: &str,
+        max_depth: usize,
+        earlier: &Tape,
+        first_change: usize,
+    ) -> Result<Tape, TapeError> {
+        match earlier.resumption(first_change, text.len()) {
+            Some(resumption) => resumption.build(text, max_depth),
+            None => Tape::build_within(text, max_depth),
+        }
+    }
+
     /// `changed`, a text that equals `text` (indexed as `earlier`) up to its first changed
-    /// byte, indexed from there ([`Tape::build_resumed`]) and from its first byte: an error
+    /// byte, indexed from there ([`build_resumed`]) and from its first byte: an error
     /// naming the text when the two differ (in the index, or in the refusal); else whether the
     /// build did resume.
     fn resumed_as_fresh(
@@ -1540,7 +1539,7 @@ mod properties {
             .position(|(a, b)| a != b)
             .unwrap_or(text.len().min(changed.len()));
         let fresh = Tape::build_within(changed, max_depth);
-        let resumed = Tape::build_resumed(changed, max_depth, earlier, first_change);
+        let resumed = build_resumed(changed, max_depth, earlier, first_change);
         let same = match (&fresh, &resumed) {
             (Ok(fresh), Ok(resumed)) => canonical(fresh, changed) == canonical(resumed, changed),
             _ => fresh.as_ref().err() == resumed.as_ref().err(),

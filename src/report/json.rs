@@ -403,13 +403,17 @@ fn push_message(out: &mut String, m: &MessageShape) {
 
 /// One report as an object; several as an array.
 pub fn render(reports: &[FileReport]) -> String {
-    let mut text = match reports {
-        [one] => report_pretty(one),
-        many => serde_json::to_string_pretty(&many.iter().map(shape).collect::<Vec<_>>())
-            .expect("a report serialises"),
-    };
-    text.push('\n');
-    text
+    match reports {
+        [one] => report_pretty(one) + "\n",
+        many => render_array(many),
+    }
+}
+
+/// The reports as a pretty-printed array, one report or many, as a run of several writes them.
+pub fn render_array(reports: &[FileReport]) -> String {
+    serde_json::to_string_pretty(&reports.iter().map(shape).collect::<Vec<_>>())
+        .expect("a report serialises")
+        + "\n"
 }
 
 /// One compact JSON report per line.

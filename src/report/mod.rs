@@ -234,7 +234,7 @@ pub fn failed_run(format: Format, message: &str, json_array: bool) -> String {
             github::escape_data(&escape::terminal(message))
         ),
         // As the stream writes an array of one report.
-        Format::Json if json_array => format!("[\n{}\n]\n", json::report_pretty_element(&report())),
+        Format::Json if json_array => json::render_array(&[report()]),
         Format::Json => json::render(&[report()]),
         Format::Jsonl => json::render_lines(&[report()]),
         Format::Sarif => sarif::render_failed(message),

@@ -186,25 +186,25 @@ impl Validator {
         // The built-in schemas are tested to compile; should a job panic, its OnceLock stays
         // empty and the panic is raised again where the schema is first needed, rather than
         // ending the process from the pool.
-        let in_background = |job: Box<dyn FnOnce() + Send>| {
+        fn in_background(job: impl FnOnce() + Send + 'static) {
             rayon::spawn(move || {
                 let _ = std::panic::catch_unwind(std::panic::AssertUnwindSafe(job));
             })
-        };
-        let core = Arc::new(OnceLock::new());
-        let core_job: Arc<OnceLock<crate::rules::core::CoreSchema>> = Arc::clone(&core);
-        in_background(Box::new(move || {
+        }
+        let core: Arc<OnceLock<crate::rules::core::CoreSchema>> = Arc::new(OnceLock::new());
+        let core_job = Arc::clone(&core);
+        in_background(move || {
             core_job.get_or_init(crate::rules::core::CoreSchema::builtin);
-        }));
+        });
         let schemas = Arc::new(OnceLock::new());
         let job = Arc::clone(&schemas);
         let job_core = Arc::clone(&core);
-        in_background(Box::new(move || {
+        in_background(move || {
             job.get_or_init(|| Schemas::with_core(job_core));
             // The kinds of objects the extension and texture rules walk, read from the
             // schemas once per process: here, rather than in the first file's rules.
             crate::rules::extensions::prepare();
-        }));
+        });
         Validator::with_compiled(schemas, core, settings)
     }
 
