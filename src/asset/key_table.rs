@@ -80,8 +80,7 @@ fn word(eight: &[u8]) -> u64 {
 
 impl KeyTable {
     /// How many distinct keys the table holds.
-    #[cfg(test)]
-    fn len(&self) -> usize {
+    pub(crate) fn len(&self) -> usize {
         self.ends.len()
     }
 

@@ -18,6 +18,8 @@
 //! distinct keys (`asset/key_table.rs`): a lookup finds the number of the key it wants once,
 //! then compares numbers, and a key the document never writes is answered without a scan.
 
+mod split;
+
 use super::key_table::KeyTable;
 use serde_json::Value;
 use std::borrow::Cow;
@@ -148,6 +150,9 @@ struct Builder<'t> {
     /// The numbers of the keys of the object being closed.
     member_keys: Vec<u32>,
     keys: KeyTable,
+    /// The most containers open at once since this was last reset (the second half of a split
+    /// build, [`split`], checks the depth limit once it knows how deep its start lies).
+    deepest: usize,
 }
 
 impl Tape {
@@ -158,32 +163,24 @@ impl Tape {
 
     /// Indexes `text`, refusing arrays and objects nested deeper than `max_depth` (the root is
     /// depth 1). The builder does not recurse; the limit protects what reads the index.
+    ///
+    /// A large text is indexed in two halves on two threads of the pool when another is free
+    /// ([`split`]); the index is the same either way.
     pub fn build_within(text: &str, max_depth: usize) -> Result<Tape, TapeError> {
         if text.len() >= u32::MAX as usize {
             return Err(TapeError::TooLarge);
         }
-        let mut builder = Builder {
-            text,
-            bytes: text.as_bytes(),
-            at: 0,
-            max_depth,
-            // A value takes at least two bytes of pretty-printed text on average.
-            entries: {
-                let mut entries = Vec::with_capacity(text.len() / 16);
-                super::pages::advise_huge(&mut entries);
-                entries
-            },
-            elements: Vec::new(),
-            scratch: Vec::new(),
-            member_keys: Vec::new(),
-            keys: KeyTable::default(),
-        };
+        if let Some(tape) = split::build(text, max_depth) {
+            return tape;
+        }
+        Tape::build_serial(text, max_depth)
+    }
+
+    /// [`Tape::build_within`] on this thread alone, front to back.
+    fn build_serial(text: &str, max_depth: usize) -> Result<Tape, TapeError> {
+        let mut builder = Builder::new(text, max_depth, text.len() / 16);
         builder.document()?;
-        Ok(Tape {
-            entries: builder.entries,
-            elements: builder.elements,
-            keys: builder.keys,
-        })
+        Ok(builder.finish())
     }
 
     /// What a build of a text of `text_len` bytes that equals this index's text up to byte
@@ -254,6 +251,7 @@ impl Resumption {
             scratch: Vec::new(),
             member_keys: Vec::new(),
             keys: self.keys,
+            deepest: 0,
         };
         let mut stack = Vec::with_capacity(point.open.len());
         for (entry, children) in &point.open {
@@ -274,11 +272,7 @@ impl Resumption {
             });
         }
         builder.after_value(&mut stack)?;
-        Ok(Tape {
-            entries: builder.entries,
-            elements: builder.elements,
-            keys: builder.keys,
-        })
+        Ok(builder.finish())
     }
 }
 
@@ -363,7 +357,37 @@ impl Tape {
     }
 }
 
-impl Builder<'_> {
+impl<'t> Builder<'t> {
+    /// A builder at the start of `text`, with room for `entries` entries (advised huge pages
+    /// when that is large).
+    fn new(text: &'t str, max_depth: usize, entries: usize) -> Builder<'t> {
+        Builder {
+            text,
+            bytes: text.as_bytes(),
+            at: 0,
+            max_depth,
+            // A value takes at least two bytes of pretty-printed text on average.
+            entries: {
+                let mut entries = Vec::with_capacity(entries);
+                super::pages::advise_huge(&mut entries);
+                entries
+            },
+            elements: Vec::new(),
+            scratch: Vec::new(),
+            member_keys: Vec::new(),
+            keys: KeyTable::default(),
+            deepest: 0,
+        }
+    }
+
+    fn finish(self) -> Tape {
+        Tape {
+            entries: self.entries,
+            elements: self.elements,
+            keys: self.keys,
+        }
+    }
+
     fn skip_whitespace(&mut self) {
         const SPACES: u64 = u64::from_ne_bytes([b' '; 8]);
         let bytes = self.bytes;
@@ -416,12 +440,21 @@ impl Builder<'_> {
 
     /// The rest of the text from the end of a value, with the containers `stack` still open.
     fn after_value(&mut self, stack: &mut Vec<Open>) -> Result<(), TapeError> {
+        self.after_value_until::<false>(stack)
+    }
+
+    /// [`Builder::after_value`], or with `ONE_VALUE` only up to the end of the value whose
+    /// containers `stack` holds (what follows it is left where it is).
+    fn after_value_until<const ONE_VALUE: bool>(
+        &mut self,
+        stack: &mut Vec<Open>,
+    ) -> Result<(), TapeError> {
         loop {
             // Close what ends here, then find where the next value starts.
             loop {
                 self.skip_whitespace();
                 let Some(open) = stack.last_mut() else {
-                    return if self.at == self.bytes.len() {
+                    return if ONE_VALUE || self.at == self.bytes.len() {
                         Ok(())
                     } else {
                         self.fail()
@@ -459,6 +492,11 @@ impl Builder<'_> {
     fn value_start(&mut self, stack: &mut Vec<Open>) -> Result<(), TapeError> {
         loop {
             let start = self.at;
+            // The end of the text, where a value should start: nothing is counted for it (the
+            // first half of a split build stops here, its containers as they stand).
+            if start == self.bytes.len() {
+                return self.fail();
+            }
             // A value that is an array element is recorded for its array.
             if let Some(open) = stack.last_mut() {
                 if open.count == MAX_AUX {
@@ -491,6 +529,7 @@ impl Builder<'_> {
                         return self.close(open);
                     }
                     stack.push(open);
+                    self.deepest = self.deepest.max(stack.len());
                     if is_object {
                         self.key()?;
                     }
@@ -528,7 +567,9 @@ impl Builder<'_> {
             self.elements.extend(self.scratch.drain(open.scratch..));
             run as u32
         };
-        let duplicates = open.is_object && open.count > 1 && self.has_duplicate_keys(open.entry);
+        let duplicates = open.is_object
+            && open.count > 1
+            && duplicate_keys(&self.entries, open.entry, next, &mut self.member_keys);
         let entry = &mut self.entries[open.entry as usize];
         entry.end = self.at as u32;
         entry.next = next;
@@ -539,27 +580,6 @@ impl Builder<'_> {
         Ok(())
     }
 
-    /// Whether the object just closed at `object` writes a key twice. Checked once here so
-    /// that reading its members needs no check. Keys are compared by their numbers.
-    fn has_duplicate_keys(&mut self, object: u32) -> bool {
-        let end = self.entries.len() as u32;
-        let mut keys = std::mem::take(&mut self.member_keys);
-        keys.clear();
-        let mut at = object + 1;
-        while at < end {
-            keys.push(self.entries[at as usize].aux() as u32);
-            at = self.entries[at as usize + 1].next;
-        }
-        let found = if keys.len() <= 16 {
-            (1..keys.len()).any(|i| keys[..i].contains(&keys[i]))
-        } else {
-            keys.sort_unstable();
-            keys.windows(2).any(|pair| pair[0] == pair[1])
-        };
-        self.member_keys = keys;
-        found
-    }
-
     /// An object key and its colon; leaves `at` on the value.
     fn key(&mut self) -> Result<(), TapeError> {
         if self.bytes.get(self.at) != Some(&b'"') {
@@ -567,6 +587,18 @@ impl Builder<'_> {
         }
         let start = self.at;
         let escaped = self.string()?;
+        self.key_entry(start, escaped)?;
+        self.skip_whitespace();
+        if self.bytes.get(self.at) != Some(&b':') {
+            return self.fail();
+        }
+        self.at += 1;
+        self.skip_whitespace();
+        Ok(())
+    }
+
+    /// Records the string from `start` to here as an object key, numbered in the key table.
+    fn key_entry(&mut self, start: usize, escaped: bool) -> Result<u32, TapeError> {
         let id = if escaped {
             // Numbered by what it spells, as the same key written without escapes is.
             let key: String = serde_json::from_str(&self.text[start..self.at]).unwrap_or_default();
@@ -579,14 +611,7 @@ impl Builder<'_> {
             return Err(TapeError::TooLarge);
         }
         let flags = if escaped { KEY | ESCAPED } else { KEY };
-        self.push(Kind::String, start, flags | id << COUNT_SHIFT);
-        self.skip_whitespace();
-        if self.bytes.get(self.at) != Some(&b':') {
-            return self.fail();
-        }
-        self.at += 1;
-        self.skip_whitespace();
-        Ok(())
+        Ok(self.push(Kind::String, start, flags | id << COUNT_SHIFT))
     }
 
     fn literal(&mut self, word: &[u8], kind: Kind, start: usize) -> Result<(), TapeError> {
@@ -690,6 +715,24 @@ impl Builder<'_> {
             }
         }
         Ok(())
+    }
+}
+
+/// Whether the object at entry `object`, whose members end before entry `end`, writes a key
+/// twice. Checked once when the object closes, so that reading its members needs no check.
+/// Keys are compared by their numbers; `keys` is scratch room.
+fn duplicate_keys(entries: &[Entry], object: u32, end: u32, keys: &mut Vec<u32>) -> bool {
+    keys.clear();
+    let mut at = object + 1;
+    while at < end {
+        keys.push(entries[at as usize].aux() as u32);
+        at = entries[at as usize + 1].next;
+    }
+    if keys.len() <= 16 {
+        (1..keys.len()).any(|i| keys[..i].contains(&keys[i]))
+    } else {
+        keys.sort_unstable();
+        keys.windows(2).any(|pair| pair[0] == pair[1])
     }
 }
 
@@ -1461,7 +1504,7 @@ mod properties {
     use super::*;
     use proptest::prelude::*;
 
-    fn json_value() -> impl Strategy<Value = Value> {
+    pub(super) fn json_value() -> impl Strategy<Value = Value> {
         let leaf = prop_oneof![
             Just(Value::Null),
             any::<bool>().prop_map(Value::Bool),
