@@ -375,7 +375,7 @@ impl<'t> Builder<'t> {
             elements: Vec::new(),
             scratch: Vec::new(),
             member_keys: Vec::new(),
-            keys: KeyTable::default(),
+            keys: KeyTable::for_text(text.len()),
             deepest: 0,
         }
     }
@@ -1103,29 +1103,49 @@ pub struct Members<'a> {
 }
 
 impl<'a> Members<'a> {
-    /// The next member with its key's number.
+    /// The next member with its key's number. Inlined where members are walked: this is the
+    /// walk of every member by every rule and schema check, and a call for each member took
+    /// half its instructions.
+    #[inline]
     fn next_keyed(&mut self) -> Option<(KeyId, Cow<'a, str>, Node<'a>)> {
+        let (k, v) = self.raw.next()?;
+        if self.duplicates {
+            return self.next_of_duplicated(k, v);
+        }
+        let node = self.object.node;
+        let id = node.node(k).entry().aux() as u32;
+        // The key as the table holds it (unescaped), as `as_str` reads a key entry, without
+        // asking the entry's kind again.
+        Some((
+            KeyId(id),
+            Cow::Borrowed(node.tape.keys.key(id)),
+            node.node(v),
+        ))
+    }
+
+    /// [`Members::next_keyed`] of an object that writes a key twice, from its member at key
+    /// entry `k` and value entry `v`: a key seen before was given at its first place, and a
+    /// first one takes its last value.
+    #[cold]
+    #[inline(never)]
+    fn next_of_duplicated(
+        &mut self,
+        mut k: u32,
+        mut v: u32,
+    ) -> Option<(KeyId, Cow<'a, str>, Node<'a>)> {
+        let node = self.object.node;
         loop {
-            let (k, v) = self.raw.next()?;
-            let node = self.object.node;
             let id = node.node(k).entry().aux() as u32;
-            // The key as the table holds it (unescaped), as `as_str` reads a key entry, without
-            // asking the entry's kind again: this is the walk of every member by every rule.
-            let key = Cow::Borrowed(node.tape.keys.key(id));
-            if !self.duplicates {
-                return Some((KeyId(id), key, node.node(v)));
-            }
-            // A key seen before was given at its first place; a first one takes its last value.
             let mut earlier = RawMembers {
                 node,
                 at: node.at + 1,
                 end: k,
             };
-            if earlier.any(|(e, _)| node.node(e).key_is(id)) {
-                continue;
+            if !earlier.any(|(e, _)| node.node(e).key_is(id)) {
+                let value = self.object.get_key(id).unwrap_or(node.node(v));
+                return Some((KeyId(id), Cow::Borrowed(node.tape.keys.key(id)), value));
             }
-            let value = self.object.get_key(id).unwrap_or(node.node(v));
-            return Some((KeyId(id), key, value));
+            (k, v) = self.raw.next()?;
         }
     }
 }
