@@ -6,7 +6,7 @@
 
 use super::{Context, Rule};
 use crate::asset::pointer;
-use crate::asset::tape::{Kind, Node};
+use crate::asset::tape::{KeyId, Kind, Node};
 use crate::diagnostics::{Code, Diagnostic, Severity};
 use crate::layers;
 use std::collections::BTreeSet;
@@ -75,9 +75,24 @@ impl Rule for Declaration {
 fn undeclared(json: Node, declared: &BTreeSet<String>, out: &mut Vec<Diagnostic>) {
     // Every name in every `extensions` object (extras included, so a superset of what the walk
     // visits): when all are declared there is nothing to report, and no walk to do.
+    // The first few distinct names are judged once each, by their key numbers: a library
+    // writes the same one or two on each of thousands of materials.
+    let mut judged: Vec<(KeyId, bool)> = Vec::new();
+    let mut is_declared = |id: KeyId, name: &str| {
+        if let Some(&(_, known)) = judged.iter().find(|(seen, _)| *seen == id) {
+            return known;
+        }
+        let known = declared.contains(name);
+        if judged.len() < 32 {
+            judged.push((id, known));
+        }
+        known
+    };
     let all_declared = json.members_named("extensions").all(|exts| {
-        exts.as_object()
-            .is_none_or(|o| o.keys().all(|name| declared.contains(name.as_ref())))
+        exts.as_object().is_none_or(|o| {
+            o.iter_keyed()
+                .all(|(id, name, _)| is_declared(id, name.as_ref()))
+        })
     });
     if all_declared {
         return;

@@ -12,7 +12,7 @@ use crate::diagnostics::{codes, Code, Diagnostic};
 use crate::layers;
 use jsonschema::error::ValidationErrorKind;
 use serde_json::Value;
-use std::collections::{BTreeSet, HashMap};
+use std::collections::HashMap;
 use std::path::Path;
 use std::sync::{Arc, OnceLock};
 
@@ -65,11 +65,25 @@ pub enum SchemaError {
 }
 
 /// Known property names of an object schema, and the same for properties that are objects
-/// with their own known properties (textureInfo).
+/// with their own known properties (textureInfo). Lists, searched in order: a layer's schema
+/// names a handful, and every member of every layer object is looked up (with std's map, its
+/// SipHash took a percent of validating the library).
 #[derive(Debug, Default)]
 struct PropertyTree {
-    known: BTreeSet<String>,
-    children: HashMap<String, PropertyTree>,
+    known: Vec<String>,
+    children: Vec<(String, PropertyTree)>,
+}
+
+impl PropertyTree {
+    fn knows(&self, key: &str) -> bool {
+        self.known.iter().any(|known| known == key)
+    }
+
+    fn child(&self, key: &str) -> Option<&PropertyTree> {
+        self.children
+            .iter()
+            .find_map(|(name, child)| (name == key).then_some(child))
+    }
 }
 
 struct LayerSchema {
@@ -231,13 +245,17 @@ fn property_tree(schema: &Value, files: &HashMap<String, Value>, depth: usize) -
     collect(schema, files, depth, &mut props);
     let mut tree = PropertyTree::default();
     for (name, sub) in props {
-        tree.known.insert(name.clone());
+        if !tree.knows(&name) {
+            tree.known.push(name.clone());
+        }
         if depth < 4 {
             let child = property_tree(&sub, files, depth + 1);
             // Only objects with a closed set of known properties are checked (not extensions
-            // or extras, whose keys are open).
+            // or extras, whose keys are open). A name defined again (through `allOf`) takes
+            // its last definition.
             if !child.known.is_empty() {
-                tree.children.insert(name, child);
+                tree.children.retain(|(known, _)| *known != name);
+                tree.children.push((name, child));
             }
         }
     }
@@ -248,13 +266,13 @@ fn unexpected(value: Node, tree: &PropertyTree, at: &str, out: &mut Vec<Diagnost
     let Some(obj) = value.as_object() else { return };
     for (key, child) in obj.iter() {
         let key = key.as_ref();
-        if !tree.known.contains(key) {
+        if !tree.knows(key) {
             out.push(Diagnostic::new(
                 &codes::UNEXPECTED_PROPERTY,
                 pointer::join(at, key),
                 format!("unexpected property '{key}'"),
             ));
-        } else if let Some(sub) = tree.children.get(key) {
+        } else if let Some(sub) = tree.child(key) {
             unexpected(child, sub, &pointer::join(at, key), out);
         }
     }
