@@ -209,11 +209,14 @@ impl BufferViews {
             )),
             Some(_) => {}
         };
+        // The keys of every primitive, found in the key table once.
+        let [primitives_key, attributes_key, indices_key, targets_key] =
+            ["primitives", "attributes", "indices", "targets"].map(|key| json.key_id(key));
         for (m, mesh) in elements(json.get("meshes")).enumerate() {
-            for (p, primitive) in elements(mesh.get("primitives")).enumerate() {
+            for (p, primitive) in elements(mesh.get_by(primitives_key)).enumerate() {
                 let at = || format!("/meshes/{m}/primitives/{p}");
                 for (name, accessor) in primitive
-                    .get("attributes")
+                    .get_by(attributes_key)
                     .and_then(|a| a.as_object())
                     .into_iter()
                     .flat_map(|a| a.iter())
@@ -223,7 +226,7 @@ impl BufferViews {
                         used(view, ARRAY_BUFFER, &pointer, out);
                     }
                 }
-                if let Some(view) = view_index(primitive.get("indices")) {
+                if let Some(view) = view_index(primitive.get_by(indices_key)) {
                     let pointer = || format!("{}/indices", at());
                     if strided(view) {
                         out.push(Diagnostic::new(
@@ -234,7 +237,7 @@ impl BufferViews {
                     }
                     used(view, ELEMENT_ARRAY_BUFFER, &pointer, out);
                 }
-                for (t, target) in elements(primitive.get("targets")).enumerate() {
+                for (t, target) in elements(primitive.get_by(targets_key)).enumerate() {
                     for (name, accessor) in target.as_object().into_iter().flat_map(|a| a.iter()) {
                         if let Some(view) = view_index(Some(accessor)) {
                             let pointer =

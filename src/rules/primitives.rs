@@ -257,11 +257,16 @@ impl Rule for Primitives {
                     Some(_) => {}
                 }
         };
+        // The keys of every primitive, found in the key table once.
+        let [primitives_key, attributes_key, targets_key, indices_key, mode_key] =
+            ["primitives", "attributes", "targets", "indices", "mode"].map(|key| json.key_id(key));
+        let [position, tangent, normal] =
+            ["POSITION", "TANGENT", "NORMAL"].map(|key| json.key_id(key));
         for (m, mesh) in elements(Some(meshes)).enumerate() {
             let mut targets_count = None;
-            for (p, primitive) in elements(mesh.get("primitives")).enumerate() {
+            for (p, primitive) in elements(mesh.get_by(primitives_key)).enumerate() {
                 let at = || format!("/meshes/{m}/primitives/{p}");
-                let Some(attributes) = primitive.get("attributes").and_then(|a| a.as_object())
+                let Some(attributes) = primitive.get_by(attributes_key).and_then(|a| a.as_object())
                 else {
                     continue;
                 };
@@ -270,18 +275,18 @@ impl Rule for Primitives {
                 }
                 if targets_count.is_none() {
                     targets_count = primitive
-                        .get("targets")
+                        .get_by(targets_key)
                         .and_then(|t| t.as_array())
                         .map(|t| t.len());
                 }
-                if !attributes.contains_key("POSITION") {
+                if !attributes.contains_id(position) {
                     out.push(Diagnostic::new(
                         &MESH_PRIMITIVE_NO_POSITION,
                         format!("{}/attributes", at()),
                         "the primitive has no POSITION attribute",
                     ));
                 }
-                if attributes.contains_key("TANGENT") && !attributes.contains_key("NORMAL") {
+                if attributes.contains_id(tangent) && !attributes.contains_id(normal) {
                     out.push(Diagnostic::new(
                         &MESH_PRIMITIVE_TANGENT_WITHOUT_NORMAL,
                         format!("{}/attributes/TANGENT", at()),
@@ -339,7 +344,7 @@ impl Rule for Primitives {
                     vertex_attribute(&attribute_at, i, view, out);
                 }
                 let mut drawn = vertices;
-                if let Some(indices) = primitive.get("indices") {
+                if let Some(indices) = primitive.get_by(indices_key) {
                     if let Some((_, view)) = accessor(indices) {
                         let scalar_uint = view.kind.as_deref().is_none_or(|k| k == "SCALAR")
                             && view
@@ -358,7 +363,7 @@ impl Rule for Primitives {
                         drawn = None;
                     }
                 }
-                let mode = primitive.get("mode").map_or(Some(4), |m| m.as_u64());
+                let mode = primitive.get_by(mode_key).map_or(Some(4), |m| m.as_u64());
                 if let (Some(mode), Some(count)) = (mode, drawn) {
                     if !fits_mode(mode, count) {
                         out.push(Diagnostic::new(
@@ -370,7 +375,7 @@ impl Rule for Primitives {
                         ));
                     }
                 }
-                for (t, target) in elements(primitive.get("targets")).enumerate() {
+                for (t, target) in elements(primitive.get_by(targets_key)).enumerate() {
                     for (name, index) in target.as_object().into_iter().flat_map(|o| o.iter()) {
                         let Some((i, view)) = accessor(index) else {
                             continue;

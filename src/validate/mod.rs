@@ -532,11 +532,13 @@ fn strings(json: Node, key: &str) -> Vec<String> {
 
 fn asset_info(json: Node) -> AssetInfo {
     let (mut materials, mut sheen, mut fuzz) = (0, 0, 0);
+    let [extensions_key, sheen_key, fuzz_key] =
+        ["extensions", layers::SHEEN, layers::FUZZ].map(|key| json.key_id(key));
     for material in crate::rules::materials(json) {
         materials += 1;
-        if let Some(extensions) = material.get("extensions").and_then(|e| e.as_object()) {
-            sheen += usize::from(extensions.contains_key(layers::SHEEN));
-            fuzz += usize::from(extensions.contains_key(layers::FUZZ));
+        if let Some(extensions) = material.get_by(extensions_key).and_then(|e| e.as_object()) {
+            sheen += usize::from(extensions.contains_id(sheen_key));
+            fuzz += usize::from(extensions.contains_id(fuzz_key));
         }
     }
     let text = |p: &str| {
