@@ -289,15 +289,19 @@ pub fn report_pretty(report: &FileReport) -> String {
     serde_json::to_string_pretty(&shape(report)).expect("a report serialises")
 }
 
-/// [`report_pretty`] as an element of a pretty-printed array: every line indented one level.
-/// Written as a one-element array, less its brackets, rather than indented line by line
-/// afterwards (a second pass over the text).
-pub fn report_pretty_element(report: &FileReport) -> String {
-    let mut text = serde_json::to_string_pretty(&[shape(report)]).expect("a report serialises");
+/// [`report_pretty`] as an element of a pretty-printed array, every line indented one level,
+/// after the array's opening bracket (`first`) or the comma before it, and a line break.
+/// Written as a one-element array less its closing bracket, whose opening bracket is the one
+/// to keep or becomes the comma: neither indented line by line afterwards (a second pass over
+/// the text) nor moved to make room for what goes before it.
+pub fn report_pretty_element(report: &FileReport, first: bool) -> String {
+    let mut text = serde_json::to_vec_pretty(&[shape(report)]).expect("a report serialises");
     // "[\n" and "\n]" around the element.
     text.truncate(text.len() - 2);
-    text.drain(..2);
-    text
+    if !first {
+        text[0] = b',';
+    }
+    String::from_utf8(text).expect("serde_json writes UTF-8")
 }
 
 /// How many messages one task of [`write_pretty`] writes.

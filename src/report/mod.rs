@@ -315,10 +315,7 @@ impl<W: std::io::Write> Stream<W> {
                 self.kept.push(report);
                 return;
             }
-            Format::Json if self.files == 1 => {
-                format!("[\n{}", json::report_pretty_element(&report))
-            }
-            Format::Json => format!(",\n{}", json::report_pretty_element(&report)),
+            Format::Json => json::report_pretty_element(&report, self.files == 1),
             Format::Sarif => {
                 self.kept.push(report);
                 return;
