@@ -598,6 +598,7 @@ impl<'t> Builder<'t> {
     }
 
     /// Records the string from `start` to here as an object key, numbered in the key table.
+    #[inline]
     fn key_entry(&mut self, start: usize, escaped: bool) -> Result<u32, TapeError> {
         let id = if escaped {
             // Numbered by what it spells, as the same key written without escapes is.
@@ -721,6 +722,7 @@ impl<'t> Builder<'t> {
 /// Whether the object at entry `object`, whose members end before entry `end`, writes a key
 /// twice. Checked once when the object closes, so that reading its members needs no check.
 /// Keys are compared by their numbers; `keys` is scratch room.
+#[inline]
 fn duplicate_keys(entries: &[Entry], object: u32, end: u32, keys: &mut Vec<u32>) -> bool {
     keys.clear();
     let mut at = object + 1;
