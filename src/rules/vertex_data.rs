@@ -22,6 +22,7 @@ use super::accessor_bounds::MAX_REPORTED;
 use super::data::{index_of, Elements, UNIT_LENGTH_VEC3, UNIT_SUM_STEP};
 use super::{elements, Context, Rule};
 use crate::asset::pointer;
+use crate::asset::tape::KeyId;
 use crate::diagnostics::{Code, Diagnostic, Severity};
 use std::collections::HashMap;
 
@@ -153,28 +154,35 @@ impl Rule for VertexData {
         // a few large meshes), their findings joined in document order.
         let mut judged: std::collections::HashSet<(&str, usize)> = std::collections::HashSet::new();
         let mut uses = Vec::new();
+        // The keys of every primitive, found in the key table once.
+        let [primitives_key, attributes_key, indices_key, normal_key, tangent_key] =
+            ["primitives", "attributes", "indices", "NORMAL", "TANGENT"].map(|k| json.key_id(k));
+        let [weights_key, joints_key] = ["WEIGHTS_0", "JOINTS_0"].map(|k| json.key_id(k));
         for (m, mesh) in elements(Some(meshes)).enumerate() {
-            for (p, primitive) in elements(mesh.get("primitives")).enumerate() {
-                let Some(attributes) = primitive.get("attributes").and_then(|a| a.as_object())
+            for (p, primitive) in elements(mesh.get_by(primitives_key)).enumerate() {
+                let Some(attributes) = primitive.get_by(attributes_key).and_then(|a| a.as_object())
                 else {
                     continue;
                 };
-                let mut first = |kind: &'static str, name: &str| {
-                    index_of(attributes.get(name)).filter(|&index| judged.insert((kind, index)))
+                let mut first = |kind: &'static str, key: Option<KeyId>| {
+                    index_of(key.and_then(|key| attributes.get_id(key)))
+                        .filter(|&index| judged.insert((kind, index)))
                 };
-                let normal = first("normal", "NORMAL");
-                let tangent = first("tangent", "TANGENT");
+                let normal = first("normal", normal_key);
+                let tangent = first("tangent", tangent_key);
                 let colors: Vec<(String, usize)> = attributes
-                    .iter()
-                    .filter(|(name, _)| name.starts_with("COLOR_"))
-                    .filter_map(|(name, _)| first("color", &name).map(|i| (name.into_owned(), i)))
+                    .iter_keyed()
+                    .filter(|(_, name, _)| name.starts_with("COLOR_"))
+                    .filter_map(|(key, name, _)| {
+                        first("color", Some(key)).map(|i| (name.into_owned(), i))
+                    })
                     .collect();
                 // A primitive with no indices, no data it is the first to use and no skinning
                 // has nothing to judge here (a library's primitives mostly share a few
                 // accessors).
                 let skinned =
-                    attributes.contains_key("WEIGHTS_0") || attributes.contains_key("JOINTS_0");
-                if primitive.get("indices").is_none()
+                    attributes.contains_id(weights_key) || attributes.contains_id(joints_key);
+                if primitive.get_by(indices_key).is_none()
                     && normal.is_none()
                     && tangent.is_none()
                     && colors.is_empty()
