@@ -295,13 +295,13 @@ pub fn report_pretty(report: &FileReport) -> String {
 /// to keep or becomes the comma: neither indented line by line afterwards (a second pass over
 /// the text) nor moved to make room for what goes before it.
 pub fn report_pretty_element(report: &FileReport, first: bool) -> String {
-    let mut text = serde_json::to_vec_pretty(&[shape(report)]).expect("a report serialises");
-    // "[\n" and "\n]" around the element.
+    let mut text = serde_json::to_string_pretty(&[shape(report)]).expect("a report serialises");
+    // "[\n" and "\n]" around the element. A replacement of the same length moves nothing.
     text.truncate(text.len() - 2);
     if !first {
-        text[0] = b',';
+        text.replace_range(..1, ",");
     }
-    String::from_utf8(text).expect("serde_json writes UTF-8")
+    text
 }
 
 /// How many messages one task of [`write_pretty`] writes.

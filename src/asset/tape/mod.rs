@@ -178,6 +178,7 @@ impl Tape {
 
     /// [`Tape::build_within`] on this thread alone, front to back.
     fn build_serial(text: &str, max_depth: usize) -> Result<Tape, TapeError> {
+        // A value takes at least two bytes of pretty-printed text on average.
         let mut builder = Builder::new(text, max_depth, text.len() / 16);
         builder.document()?;
         Ok(builder.finish())
@@ -241,18 +242,9 @@ impl Resumption {
             return Tape::build_within(text, max_depth);
         }
         let point = self.point;
-        let mut builder = Builder {
-            text,
-            bytes: text.as_bytes(),
-            at: point.at,
-            max_depth,
-            entries: self.entries,
-            elements: self.elements,
-            scratch: Vec::new(),
-            member_keys: Vec::new(),
-            keys: self.keys,
-            deepest: 0,
-        };
+        let mut builder =
+            Builder::with_parts(text, max_depth, self.entries, self.elements, self.keys);
+        builder.at = point.at;
         let mut stack = Vec::with_capacity(point.open.len());
         for (entry, children) in &point.open {
             let reopened = &mut builder.entries[*entry as usize];
@@ -361,21 +353,36 @@ impl<'t> Builder<'t> {
     /// A builder at the start of `text`, with room for `entries` entries (advised huge pages
     /// when that is large).
     fn new(text: &'t str, max_depth: usize, entries: usize) -> Builder<'t> {
+        let mut room = Vec::with_capacity(entries);
+        super::pages::advise_huge(&mut room);
+        Builder::with_parts(
+            text,
+            max_depth,
+            room,
+            Vec::new(),
+            KeyTable::for_text(text.len()),
+        )
+    }
+
+    /// A builder at the start of `text` that goes on from `entries`, `elements` and `keys`
+    /// (empty for a fresh build, an earlier index's for a resumed one).
+    fn with_parts(
+        text: &'t str,
+        max_depth: usize,
+        entries: Vec<Entry>,
+        elements: Vec<u32>,
+        keys: KeyTable,
+    ) -> Builder<'t> {
         Builder {
             text,
             bytes: text.as_bytes(),
             at: 0,
             max_depth,
-            // A value takes at least two bytes of pretty-printed text on average.
-            entries: {
-                let mut entries = Vec::with_capacity(entries);
-                super::pages::advise_huge(&mut entries);
-                entries
-            },
-            elements: Vec::new(),
+            entries,
+            elements,
             scratch: Vec::new(),
             member_keys: Vec::new(),
-            keys: KeyTable::for_text(text.len()),
+            keys,
             deepest: 0,
         }
     }
@@ -1062,10 +1069,7 @@ impl<'a> Object<'a> {
     }
 
     pub fn contains_key(&self, key: &str) -> bool {
-        self.node.tape.keys.id(key).is_some_and(|id| {
-            self.raw_members()
-                .any(|(k, _)| self.node.node(k).key_is(id))
-        })
+        self.contains_id(self.node.tape.keys.id(key).map(KeyId))
     }
 
     /// Distinct keys.

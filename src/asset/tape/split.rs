@@ -71,7 +71,7 @@ enum Token {
 }
 
 struct SecondHalf {
-    builder_entries: Vec<super::Entry>,
+    entries: Vec<super::Entry>,
     elements: Vec<u32>,
     keys: KeyTable,
     tokens: Vec<Token>,
@@ -255,7 +255,7 @@ fn second_half(text: &str, cut: usize) -> Result<SecondHalf, TapeError> {
         tokens.push(token);
     }
     Ok(SecondHalf {
-        builder_entries: builder.entries,
+        entries: builder.entries,
         elements: builder.elements,
         keys: builder.keys,
         tokens,
@@ -385,9 +385,9 @@ fn stitch(first: FirstHalf, second: SecondHalf, max_depth: usize) -> Option<Tape
     }
 
     let mut entries = std::mem::take(&mut joined.entries);
-    entries.reserve(second.builder_entries.len());
+    entries.reserve(second.entries.len());
     let flags = (1 << COUNT_SHIFT) - 1;
-    for entry in &second.builder_entries {
+    for entry in &second.entries {
         let mut entry = *entry;
         entry.next += offset;
         if entry.meta & KEY != 0 {
