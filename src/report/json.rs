@@ -286,7 +286,7 @@ fn outline(report: &FileReport) -> ReportShape<'_> {
 
 /// One file's report, pretty-printed (two-space indent, no final newline).
 pub fn report_pretty(report: &FileReport) -> String {
-    serde_json::to_string_pretty(&shape(report)).expect("a report serialises")
+    super::pretty::to_string(&shape(report)).expect("a report serialises")
 }
 
 /// [`report_pretty`] as an element of a pretty-printed array, every line indented one level,
@@ -295,7 +295,7 @@ pub fn report_pretty(report: &FileReport) -> String {
 /// to keep or becomes the comma: neither indented line by line afterwards (a second pass over
 /// the text) nor moved to make room for what goes before it.
 pub fn report_pretty_element(report: &FileReport, first: bool) -> String {
-    let mut text = serde_json::to_string_pretty(&[shape(report)]).expect("a report serialises");
+    let mut text = super::pretty::to_string(&[shape(report)]).expect("a report serialises");
     // "[\n" and "\n]" around the element. A replacement of the same length moves nothing.
     text.truncate(text.len() - 2);
     if !first {
@@ -315,7 +315,7 @@ const RUNS_IN_HAND: usize = 8;
 /// is written around them.
 pub fn write_pretty(out: &mut impl std::io::Write, report: &FileReport) -> std::io::Result<()> {
     use rayon::prelude::*;
-    let outline = serde_json::to_string_pretty(&outline(report))?;
+    let outline = super::pretty::to_string(&outline(report))?;
     // An empty list is written `[]`; no string value holds this text, as its quotes would be
     // escaped there.
     const EMPTY: &str = "\n    \"messages\": [],";
@@ -393,7 +393,7 @@ fn push_message(out: &mut String, m: &MessageShape) {
     push_quoted(out, m.pointer);
     if let Some(fix) = &m.fix {
         // As the printer writes it at this depth: its lines after the first indented by 8.
-        let text = serde_json::to_string_pretty(fix).expect("a fix serialises");
+        let text = super::pretty::to_string(fix).expect("a fix serialises");
         out.push_str(",\n        \"fix\": ");
         for (i, line) in text.lines().enumerate() {
             if i > 0 {
@@ -415,7 +415,7 @@ pub fn render(reports: &[FileReport]) -> String {
 
 /// The reports as a pretty-printed array, one report or many, as a run of several writes them.
 pub fn render_array(reports: &[FileReport]) -> String {
-    serde_json::to_string_pretty(&reports.iter().map(shape).collect::<Vec<_>>())
+    super::pretty::to_string(&reports.iter().map(shape).collect::<Vec<_>>())
         .expect("a report serialises")
         + "\n"
 }

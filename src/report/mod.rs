@@ -7,6 +7,7 @@ pub mod escape;
 pub mod fold;
 pub mod github;
 pub mod json;
+pub mod pretty;
 pub mod sarif;
 pub mod text;
 

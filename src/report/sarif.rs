@@ -549,7 +549,7 @@ pub fn render_failed(message: &str) -> String {
             results: Vec::new(),
         }],
     };
-    let mut text = serde_json::to_string_pretty(&log).expect("a SARIF log serialises");
+    let mut text = super::pretty::to_string(&log).expect("a SARIF log serialises");
     text.push('\n');
     text
 }
@@ -575,7 +575,7 @@ pub fn write(out: &mut impl std::io::Write, reports: &[FileReport]) -> std::io::
     let artifacts: Vec<ArtifactLocation> =
         reports.iter().map(|r| artifact_location(&r.path)).collect();
     let missing = missing_entries(reports);
-    serde_json::to_writer_pretty(&mut *out, &log(reports, &artifacts, &missing))?;
+    super::pretty::to_writer(&mut *out, &log(reports, &artifacts, &missing))?;
     out.write_all(b"\n")
 }
 
