@@ -144,6 +144,46 @@ fn edited_pointer(edit: &Edit) -> &str {
     }
 }
 
+/// The path of `edit` to the document `root`, with whether it keeps every extension object
+/// where it was ([`crate::rules::EditPath::keeping_extensions`]): what it sets and what was
+/// there hold no `extensions` member, and it removes no array element (which would move the
+/// elements after it).
+fn edit_path<'e>(root: Node, edit: &'e Edit) -> crate::rules::EditPath<'e> {
+    let pointer = edited_pointer(edit);
+    let path = crate::rules::EditPath::of(pointer);
+    let old = root.pointer(pointer);
+    let old_keeps = || old.is_none_or(|old| old.members_named("extensions").next().is_none());
+    let keeps = match edit {
+        Edit::Set { value, .. } => {
+            let new_keeps = match value {
+                // Compact text that velvet wrote quotes a key as it is: a member named
+                // `extensions` is the text `"extensions"` in it.
+                crate::edit::SetValue::Text(text) => !text.contains("\"extensions\""),
+                crate::edit::SetValue::Value(value) => !value_holds_key(value, "extensions"),
+            };
+            new_keeps && old_keeps()
+        }
+        Edit::Replace { value, .. } => !value_holds_key(value, "extensions") && old_keeps(),
+        Edit::Remove { .. } => {
+            let parent = pointer.rsplit_once('/').map_or("", |(parent, _)| parent);
+            old_keeps() && !root.pointer(parent).is_some_and(|p| p.is_array())
+        }
+        Edit::DeclareUsed { .. } => false,
+    };
+    path.keeping_extensions(keeps)
+}
+
+/// Whether `value` has an object member named `key` at any depth.
+fn value_holds_key(value: &serde_json::Value, key: &str) -> bool {
+    match value {
+        serde_json::Value::Object(members) => members
+            .iter()
+            .any(|(k, v)| k == key || value_holds_key(v, key)),
+        serde_json::Value::Array(elements) => elements.iter().any(|v| value_holds_key(v, key)),
+        _ => false,
+    }
+}
+
 /// A key of the places `edits` name, in order: edits with equal keys are then compared whole,
 /// so two lists whose keys collide are still told apart.
 fn places_key(edits: &[Edit]) -> u64 {
@@ -889,10 +929,8 @@ impl<'v> Fixing<'v> {
         // fix of the byte-order mark or the container changes what lies outside the text.
         let root = source.root();
         let exists = |pointer: &str| root.pointer(pointer).is_some();
-        let paths: Vec<crate::rules::EditPath> = edits
-            .iter()
-            .map(|edit| crate::rules::EditPath::of(edited_pointer(edit)))
-            .collect();
+        let paths: Vec<crate::rules::EditPath> =
+            edits.iter().map(|edit| edit_path(root, edit)).collect();
         let touched = |reads: &crate::rules::Reads| {
             paths.iter().any(|path| reads.touched_by_path(path, exists))
         };
@@ -1707,6 +1745,80 @@ mod tests {
         assert!(!view(1).holds(&finding("/bufferViews/10/target")));
         assert!(!view(1).holds(&finding("/bufferViews")));
         assert!(!view(1).holds(&finding("/accessors/1")));
+    }
+
+    #[test]
+    fn an_edit_touches_the_extension_objects_where_it_brings_takes_or_moves_one_or_edits_inside() {
+        let text = r#"{"asset": {"version": "2.0"},
+            "extensionsUsed": ["KHR_materials_sheen"],
+            "materials": [{"name": "a"},
+                          {"extensions": {"KHR_materials_sheen": {"sheenRoughnessFactor": 0.5}}}],
+            "bufferViews": [{"buffer": 0, "byteLength": 4}],
+            "nodes": [{"extras": {"note": {"extensions": {}}}}]}"#;
+        let asset = crate::asset::load_bytes(Path::new("t.gltf"), text.as_bytes())
+            .asset
+            .unwrap();
+        let root = asset.root();
+        let set = |pointer: &str, value: serde_json::Value| Edit::Set {
+            pointer: pointer.into(),
+            value: crate::edit::SetValue::Value(value),
+        };
+        let set_text = |pointer: &str, text: &str| Edit::Set {
+            pointer: pointer.into(),
+            value: crate::edit::SetValue::Text(text.into()),
+        };
+        let remove = |pointer: &str| Edit::Remove {
+            pointer: pointer.into(),
+        };
+        let touched = |edit: &Edit| {
+            crate::rules::Reads::Extensions.touched_by_path(&edit_path(root, edit), |_| true)
+        };
+        // Elsewhere, holding none and moving none: untouched.
+        assert!(!touched(&set(
+            "/bufferViews/0/target",
+            serde_json::json!(34962)
+        )));
+        assert!(!touched(&set("/materials/0/name", serde_json::json!("b"))));
+        assert!(!touched(&set_text(
+            "/materials/0/pbrMetallicRoughness",
+            r#"{"roughnessFactor":1}"#
+        )));
+        assert!(!touched(&remove("/materials/0/name")));
+        // Inside an extension object, at a list, at the root, or a declaration.
+        assert!(touched(&set(
+            "/materials/1/extensions/KHR_materials_sheen/sheenRoughnessFactor",
+            serde_json::json!(1)
+        )));
+        assert!(touched(&set("/extensionsRequired", serde_json::json!([]))));
+        assert!(touched(&remove("/extensionsUsed/0")));
+        assert!(touched(&remove("")));
+        assert!(touched(&Edit::DeclareUsed {
+            extension: "KHR_materials_fuzz".into()
+        }));
+        // Bringing one (as a value or as text), replacing or removing a value that holds one
+        // (an `extensions` member in extras too), or removing an array element, which moves
+        // the elements after it.
+        assert!(touched(&set(
+            "/materials/0/x",
+            serde_json::json!({"extensions": {}})
+        )));
+        assert!(touched(&set_text(
+            "/materials/0/x",
+            r#"{"a":[{"extensions":{}}]}"#
+        )));
+        assert!(touched(&Edit::Replace {
+            pointer: "/materials/0/x".into(),
+            value: serde_json::json!([{"b": {"extensions": {}}}])
+        }));
+        assert!(touched(&set(
+            "/materials/1",
+            serde_json::json!({"name": "c"})
+        )));
+        assert!(touched(&remove("/nodes/0/extras")));
+        assert!(touched(&remove("/materials/0")));
+        assert!(touched(&remove("/bufferViews/0")));
+        // What an edit path made without the values says: touched.
+        assert!(crate::rules::Reads::Extensions.touched_by("/materials/0/name", |_| true));
     }
 
     #[test]

@@ -51,6 +51,11 @@ fn names(json: Node, key: &str) -> Vec<(usize, String)> {
 }
 
 impl Rule for Declaration {
+    /// The names of the extension objects, where the first of each stands, and the two lists.
+    fn reads(&self) -> super::Reads {
+        super::Reads::Extensions
+    }
+
     fn codes(&self) -> &'static [&'static Code] {
         &[
             &UNDECLARED_EXTENSION,

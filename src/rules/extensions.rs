@@ -955,6 +955,12 @@ impl Rule for ExtensionObjects {
         2
     }
 
+    /// Where each extension object stands and what it holds: the kinds of the objects that
+    /// hold them come from the paths to them.
+    fn reads(&self) -> super::Reads {
+        super::Reads::Extensions
+    }
+
     fn codes(&self) -> &'static [&'static Code] {
         &[&UNEXPECTED_EXTENSION_OBJECT]
     }

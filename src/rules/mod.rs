@@ -282,6 +282,13 @@ pub enum Reads {
         values: &'static [&'static str],
         elements: &'static [&'static str],
     },
+    /// Only the extension objects (where each stands and what it holds) and the names
+    /// `extensionsUsed` and `extensionsRequired` list. An edit touches them when it is at the
+    /// root, at or inside one of those lists or an `extensions` object, or brings, takes away
+    /// or moves an extension object ([`EditPath::keeping_extensions`] says it does none of
+    /// these): a fix of a buffer view's target leaves a library's 20,000 extension objects as
+    /// they were, and the rules that judge them give the file's findings again.
+    Extensions,
 }
 
 impl Reads {
@@ -307,6 +314,15 @@ impl Reads {
             Reads::Document => return true,
             Reads::Places { values, elements } => {
                 return places_touched_by(values, elements, &edit.tokens);
+            }
+            Reads::Extensions => {
+                let lists = ["extensionsUsed", "extensionsRequired"];
+                return !edit.keeps_extensions
+                    || edit
+                        .tokens
+                        .first()
+                        .is_none_or(|p| lists.contains(&p.as_ref()))
+                    || edit.tokens.iter().any(|token| token == "extensions");
             }
             Reads::Properties { properties, except } => (properties, except),
         };
@@ -334,6 +350,8 @@ pub struct EditPath<'p> {
     tokens: Vec<std::borrow::Cow<'p, str>>,
     /// Where `/{property}/{index}` ends in the pointer, when the edit lies below it.
     element_end: Option<usize>,
+    /// Whether the edit is known to leave every extension object where it was.
+    keeps_extensions: bool,
 }
 
 impl<'p> EditPath<'p> {
@@ -346,7 +364,17 @@ impl<'p> EditPath<'p> {
                 .map(|token| crate::asset::pointer::unescape(token))
                 .collect(),
             element_end: (raw.len() >= 3).then(|| raw[0].len() + raw[1].len() + 2),
+            keeps_extensions: false,
         }
+    }
+
+    /// The path of an edit that, as its caller knows, brings no extension object, takes none
+    /// away and moves none (no element of an array before one shifts): what it sets and what
+    /// it replaces or removes hold no `extensions` member at any depth, and it removes no
+    /// array element. A path made by [`EditPath::of`] is not known to.
+    pub fn keeping_extensions(mut self, keeps: bool) -> EditPath<'p> {
+        self.keeps_extensions = keeps;
+        self
     }
 }
 
