@@ -966,21 +966,47 @@ impl<'a> Node<'a> {
     /// The value as a `serde_json::Value`, for the few places that need one (error reports,
     /// comparisons of whole values).
     pub fn to_value(&self) -> Value {
-        match self.kind() {
-            // A scalar is made directly (a number keeps its text, as serde_json reads it).
+        // Made from the index, not parsed again from the text: the value serde_json reads from
+        // this value's text, null where it refuses the text (nested deeper than its limit).
+        self.value_within(SERDE_DEPTH_LIMIT).unwrap_or(Value::Null)
+    }
+
+    /// [`Node::to_value`] with `depth` more containers allowed inside this one (this one
+    /// included); `None` past them, as serde_json refuses such a text.
+    fn value_within(&self, depth: usize) -> Option<Value> {
+        Some(match self.kind() {
             Kind::Null => Value::Null,
             Kind::Bool => Value::Bool(self.as_bool() == Some(true)),
-            Kind::Number => self
-                .raw()
-                .parse::<serde_json::Number>()
-                .map_or(Value::Null, Value::Number),
-            Kind::String => self
-                .as_str()
-                .map_or(Value::Null, |s| Value::String(s.into_owned())),
-            Kind::Array | Kind::Object => serde_json::from_str(self.raw()).unwrap_or(Value::Null),
-        }
+            // The number keeps its text, as serde_json reads it (arbitrary precision).
+            Kind::Number => Value::Number(self.raw().parse::<serde_json::Number>().ok()?),
+            Kind::String => Value::String(self.as_str()?.into_owned()),
+            Kind::Array => {
+                let depth = depth.checked_sub(1)?;
+                let array = self.as_array()?;
+                let mut elements = Vec::with_capacity(array.len());
+                for element in array.iter() {
+                    elements.push(element.value_within(depth)?);
+                }
+                Value::Array(elements)
+            }
+            Kind::Object => {
+                let depth = depth.checked_sub(1)?;
+                let object = self.as_object()?;
+                let mut members = serde_json::Map::with_capacity(object.len());
+                // Each key once, at its first place, with its last value: serde_json's map
+                // (insertion order) keeps a repeated key so.
+                for (key, value) in object.iter() {
+                    members.insert(key.into_owned(), value.value_within(depth)?);
+                }
+                Value::Object(members)
+            }
+        })
     }
 }
+
+/// How many containers serde_json reads one inside another: it refuses the 128th (its
+/// recursion limit).
+const SERDE_DEPTH_LIMIT: usize = 127;
 
 /// What [`Node::get`] takes: a key or an array index.
 pub trait Index {
@@ -1334,6 +1360,53 @@ impl<'a> JsonView<'a> for &'a Value {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every value of `text`, made from the index, is the value serde_json reads from the
+    /// value's own text (null where it refuses it).
+    fn assert_values_are_serde_jsons(text: &str) {
+        let tape = Tape::build(text).unwrap();
+        let mut stack = vec![tape.root(text)];
+        while let Some(node) = stack.pop() {
+            let read: Value = serde_json::from_str(node.raw()).unwrap_or(Value::Null);
+            assert_eq!(node.to_value(), read, "{}", node.raw());
+            // Compared as text too: a map's order and a number's spelling.
+            assert_eq!(node.to_value().to_string(), read.to_string());
+            if let Some(array) = node.as_array() {
+                stack.extend(array.iter());
+            }
+            if let Some(object) = node.as_object() {
+                stack.extend(object.iter().map(|(_, v)| v));
+            }
+        }
+    }
+
+    #[test]
+    fn a_value_made_from_the_index_is_what_serde_json_reads_from_its_text() {
+        assert_values_are_serde_jsons(
+            r#"{"b": [1, 1.50, -0, 1e400, 12345678901234567890123, 2E-3], "a": {"x": null, "y": true},
+                "esc\u0041\n": "\u00e9\ud83d\ude00\"", "a": {"z": false}, "": [[], {}, ""],
+                "b": "last"}"#,
+        );
+    }
+
+    #[test]
+    fn a_value_nested_past_serde_jsons_limit_is_null_as_serde_json_refuses_its_text() {
+        for depth in [126, 127, 128, 129, 140] {
+            let text = format!("{}1{}", "[".repeat(depth), "]".repeat(depth));
+            let tape = Tape::build(&text).unwrap();
+            let root = tape.root(&text);
+            let expected: Value = serde_json::from_str(&text).unwrap_or(Value::Null);
+            assert_eq!(root.to_value(), expected, "depth {depth}");
+            assert_eq!(root.to_value().is_null(), depth >= 128, "depth {depth}");
+            let objects = format!("{}1{}", "{\"k\":".repeat(depth), "}".repeat(depth));
+            let tape = Tape::build(&objects).unwrap();
+            assert_eq!(
+                tape.root(&objects).to_value().is_null(),
+                depth >= 128,
+                "depth {depth}"
+            );
+        }
+    }
 
     /// Rebuilds a `Value` through the index's own accessors (not `to_value`).
     pub(super) fn rebuild(node: Node) -> Value {
@@ -1769,6 +1842,33 @@ mod properties {
     }
 
     proptest! {
+        /// Every value of any JSON text, made from the index, is what serde_json reads from
+        /// that value's text.
+        #[test]
+        fn a_value_made_from_the_index_is_serde_jsons_reading_of_its_text(
+            value in json_value(),
+            pretty in any::<bool>(),
+        ) {
+            let text = if pretty {
+                serde_json::to_string_pretty(&value).unwrap()
+            } else {
+                serde_json::to_string(&value).unwrap()
+            };
+            let tape = Tape::build(&text).unwrap();
+            prop_assert_eq!(tape.root(&text).to_value(), value);
+            let mut stack = vec![tape.root(&text)];
+            while let Some(node) = stack.pop() {
+                let read: Value = serde_json::from_str(node.raw()).unwrap();
+                prop_assert_eq!(node.to_value(), read);
+                if let Some(array) = node.as_array() {
+                    stack.extend(array.iter());
+                }
+                if let Some(object) = node.as_object() {
+                    stack.extend(object.iter().map(|(_, v)| v));
+                }
+            }
+        }
+
         /// A text with a part replaced, indexed from the earlier text's index from the first
         /// changed byte on, is indexed as a fresh build indexes it: the same entries, runs and
         /// key lookups, or the same refusal.
