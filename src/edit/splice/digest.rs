@@ -116,15 +116,19 @@ fn feed_node(d: &mut Digest, node: Node) {
     }
 }
 
-/// Feeds `node` as [`feed_node`] does, with each of `sets` (tokens below `node`, value) in its
-/// place: a set member where the member stands, a new one after the object's members, in
-/// order. Every set's path exists in `node` up to its last token (see `members_set_in_place`,
-/// in `edits.rs`).
-pub(super) fn feed_edited<T: AsRef<str>>(d: &mut Digest, node: Node, sets: &[(&[T], &Value)]) {
+/// Feeds `node` as [`feed_node`] does, with each of `sets` (tokens below `node`, value or
+/// `None` for a removal) in its place: a set member or array element where it stands, a new
+/// member after the object's members, in order, a removed one left out. Every set's path exists in `node`
+/// up to its last token (see `members_set_in_place`, in `edits.rs`).
+pub(super) fn feed_edited<T: AsRef<str>>(
+    d: &mut Digest,
+    node: Node,
+    sets: &[(&[T], Option<&Value>)],
+) {
     if sets.is_empty() {
         return feed_node(d, node);
     }
-    let below = |token: &str| -> Vec<(&[T], &Value)> {
+    let below = |token: &str| -> Vec<(&[T], Option<&Value>)> {
         sets.iter()
             .filter(|(t, _)| t.len() > 1 && t[0].as_ref() == token)
             .map(|(t, v)| (&t[1..], *v))
@@ -137,19 +141,27 @@ pub(super) fn feed_edited<T: AsRef<str>>(d: &mut Digest, node: Node, sets: &[(&[
             };
             d.tag(b'{');
             for (key, member) in object.iter() {
-                d.text(b':', &key);
                 match sets
                     .iter()
                     .find(|(t, _)| t.len() == 1 && t[0].as_ref() == key)
                 {
-                    Some((_, new)) => feed_value(d, new),
-                    None => feed_edited(d, member, &below(&key)),
+                    Some((_, None)) => {} // removed
+                    Some((_, Some(new))) => {
+                        d.text(b':', &key);
+                        feed_value(d, new);
+                    }
+                    None => {
+                        d.text(b':', &key);
+                        feed_edited(d, member, &below(&key));
+                    }
                 }
             }
             for (tokens, new) in sets {
-                if tokens.len() == 1 && !object.contains_key(tokens[0].as_ref()) {
-                    d.text(b':', tokens[0].as_ref());
-                    feed_value(d, new);
+                if let (1, Some(new)) = (tokens.len(), new) {
+                    if !object.contains_key(tokens[0].as_ref()) {
+                        d.text(b':', tokens[0].as_ref());
+                        feed_value(d, new);
+                    }
                 }
             }
             d.tag(b'}');
@@ -162,7 +174,14 @@ pub(super) fn feed_edited<T: AsRef<str>>(d: &mut Digest, node: Node, sets: &[(&[
                 .flat_map(|a| a.iter())
                 .enumerate()
             {
-                feed_edited(d, item, &below(&i.to_string()));
+                let token = i.to_string();
+                match sets
+                    .iter()
+                    .find(|(t, _)| t.len() == 1 && t[0].as_ref() == token)
+                {
+                    Some((_, Some(new))) => feed_value(d, new),
+                    _ => feed_edited(d, item, &below(&token)),
+                }
             }
             d.tag(b']');
         }

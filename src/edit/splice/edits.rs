@@ -237,10 +237,10 @@ enum UnitCheck {
 
 /// One edit of [`members_set_in_place`]: where it sets, as tokens below the element, and the
 /// value the text will hold (a [`Edit::Set`]'s as velvet writes it, a [`Edit::Replace`]'s as
-/// given).
+/// given), or `None` where an [`Edit::Remove`] takes the member away.
 struct MemberSet<'e> {
     tokens: Vec<std::borrow::Cow<'e, str>>,
-    value: SetTo<'e>,
+    value: Option<SetTo<'e>>,
 }
 
 /// What a member is set to: a value, or compact text as [`write_compact`] writes it.
@@ -269,16 +269,21 @@ impl SetTo<'_> {
     }
 }
 
-/// The splices of an element unit whose edits each set or replace a member of an object the
-/// element already holds (the fuzz object a migration adds to a material's `extensions`, a factor it
-/// replaces), made from the index alone: the element is not read into a value, edited and
-/// compared with its text, which for a migration of every material was most of the writer's
-/// work. Returns the splices, whether they change anything, and how the element reads back
-/// as meant: when every edit adds a member, whether each inserted text reads as its members
-/// ([`inserted_members_read_as`]); otherwise the digest the element must read back as, fed
-/// from the index with the set values in their places, as the edited value would feed it. `None` for edits of another kind (a removal, an array element, a path through
-/// a missing key or an object that writes a key twice, two edits of one place); the caller then
-/// takes the general way.
+/// The splices of an element unit whose edits each set, replace or remove a member of an
+/// object the element already holds, or set an element of an array it holds (the fuzz object a
+/// migration adds to a material's `extensions`, a factor it replaces, a texture a fix removes,
+/// a component a fix clamps), made from the index alone:
+/// the element is not read into a value, edited and compared with its text, which for a
+/// migration of every material was most of the writer's work. A removal takes the member and
+/// one separator, as the general way does. Returns the splices, whether they change anything,
+/// and how the element reads back as meant: when every edit adds a member, whether each
+/// inserted text reads as its members ([`inserted_members_read_as`]); otherwise the digest the
+/// element must read back as, fed from the index with the set values in their places and the
+/// removed members left out, as the edited value would feed it. `None` for edits the general
+/// way writes otherwise or that it refuses (an array element removed or appended, a path through a
+/// missing key or an object that writes a key twice, two edits of one place, a removal of an
+/// absent or only member, an object that both loses and gains members or loses two); the
+/// caller then takes the general way.
 fn members_set_in_place(
     text: &str,
     element: Node,
@@ -294,17 +299,21 @@ fn members_set_in_place(
             Edit::Set {
                 pointer,
                 value: SetValue::Text(text),
-            } => (pointer, SetTo::Text(text)),
+            } => (pointer, Some(SetTo::Text(text))),
             Edit::Set {
                 pointer,
                 value: SetValue::Value(value),
-            } if is_written(value) => (pointer, SetTo::Value(Cow::Borrowed(value))),
+            } if is_written(value) => (pointer, Some(SetTo::Value(Cow::Borrowed(value)))),
             Edit::Set {
                 pointer,
                 value: SetValue::Value(value),
-            } => (pointer, SetTo::Value(Cow::Owned(written(value.clone())))),
-            Edit::Replace { pointer, value } => (pointer, SetTo::Value(Cow::Borrowed(value))),
-            _ => return None,
+            } => (
+                pointer,
+                Some(SetTo::Value(Cow::Owned(written(value.clone())))),
+            ),
+            Edit::Replace { pointer, value } => (pointer, Some(SetTo::Value(Cow::Borrowed(value)))),
+            Edit::Remove { pointer } => (pointer, None),
+            Edit::DeclareUsed { .. } => return None,
         };
         let within = pointer
             .strip_prefix(prefix)
@@ -331,35 +340,75 @@ fn members_set_in_place(
     // kept to the end of the write, by the twenty thousand.
     let mut splices = Vec::with_capacity(1);
     let mut changed = false;
-    // Whether some edit sets a member the element holds already.
+    // Whether some edit sets or removes a member the element holds already.
     let mut replaced = false;
     // New members by the object that receives them, in the order the edits add them.
     let mut inserts: Vec<(Node, Vec<(&str, Meant)>)> = Vec::new();
+    // Where each object that loses a member starts.
+    let mut removed_from: Vec<usize> = Vec::new();
     for set in &sets {
         let (key, path) = set.tokens.split_last()?;
         let mut parent = element;
         for token in path {
             parent = member_or_element(parent, token)?;
         }
+        if let Some(array) = parent.as_array() {
+            // An element the array holds, set (a factor's component clamped): the general way
+            // diffs it with its new value too. A removal or an append moves or adds elements:
+            // the general way.
+            let value = set.value.as_ref()?.value();
+            let old = array.get(crate::asset::pointer::array_index(key)?)?;
+            replaced = true;
+            changed |= !matches(old, &value, Compare::Exact);
+            diff(text, old, &value, layout, &mut splices);
+            continue;
+        }
         let object = parent
             .as_object()
             .filter(|o| !o.is_empty() && !o.has_duplicate_keys())?;
-        match object.get(key) {
-            Some(old) => {
+        match (&set.value, object.get(key)) {
+            (Some(value), Some(old)) => {
                 replaced = true;
-                let value = set.value.value();
+                let value = value.value();
                 changed |= !matches(old, &value, Compare::Exact);
                 diff(text, old, &value, layout, &mut splices);
             }
-            None => {
+            (Some(value), None) => {
                 changed = true;
                 let at = parent.span().start;
                 match inserts.iter_mut().find(|(p, _)| p.span().start == at) {
-                    Some((_, new)) => new.push((key, set.value.meant())),
-                    None => inserts.push((parent, vec![(key.as_ref(), set.value.meant())])),
+                    Some((_, new)) => new.push((key, value.meant())),
+                    None => inserts.push((parent, vec![(key.as_ref(), value.meant())])),
                 }
             }
+            (None, Some(_)) => {
+                // The general way writes anew an object that loses two members (which may
+                // stand side by side, whose separators one removal each would both take).
+                if removed_from.contains(&parent.span().start) {
+                    return None;
+                }
+                removed_from.push(parent.span().start);
+                let entries = object.entries();
+                let i = entries
+                    .iter()
+                    .position(|(k, _)| k.as_str().is_some_and(|k| k == *key))?;
+                let members: Vec<(usize, Node)> =
+                    entries.iter().map(|(k, v)| (k.span().start, *v)).collect();
+                // An only member's object is written anew by the general way.
+                splices.push(removal(&members, i)?);
+                replaced = true;
+                changed = true;
+            }
+            // Nothing to remove: the general way says what that does.
+            (None, None) => return None,
         }
+    }
+    // An object that both loses and gains members is written anew by the general way.
+    if inserts
+        .iter()
+        .any(|(parent, _)| removed_from.contains(&parent.span().start))
+    {
+        return None;
     }
     for (parent, new) in &inserts {
         let members: Vec<(usize, Node)> = parent
@@ -389,11 +438,14 @@ fn members_set_in_place(
         return Some((splices, changed, ElementCheck::Inserted(reads_back)));
     }
     let mut d = Digest::new();
-    let values: Vec<std::borrow::Cow<Value>> = sets.iter().map(|s| s.value.value()).collect();
-    let sets: Vec<(&[std::borrow::Cow<str>], &Value)> = sets
+    let values: Vec<Option<std::borrow::Cow<Value>>> = sets
+        .iter()
+        .map(|s| s.value.as_ref().map(SetTo::value))
+        .collect();
+    let sets: Vec<(&[std::borrow::Cow<str>], Option<&Value>)> = sets
         .iter()
         .zip(&values)
-        .map(|(s, value)| (s.tokens.as_slice(), value.as_ref()))
+        .map(|(s, value)| (s.tokens.as_slice(), value.as_deref()))
         .collect();
     feed_edited(&mut d, element, &sets);
     Some((splices, changed, ElementCheck::Digest(d.finish())))
@@ -667,6 +719,140 @@ mod tests {
     }
 
     #[test]
+    fn members_removed_and_array_elements_set_are_spliced_from_the_index_as_the_general_way_does() {
+        // The element in three layouts: one-line objects, tabs with CRLF, minified.
+        let texts = [
+            "{\n  \"materials\": [\n    {\"name\": \"a\"},\n    {\"name\": \"b\", \"extensions\": {\"KHR_materials_sheen\": {\"sheenColorFactor\": [1.5, 0, 0], \"sheenColorTexture\": {\"index\": 0}, \"sheenRoughnessFactor\": 0.5}}, \"extras\": {\"k\": 1}}\n  ]\n}\n",
+            "{\r\n\t\"materials\": [\r\n\t\t{\"name\": \"a\"},\r\n\t\t{\r\n\t\t\t\"name\": \"b\",\r\n\t\t\t\"extensions\": {\r\n\t\t\t\t\"KHR_materials_sheen\": {\r\n\t\t\t\t\t\"sheenColorFactor\": [1.5, 0, 0],\r\n\t\t\t\t\t\"sheenColorTexture\": {\"index\": 0},\r\n\t\t\t\t\t\"sheenRoughnessFactor\": 0.5\r\n\t\t\t\t}\r\n\t\t\t},\r\n\t\t\t\"extras\": {\"k\": 1}\r\n\t\t}\r\n\t]\r\n}",
+            "{\"materials\":[{\"name\":\"a\"},{\"name\":\"b\",\"extensions\":{\"KHR_materials_sheen\":{\"sheenColorFactor\":[1.5,0,0],\"sheenColorTexture\":{\"index\":0},\"sheenRoughnessFactor\":0.5}},\"extras\":{\"k\":1}}]}",
+        ];
+        let sheen = "/materials/1/extensions/KHR_materials_sheen";
+        // (the edits, whether the index's way takes them)
+        let cases: Vec<(Vec<Edit>, bool)> = vec![
+            // The first, a middle and the last member; with a set beside it in its object and
+            // in another; with a member added to another object.
+            (vec![Edit::remove("/materials/1/name")], true),
+            (
+                vec![Edit::remove(format!("{sheen}/sheenColorTexture"))],
+                true,
+            ),
+            (vec![Edit::remove("/materials/1/extras")], true),
+            (
+                vec![
+                    Edit::set(
+                        format!("{sheen}/sheenColorFactor/0"),
+                        serde_json::json!(1.0),
+                    ),
+                    Edit::remove(format!("{sheen}/sheenColorTexture")),
+                ],
+                true,
+            ),
+            // An element of an array set, alone and as an object.
+            (
+                vec![Edit::set(
+                    format!("{sheen}/sheenColorFactor/2"),
+                    serde_json::json!(0.25),
+                )],
+                true,
+            ),
+            (
+                vec![Edit::set(
+                    format!("{sheen}/sheenColorFactor/1"),
+                    serde_json::json!({"a": [1]}),
+                )],
+                true,
+            ),
+            (
+                vec![
+                    Edit::remove(format!("{sheen}/sheenColorTexture")),
+                    Edit::set(
+                        format!("{sheen}/sheenRoughnessFactor"),
+                        serde_json::json!(0.25),
+                    ),
+                    Edit::set("/materials/1/extras/j", serde_json::json!(2)),
+                ],
+                true,
+            ),
+            // Left to the general way: two members of one object, side by side or not; an
+            // object that loses one and gains one; an only member; an absent member; an
+            // array element removed or appended.
+            (
+                vec![
+                    Edit::remove(format!("{sheen}/sheenColorFactor")),
+                    Edit::remove(format!("{sheen}/sheenColorTexture")),
+                ],
+                false,
+            ),
+            (
+                vec![
+                    Edit::remove("/materials/1/name"),
+                    Edit::remove("/materials/1/extras"),
+                ],
+                false,
+            ),
+            (
+                vec![
+                    Edit::remove(format!("{sheen}/sheenColorTexture")),
+                    Edit::set(
+                        format!("{sheen}/sheenRoughnessTexture"),
+                        serde_json::json!({"index": 0}),
+                    ),
+                ],
+                false,
+            ),
+            (vec![Edit::remove("/materials/1/extras/k")], false),
+            (vec![Edit::remove("/materials/1/absent")], false),
+            (
+                vec![Edit::remove(format!("{sheen}/sheenColorFactor/2"))],
+                false,
+            ),
+            (
+                vec![Edit::set(
+                    format!("{sheen}/sheenColorFactor/3"),
+                    serde_json::json!(1),
+                )],
+                false,
+            ),
+            (
+                vec![Edit::set(
+                    format!("{sheen}/sheenColorFactor/-"),
+                    serde_json::json!(1),
+                )],
+                false,
+            ),
+        ];
+        for text in texts {
+            let tape = crate::asset::tape::Tape::build(text).unwrap();
+            let root = tape.root(text);
+            let element = root.pointer("/materials/1").unwrap();
+            let layout = Layout::detect(text, root);
+            for (edits, in_place) in &cases {
+                let refs: Vec<&Edit> = edits.iter().collect();
+                let taken = members_set_in_place(text, element, "/materials/1", &refs, &layout);
+                assert_eq!(taken.is_some(), *in_place, "{edits:?} in {text}");
+                let mut whole: Value = serde_json::from_str(text).unwrap();
+                crate::edit::apply(&mut whole, edits).unwrap();
+                if let Some((_, changed, check)) = taken {
+                    assert!(changed);
+                    let ElementCheck::Digest(digest) = check else {
+                        panic!("removals are checked by digest")
+                    };
+                    assert_eq!(digest, value_digest(&whole["materials"][1]), "{edits:?}");
+                }
+                // The splicer may decline what the general way writes (the caller then writes
+                // the whole document); never what the index's way takes.
+                match splice_edits_text(text, root, edits).unwrap() {
+                    Some((out, _)) => {
+                        assert_eq!(out, spliced(text, &whole), "{edits:?} in {text}");
+                        assert!(reads_as_written(&out, &whole), "{edits:?} in {text}");
+                    }
+                    None => assert!(!in_place, "{edits:?} in {text}"),
+                }
+            }
+        }
+    }
+
+    #[test]
     fn members_set_in_an_existing_object_are_spliced_from_the_index_as_the_general_way_does() {
         // Layouts: two spaces with one-line objects, tabs with CRLF, minified; a number
         // spelled with an exponent.
@@ -718,15 +904,14 @@ mod tests {
             assert_eq!(out, spliced(text, &whole), "{text}");
             assert!(reads_as_written(&out, &whole));
         }
-        // Removals, paths through missing objects and two edits of one place take the general
-        // way, which gives the same text.
+        // Paths through missing objects and two edits of one place take the general way,
+        // which gives the same text.
         let text = texts[0];
         let tape = crate::asset::tape::Tape::build(text).unwrap();
         let root = tape.root(text);
         let element = root.pointer("/materials/1").unwrap();
         let layout = Layout::detect(text, root);
         for others in [
-            vec![Edit::remove("/materials/1/name")],
             vec![Edit::set("/materials/1/extras/a", serde_json::json!(1))],
             vec![
                 Edit::set("/materials/1/extensions", serde_json::json!({})),
@@ -814,6 +999,92 @@ mod tests {
                 let mut whole: Value = serde_json::from_str(text).unwrap();
                 crate::edit::apply(&mut whole, &as_value).unwrap();
                 assert!(reads_as_written(&spliced.0, &whole));
+            }
+        }
+    }
+
+    mod properties {
+        use super::*;
+        use proptest::prelude::*;
+
+        /// A value a material's member may hold: scalars, and objects and arrays of them.
+        fn member_value() -> impl Strategy<Value = Value> {
+            let leaf = prop_oneof![
+                Just(Value::Null),
+                any::<bool>().prop_map(Value::Bool),
+                (0u32..100).prop_map(Value::from),
+                (0.0f64..2.0).prop_map(Value::from),
+                "[a-z]{0,3}".prop_map(Value::String),
+            ];
+            leaf.prop_recursive(3, 24, 4, |inner| {
+                prop_oneof![
+                    prop::collection::vec(inner.clone(), 0..4).prop_map(Value::Array),
+                    prop::collection::vec(("[a-d]", inner), 0..4)
+                        .prop_map(|m| Value::Object(m.into_iter().collect())),
+                ]
+            })
+        }
+
+        /// Every pointer below `value` (its members and elements, at any depth).
+        fn places(at: &str, value: &Value, out: &mut Vec<String>) {
+            let children: Vec<(String, &Value)> = match value {
+                Value::Object(m) => m.iter().map(|(k, v)| (k.clone(), v)).collect(),
+                Value::Array(a) => a
+                    .iter()
+                    .enumerate()
+                    .map(|(i, v)| (i.to_string(), v))
+                    .collect(),
+                _ => Vec::new(),
+            };
+            for (token, child) in children {
+                let pointer = format!("{at}/{token}");
+                out.push(pointer.clone());
+                places(&pointer, child, out);
+            }
+        }
+
+        proptest! {
+            #![proptest_config(ProptestConfig::with_cases(256))]
+
+            /// Sets and removals of members and elements inside a material, in any layout,
+            /// spliced by whichever way takes them, give the text the whole edited document
+            /// is written as, or are declined (the caller then writes the whole document).
+            #[test]
+            fn members_and_elements_set_or_removed_are_spliced_as_the_whole_edited_document_is_written(
+                material in prop::collection::vec(("[a-d]", member_value()), 1..5),
+                picks in prop::collection::vec(
+                    (any::<prop::sample::Index>(), any::<bool>(), member_value()), 1..4),
+                pretty in any::<bool>(),
+            ) {
+                let material = Value::Object(material.into_iter().collect());
+                let doc = serde_json::json!({"asset": {"version": "2.0"},
+                    "materials": [{"name": "first"}, material, {"name": "last"}]});
+                let text = if pretty {
+                    serde_json::to_string_pretty(&doc).unwrap()
+                } else {
+                    serde_json::to_string(&doc).unwrap()
+                };
+                let mut at = Vec::new();
+                places("/materials/1", &doc["materials"][1], &mut at);
+                prop_assume!(!at.is_empty());
+                let edits: Vec<Edit> = picks
+                    .iter()
+                    .map(|(index, remove, value)| {
+                        let pointer = index.get(&at).clone();
+                        if *remove {
+                            Edit::remove(pointer)
+                        } else {
+                            Edit::set(pointer, value.clone())
+                        }
+                    })
+                    .collect();
+                let mut whole = doc.clone();
+                prop_assume!(crate::edit::apply(&mut whole, &edits).is_ok());
+                let tape = crate::asset::tape::Tape::build(&text).unwrap();
+                if let Some((out, _)) = splice_edits_text(&text, tape.root(&text), &edits).unwrap() {
+                    prop_assert_eq!(&out, &spliced(&text, &whole));
+                    prop_assert!(reads_as_written(&out, &whole));
+                }
             }
         }
     }
