@@ -15,7 +15,7 @@ use crate::diagnostics::{codes, Code, Diagnostic, Severity};
 use jsonschema::error::ValidationErrorKind;
 use serde_json::Value;
 use std::collections::HashMap;
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 macro_rules! core_schema {
     ($name:literal) => {
@@ -184,36 +184,80 @@ pub(crate) fn prepare_meta_schema() {
 /// The core schema compiled for one run.
 pub struct CoreSchema {
     validator: jsonschema::Validator<TapeJson>,
+    /// The schema of each of [`ELEMENT_ARRAYS`]' elements, compiled once a run has judged
+    /// [`COMPILE_AFTER`] of them alone (a fix's trial judges the elements it edits).
+    elements: [OnceLock<jsonschema::Validator<TapeJson>>; ELEMENT_ARRAYS.len()],
+    /// How many elements of each array were judged alone before its schema was compiled.
+    judged: [std::sync::atomic::AtomicUsize; ELEMENT_ARRAYS.len()],
+}
+
+/// How many elements of an array are judged in a minimal document of their own before their
+/// schema is compiled by itself. A compile costs some 1.2 million instructions, as much as a
+/// hundred such documents: a run over one file judges a few, a run over a library thousands.
+const COMPILE_AFTER: usize = 64;
+
+/// The core schemas' compile options: draft 2020-12, the files compiled in.
+fn core_options() -> jsonschema::ValidationOptions<'static, Arc<dyn jsonschema::Retrieve>, TapeJson>
+{
+    jsonschema::options_for::<TapeJson>()
+        .with_draft(jsonschema::Draft::Draft202012)
+        // URIs are judged by the resources rule, which knows what a glTF URI may be.
+        .should_validate_formats(false)
+        .with_retriever(super::schema::FileRetriever(Arc::new(CORE_FILES.clone())))
 }
 
 impl CoreSchema {
     /// The official schemas compiled into velvet.
     pub fn builtin() -> CoreSchema {
-        let files = CORE_FILES.clone();
-        let root = files["glTF.schema.json"].clone();
-        let validator = jsonschema::options_for::<TapeJson>()
-            .with_draft(jsonschema::Draft::Draft202012)
-            // URIs are judged by the resources rule, which knows what a glTF URI may be.
-            .should_validate_formats(false)
-            .with_retriever(super::schema::FileRetriever(Arc::new(files)))
-            .build(&root)
-            .expect("core schemas compile");
-        CoreSchema { validator }
+        let root = CORE_FILES["glTF.schema.json"].clone();
+        let validator = core_options().build(&root).expect("core schemas compile");
+        CoreSchema {
+            validator,
+            elements: std::array::from_fn(|_| OnceLock::new()),
+            judged: std::array::from_fn(|_| Default::default()),
+        }
     }
 
-    /// Whether `element`, an element of the root's array `property`, passes its schema: it is
-    /// judged as the one element of that array in an otherwise minimal document. False for an
-    /// array whose elements are not judged one by one.
+    /// Whether `element`, an element of the root's array `property`, passes its schema: as the
+    /// one element of that array in an otherwise minimal document, or by the schema the root's
+    /// `items` names for that array, which judges the same (the root's other constraints hold
+    /// in any document with that one element). False for an array whose elements are not
+    /// judged one by one.
     pub fn element_passes(&self, property: &str, element: Node) -> bool {
-        if !ELEMENT_ARRAYS.contains(&property) {
+        use std::sync::atomic::Ordering;
+        let Some(at) = ELEMENT_ARRAYS.iter().position(|p| *p == property) else {
             return false;
+        };
+        if self.elements[at].get().is_none()
+            && self.judged[at].fetch_add(1, Ordering::Relaxed) < COMPILE_AFTER
+        {
+            return self.passes_in_minimal_document(property, element);
         }
+        self.element_schema(at).is_valid(element)
+    }
+
+    /// Whether `element` passes as the one element of `property` in a document that has only
+    /// that array and `asset`.
+    fn passes_in_minimal_document(&self, property: &str, element: Node) -> bool {
         let text = format!(
             r#"{{"asset":{{"version":"2.0"}},"{property}":[{}]}}"#,
             element.raw()
         );
         crate::asset::tape::Tape::build(&text)
             .is_ok_and(|tape| self.validator.is_valid(tape.root(&text)))
+    }
+
+    /// The schema of an element of `ELEMENT_ARRAYS[at]`, compiled on first use.
+    fn element_schema(&self, at: usize) -> &jsonschema::Validator<TapeJson> {
+        self.elements[at].get_or_init(|| {
+            let items = &CORE_FILES["glTF.schema.json"]["properties"][ELEMENT_ARRAYS[at]]["items"];
+            let schema = serde_json::json!({
+                "$schema": "https://json-schema.org/draft/2020-12/schema",
+                "$id": "velvet.element.schema.json",
+                "$ref": items["$ref"],
+            });
+            core_options().build(&schema).expect("core schemas compile")
+        })
     }
 
     /// Validates `json`, pushing one diagnostic per schema error.
@@ -795,6 +839,58 @@ mod tests {
         let tape = crate::asset::tape::Tape::build(&text).unwrap();
         CoreSchema::builtin().check(tape.root(&text), &mut out);
         out.into_iter().map(|d| (d.code, d.pointer)).collect()
+    }
+
+    #[test]
+    fn an_element_passes_its_schema_exactly_when_a_document_of_it_alone_passes() {
+        // Every element of the root's arrays in every fixture document, and each of them with
+        // a member given a value of the wrong type: judged by the element schema, as the one
+        // element of its array in an otherwise minimal document.
+        let core = CoreSchema::builtin();
+        let (mut judged, mut failing) = (0, 0);
+        let mut compare = |property: &str, element: &Value| {
+            let text = element.to_string();
+            let tape = crate::asset::tape::Tape::build(&text).unwrap();
+            let at = ELEMENT_ARRAYS.iter().position(|p| *p == property).unwrap();
+            let alone = core.element_schema(at).is_valid(tape.root(&text));
+            let doc = json!({"asset": {"version": "2.0"}, property: [element]}).to_string();
+            let tape = crate::asset::tape::Tape::build(&doc).unwrap();
+            let in_document = core.validator.is_valid(tape.root(&doc));
+            assert_eq!(alone, in_document, "{property}: {text}");
+            let tape = crate::asset::tape::Tape::build(&text).unwrap();
+            assert_eq!(core.element_passes(property, tape.root(&text)), in_document);
+            judged += 1;
+            failing += usize::from(!alone);
+        };
+        for path in crate::rules::fixture_documents(&["gltf"]) {
+            let text = std::fs::read_to_string(&path).unwrap();
+            let Ok(Value::Object(root)) = serde_json::from_str::<Value>(&text) else {
+                continue;
+            };
+            for property in ELEMENT_ARRAYS {
+                let Some(Value::Array(elements)) = root.get(*property) else {
+                    continue;
+                };
+                for element in elements {
+                    compare(property, element);
+                    if let Value::Object(members) = element {
+                        for key in members.keys() {
+                            let mut wrong = members.clone();
+                            wrong.insert(key.clone(), json!([[true]]));
+                            compare(property, &Value::Object(wrong));
+                        }
+                    }
+                }
+            }
+        }
+        assert!(
+            judged > 1000 && failing > 100,
+            "{judged} elements, {failing} failing"
+        );
+        // An array whose elements are not judged one by one.
+        let text = "\"KHR_materials_sheen\"";
+        let tape = crate::asset::tape::Tape::build(text).unwrap();
+        assert!(!core.element_passes("extensionsUsed", tape.root(text)));
     }
 
     #[test]
