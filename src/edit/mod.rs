@@ -287,13 +287,27 @@ fn remove(json: &mut Value, path: &str) -> Result<bool, EditError> {
             pointer: path.to_string(),
         });
     };
-    let parent_pointer: String = parents
-        .iter()
-        .map(|t| format!("/{}", pointer::escape(t)))
-        .collect();
-    let Some(parent) = json.pointer_mut(&parent_pointer) else {
-        return Ok(false);
-    };
+    // The parent, found token by token as `Value::pointer_mut` finds it (an array index
+    // without a sign or leading zeros), without writing its pointer and splitting it again.
+    let mut parent = json;
+    for token in parents {
+        let child = match parent {
+            Value::Object(map) => map.get_mut(token.as_str()),
+            Value::Array(items) => {
+                let plain =
+                    !token.starts_with('+') && !(token.starts_with('0') && token.len() != 1);
+                plain
+                    .then(|| token.parse::<usize>().ok())
+                    .flatten()
+                    .and_then(move |i| items.get_mut(i))
+            }
+            _ => None,
+        };
+        let Some(child) = child else {
+            return Ok(false);
+        };
+        parent = child;
+    }
     Ok(match parent {
         // shift_remove: `remove` would move the last key into the gap.
         Value::Object(map) => map.shift_remove(last).is_some(),
@@ -415,6 +429,25 @@ mod tests {
         )
         .unwrap();
         assert_eq!(text(&v), r#"{"a":1,"c":3,"d":[1,2]}"#);
+    }
+
+    #[test]
+    fn remove_reaches_its_parent_through_arrays_only_by_plain_indices_and_escaped_keys() {
+        // As a JSON pointer reads them: no sign, no leading zero; `~1` a slash, `~0` a tilde.
+        let mut v = doc(r#"{"a":[{"x":1},{"x":2,"y":3}],"k/~":{"m":1,"n":2}}"#);
+        let changed = apply(
+            &mut v,
+            &[
+                Edit::remove("/a/01/x"),
+                Edit::remove("/a/+1/x"),
+                Edit::remove("/a/-/x"),
+                Edit::remove("/a/0/x/deeper"),
+            ],
+        )
+        .unwrap();
+        assert!(!changed);
+        apply(&mut v, &[Edit::remove("/a/1/x"), Edit::remove("/k~1~0/m")]).unwrap();
+        assert_eq!(text(&v), r#"{"a":[{"x":1},{"y":3}],"k/~":{"n":2}}"#);
     }
 
     #[test]
