@@ -294,9 +294,8 @@ fn remove(json: &mut Value, path: &str) -> Result<bool, EditError> {
         let child = match parent {
             Value::Object(map) => map.get_mut(token.as_str()),
             Value::Array(items) => {
-                let plain =
-                    !token.starts_with('+') && !(token.starts_with('0') && token.len() != 1);
-                plain
+                let padded = token.starts_with('+') || (token.starts_with('0') && token.len() != 1);
+                (!padded)
                     .then(|| token.parse::<usize>().ok())
                     .flatten()
                     .and_then(move |i| items.get_mut(i))
