@@ -70,7 +70,13 @@ pub(super) fn matches(node: Node, value: &Value, compare: Compare) -> bool {
 /// Writes `after` over `span`: on one line where the old value was a one-line container, laid
 /// out over lines (at the indentation of the line it starts on) where it was a scalar or a
 /// multi-line container.
-fn replace(text: &str, node: Node, after: &Value, layout: &Layout, out: &mut Vec<Splice>) {
+pub(super) fn replace(
+    text: &str,
+    node: Node,
+    after: &Value,
+    layout: &Layout,
+    out: &mut Vec<Splice>,
+) {
     let was_one_line_container =
         matches!(node.kind(), Kind::Object | Kind::Array) && one_line(text, node);
     let span = node.span();

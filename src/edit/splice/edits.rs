@@ -6,7 +6,7 @@
 //! the inserted text or by the digest of the part's new text; only a part that adds or removes
 //! a top-level member needs the whole output indexed.
 
-use super::diff::{diff, insert_members, matches, removal};
+use super::diff::{self, diff, insert_members, matches, removal};
 use super::digest::{feed_edited, node_digest, value_digest, Digest};
 use super::layout::Layout;
 use super::read_back::{inserted_members_read_as, Compare, Meant};
@@ -272,18 +272,20 @@ impl SetTo<'_> {
 /// The splices of an element unit whose edits each set, replace or remove a member of an
 /// object the element already holds, or set an element of an array it holds (the fuzz object a
 /// migration adds to a material's `extensions`, a factor it replaces, a texture a fix removes,
-/// a component a fix clamps), made from the index alone:
-/// the element is not read into a value, edited and compared with its text, which for a
-/// migration of every material was most of the writer's work. A removal takes the member and
-/// one separator, as the general way does. Returns the splices, whether they change anything,
-/// and how the element reads back as meant: when every edit adds a member, whether each
-/// inserted text reads as its members ([`inserted_members_read_as`]); otherwise the digest the
-/// element must read back as, fed from the index with the set values in their places and the
-/// removed members left out, as the edited value would feed it. `None` for edits the general
-/// way writes otherwise or that it refuses (an array element removed or appended, a path through a
-/// missing key or an object that writes a key twice, two edits of one place, a removal of an
-/// absent or only member, an object that both loses and gains members or loses two); the
-/// caller then takes the general way.
+/// a component a fix clamps), made from the index alone: the element is not read into a value,
+/// edited and compared with its text, which for a migration of every material was most of the
+/// writer's work. A removal takes the member and one separator, as the general way does; an
+/// object that both loses and gains members (a draft sheen upgraded) is written anew with the
+/// edits inside it made, as the general way writes it, and only it is read into a value.
+/// Returns the splices, whether they change anything, and how the element reads back as meant:
+/// when every edit adds a member, whether each inserted text reads as its members
+/// ([`inserted_members_read_as`]); otherwise the digest the element must read back as, fed from
+/// the index with the set values in their places and the removed members left out, as the
+/// edited value would feed it. `None` for edits the general way writes otherwise or that it
+/// refuses (an array element removed or appended, a path through a missing key or an object
+/// that writes a key twice, two edits of one place, a removal of an absent or only member, two
+/// removals from one object that gains nothing, an object to be written anew inside another);
+/// the caller then takes the general way.
 fn members_set_in_place(
     text: &str,
     element: Node,
@@ -346,12 +348,65 @@ fn members_set_in_place(
     let mut inserts: Vec<(Node, Vec<(&str, Meant)>)> = Vec::new();
     // Where each object that loses a member starts.
     let mut removed_from: Vec<usize> = Vec::new();
+    // Each edit's parent: the object or array whose member or element it sets or removes.
+    let mut parents: Vec<Node> = Vec::with_capacity(sets.len());
     for set in &sets {
-        let (key, path) = set.tokens.split_last()?;
+        let (_, path) = set.tokens.split_last()?;
         let mut parent = element;
         for token in path {
             parent = member_or_element(parent, token)?;
         }
+        parents.push(parent);
+    }
+    // The objects that both lose and gain members (a draft sheen upgraded: two properties out,
+    // two in), with how deep each lies below the element: the general way writes each anew,
+    // with the edits inside it made, and so is it written here.
+    let mut rewritten: Vec<(Node, usize)> = Vec::new();
+    for (set, parent) in sets.iter().zip(&parents) {
+        let gains = |start: usize| {
+            sets.iter().zip(&parents).any(|(other, p)| {
+                p.span().start == start
+                    && other.value.is_some()
+                    && other.tokens.last().is_some_and(|key| {
+                        p.as_object()
+                            .is_some_and(|o| !o.has_duplicate_keys() && !o.contains_key(key))
+                    })
+            })
+        };
+        let start = parent.span().start;
+        // A member there to remove (removing an absent one changes nothing), from an object
+        // that writes each key once.
+        let loses = set.value.is_none()
+            && set.tokens.last().is_some_and(|key| {
+                parent
+                    .as_object()
+                    .is_some_and(|o| !o.has_duplicate_keys() && o.contains_key(key))
+            });
+        if loses && gains(start) && !rewritten.iter().any(|(r, _)| r.span().start == start) {
+            rewritten.push((*parent, set.tokens.len() - 1));
+        }
+    }
+    let within_rewritten = |node: &Node| {
+        rewritten.iter().position(|(r, _)| {
+            r.span().start <= node.span().start && node.span().end <= r.span().end
+        })
+    };
+    // One rewritten object inside another: left to the general way.
+    if rewritten.iter().any(|(r, _)| {
+        rewritten
+            .iter()
+            .filter(|(o, _)| o.span().start <= r.span().start && r.span().end <= o.span().end)
+            .count()
+            > 1
+    }) {
+        return None;
+    }
+    for (set, parent) in sets.iter().zip(&parents) {
+        if within_rewritten(parent).is_some() {
+            continue;
+        }
+        let parent = *parent;
+        let key = set.tokens.last()?;
         if let Some(array) = parent.as_array() {
             // An element the array holds, set (a factor's component clamped): the general way
             // diffs it with its new value too. A removal or an append moves or adds elements:
@@ -382,8 +437,8 @@ fn members_set_in_place(
                 }
             }
             (None, Some(_)) => {
-                // The general way writes anew an object that loses two members (which may
-                // stand side by side, whose separators one removal each would both take).
+                // Two members of one object: the general way removes them one by one, and
+                // side by side their separators would overlap; left to it.
                 if removed_from.contains(&parent.span().start) {
                     return None;
                 }
@@ -403,12 +458,31 @@ fn members_set_in_place(
             (None, None) => return None,
         }
     }
-    // An object that both loses and gains members is written anew by the general way.
-    if inserts
-        .iter()
-        .any(|(parent, _)| removed_from.contains(&parent.span().start))
-    {
-        return None;
+    // Each rewritten object: its value with the edits inside it made, written over it.
+    for (r, depth) in &rewritten {
+        let mut value = r.to_value();
+        for ((set, parent), edit) in sets.iter().zip(&parents).zip(edits) {
+            if within_rewritten(parent).is_none_or(|at| rewritten[at].0.span() != r.span()) {
+                continue;
+            }
+            let (Edit::Set { pointer, .. }
+            | Edit::Replace { pointer, .. }
+            | Edit::Remove { pointer }) = edit
+            else {
+                return None;
+            };
+            // The edit's pointer below the object: past the element's prefix and `depth` tokens.
+            let below_element = &pointer[prefix.len()..];
+            let at = below_element
+                .match_indices('/')
+                .nth(*depth)
+                .map(|(at, _)| at)?;
+            debug_assert!(set.tokens.len() > *depth);
+            crate::edit::apply(&mut value, &[edit.at(&below_element[at..])]).ok()?;
+        }
+        diff::replace(text, *r, &value, layout, &mut splices);
+        replaced = true;
+        changed = true;
     }
     for (parent, new) in &inserts {
         let members: Vec<(usize, Node)> = parent
@@ -773,9 +847,34 @@ mod tests {
                 ],
                 true,
             ),
+            // An object that loses one member and gains another: written anew, as the general
+            // way writes it.
+            (
+                vec![
+                    Edit::remove(format!("{sheen}/sheenColorTexture")),
+                    Edit::set(
+                        format!("{sheen}/sheenRoughnessTexture"),
+                        serde_json::json!({"index": 0}),
+                    ),
+                ],
+                true,
+            ),
+            // The draft's upgrade: two members out, two in, the object written anew.
+            (
+                vec![
+                    Edit::remove(format!("{sheen}/sheenColorFactor")),
+                    Edit::set(format!("{sheen}/sheenFactor"), serde_json::json!(1.0)),
+                    Edit::remove(format!("{sheen}/sheenColorTexture")),
+                    Edit::set(
+                        format!("{sheen}/sheenColor"),
+                        serde_json::json!([1, 0.5, 0]),
+                    ),
+                    Edit::set("/materials/1/name", serde_json::json!("c")),
+                ],
+                true,
+            ),
             // Left to the general way: two members of one object, side by side or not; an
-            // object that loses one and gains one; an only member; an absent member; an
-            // array element removed or appended.
+            // only member; an absent member; an array element removed or appended.
             (
                 vec![
                     Edit::remove(format!("{sheen}/sheenColorFactor")),
@@ -790,13 +889,13 @@ mod tests {
                 ],
                 false,
             ),
+            // An object to be written anew inside another one to be written anew.
             (
                 vec![
+                    Edit::remove("/materials/1/name"),
+                    Edit::set("/materials/1/x", serde_json::json!(1)),
                     Edit::remove(format!("{sheen}/sheenColorTexture")),
-                    Edit::set(
-                        format!("{sheen}/sheenRoughnessTexture"),
-                        serde_json::json!({"index": 0}),
-                    ),
+                    Edit::set(format!("{sheen}/y"), serde_json::json!(2)),
                 ],
                 false,
             ),
