@@ -174,7 +174,7 @@ fn edit_path<'e>(root: Node, edit: &'e Edit) -> crate::rules::EditPath<'e> {
 }
 
 /// Whether `value` has an object member named `key` at any depth.
-fn value_holds_key(value: &serde_json::Value, key: &str) -> bool {
+pub(crate) fn value_holds_key(value: &serde_json::Value, key: &str) -> bool {
     match value {
         serde_json::Value::Object(members) => members
             .iter()

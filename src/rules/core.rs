@@ -196,14 +196,17 @@ pub struct CoreSchema {
 /// hundred such documents: a run over one file judges a few, a run over a library thousands.
 const COMPILE_AFTER: usize = 64;
 
-/// The core schemas' compile options: draft 2020-12, the files compiled in.
+/// The core schemas' compile options: draft 2020-12, the files compiled in (shared by the
+/// core schema and the element schemas, copied once).
 fn core_options() -> jsonschema::ValidationOptions<'static, Arc<dyn jsonschema::Retrieve>, TapeJson>
 {
+    static FILES: std::sync::LazyLock<Arc<HashMap<String, Value>>> =
+        std::sync::LazyLock::new(|| Arc::new(CORE_FILES.clone()));
     jsonschema::options_for::<TapeJson>()
         .with_draft(jsonschema::Draft::Draft202012)
         // URIs are judged by the resources rule, which knows what a glTF URI may be.
         .should_validate_formats(false)
-        .with_retriever(super::schema::FileRetriever(Arc::new(CORE_FILES.clone())))
+        .with_retriever(super::schema::FileRetriever(Arc::clone(&FILES)))
 }
 
 impl CoreSchema {

@@ -700,13 +700,7 @@ mod tests {
 
     /// Whether `value` has a member named `extensions` at any depth.
     fn holds_extensions(value: &serde_json::Value) -> bool {
-        match value {
-            serde_json::Value::Object(members) => members
-                .iter()
-                .any(|(k, v)| k == "extensions" || holds_extensions(v)),
-            serde_json::Value::Array(elements) => elements.iter().any(holds_extensions),
-            _ => false,
-        }
+        crate::fix::value_holds_key(value, "extensions")
     }
 
     #[test]

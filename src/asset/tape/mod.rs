@@ -1663,11 +1663,12 @@ mod tests {
 }
 
 #[cfg(test)]
-mod properties {
+pub(crate) mod properties {
     use super::*;
     use proptest::prelude::*;
 
-    pub(super) fn json_value() -> impl Strategy<Value = Value> {
+    /// Any JSON value: scalars, escaped strings, and arrays and objects of them a few deep.
+    pub(crate) fn json_value() -> impl Strategy<Value = Value> {
         let leaf = prop_oneof![
             Just(Value::Null),
             any::<bool>().prop_map(Value::Bool),

@@ -107,7 +107,7 @@ fn diff_object(
     }
     // (where the key's opening quote stands, the value), and the keys decoded.
     let entries = object.entries();
-    let members: Vec<(usize, Node)> = entries.iter().map(|(k, v)| (k.span().start, *v)).collect();
+    let members = member_starts(&entries);
     let keys: Vec<std::borrow::Cow<str>> = entries
         .iter()
         .map(|(k, _)| k.as_str().unwrap_or_default())
@@ -155,6 +155,12 @@ fn diff_object(
         }
     }
     insert_members(text, span, &members, &placed, layout, out);
+}
+
+/// An object's members as the splices cut them: (where the key's opening quote stands, the
+/// value), from its entries (key, value).
+pub(super) fn member_starts<'a>(entries: &[(Node<'a>, Node<'a>)]) -> Vec<(usize, Node<'a>)> {
+    entries.iter().map(|(k, v)| (k.span().start, *v)).collect()
 }
 
 /// The splice that removes member `i` of an object with `members` (as (where the key starts,
