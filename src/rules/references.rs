@@ -169,10 +169,13 @@ impl Rule for References {
                 .and_then(|a| a.as_array())
                 .map_or(0, |a| a.len())
         };
-        // Most targets are fixed: their length is read once.
-        let fixed_len: Vec<Option<usize>> = LINKS
+        let targets = targets();
+        // The fixed targets' lengths, each distinct array read once.
+        let lengths: Vec<usize> = targets.arrays.iter().map(|a| array_len(a)).collect();
+        let fixed_len: Vec<Option<usize>> = targets
+            .fixed
             .iter()
-            .map(|(_, target)| (!target.contains("{0}")).then(|| array_len(target)))
+            .map(|array| array.map(|a| lengths[a]))
             .collect();
         let steps = steps();
         // The document's number for each key the patterns name, found once: the walk then
@@ -180,17 +183,18 @@ impl Rule for References {
         let ids: Vec<Option<KeyId>> = steps.keys.iter().map(|key| json.key_id(key)).collect();
         let mut found: Vec<(usize, Diagnostic)> = Vec::new();
         // Which elements of each of PRUNED something refers to.
-        let mut used: Vec<Vec<bool>> = PRUNED.iter().map(|a| vec![false; array_len(a)]).collect();
+        let mut used: Vec<Vec<bool>> = targets
+            .pruned
+            .iter()
+            .map(|&a| vec![false; lengths[a]])
+            .collect();
         // For each link into a root extension the document lacks, that extension's name: the
         // objects that hold such an index depend on it (see below).
-        let missing_root: Vec<Option<&str>> = LINKS
+        let root_extensions = json.get("extensions");
+        let missing_root: Vec<Option<&str>> = targets
+            .root_extension
             .iter()
-            .map(|(_, target)| {
-                target
-                    .strip_prefix("/extensions/")
-                    .and_then(|rest| rest.split('/').next())
-                    .filter(|name| json.get("extensions").and_then(|e| e.get(*name)).is_none())
-            })
+            .map(|name| name.filter(|name| root_extensions.and_then(|e| e.get(*name)).is_none()))
             .collect();
         let mut holders: Vec<(usize, String)> = Vec::new();
         let mut found_at = |reached: Reached, link: usize, path: &[Token], value: Node| {
@@ -398,6 +402,52 @@ enum Reached {
 struct Steps {
     root: Vec<Step>,
     keys: Vec<&'static str>,
+}
+
+/// What each link of [`LINKS`] indexes, worked out once rather than on each document.
+struct Targets {
+    /// The arrays the links with a fixed target index, and [`PRUNED`]'s, each once.
+    arrays: Vec<&'static str>,
+    /// Each link's target in `arrays`; `None` for a target that names an index of its path
+    /// (`{0}`).
+    fixed: Vec<Option<usize>>,
+    /// Each of [`PRUNED`] in `arrays`.
+    pruned: [usize; PRUNED.len()],
+    /// For each link into a root extension's array, that extension's name.
+    root_extension: Vec<Option<&'static str>>,
+}
+
+fn targets() -> &'static Targets {
+    static TARGETS: std::sync::OnceLock<Targets> = std::sync::OnceLock::new();
+    TARGETS.get_or_init(|| {
+        let mut arrays: Vec<&'static str> = Vec::new();
+        let mut place = |array: &'static str| match arrays.iter().position(|a| *a == array) {
+            Some(at) => at,
+            None => {
+                arrays.push(array);
+                arrays.len() - 1
+            }
+        };
+        let fixed = LINKS
+            .iter()
+            .map(|(_, target)| (!target.contains("{0}")).then(|| place(target)))
+            .collect();
+        let pruned = PRUNED.map(&mut place);
+        let root_extension = LINKS
+            .iter()
+            .map(|(_, target)| {
+                target
+                    .strip_prefix("/extensions/")
+                    .and_then(|rest| rest.split('/').next())
+            })
+            .collect();
+        Targets {
+            arrays,
+            fixed,
+            pruned,
+            root_extension,
+        }
+    })
 }
 
 /// [`LINKS`] as a tree of steps, built once.
