@@ -8,6 +8,7 @@ use crate::asset::Asset;
 use crate::diagnostics::{Code, Diagnostic, Safety};
 use crate::edit::Edit;
 use crate::migrate::plan::Primitives;
+use std::collections::HashMap;
 use std::sync::OnceLock;
 
 /// What a fixer proposes: a title saying what it does, and the edits.
@@ -28,6 +29,10 @@ pub struct Planning<'a> {
     pub primitives: Primitives<'a>,
     /// The document's prune: one proposal repairs every UNUSED_OBJECT finding.
     pub(super) prune: OnceLock<Option<Proposal>>,
+    /// Each material's draft-sheen upgrade, by material index: the draft's findings in one
+    /// material (one per draft property) are repaired by the one upgrade, which plans the
+    /// material as migrate does.
+    pub(super) upgrades: std::sync::Mutex<HashMap<usize, Option<Proposal>>>,
 }
 
 impl<'a> Planning<'a> {
@@ -36,6 +41,7 @@ impl<'a> Planning<'a> {
             asset,
             primitives: Primitives::new(asset.root()),
             prune: OnceLock::new(),
+            upgrades: Default::default(),
         }
     }
 }

@@ -21,7 +21,22 @@ fn upgrade(planning: &Planning, d: &Diagnostic) -> Option<Proposal> {
         .split('/')
         .next()
         .and_then(crate::asset::pointer::array_index)?;
-    let plan = plan_material(asset, index, &Options::default(), &planning.primitives)?;
+    let upgrades = || planning.upgrades.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some(proposal) = upgrades().get(&index) {
+        return proposal.clone();
+    }
+    let proposal = upgrade_material(asset, index, &planning.primitives);
+    upgrades().insert(index, proposal.clone());
+    proposal
+}
+
+/// The draft sheen of material `index` upgraded, if it needs no texture baked.
+fn upgrade_material(
+    asset: &crate::asset::Asset,
+    index: usize,
+    primitives: &crate::migrate::plan::Primitives,
+) -> Option<Proposal> {
+    let plan = plan_material(asset, index, &Options::default(), primitives)?;
     if !plan.conversions.contains(&Conversion::LegacyUpgrade) || !plan.bakes.is_empty() {
         return None;
     }
