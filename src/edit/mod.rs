@@ -293,13 +293,7 @@ fn remove(json: &mut Value, path: &str) -> Result<bool, EditError> {
     for token in parents {
         let child = match parent {
             Value::Object(map) => map.get_mut(token.as_str()),
-            Value::Array(items) => {
-                let padded = token.starts_with('+') || (token.starts_with('0') && token.len() != 1);
-                (!padded)
-                    .then(|| token.parse::<usize>().ok())
-                    .flatten()
-                    .and_then(move |i| items.get_mut(i))
-            }
+            Value::Array(items) => pointer::array_index(token).and_then(move |i| items.get_mut(i)),
             _ => None,
         };
         let Some(child) = child else {

@@ -156,18 +156,21 @@ pub(crate) fn close_open_enums(schema: &mut Value) {
     }
 }
 
-/// The core schema files parsed, their open enums closed: read once for the core schema and
-/// for every extension schema that compiles.
-pub(crate) static CORE_FILES: std::sync::LazyLock<HashMap<String, Value>> =
+/// The core schema files parsed, their open enums closed: read once, and shared by the core
+/// schema, the element schemas and every extension schema that compiles.
+pub(crate) static CORE_FILES: std::sync::LazyLock<Arc<HashMap<String, Value>>> =
     std::sync::LazyLock::new(|| {
-        CORE_SCHEMAS
-            .iter()
-            .map(|(name, text)| {
-                let mut schema = serde_json::from_str(text).expect("core schemas are valid JSON");
-                close_open_enums(&mut schema);
-                (name.to_string(), schema)
-            })
-            .collect()
+        Arc::new(
+            CORE_SCHEMAS
+                .iter()
+                .map(|(name, text)| {
+                    let mut schema =
+                        serde_json::from_str(text).expect("core schemas are valid JSON");
+                    close_open_enums(&mut schema);
+                    (name.to_string(), schema)
+                })
+                .collect(),
+        )
     });
 
 /// Builds jsonschema's validator of the core schemas' meta-schema (draft 2020-12), which it
@@ -196,17 +199,14 @@ pub struct CoreSchema {
 /// hundred such documents: a run over one file judges a few, a run over a library thousands.
 const COMPILE_AFTER: usize = 64;
 
-/// The core schemas' compile options: draft 2020-12, the files compiled in (shared by the
-/// core schema and the element schemas, copied once).
+/// The core schemas' compile options: draft 2020-12, the files compiled in.
 fn core_options() -> jsonschema::ValidationOptions<'static, Arc<dyn jsonschema::Retrieve>, TapeJson>
 {
-    static FILES: std::sync::LazyLock<Arc<HashMap<String, Value>>> =
-        std::sync::LazyLock::new(|| Arc::new(CORE_FILES.clone()));
     jsonschema::options_for::<TapeJson>()
         .with_draft(jsonschema::Draft::Draft202012)
         // URIs are judged by the resources rule, which knows what a glTF URI may be.
         .should_validate_formats(false)
-        .with_retriever(super::schema::FileRetriever(Arc::clone(&FILES)))
+        .with_retriever(super::schema::FileRetriever::new(Arc::clone(&CORE_FILES)))
 }
 
 impl CoreSchema {

@@ -31,7 +31,7 @@ use crate::diagnostics::{Code, Diagnostic, Severity};
 use crate::layers;
 use serde_json::Value;
 use std::collections::HashMap;
-use std::sync::{Arc, LazyLock, OnceLock};
+use std::sync::{LazyLock, OnceLock};
 
 macro_rules! ext_file {
     ($dir:literal, $name:literal) => {
@@ -927,16 +927,20 @@ impl ExtensionSchemas {
 }
 
 fn compile(placement: &Placement) -> jsonschema::Validator<TapeJson> {
-    let mut files = super::core::CORE_FILES.clone();
+    let mut files = HashMap::new();
     for (name, text) in folder_of(placement.extension) {
         let mut schema = serde_json::from_str(text).expect("compiled-in schemas are valid JSON");
         super::core::close_open_enums(&mut schema);
         files.insert(name.to_string(), schema);
     }
-    let root = files[placement.schema].clone();
+    let files = super::schema::FileRetriever::over_core(files);
+    let root = files
+        .file(placement.schema)
+        .expect("every placement names a compiled-in schema")
+        .clone();
     // Each file declares its draft (draft 4 or 2020-12), and is read as it declares.
     jsonschema::options_for::<TapeJson>()
-        .with_retriever(super::schema::FileRetriever(Arc::new(files)))
+        .with_retriever(files)
         // A JSON pointer (KHR_animation_pointer) is judged by its format; URIs are the
         // resources rule's to judge, which knows what a glTF URI may be.
         .should_validate_formats(true)

@@ -102,8 +102,34 @@ pub struct Schemas {
     pub extensions: super::extensions::ExtensionSchemas,
 }
 
-/// Serves `$ref`s from in-memory schema files, by the reference's last path segment.
-pub(crate) struct FileRetriever(pub(crate) Arc<HashMap<String, Value>>);
+/// Serves `$ref`s from in-memory schema files, by the reference's last path segment: its own
+/// files first, then the core schema files, shared rather than copied into each retriever.
+pub(crate) struct FileRetriever {
+    files: Arc<HashMap<String, Value>>,
+    core: Option<Arc<HashMap<String, Value>>>,
+}
+
+impl FileRetriever {
+    /// Serves `files` alone.
+    pub(crate) fn new(files: Arc<HashMap<String, Value>>) -> FileRetriever {
+        FileRetriever { files, core: None }
+    }
+
+    /// Serves `files`, and the core schema files that `files` does not name.
+    pub(crate) fn over_core(files: HashMap<String, Value>) -> FileRetriever {
+        FileRetriever {
+            files: Arc::new(files),
+            core: Some(Arc::clone(&super::core::CORE_FILES)),
+        }
+    }
+
+    /// The file named `name`.
+    pub(crate) fn file(&self, name: &str) -> Option<&Value> {
+        self.files
+            .get(name)
+            .or_else(|| self.core.as_ref()?.get(name))
+    }
+}
 
 impl jsonschema::Retrieve for FileRetriever {
     fn retrieve(
@@ -111,8 +137,7 @@ impl jsonschema::Retrieve for FileRetriever {
         uri: &jsonschema::Uri<String>,
     ) -> Result<Value, Box<dyn std::error::Error + Send + Sync>> {
         let name = uri.path().as_str().rsplit('/').next().unwrap_or_default();
-        self.0
-            .get(name)
+        self.file(name)
             .cloned()
             .ok_or_else(|| format!("no schema file named '{name}'").into())
     }
@@ -191,7 +216,7 @@ impl Schemas {
             let schema = &files[name];
             let validator = jsonschema::options_for::<TapeJson>()
                 .with_draft(jsonschema::Draft::Draft4)
-                .with_retriever(FileRetriever(files.clone()))
+                .with_retriever(FileRetriever::new(files.clone()))
                 .build(schema)
                 .map_err(|e| SchemaError::Compile {
                     name: name.to_string(),

@@ -698,11 +698,6 @@ mod tests {
             .collect()
     }
 
-    /// Whether `value` has a member named `extensions` at any depth.
-    fn holds_extensions(value: &serde_json::Value) -> bool {
-        crate::fix::value_holds_key(value, "extensions")
-    }
-
     #[test]
     fn a_rule_finds_the_same_in_a_document_that_lacks_what_the_rule_does_not_read() {
         // A fix's trial takes a rule's findings from the file's report when the fix edits
@@ -721,7 +716,6 @@ mod tests {
                 continue;
             };
             let found = findings_by_rule(&report);
-            // (what went, as the pointer an edit of it would have; the document without it)
             // (what went, as the pointer an edit of it would have; whether what went held no
             // extension object; the document without it)
             let mut lesser: Vec<(String, bool, serde_json::Map<String, serde_json::Value>)> = whole
@@ -729,7 +723,11 @@ mod tests {
                 .map(|(key, value)| {
                     let mut less = whole.clone();
                     less.shift_remove(key);
-                    (format!("/{key}"), !holds_extensions(value), less)
+                    (
+                        format!("/{key}"),
+                        !crate::fix::value_holds_key(value, "extensions"),
+                        less,
+                    )
                 })
                 .collect();
             // Each member of the elements of each top-level array, gone from every element
@@ -755,7 +753,7 @@ mod tests {
                 let mut keeps_extensions = true;
                 for element in elements.iter_mut().filter_map(|e| e.as_object_mut()) {
                     if let Some(gone) = element.shift_remove(&member) {
-                        keeps_extensions &= !holds_extensions(&gone);
+                        keeps_extensions &= !crate::fix::value_holds_key(&gone, "extensions");
                     }
                 }
                 // Named as an edit of the first element would name it: what the rule reads
